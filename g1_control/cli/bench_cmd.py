@@ -1,0 +1,31 @@
+"""`g1 bench NAME`: speed benchmarks that print figures and ratios against a baseline
+measured in the same run (never asserted in unit tests: the machines are shared and noisy)."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+
+# name -> "module:function"; the function takes the parsed args and returns an exit code.
+BENCHMARKS = {
+    "loop": ("g1_control.loop.bench:main", "full loop in lockstep: real-time factor, per-stage p50/p99"),
+}
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "bench",
+        help="run a speed benchmark",
+        description="Speed benchmarks. Each prints its figures and ratios against a baseline measured in the same run.\n"
+        + "\n".join(f"  {name:10s} {text}" for name, (_, text) in BENCHMARKS.items()),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("name", choices=sorted(BENCHMARKS), help="which benchmark")
+    parser.add_argument("--seconds", type=float, default=20.0, help="simulated/measured duration (default 20)")
+    parser.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
+    parser.set_defaults(func=_run)
+
+
+def _run(args) -> int:
+    module_name, func_name = BENCHMARKS[args.name][0].split(":")
+    return int(getattr(importlib.import_module(module_name), func_name)(args) or 0)

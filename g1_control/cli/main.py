@@ -1,0 +1,51 @@
+"""`g1`: one command, one subcommand per job.
+
+Each subcommand lives in its own module under g1_control.cli and exposes
+`register(subparsers)`, which adds its parser and sets `func` (called with the parsed args,
+returning an exit code). Modules are imported only when listed here, and heavy imports happen
+inside `func`, so `g1 --help` stays fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from g1_control.errors import G1ControlError
+
+SUBCOMMAND_MODULES = (
+    "g1_control.cli.bench_cmd",
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="g1",
+        description="g1-control: real-time whole-body control for the Unitree G1, in simulation and on the robot.",
+        epilog="Start with: g1 launch launch/sim_walk.yaml",
+    )
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for module_name in SUBCOMMAND_MODULES:
+        importlib.import_module(module_name).register(subparsers)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 2
+    try:
+        return int(args.func(args) or 0)
+    except G1ControlError as exc:
+        print(f"g1 {args.command}: error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(f"g1 {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

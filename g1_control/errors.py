@@ -1,0 +1,29 @@
+"""Named errors. Each message says what was wrong and what was expected."""
+
+
+class G1ControlError(Exception):
+    """Base class of every error this project raises on purpose."""
+
+
+class InvalidCommandError(G1ControlError, ValueError):
+    """An operator command that must not reach the robot (NaN, unknown button, ...)."""
+
+
+class InvalidStateError(G1ControlError, ValueError):
+    """A robot state no controller may act on (wrong shape, NaN, broken quaternion)."""
+
+
+class LaunchFileError(G1ControlError, ValueError):
+    """A launch file that fails validation; raised before anything runs."""
+
+
+class PolicyMismatchError(G1ControlError, ValueError):
+    """A policy whose joint order, gains or observation size does not match the robot."""
+
+
+class PolicyFetchError(G1ControlError, RuntimeError):
+    """Policy files could not be obtained (registry unreachable, hash mismatch, ...)."""
+
+
+class RobotDescriptionError(G1ControlError, RuntimeError):
+    """The G1 description package is missing or does not look like the G1."""

@@ -1,0 +1,143 @@
+"""The G1 description (URDF + meshes) from the `example-robot-data` registry package, and the
+pinocchio and MuJoCo models built from it. Nothing is downloaded at run time.
+
+MuJoCo gets the same URDF through MjSpec, then what a URDF cannot say: a free joint on the
+pelvis, armature and motors from g1.py, an IMU site, a floor, and collisions restricted to
+robot-vs-floor (the G1 URDF's feet are four small spheres each, as in Menagerie).
+"""
+
+from __future__ import annotations
+
+import functools
+import sysconfig
+from pathlib import Path
+
+import numpy as np
+
+from g1_control.errors import RobotDescriptionError
+from g1_control.robot import g1
+
+URDF_RELATIVE = "robots/g1_description/urdf/g1_29dof_rev_1_0.urdf"
+
+
+@functools.cache
+def description_dir() -> Path:
+    """Folder holding robots/g1_description inside the installed example-robot-data package."""
+    candidates = []
+    for key in ("purelib", "platlib", "data"):
+        root = Path(sysconfig.get_paths()[key])
+        candidates += [root / "cmeel.prefix/share/example-robot-data", root / "share/example-robot-data"]
+    try:  # newer example-robot-data ships a small python helper exposing its data dir
+        import example_robot_data  # type: ignore[import-not-found]
+
+        candidates.insert(0, Path(example_robot_data.getModelPath(URDF_RELATIVE)))
+    except Exception:  # noqa: BLE001 - absent or old helper: fall back to the known layout
+        pass
+    for cand in candidates:
+        if (cand / URDF_RELATIVE).is_file():
+            return cand
+    raise RobotDescriptionError(
+        "The G1 URDF was not found. It ships in the 'example-robot-data' package: "
+        "run `pip install example-robot-data` (looked in: " + ", ".join(map(str, candidates)) + ")"
+    )
+
+
+def urdf_path() -> Path:
+    return description_dir() / URDF_RELATIVE
+
+
+def mesh_dir() -> Path:
+    return description_dir() / "robots/g1_description/meshes"
+
+
+@functools.cache
+def pinocchio_model():
+    """pinocchio.Model of the G1 with a free-flyer root (nq 36, nv 35)."""
+    import pinocchio as pin
+
+    model = pin.buildModelFromUrdf(str(urdf_path()), pin.JointModelFreeFlyer())
+    names = [model.names[i] for i in range(2, model.njoints)]
+    if tuple(names) != g1.JOINT_NAMES:
+        raise RobotDescriptionError(f"URDF joint order {names} differs from g1.JOINT_NAMES")
+    return model
+
+
+def pinocchio_q(base_pos_w: np.ndarray, base_quat_wxyz: np.ndarray, q_rad: np.ndarray) -> np.ndarray:
+    """Pinocchio configuration (x y z, qx qy qz qw, joints) from our conventions."""
+    w, x, y, z = base_quat_wxyz
+    return np.concatenate([base_pos_w, [x, y, z, w], q_rad])
+
+
+def mujoco_spec(floor: bool = True, timestep_s: float = 0.005):
+    """MjSpec of the G1 scene built from the URDF (see module docstring)."""
+    import mujoco
+
+    xml = urdf_path().read_text()
+    # MuJoCo's URDF importer resolves meshes by file name in meshdir.
+    xml = xml.replace("package://example-robot-data/robots/g1_description/meshes/", "")
+    mujoco_ext = (
+        f'<mujoco><compiler meshdir="{mesh_dir()}" strippath="true" discardvisual="false" '
+        'balanceinertia="true" fusestatic="false"/></mujoco>'
+    )
+    xml = xml.replace("<robot name=\"g1_29dof_rev_1_0\">", "<robot name=\"g1_29dof_rev_1_0\">" + mujoco_ext, 1)
+    if mujoco_ext not in xml:
+        head, rest = xml.split("<robot", 1)
+        name_end = rest.index(">") + 1
+        xml = head + "<robot" + rest[:name_end] + mujoco_ext + rest[name_end:]
+    spec = mujoco.MjSpec.from_string(xml)
+    spec.option.timestep = timestep_s
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.compiler.degree = False
+
+    pelvis = spec.body(g1.BASE_BODY)
+    pelvis.add_freejoint(name="floating_base")
+    pelvis.pos = [0.0, 0.0, g1.DEFAULT_PELVIS_HEIGHT_M]
+
+    for i, name in enumerate(g1.JOINT_NAMES):
+        joint = spec.joint(name)
+        joint.armature = float(g1.ARMATURE_KGM2[i])
+        joint.range = [float(g1.Q_MIN_RAD[i]), float(g1.Q_MAX_RAD[i])]
+        joint.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+        motor = spec.add_actuator(name=name.removesuffix("_joint"), target=name)
+        motor.trntype = mujoco.mjtTrn.mjTRN_JOINT
+        limit = float(g1.EFFORT_LIMIT_NM[i])
+        motor.ctrlrange = [-limit, limit]
+        motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
+
+    # Collisions: robot geoms touch the floor only (contype 0 / conaffinity 1 vs floor 1 / 0).
+    for geom in spec.geoms:
+        if geom.type == mujoco.mjtGeom.mjGEOM_MESH:
+            geom.contype, geom.conaffinity = 0, 0
+            geom.group = 2
+        else:
+            geom.contype, geom.conaffinity = 0, 1
+            geom.condim = 3
+            geom.friction = [1.0, 0.005, 0.0001]
+
+    pelvis.add_site(name="imu", pos=[0.0, 0.0, 0.0])
+    spec.add_sensor(name="imu_gyro", type=mujoco.mjtSensor.mjSENS_GYRO,
+                    objtype=mujoco.mjtObj.mjOBJ_SITE, objname="imu")
+    spec.add_sensor(name="imu_acc", type=mujoco.mjtSensor.mjSENS_ACCELEROMETER,
+                    objtype=mujoco.mjtObj.mjOBJ_SITE, objname="imu")
+    spec.add_sensor(name="imu_quat", type=mujoco.mjtSensor.mjSENS_FRAMEQUAT,
+                    objtype=mujoco.mjtObj.mjOBJ_SITE, objname="imu")
+
+    if floor:
+        world = spec.worldbody
+        world.add_light(pos=[0, 0, 3], dir=[0, 0, -1], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL)
+        tex = spec.add_texture(name="grid", type=mujoco.mjtTexture.mjTEXTURE_2D,
+                               builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
+                               rgb1=[0.25, 0.3, 0.35], rgb2=[0.35, 0.4, 0.45], width=300, height=300)
+        mat = spec.add_material(name="grid", texrepeat=[5, 5], reflectance=0.1)
+        mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = tex.name
+        world.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 0.05],
+                       material="grid", contype=1, conaffinity=0, condim=3, friction=[1.0, 0.005, 0.0001])
+        spec.visual.global_.offwidth = 1280
+        spec.visual.global_.offheight = 720
+    return spec
+
+
+@functools.cache
+def mujoco_model(timestep_s: float = 0.005):
+    """Compiled MjModel of the G1 scene (cached; treat as read-only)."""
+    return mujoco_spec(timestep_s=timestep_s).compile()

@@ -1,0 +1,162 @@
+"""Plain data passed between the stages of one control tick.
+
+Arrays are float64 numpy arrays in the robot's joint order (g1_control.robot.g1.JOINT_NAMES);
+units are in the field names. Quaternions are (w, x, y, z). "_w" is the world frame, "_b" the
+base (pelvis) frame. Nothing here does I/O or math beyond validation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from g1_control.errors import InvalidCommandError, InvalidStateError
+from g1_control.robot.g1 import NUM_JOINTS
+
+
+def _zeros() -> np.ndarray:
+    return np.zeros(NUM_JOINTS)
+
+
+BUTTONS = frozenset(
+    {"start", "stop", "estop", "run", "style_next", "style_prev", "policy_switch", "damp"}
+)
+"""Operator buttons a Command may carry (edges: present on the tick they were pressed)."""
+
+
+@dataclass
+class EffectorGoal:
+    """Put a named robot frame at a world point (optionally by time t_s from now)."""
+
+    frame: str
+    pos_w_m: np.ndarray
+    t_s: float | None = None
+
+
+@dataclass
+class Command:
+    """Operator intent for one tick."""
+
+    vx_mps: float = 0.0
+    vy_mps: float = 0.0
+    wz_radps: float = 0.0
+    heading_rad: float | None = None
+    style: str = "default"
+    pelvis_height_m: float | None = None
+    goals: list[EffectorGoal] = field(default_factory=list)
+    buttons: frozenset[str] = frozenset()
+
+    def validate(self) -> Command:
+        """Raise InvalidCommandError naming the first bad field; return self when fine."""
+        for name in ("vx_mps", "vy_mps", "wz_radps", "heading_rad", "pelvis_height_m"):
+            value = getattr(self, name)
+            if value is not None and not np.isfinite(value):
+                raise InvalidCommandError(f"Command.{name} is {value}; it must be a finite number")
+        for goal in self.goals:
+            pos = np.asarray(goal.pos_w_m, dtype=float)
+            if pos.shape != (3,) or not np.all(np.isfinite(pos)):
+                raise InvalidCommandError(
+                    f"Command goal for frame '{goal.frame}' has position {goal.pos_w_m!r}; "
+                    "it must be 3 finite numbers"
+                )
+        unknown = set(self.buttons) - BUTTONS
+        if unknown:
+            raise InvalidCommandError(
+                f"Command has unknown buttons {sorted(unknown)}; known: {sorted(BUTTONS)}"
+            )
+        return self
+
+
+@dataclass
+class RobotState:
+    """What the robot (or simulator) reports, as the low-level protocol carries it."""
+
+    t_s: float = 0.0
+    q_rad: np.ndarray = field(default_factory=_zeros)
+    dq_radps: np.ndarray = field(default_factory=_zeros)
+    tau_nm: np.ndarray = field(default_factory=_zeros)
+    imu_quat_wxyz: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0, 0.0]))
+    imu_gyro_radps: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    imu_acc_mps2: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 9.81]))
+    motor_temperature_c: np.ndarray = field(default_factory=_zeros)
+    mode_machine: int = 5
+    tick: int = 0
+    wireless_remote: bytes = b""
+    # Ground truth, present only in simulation (None on the robot): for tests and logs.
+    base_pos_w_m: np.ndarray | None = None
+    base_linvel_w_mps: np.ndarray | None = None
+
+    def validate(self) -> RobotState:
+        """Raise InvalidStateError for a state no controller may act on."""
+        for name in ("q_rad", "dq_radps", "tau_nm"):
+            arr = getattr(self, name)
+            if arr.shape != (NUM_JOINTS,):
+                raise InvalidStateError(f"RobotState.{name} has shape {arr.shape}; expected ({NUM_JOINTS},)")
+        for name in ("q_rad", "dq_radps", "imu_quat_wxyz", "imu_gyro_radps", "imu_acc_mps2"):
+            arr = getattr(self, name)
+            if not np.all(np.isfinite(arr)):
+                raise InvalidStateError(f"RobotState.{name} contains NaN or inf")
+        norm = float(np.linalg.norm(self.imu_quat_wxyz))
+        if abs(norm - 1.0) > 1e-2:
+            raise InvalidStateError(f"RobotState.imu_quat_wxyz has norm {norm:.4f}; expected 1")
+        return self
+
+
+@dataclass
+class KinematicReference:
+    """Whole-body target from the generator: root pose, posture, named frame targets, contacts."""
+
+    t_s: float = 0.0
+    root_pos_w_m: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    root_quat_wxyz: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0, 0.0]))
+    root_linvel_b_mps: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    root_angvel_b_radps: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    q_rad: np.ndarray = field(default_factory=_zeros)
+    frame_targets_w: dict[str, np.ndarray] = field(default_factory=dict)
+    """Frame name -> 7-vector (x, y, z, qw, qx, qy, qz) in the world frame."""
+    contacts: np.ndarray = field(default_factory=lambda: np.ones(2, dtype=bool))
+    """(left foot, right foot) in contact."""
+    style: str = "default"
+
+
+@dataclass
+class JointReference:
+    """Feasible whole-body reference for the tracker."""
+
+    t_s: float = 0.0
+    q_rad: np.ndarray = field(default_factory=_zeros)
+    dq_radps: np.ndarray = field(default_factory=_zeros)
+    root_pos_w_m: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    root_quat_wxyz: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0, 0.0]))
+    root_linvel_b_mps: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    """Commanded base velocity in the heading frame (x forward, y left); locomotion trackers follow it."""
+    root_angvel_b_radps: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    contacts: np.ndarray = field(default_factory=lambda: np.ones(2, dtype=bool))
+    upper_body_override: bool = False
+    """When True, a balancing tracker takes waist/arm targets from q_rad instead of its own."""
+
+
+@dataclass
+class MotorCommand:
+    """Per-joint command for the robot's motor law:
+    tau = tau_nm + kp * (q_rad - q) + kd * (dq_radps - dq), clipped to effort limits."""
+
+    q_rad: np.ndarray = field(default_factory=_zeros)
+    dq_radps: np.ndarray = field(default_factory=_zeros)
+    kp: np.ndarray = field(default_factory=_zeros)
+    kd: np.ndarray = field(default_factory=_zeros)
+    tau_nm: np.ndarray = field(default_factory=_zeros)
+    enable: np.ndarray = field(default_factory=lambda: np.ones(NUM_JOINTS, dtype=bool))
+
+    @classmethod
+    def damping(cls, kd: np.ndarray | float = 2.0) -> MotorCommand:
+        """The fail-safe command: no stiffness, velocity damping only."""
+        return cls(kd=np.broadcast_to(np.asarray(kd, dtype=float), (NUM_JOINTS,)).copy())
+
+    def copy(self) -> MotorCommand:
+        return MotorCommand(self.q_rad.copy(), self.dq_radps.copy(), self.kp.copy(),
+                            self.kd.copy(), self.tau_nm.copy(), self.enable.copy())
+
+    def is_finite(self) -> bool:
+        return all(np.all(np.isfinite(a)) for a in (self.q_rad, self.dq_radps, self.kp, self.kd, self.tau_nm))

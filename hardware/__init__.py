@@ -1,0 +1,1 @@
+"""Real-robot transports (installed as g1_control.hardware)."""

@@ -1,0 +1,1 @@
+"""Learned models and their adapters (installed as g1_control.policies)."""

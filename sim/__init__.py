@@ -1,0 +1,1 @@
+"""MuJoCo simulation backend (installed as g1_control.sim)."""

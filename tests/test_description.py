@@ -1,0 +1,41 @@
+"""The pinocchio and MuJoCo models are built from one URDF and must agree."""
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+
+from g1_control.robot import description, g1
+
+
+def test_models_have_the_g1_joints_in_order():
+    mj = description.mujoco_model()
+    assert [mj.joint(i).name for i in range(1, mj.njnt)] == list(g1.JOINT_NAMES)
+    assert [mj.actuator(i).name + "_joint" for i in range(mj.nu)] == list(g1.JOINT_NAMES)
+    np.testing.assert_allclose(mj.dof_armature[6:], g1.ARMATURE_KGM2)
+    np.testing.assert_allclose(mj.actuator_ctrlrange[:, 1], g1.EFFORT_LIMIT_NM)
+    pm = description.pinocchio_model()
+    assert (pm.nq, pm.nv) == (36, 35)
+    assert abs(pin.computeTotalMass(pm) - mj.body_subtreemass[1]) < 1e-6
+
+
+def test_forward_kinematics_agree(rng=np.random.default_rng(0)):
+    mj = description.mujoco_model()
+    data = mujoco.MjData(mj)
+    pm = description.pinocchio_model()
+    pd = pm.createData()
+    bodies = ["left_ankle_roll_link", "right_ankle_roll_link", "left_wrist_yaw_link",
+              "right_wrist_yaw_link", "torso_link", "left_knee_link"]
+    worst = 0.0
+    for _ in range(20):
+        q = rng.uniform(g1.Q_MIN_RAD, g1.Q_MAX_RAD)
+        quat = rng.normal(size=4)
+        quat /= np.linalg.norm(quat)
+        pos = rng.normal(size=3)
+        data.qpos[:] = np.concatenate([pos, quat, q])
+        mujoco.mj_kinematics(mj, data)
+        pin.framesForwardKinematics(pm, pd, description.pinocchio_q(pos, quat, q))
+        for body in bodies:
+            fid = pm.getFrameId(body)
+            worst = max(worst, np.abs(pd.oMf[fid].translation - data.body(body).xpos).max())
+            np.testing.assert_allclose(pd.oMf[fid].rotation, data.body(body).xmat.reshape(3, 3), atol=1e-6)
+    assert worst < 1e-6
