@@ -60,7 +60,7 @@ ASSETS: dict[str, WheelAsset] = {
 
 
 def cache_dir() -> Path:
-    return Path(os.environ.get("G1_CONTROL_CACHE", Path.home() / ".cache" / "g1-control"))
+    return Path(os.environ.get("G1_CONTROL_CACHE") or Path.home() / ".cache" / "g1-control")
 
 
 def asset_dir(name: str) -> Path:

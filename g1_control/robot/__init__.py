@@ -1,1 +1,1 @@
-"""G1 robot facts and models."""
+"""G1 robot facts (g1.py), models built from its description (description.py) and the motor law."""

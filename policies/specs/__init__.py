@@ -1,0 +1,1 @@
+"""Policy specs (YAML): how to feed and read each tracking policy."""
