@@ -15,6 +15,8 @@ import sys
 from g1_control.errors import G1ControlError
 
 SUBCOMMAND_MODULES = (
+    "g1_control.cli.launch_cmd",
+    "g1_control.cli.policies_cmd",
     "g1_control.cli.bench_cmd",
 )
 

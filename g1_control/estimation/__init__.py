@@ -1,0 +1,1 @@
+"""Base state estimation (IMU + leg kinematics)."""

@@ -38,10 +38,10 @@ class VelocityCorrectionConfig:
     """
 
     enabled: bool = True
-    feedforward: tuple[float, float, float] = (1.15, 1.1, 1.0)
-    ki: tuple[float, float, float] = (0.8, 0.6, 0.5)
-    integral_limit: tuple[float, float, float] = (0.4, 0.3, 0.4)
-    velocity_filter_tau_s: float = 0.25
+    feedforward: tuple[float, float, float] = (1.0, 1.5, 1.0)
+    ki: tuple[float, float, float] = (2.0, 2.0, 1.0)
+    integral_limit: tuple[float, float, float] = (0.5, 0.7, 0.4)
+    velocity_filter_tau_s: float = 0.1
 
 
 class VelocityCorrector:

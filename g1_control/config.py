@@ -1,0 +1,112 @@
+"""Typed configuration from plain dicts (YAML): dataclasses are the schema.
+
+`from_dict(Cls, data, path)` builds a dataclass, refusing unknown keys, missing required fields
+and wrong types with one error that names the key path ("tracker.rate_hz: expected a number,
+got 'fast'"). Supported field types: bool, int, float, str, Literal[...], X | None, list[X],
+tuple[X, ...], dict[str, X] and nested dataclasses.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import types
+import typing
+from typing import Any, Literal, TypeVar
+
+from g1_control.errors import LaunchFileError
+
+T = TypeVar("T")
+
+
+def _type_name(tp) -> str:
+    if typing.get_origin(tp) is Literal:
+        return "one of " + ", ".join(repr(a) for a in typing.get_args(tp))
+    return getattr(tp, "__name__", str(tp))
+
+
+def _convert(tp, value: Any, path: str, error: type[Exception]):
+    origin, args = typing.get_origin(tp), typing.get_args(tp)
+    if origin in (typing.Union, types.UnionType):
+        if value is None and type(None) in args:
+            return None
+        inner = [a for a in args if a is not type(None)]
+        last: Exception | None = None
+        for a in inner:
+            try:
+                return _convert(a, value, path, error)
+            except error as exc:
+                last = exc
+        raise last  # type: ignore[misc]
+    if origin is Literal:
+        if value not in args:
+            raise error(f"{path}: expected {_type_name(tp)}, got {value!r}")
+        return value
+    if origin in (list, tuple):
+        if not isinstance(value, (list, tuple)):
+            raise error(f"{path}: expected a list, got {type(value).__name__} {value!r}")
+        if origin is tuple and args and args[-1] is not Ellipsis:
+            if len(value) != len(args):
+                raise error(f"{path}: expected {len(args)} items, got {len(value)}")
+            return tuple(_convert(a, v, f"{path}[{i}]", error) for i, (a, v) in enumerate(zip(args, value)))
+        item = args[0] if args else Any
+        items = [_convert(item, v, f"{path}[{i}]", error) for i, v in enumerate(value)]
+        return tuple(items) if origin is tuple else items
+    if origin is dict:
+        if not isinstance(value, dict):
+            raise error(f"{path}: expected a mapping, got {type(value).__name__}")
+        return {str(k): _convert(args[1], v, f"{path}.{k}", error) for k, v in value.items()}
+    if dataclasses.is_dataclass(tp):
+        return from_dict(tp, value, path, error)
+    if tp is Any:
+        return value
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise error(f"{path}: expected true or false, got {value!r}")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise error(f"{path}: expected an integer, got {value!r}")
+        return value
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise error(f"{path}: expected a number, got {value!r}")
+        if not math.isfinite(value):
+            raise error(f"{path}: expected a finite number, got {value!r}")
+        return float(value)
+    if tp is str:
+        if not isinstance(value, str):
+            raise error(f"{path}: expected a string, got {value!r}")
+        return value
+    raise TypeError(f"unsupported config field type {tp!r} at {path}")
+
+
+def from_dict(cls: type[T], data: Any, path: str = "", error: type[Exception] = LaunchFileError) -> T:
+    """Build dataclass `cls` from `data`, validating every field (see module docstring)."""
+    where = path or cls.__name__
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise error(f"{where}: expected a mapping of {cls.__name__} fields, got {type(data).__name__} {data!r}")
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    unknown = sorted(set(data) - set(fields))
+    if unknown:
+        raise error(f"{where}: unknown key{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))}; "
+                    f"allowed: {', '.join(fields)}")
+    kwargs = {}
+    for name, f in fields.items():
+        key_path = f"{path}.{name}" if path else name
+        if name in data:
+            kwargs[name] = _convert(hints[name], data[name], key_path, error)
+        elif f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+            raise error(f"{key_path}: required field is missing")
+    obj = cls(**kwargs)
+    check = getattr(obj, "validate", None)
+    if callable(check):
+        check(where)
+    return obj
+
+
+def to_dict(obj) -> dict:
+    return dataclasses.asdict(obj)

@@ -1,0 +1,1 @@
+"""Motion generators: operator Command -> KinematicReference."""

@@ -1,0 +1,47 @@
+"""The simplest generator: the operator's velocity command as a whole-body reference.
+
+Root velocity from the command, posture at the default pose, both feet in contact. It is
+feasible by construction, so its retargeter only copies fields (no IK). The learned generator
+replaces both without touching the loop.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from g1_control.interfaces import Generator, Retargeter
+from g1_control.robot import g1
+from g1_control.types import Command, JointReference, KinematicReference, RobotState
+
+
+class VelocityReferenceGenerator(Generator):
+    def __init__(self, max_vx_mps: float = 1.0, max_vy_mps: float = 0.6, max_wz_radps: float = 1.0):
+        self._limits = np.array([max_vx_mps, max_vy_mps, max_wz_radps])
+        self._ref = KinematicReference(q_rad=g1.DEFAULT_Q_RAD.copy())
+
+    def update(self, command: Command, state: RobotState) -> KinematicReference:
+        v = np.clip([command.vx_mps, command.vy_mps, command.wz_radps], -self._limits, self._limits)
+        ref = self._ref
+        ref.t_s = state.t_s
+        ref.root_linvel_b_mps[:2] = v[:2]
+        ref.root_angvel_b_radps[2] = v[2]
+        ref.style = command.style
+        return ref
+
+
+class CopyRetargeter(Retargeter):
+    """For references that are feasible by construction: copies fields, solves nothing."""
+
+    def __init__(self) -> None:
+        self._out = JointReference()
+
+    def solve(self, reference: KinematicReference, q_prev: np.ndarray) -> JointReference:
+        out = self._out
+        out.t_s = reference.t_s
+        out.q_rad[:] = reference.q_rad
+        out.root_pos_w_m[:] = reference.root_pos_w_m
+        out.root_quat_wxyz[:] = reference.root_quat_wxyz
+        out.root_linvel_b_mps[:] = reference.root_linvel_b_mps
+        out.root_angvel_b_radps[:] = reference.root_angvel_b_radps
+        out.contacts[:] = reference.contacts
+        return out

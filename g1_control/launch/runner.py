@@ -1,0 +1,230 @@
+"""Build the loop a launch file describes, run it, and write the run folder:
+
+    runs/<name>-<time>/
+      launch.yaml     the validated launch file as run
+      log.npz         per-tracker-tick log (see loop.control_loop.RunLog)
+      summary.json    fell or not, commanded vs achieved velocity per segment, stage timings, RTF
+      velocity.png    commanded vs achieved velocity and pelvis height
+      video.mp4       when headless rendering is available (EGL or OSMesa)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from g1_control.generator.velocity import CopyRetargeter, VelocityReferenceGenerator
+from g1_control.launch.schema import LaunchFile, Segment
+from g1_control.loop.control_loop import ControlLoop, LoopRates
+from g1_control.teleop.scripted import ScriptedInput, random_timeline
+
+STEADY_STATE_SKIP_S = 2.0
+"""Time after a segment starts before its velocity counts as steady state."""
+
+
+@dataclass
+class SegmentResult:
+    label: str
+    start_s: float
+    end_s: float
+    commanded: tuple[float, float, float]
+    achieved: tuple[float, float, float]
+
+    def error_pct(self) -> tuple[float | None, float | None, float | None]:
+        """Relative error per axis where the command is meaningfully non-zero."""
+        return tuple(
+            (100.0 * (a - c) / c) if abs(c) >= 0.1 else None for c, a in zip(self.commanded, self.achieved)
+        )  # type: ignore[return-value]
+
+
+@dataclass
+class RunResult:
+    name: str
+    fell: bool
+    duration_s: float
+    wall_s: float
+    segments: list[SegmentResult]
+    timings: dict[str, dict[str, float]]
+    deadline_misses: int
+    overruns: int
+    events: list[dict]
+    estimator_rms_mps: float | None
+    run_dir: Path | None = None
+    video: str | None = None
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def real_time_factor(self) -> float:
+        return self.duration_s / self.wall_s if self.wall_s > 0 else float("inf")
+
+
+def timeline_of(launch: LaunchFile) -> list[Segment]:
+    if launch.input.type == "random":
+        return random_timeline(launch.input.random, launch.total_duration_s)
+    return list(launch.input.timeline)
+
+
+def build_loop(launch: LaunchFile, segments: list[Segment]) -> ControlLoop:
+    from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
+    from g1_control.trackers.locomotion import LocomotionPolicyTracker, VelocityCorrectionConfig
+    from g1_control.trackers.policy_spec import load_spec
+
+    spec = load_spec(launch.tracker.policy)
+    tracker = LocomotionPolicyTracker(spec, VelocityCorrectionConfig(enabled=launch.tracker.velocity_correction))
+    wallclock = launch.backend.mode == "wallclock"
+    backend = MujocoBackend(MujocoConfig(physics_dt_s=launch.backend.physics_dt_s, lockstep=True))
+    r, lim = launch.rates, launch.limits
+    loop_box: list[ControlLoop] = []
+    device = ScriptedInput(segments, clock=lambda: loop_box[0].time_s)
+    loop = ControlLoop(
+        backend, device, VelocityReferenceGenerator(lim.max_vx_mps, lim.max_vy_mps, lim.max_wz_radps),
+        CopyRetargeter(), tracker,
+        LoopRates(r.lowlevel_hz, r.tracker_hz, r.input_hz, r.estimator_hz),
+        wallclock=wallclock, max_tilt_rad=lim.max_tilt_rad,
+        log_capacity=int(launch.total_duration_s * r.tracker_hz) + 2,
+    )
+    loop_box.append(loop)
+    return loop
+
+
+def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentResult]:
+    log = loop.log.arrays()
+    t = log["t_s"]
+    achieved = log["velocity_true"] if not np.isnan(log["velocity_true"]).all() else log["velocity_est"]
+    out, start = [], 0.0
+    for seg in segments:
+        end = start + seg.duration_s
+        window = (t >= start + min(STEADY_STATE_SKIP_S, seg.duration_s / 2)) & (t < end)
+        mean = achieved[window].mean(axis=0) if window.any() else np.full(3, np.nan)
+        out.append(SegmentResult(seg.label or "segment", start, end, (seg.vx_mps, seg.vy_mps, seg.wz_radps),
+                                 tuple(float(x) for x in mean)))
+        start = end
+    return out
+
+
+def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None = None,
+        progress: bool = True, viewer: bool = False) -> RunResult:
+    """Run `launch` to the end (or a fall); write the run folder when `out_root` is given."""
+    segments = timeline_of(launch)
+    loop = build_loop(launch, segments)
+    loop.reset()
+    duration = launch.total_duration_s
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=round(duration, 1), unit="sim s", desc=launch.name, bar_format="{l_bar}{bar}| {n:.1f}/{total} sim s [{elapsed}<{remaining}]")
+    ticks_per_update = int(loop.rates.lowlevel_hz)
+    view = _open_viewer(loop) if viewer else None
+
+    def on_tick(i: int) -> None:
+        if bar is not None and (i + 1) % ticks_per_update == 0:
+            bar.update(1.0)
+            if loop.fell:
+                bar.set_postfix_str("FELL")
+        if view is not None and (i + 1) % 10 == 0:
+            view.sync()
+
+    t0 = time.perf_counter()
+    try:
+        loop.run(duration, progress=on_tick)
+    finally:
+        wall = time.perf_counter() - t0
+        if bar is not None:
+            bar.close()
+        if view is not None:
+            view.close()
+        loop.backend.close()
+    result = _result(launch, loop, segments, wall)
+    if out_root is not None:
+        write_run_folder(result, launch, loop, Path(out_root), video)
+    return result
+
+
+def _open_viewer(loop: ControlLoop):
+    import mujoco.viewer
+
+    return mujoco.viewer.launch_passive(loop.backend.model, loop.backend.data)
+
+
+def _result(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], wall: float) -> RunResult:
+    log = loop.log.arrays()
+    est_rms = None
+    valid = ~np.isnan(log["velocity_true"][:, 0])
+    if valid.sum() > 10:
+        err = log["velocity_est"][valid, :2] - log["velocity_true"][valid, :2]
+        est_rms = float(np.sqrt((err**2).sum(axis=1).mean()))
+    return RunResult(
+        name=launch.name, fell=loop.fell, duration_s=loop.time_s, wall_s=wall,
+        segments=segment_results(loop, segments), timings=loop.scheduler.report(),
+        deadline_misses=loop.scheduler.deadline_misses, overruns=loop.scheduler.overruns,
+        events=[dataclasses.asdict(e) for e in loop.events], estimator_rms_mps=est_rms,
+    )
+
+
+def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, out_root: Path,
+                     video: bool | None) -> Path:
+    run_dir = out_root / f"{launch.name}-{time.strftime('%Y%m%d-%H%M%S')}"
+    suffix = 1
+    while run_dir.exists():
+        suffix += 1
+        run_dir = out_root / f"{launch.name}-{time.strftime('%Y%m%d-%H%M%S')}-{suffix}"
+    run_dir.mkdir(parents=True)
+    result.run_dir = run_dir
+    (run_dir / "launch.yaml").write_text(yaml.safe_dump(dataclasses.asdict(launch), sort_keys=False))
+    np.savez_compressed(run_dir / "log.npz", **loop.log.arrays())
+    if launch.output.plot:
+        from g1_control.launch.plots import plot_run
+
+        plot_run(loop.log.arrays(), result, run_dir / "velocity.png")
+    want_video = launch.output.video == "on" or (launch.output.video == "auto" and video is not False)
+    if video is True:
+        want_video = True
+    if want_video:
+        from g1_control.sim.render import render_video
+
+        backend = render_video(run_dir / "log.npz", run_dir / "video.mp4", launch.output.video_fps,
+                               launch.output.video_size)
+        result.video = str(run_dir / "video.mp4") if backend else None
+        result.extra["render_backend"] = backend
+    (run_dir / "summary.json").write_text(json.dumps(summary_dict(result), indent=2))
+    return run_dir
+
+
+def summary_dict(result: RunResult) -> dict:
+    d = dataclasses.asdict(result)
+    d["run_dir"] = str(result.run_dir) if result.run_dir else None
+    d["real_time_factor"] = result.real_time_factor
+    d["segments"] = [dict(dataclasses.asdict(s), error_pct=s.error_pct()) for s in result.segments]
+    return d
+
+
+def format_summary(result: RunResult) -> str:
+    lines = [
+        f"run '{result.name}': {'FELL' if result.fell else 'no fall'}; {result.duration_s:.1f} s simulated in "
+        f"{result.wall_s:.1f} s wall (real-time factor {result.real_time_factor:.1f}x)",
+        "",
+        f"{'segment':<12} {'time (s)':>11}   {'commanded vx vy wz':>22}   {'achieved vx vy wz':>22}   error %",
+    ]
+    for s in result.segments:
+        err = " ".join("   -  " if e is None else f"{e:+5.1f}" for e in s.error_pct())
+        cmd = " ".join(f"{v:+6.2f}" for v in s.commanded)
+        ach = " ".join(f"{v:+6.2f}" for v in s.achieved)
+        lines.append(f"{s.label[:12]:<12} {s.start_s:5.1f}-{s.end_s:5.1f}   {cmd:>22}   {ach:>22}   {err}")
+    lines += ["", f"{'stage':<12} {'calls':>7} {'p50 us':>8} {'p99 us':>8} {'max us':>8}"]
+    for name, t in result.timings.items():
+        lines.append(f"{name:<12} {t['calls']:>7} {t['p50_us']:>8.1f} {t['p99_us']:>8.1f} {t['max_us']:>8.1f}")
+    lines.append(f"deadline misses: {result.deadline_misses}; ticks over budget: {result.overruns}")
+    if result.estimator_rms_mps is not None:
+        lines.append(f"state estimator velocity RMS error vs ground truth: {result.estimator_rms_mps:.3f} m/s")
+    for e in result.events:
+        lines.append(f"event at {e['t_s']:.2f} s: {e['kind']}: {e['detail']}")
+    if result.run_dir:
+        lines.append(f"run folder: {result.run_dir}" + (f" (video: {Path(result.video).name})" if result.video else ""))
+    return "\n".join(lines)

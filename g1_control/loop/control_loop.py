@@ -1,0 +1,210 @@
+"""The fixed-rate control loop: input -> estimator -> generator -> retargeter -> tracker ->
+guard -> low-level stream, as scheduler stages at their own rates (see scheduler.py)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from g1_control.errors import InvalidCommandError, InvalidStateError
+from g1_control.estimation.estimator import StateEstimator, quat_to_rot, yaw_of
+from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, Tracker
+from g1_control.loop.scheduler import Scheduler, Stage
+from g1_control.robot import g1
+from g1_control.types import Command, MotorCommand, RobotState
+
+
+@dataclass
+class LoopRates:
+    lowlevel_hz: float = 500.0
+    tracker_hz: float = 50.0
+    input_hz: float = 100.0
+    estimator_hz: float = 100.0
+
+
+@dataclass
+class LoopEvent:
+    t_s: float
+    kind: str
+    detail: str
+
+
+@dataclass
+class RunLog:
+    """Per-tracker-tick records, preallocated for the whole run (no allocation in the loop)."""
+
+    capacity: int
+    n: int = 0
+    t_s: np.ndarray = field(init=False)
+    command: np.ndarray = field(init=False)          # operator (vx, vy, wz)
+    policy_command: np.ndarray = field(init=False)   # after velocity correction
+    velocity_est: np.ndarray = field(init=False)     # estimator (vx, vy, wz), heading frame
+    velocity_true: np.ndarray = field(init=False)    # ground truth, heading frame (NaN on a robot)
+    base_pos_m: np.ndarray = field(init=False)
+    base_quat_wxyz: np.ndarray = field(init=False)   # IMU orientation (the sim's IMU sits on the pelvis)
+    yaw_rad: np.ndarray = field(init=False)
+    tilt_rad: np.ndarray = field(init=False)
+    q_rad: np.ndarray = field(init=False)
+    q_target_rad: np.ndarray = field(init=False)
+    tau_nm: np.ndarray = field(init=False)
+
+    def __post_init__(self) -> None:
+        c, j = self.capacity, g1.NUM_JOINTS
+        self.t_s = np.zeros(c)
+        for name, width in (("command", 3), ("policy_command", 3), ("velocity_est", 3), ("velocity_true", 3),
+                            ("base_pos_m", 3), ("base_quat_wxyz", 4), ("q_rad", j), ("q_target_rad", j), ("tau_nm", j)):
+            setattr(self, name, np.full((c, width), np.nan))
+        self.yaw_rad = np.full(c, np.nan)
+        self.tilt_rad = np.full(c, np.nan)
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        names = ("t_s", "command", "policy_command", "velocity_est", "velocity_true", "base_pos_m", "base_quat_wxyz", "yaw_rad",
+                 "tilt_rad", "q_rad", "q_target_rad", "tau_nm")
+        return {name: getattr(self, name)[: self.n] for name in names}
+
+
+def tilt_of(quat_wxyz: np.ndarray) -> float:
+    """Angle between the body z axis and the world vertical (rad)."""
+    w, x, y, z = quat_wxyz
+    return float(np.arccos(np.clip(1 - 2 * (x * x + y * y), -1.0, 1.0)))
+
+
+class ControlLoop:
+    def __init__(self, backend: Backend, input_device: InputDevice, generator: Generator, retargeter: Retargeter,
+                 tracker: Tracker, rates: LoopRates | None = None, *, estimator: StateEstimator | None = None,
+                 wallclock: bool = False, max_tilt_rad: float = 1.0, log_capacity: int = 0):
+        self.backend, self.input, self.generator = backend, input_device, generator
+        self.retargeter, self.tracker = retargeter, tracker
+        self.rates = rates or LoopRates()
+        self.estimator = estimator or StateEstimator()
+        self.max_tilt_rad = max_tilt_rad
+        self.command = Command()
+        self.state = RobotState()
+        self.motor_command = MotorCommand.damping(g1.KD_DEFAULT)
+        self.damping = MotorCommand.damping(g1.KD_DEFAULT)
+        self.fell = False
+        self.faulted = False
+        self.invalid_commands = 0
+        self.events: list[LoopEvent] = []
+        self.log = RunLog(max(1, log_capacity))
+        r = self.rates
+        stages = [
+            Stage("input", r.input_hz, self._input),
+            Stage("estimator", r.estimator_hz, self._estimate),
+            Stage("generator", r.tracker_hz, self._generate),
+            Stage("retargeter", r.tracker_hz, self._retarget),
+            Stage("tracker", r.tracker_hz, self._track),
+            Stage("guard", r.tracker_hz, self._guard),
+            Stage("lowlevel", r.lowlevel_hz, self._lowlevel),
+            Stage("log", r.tracker_hz, self._log),
+        ]
+        self.scheduler = Scheduler(r.lowlevel_hz, stages, wallclock=wallclock)
+        self._kin_ref = None
+        self._joint_ref = None
+
+    # -- lifecycle ---------------------------------------------------------------------------------
+    def reset(self) -> RobotState:
+        self.state = self.backend.reset()
+        self.estimator.reset(self.state)
+        self.tracker.reset(self.state)
+        self.generator.reset(self.state)
+        return self.state
+
+    def run(self, duration_s: float, progress=None) -> int:
+        n = int(round(duration_s * self.rates.lowlevel_hz))
+        return self.scheduler.run(n, progress=progress)
+
+    @property
+    def time_s(self) -> float:
+        return self.scheduler.time_s
+
+    def _event(self, kind: str, detail: str) -> None:
+        self.events.append(LoopEvent(self.time_s, kind, detail))
+
+    # -- stages --------------------------------------------------------------------------------------
+    def _input(self) -> None:
+        command = self.input.poll()
+        try:
+            self.command = command.validate()
+        except InvalidCommandError as exc:
+            # Keep the last good command; the bad one never reaches the tracker.
+            self.invalid_commands += 1
+            if self.invalid_commands == 1 or self.invalid_commands % 100 == 0:
+                self._event("invalid_command", str(exc))
+
+    def _read_state(self) -> RobotState | None:
+        state = self.backend.read_state()
+        try:
+            self.state = state.validate()
+        except InvalidStateError as exc:
+            self._fault(f"invalid robot state: {exc}")
+            return None
+        return self.state
+
+    def _estimate(self) -> None:
+        state = self._read_state()
+        if state is not None:
+            est = self.estimator.update(state)
+            if hasattr(self.tracker, "velocity_estimate"):
+                self.tracker.velocity_estimate = est.heading_velocity
+
+    def _generate(self) -> None:
+        self._kin_ref = self.generator.update(self.command, self.state)
+
+    def _retarget(self) -> None:
+        self._joint_ref = self.retargeter.solve(self._kin_ref, self.state.q_rad)
+
+    def _track(self) -> None:
+        if self.faulted:
+            return
+        state = self._read_state()
+        if state is None:
+            return
+        command = self.tracker.act(self._joint_ref, state)
+        if not command.is_finite():
+            self._fault("tracker produced a non-finite motor command")
+            return
+        self.motor_command = command
+
+    def _guard(self) -> None:
+        tilt = tilt_of(self.state.imu_quat_wxyz)
+        if not self.fell and tilt > self.max_tilt_rad:
+            self.fell = True
+            self._fault(f"fall detected: pelvis tilt {tilt:.2f} rad > {self.max_tilt_rad} rad")
+
+    def _fault(self, detail: str) -> None:
+        if not self.faulted:
+            self._event("fault", detail + "; damping")
+        self.faulted = True
+        self.motor_command = self.damping
+
+    def _lowlevel(self) -> None:
+        self.backend.write_command(self.motor_command)
+        if self.backend.lockstep:
+            self.backend.step(self.scheduler.dt_s)
+
+    def _log(self) -> None:
+        log = self.log
+        i = log.n
+        if i >= log.capacity:
+            return
+        s, est = self.state, self.estimator.estimate
+        log.t_s[i] = self.time_s
+        log.command[i] = (self.command.vx_mps, self.command.vy_mps, self.command.wz_radps)
+        log.policy_command[i] = getattr(self.tracker, "last_policy_command", log.command[i])
+        log.velocity_est[i] = est.heading_velocity
+        yaw = yaw_of(s.imu_quat_wxyz)
+        log.yaw_rad[i] = yaw
+        log.base_quat_wxyz[i] = s.imu_quat_wxyz
+        log.tilt_rad[i] = tilt_of(s.imu_quat_wxyz)
+        if s.base_linvel_w_mps is not None:
+            c, sn = np.cos(yaw), np.sin(yaw)
+            v = s.base_linvel_w_mps
+            wz = (quat_to_rot(s.imu_quat_wxyz) @ s.imu_gyro_radps)[2]
+            log.velocity_true[i] = (c * v[0] + sn * v[1], -sn * v[0] + c * v[1], wz)
+            log.base_pos_m[i] = s.base_pos_w_m
+        log.q_rad[i] = s.q_rad
+        log.q_target_rad[i] = self.motor_command.q_rad
+        log.tau_nm[i] = s.tau_nm
+        log.n = i + 1

@@ -1,0 +1,118 @@
+"""Multi-rate fixed-rate scheduling with per-stage timing and deadline-miss counting.
+
+One base tick runs at the fastest rate (the low-level command stream). Every stage runs on
+ticks that are a multiple of its period, in the order the stages were given, so one tick is
+"input, estimator, generator, tracker, safety, low-level" when all are due. The same code runs
+in lockstep (as fast as possible; the backend advances simulated time) and in wall-clock mode
+(each tick waits for its deadline). A tick that ends after its deadline is a deadline miss.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class Stage:
+    name: str
+    rate_hz: float
+    fn: Callable[[], None]
+    period_ticks: int = 0
+
+
+@dataclass
+class StageTimes:
+    """Durations of a stage's calls (seconds), in a preallocated ring buffer."""
+
+    capacity: int = 1 << 16
+    samples: np.ndarray = field(init=False)
+    count: int = 0
+
+    def __post_init__(self) -> None:
+        self.samples = np.zeros(self.capacity)
+
+    def add(self, seconds: float) -> None:
+        self.samples[self.count % self.capacity] = seconds
+        self.count += 1
+
+    def summary(self) -> dict[str, float]:
+        data = self.samples[: min(self.count, self.capacity)]
+        if data.size == 0:
+            return {"calls": 0, "p50_us": 0.0, "p99_us": 0.0, "max_us": 0.0, "mean_us": 0.0}
+        p50, p99 = np.percentile(data, [50, 99]) * 1e6
+        return {"calls": self.count, "p50_us": float(p50), "p99_us": float(p99),
+                "max_us": float(data.max() * 1e6), "mean_us": float(data.mean() * 1e6)}
+
+
+class Scheduler:
+    def __init__(self, base_rate_hz: float, stages: list[Stage], *, wallclock: bool = False,
+                 clock: Callable[[], float] = time.perf_counter, sleep: Callable[[float], None] = time.sleep):
+        if base_rate_hz <= 0:
+            raise ValueError(f"base rate must be positive, got {base_rate_hz}")
+        self.base_rate_hz = base_rate_hz
+        self.dt_s = 1.0 / base_rate_hz
+        self.stages = stages
+        for stage in stages:
+            ratio = base_rate_hz / stage.rate_hz
+            if stage.rate_hz <= 0 or abs(ratio - round(ratio)) > 1e-9:
+                raise ValueError(f"stage '{stage.name}' rate {stage.rate_hz} Hz does not divide the base rate "
+                                 f"{base_rate_hz} Hz into whole ticks")
+            stage.period_ticks = int(round(ratio))
+        self.wallclock = wallclock
+        self.clock = clock
+        self.sleep = sleep
+        self.times = {s.name: StageTimes() for s in stages}
+        self.tick_times = StageTimes()
+        self.tick_index = 0
+        self.deadline_misses = 0
+        self.overruns = 0
+        """Ticks whose compute alone took longer than the tick period (would miss in real time)."""
+        self._t0: float | None = None
+
+    @property
+    def time_s(self) -> float:
+        """Control time: ticks run so far times the tick period."""
+        return self.tick_index * self.dt_s
+
+    def tick(self) -> None:
+        clock = self.clock
+        if self._t0 is None:
+            self._t0 = clock()
+        start = clock()
+        k = self.tick_index
+        for stage in self.stages:
+            if k % stage.period_ticks == 0:
+                s0 = clock()
+                stage.fn()
+                self.times[stage.name].add(clock() - s0)
+        end = clock()
+        self.tick_times.add(end - start)
+        if end - start > self.dt_s:
+            self.overruns += 1
+        self.tick_index += 1
+        if self.wallclock:
+            deadline = self._t0 + self.tick_index * self.dt_s
+            if end > deadline:
+                self.deadline_misses += 1
+            else:
+                self.sleep(deadline - end)
+
+    def run(self, n_ticks: int, stop: Callable[[], bool] | None = None,
+            progress: Callable[[int], None] | None = None) -> int:
+        """Run up to `n_ticks` ticks; returns how many ran (fewer when `stop()` turns true)."""
+        for i in range(n_ticks):
+            if stop is not None and stop():
+                return i
+            self.tick()
+            if progress is not None:
+                progress(i)
+        return n_ticks
+
+    def report(self) -> dict[str, dict[str, float]]:
+        out = {name: t.summary() for name, t in self.times.items()}
+        out["tick"] = self.tick_times.summary()
+        return out
