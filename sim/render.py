@@ -58,7 +58,7 @@ def _render(log_path: Path, out_path: Path, fps: float, size: tuple[int, int], q
         with imageio.get_writer(out_path, fps=fps, codec="libx264", quality=7, macro_block_size=8) as writer:
             for i in tqdm(idx, desc="render", unit="frame", disable=quiet):
                 data.qpos[:3], data.qpos[3:7], data.qpos[7:] = pos[i], quat[i], q[i]
-                mujoco.mj_kinematics(model, data)
+                mujoco.mj_forward(model, data)  # also the subtree CoM the tracking camera follows
                 renderer.update_scene(data, camera)
                 writer.append_data(renderer.render())
     finally:
