@@ -221,3 +221,87 @@ def test_find_gamepads_ignores_what_is_not_evdev(tmp_path):
     (tmp_path / "event0").write_bytes(b"")
     os.mkfifo(tmp_path / "event1")
     assert find_gamepads(str(tmp_path)) == []
+
+
+# -- the evdev-node path: ioctls answered by a stand-in for the kernel's evdev driver ----------
+def test_ioctl_numbers_match_the_kernel_headers():
+    # values of the macros in linux/input.h on x86_64 / aarch64
+    assert ev.EVIOCGVERSION == 0x80044501
+    assert ev.EVIOCGABS(ev.ABS_X) == 0x80184540
+    assert ev.EVIOCGKEY(96) == 0x80604518
+    assert ev.EVIOCGBIT(ev.EV_ABS, 8) == 0x80084523
+
+
+class FakeEvdevDriver:
+    """Answers the evdev ioctls for one fd the way the kernel does for an xpad pad."""
+
+    def __init__(self, real_ioctl):
+        self.real_ioctl = real_ioctl
+        self.fd = None
+        self.abs = {ev.ABS_X: [0, -32768, 32767], ev.ABS_Y: [0, -32768, 32767],
+                    ev.ABS_RX: [0, -32768, 32767], ev.ABS_RY: [0, -32768, 32767],
+                    ev.ABS_Z: [0, 0, 255], ev.ABS_RZ: [0, 0, 255], ev.ABS_HAT0X: [0, -1, 1], ev.ABS_HAT0Y: [0, -1, 1]}
+        self.keys_down = set()
+
+    def __call__(self, fd, request, buf, mutate=True):
+        if fd != self.fd:
+            return self.real_ioctl(fd, request, buf, mutate)
+        nr, size = request & 0xFF, (request >> 16) & 0x3FFF
+        if nr == 0x01:
+            buf[:4] = ev.struct.pack("i", 0x010001)
+        elif 0x40 <= nr < 0x80 and (nr - 0x40) in self.abs:
+            value, lo, hi = self.abs[nr - 0x40]
+            buf[:size] = ev.struct.pack(ev.ABSINFO_FORMAT, value, lo, hi, 16, 128, 0)
+        elif nr == 0x18:
+            bits = bytearray(size)
+            for code in self.keys_down:
+                bits[code // 8] |= 1 << (code % 8)
+            buf[:size] = bits
+        else:
+            raise OSError(errno.EINVAL, "unsupported")
+        return 0
+
+
+@pytest.fixture
+def evdev_node(monkeypatch):
+    """A gamepad on a character device whose ioctls the fake driver answers and whose events come
+    from a pipe (the one piece of the kernel a test cannot create without /dev/uinput)."""
+    driver = FakeEvdevDriver(ev.fcntl.ioctl)
+    monkeypatch.setattr(ev.fcntl, "ioctl", driver)
+    real_open = os.open
+
+    def open_records_fd(path, flags, *args):
+        fd = real_open(path, flags, *args)
+        if path == "/dev/null":
+            driver.fd = fd
+        return fd
+
+    monkeypatch.setattr("g1_control.teleop.gamepad.os.open", open_records_fd)
+    read_end, write_end = os.pipe()
+    os.set_blocking(read_end, False)
+    yield driver, lambda pad: setattr(pad, "_read_bytes", lambda fd, n: os.read(read_end, n)), write_end
+    os.close(read_end)
+    os.close(write_end)
+
+
+def test_evdev_node_ranges_initial_state_and_resync(evdev_node):
+    driver, route, write_end = evdev_node
+    driver.abs[ev.ABS_Y][0] = -32768  # the stick is already pushed forward when teleop starts
+    driver.keys_down = {ev.BTN_NORTH}
+    pad = EvdevGamepad("/dev/null", no_slew(), clock=Clock())
+    route(pad)
+    assert pad._ranges["left_trigger"] == (0, 255)  # asked from the device, not the xpad default
+    cmd = pad.poll()
+    assert cmd.vx_mps == pytest.approx(1.0, abs=1e-4) and cmd.buttons == {"policy_switch"}
+    os.write(write_end, frame((ev.EV_ABS, ev.ABS_Z, 255)))
+    assert pad.poll().pelvis_height_m == pytest.approx(CommandLimits().pelvis_height_m[0])
+    # events are lost in the kernel buffer; the driver's state now has LB+RB held, stick centred
+    driver.abs[ev.ABS_Y][0] = 0
+    driver.abs[ev.ABS_Z][0] = 0
+    driver.keys_down = {ev.BTN_TL, ev.BTN_TR}
+    os.write(write_end, ev.pack_event(ev.EV_SYN, ev.SYN_DROPPED, 0) + frame((ev.EV_ABS, ev.ABS_X, 32767)))
+    cmd = pad.poll()
+    assert cmd.buttons == {"estop"} and (cmd.vx_mps, cmd.vy_mps) == (0.0, 0.0)
+    assert cmd.pelvis_height_m == pytest.approx(CommandLimits().pelvis_height_m[1])
+    pad.close()
+
