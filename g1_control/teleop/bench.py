@@ -76,13 +76,13 @@ def _ping_pong(write_fd: int, read_fd: int, payload: Callable[[int], bytes], wai
     max_gap_s: the writer's longest random pause; a full loop period in the loop phase, so events
     land at every phase of the loop's tick as an operator's would."""
     ack_r, ack_w = os.pipe()
-    result = tempfile.NamedTemporaryFile(prefix="g1_teleop_bench_", delete=False)
-    result.close()
+    result_fd, result_path = tempfile.mkstemp(prefix="g1_teleop_bench_")
+    os.close(result_fd)
     pid = os.fork()
     if pid == 0:  # the writer: only os calls, then leave without running the parent's cleanup
         try:
             os.close(ack_w)
-            _writer(write_fd, ack_r, result.name, payload, max_gap_s)
+            _writer(write_fd, ack_r, result_path, payload, max_gap_s)
         finally:
             os._exit(0)
     os.close(ack_r)
@@ -100,11 +100,11 @@ def _ping_pong(write_fd: int, read_fd: int, payload: Callable[[int], bytes], wai
                 break
             os.write(ack_w, b"k")
         os.waitpid(pid, 0)
-        with open(result.name, "rb") as fh:
+        with open(result_path, "rb") as fh:
             written = np.frombuffer(fh.read(), dtype=np.int64)
     finally:
         os.close(ack_w)
-        os.unlink(result.name)
+        os.unlink(result_path)
     lat_us = (np.asarray(seen, dtype=np.int64) - written[: len(seen)]) / 1e3
     return lat_us[0::2], lat_us[1::2]
 

@@ -42,19 +42,19 @@ def _ior(nr: int, size: int) -> int:
 EVIOCGVERSION = _ior(0x01, 4)
 
 
-def EVIOCGABS(code: int) -> int:  # noqa: N802 - the kernel's name
+def EVIOCGABS(code: int) -> int:
     return _ior(0x40 + code, ABSINFO_SIZE)
 
 
-def EVIOCGKEY(length: int) -> int:  # noqa: N802
+def EVIOCGKEY(length: int) -> int:
     return _ior(0x18, length)
 
 
-def EVIOCGBIT(ev_type: int, length: int) -> int:  # noqa: N802
+def EVIOCGBIT(ev_type: int, length: int) -> int:
     return _ior(0x20 + ev_type, length)
 
 
-def EVIOCGNAME(length: int) -> int:  # noqa: N802
+def EVIOCGNAME(length: int) -> int:
     return _ior(0x06, length)
 
 

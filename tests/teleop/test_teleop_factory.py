@@ -62,7 +62,7 @@ def test_gamepad_from_config(tmp_path):
 
 
 def test_gamepad_auto_without_gamepads(monkeypatch):
-    monkeypatch.setattr("g1_control.teleop.gamepad.find_gamepads", lambda: [])
+    monkeypatch.setattr("g1_control.teleop.gamepad.find_gamepads", list)
     with pytest.raises(InputDeviceError, match="input.path is 'auto' but no gamepad was found"):
         make_input_device({"type": "gamepad", "path": "auto"})
 

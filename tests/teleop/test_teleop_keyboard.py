@@ -48,7 +48,7 @@ def test_decode_keys():
 
 
 def test_raw_mode_is_set_and_restored(pty_pair):
-    master, slave = pty_pair
+    _, slave = pty_pair
     before = termios.tcgetattr(slave)
     keyboard = TerminalKeyboard(path=os.ttyname(slave), clock=Clock())
     now = termios.tcgetattr(slave)

@@ -138,7 +138,7 @@ def test_nan_and_out_of_range_axes_are_clamped_and_counted():
 def test_chords_fire_once_and_the_larger_chord_wins():
     m = mapping({"buttons": {"L1": "style_next", "L1+R1": "estop", "A": "run", "L1+A": "policy_switch"}})
     mapper = CommandMapper(m)
-    press = lambda held, t, pressed=(): mapper.update(InputSnapshot(held=frozenset(held), pressed=pressed), t)  # noqa: E731
+    press = lambda held, t, pressed=(): mapper.update(InputSnapshot(held=frozenset(held), pressed=pressed), t)
     assert press({"L1", "R1"}, 0.0).buttons == {"estop"}  # together: only the chord
     assert press(set(), 0.1).buttons == frozenset()
     assert press({"L1"}, 0.2).buttons == {"style_next"}
