@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import struct
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -84,6 +85,8 @@ class UnitreeRemote(TeleopDevice):
         self._last_bytes: bytes | None = None
         self._reading = RemoteReading(frozenset(), 0.0, 0.0, 0.0, 0.0, 0.0)
         self._presses: list[str] = []
+        # feed() may run on the transport's receive thread while poll() runs on the loop's.
+        self._lock = threading.Lock()
         self.decode_errors = 0
         self.samples = 0
 
@@ -92,12 +95,14 @@ class UnitreeRemote(TeleopDevice):
         try:
             reading = decode_wireless_remote(data)
         except RemoteDecodeError:
-            self.decode_errors += 1
+            with self._lock:
+                self.decode_errors += 1
             return
-        self._presses.extend(sorted(reading.buttons - self._reading.buttons))
-        self._reading = reading
-        self._last_fresh_s = self._clock()
-        self.samples += 1
+        with self._lock:
+            self._presses.extend(sorted(reading.buttons - self._reading.buttons))
+            self._reading = reading
+            self._last_fresh_s = self._clock()
+            self.samples += 1
 
     def _pull(self) -> None:
         try:
@@ -122,9 +127,11 @@ class UnitreeRemote(TeleopDevice):
     def _read(self) -> InputSnapshot:
         if self._source is not None:
             self._pull()
-        silent_s = self._clock() - self._last_fresh_s
-        if silent_s > self.stale_after_s:
-            what = f" ({self.decode_errors} malformed samples)" if self.decode_errors else ""
-            raise DeviceLost(f"no remote data for {silent_s:.3f} s (limit {self.stale_after_s} s){what}")
-        presses, self._presses = tuple(self._presses), []
-        return InputSnapshot(axes=self._reading.axes(), held=self._reading.buttons, pressed=presses)
+        with self._lock:
+            silent_s = self._clock() - self._last_fresh_s
+            if silent_s > self.stale_after_s:
+                what = f" ({self.decode_errors} malformed samples)" if self.decode_errors else ""
+                raise DeviceLost(f"no remote data for {silent_s:.3f} s (limit {self.stale_after_s} s){what}")
+            presses, self._presses = tuple(self._presses), []
+            reading = self._reading
+        return InputSnapshot(axes=reading.axes(), held=reading.buttons, pressed=presses)
