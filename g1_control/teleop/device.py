@@ -13,6 +13,7 @@ import time
 from abc import abstractmethod
 from collections.abc import Callable
 
+from g1_control.errors import LaunchFileError
 from g1_control.interfaces import InputDevice
 from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.mapper import CommandMapper
@@ -35,7 +36,7 @@ class TeleopDevice(InputDevice):
     def __init__(self, mapping: MappingConfig, limits: CommandLimits | None = None, *,
                  name: str | None = None, clock: Callable[[], float] = time.monotonic) -> None:
         if mapping.layout.kind != self.kind:
-            raise ValueError(f"{type(self).__name__} needs a {self.kind} mapping, got one for {mapping.layout.kind}")
+            raise LaunchFileError(f"{type(self).__name__} needs a {self.kind} mapping, got one for a {mapping.layout.kind}")
         self.mapper = CommandMapper(mapping, limits)
         self.name = name or self.kind
         self._clock = clock

@@ -21,7 +21,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from g1_control.errors import RemoteDecodeError
+from g1_control.errors import LaunchFileError, RemoteDecodeError
 from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.device import DeviceLost, TeleopDevice
 from g1_control.teleop.layouts import REMOTE_BUTTON_BITS
@@ -77,7 +77,7 @@ class UnitreeRemote(TeleopDevice):
                  name: str | None = None) -> None:
         super().__init__(mapping or MappingConfig.default("unitree_remote"), limits, name=name, clock=clock)
         if not (isinstance(stale_after_s, (int, float)) and math.isfinite(stale_after_s) and stale_after_s > 0):
-            raise ValueError(f"stale_after_s is {stale_after_s!r}; expected a positive number of seconds")
+            raise LaunchFileError(f"stale_after_s is {stale_after_s!r}; expected a positive number of seconds")
         self._source = state_source
         self.stale_after_s = float(stale_after_s)
         self._last_fresh_s = clock()

@@ -149,3 +149,12 @@ def test_never_any_data_is_loss_after_the_stale_time():
     clock.t = 0.3
     remote.poll()
     assert remote.lost
+
+
+def test_wrong_mapping_or_stale_time_is_refused():
+    from g1_control.errors import LaunchFileError
+
+    with pytest.raises(LaunchFileError, match="UnitreeRemote needs a unitree_remote mapping, got one for a keyboard"):
+        UnitreeRemote(MappingConfig.default("keyboard"))
+    with pytest.raises(LaunchFileError, match="stale_after_s is -1; expected a positive number of seconds"):
+        UnitreeRemote(stale_after_s=-1)
