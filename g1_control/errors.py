@@ -27,3 +27,11 @@ class PolicyFetchError(G1ControlError, RuntimeError):
 
 class RobotDescriptionError(G1ControlError, RuntimeError):
     """The G1 description package is missing or does not look like the G1."""
+
+
+class InputDeviceError(G1ControlError, RuntimeError):
+    """An operator input device that cannot be opened or used (missing path, no permission, not a tty)."""
+
+
+class RemoteDecodeError(G1ControlError, ValueError):
+    """Wireless-remote bytes that do not have the layout the G1 reports (40 bytes, see FACTS.md)."""

@@ -9,6 +9,7 @@ import importlib
 # name -> "module:function"; the function takes the parsed args and returns an exit code.
 BENCHMARKS = {
     "loop": ("g1_control.loop.bench:main", "full loop in lockstep: real-time factor, per-stage p50/p99"),
+    "teleop": ("g1_control.teleop.bench:main", "input event -> Command latency p50/p99 per device vs bare os.read"),
 }
 
 

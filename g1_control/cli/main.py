@@ -18,6 +18,7 @@ SUBCOMMAND_MODULES = (
     "g1_control.cli.launch_cmd",
     "g1_control.cli.policies_cmd",
     "g1_control.cli.bench_cmd",
+    "g1_control.teleop.cli",
 )
 
 
