@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 from pathlib import Path
 
 
@@ -50,11 +49,11 @@ def _run(args) -> int:
         return 0
     from g1_control.launch.runner import format_summary, run
 
-    viewer_setting = args.viewer or launch.viewer
-    viewer = viewer_setting == "on" or (viewer_setting == "auto" and bool(os.environ.get("DISPLAY")))
+    setting = {"on": True, "off": False, "auto": "auto"}[args.viewer] if args.viewer else launch.viewer
+    viewer = setting is True or (setting == "auto" and bool(os.environ.get("DISPLAY")))
     if viewer:
         launch.backend.mode = "wallclock"
     result = run(launch, out_root=args.out or Path(launch.output.dir), video=args.video,
-                 progress=not args.quiet and sys.stderr.isatty() or not args.quiet, viewer=viewer)
+                 progress=not args.quiet, viewer=viewer)
     print(format_summary(result))
     return 1 if result.fell else 0

@@ -183,9 +183,7 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, o
         from g1_control.launch.plots import plot_run
 
         plot_run(loop.log.arrays(), result, run_dir / "velocity.png")
-    want_video = launch.output.video == "on" or (launch.output.video == "auto" and video is not False)
-    if video is True:
-        want_video = True
+    want_video = video if video is not None else launch.output.video in (True, "auto")
     if want_video:
         from g1_control.sim.render import render_video
 

@@ -100,7 +100,8 @@ class LimitsConfig:
 @dataclass
 class OutputConfig:
     dir: str = "runs"
-    video: Literal["auto", "on", "off"] = "auto"
+    video: bool | Literal["auto"] = "auto"
+    """true/false, or auto: render when headless rendering (EGL or OSMesa) works."""
     video_fps: float = 10.0
     video_size: tuple[int, int] = (480, 360)
     plot: bool = True
@@ -117,7 +118,8 @@ class LaunchFile:
     input: InputConfig = field(default_factory=InputConfig)
     limits: LimitsConfig = field(default_factory=LimitsConfig)
     output: OutputConfig = field(default_factory=OutputConfig)
-    viewer: Literal["auto", "on", "off"] = "auto"
+    viewer: bool | Literal["auto"] = "auto"
+    """true/false, or auto: open the MuJoCo viewer when a display exists."""
     description: str = ""
 
     def validate(self, where: str) -> None:

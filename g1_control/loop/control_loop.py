@@ -102,6 +102,7 @@ class ControlLoop:
         self.scheduler = Scheduler(r.lowlevel_hz, stages, wallclock=wallclock)
         self._kin_ref = None
         self._joint_ref = None
+        self._state_tick = -1
 
     # -- lifecycle ---------------------------------------------------------------------------------
     def reset(self) -> RobotState:
@@ -134,6 +135,11 @@ class ControlLoop:
                 self._event("invalid_command", str(exc))
 
     def _read_state(self) -> RobotState | None:
+        """The robot's state for this tick (read once per tick, shared by the stages)."""
+        tick = self.scheduler.tick_index
+        if self._state_tick == tick:
+            return None if self.faulted else self.state
+        self._state_tick = tick
         state = self.backend.read_state()
         try:
             self.state = state.validate()

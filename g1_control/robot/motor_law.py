@@ -19,6 +19,8 @@ def motor_torque(command: MotorCommand, q_rad: np.ndarray, dq_radps: np.ndarray,
     tau = np.multiply(command.kp, command.q_rad - q_rad, out=out)
     tau += command.kd * (command.dq_radps - dq_radps)
     tau += command.tau_nm
-    np.clip(tau, -EFFORT_LIMIT_NM, EFFORT_LIMIT_NM, out=tau)
-    tau[~command.enable] = 0.0
+    np.minimum(tau, EFFORT_LIMIT_NM, out=tau)
+    np.maximum(tau, -EFFORT_LIMIT_NM, out=tau)
+    if not command.enable.all():
+        tau[~command.enable] = 0.0
     return tau
