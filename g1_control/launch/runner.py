@@ -22,7 +22,8 @@ import yaml
 from g1_control.generator.velocity import CopyRetargeter, VelocityReferenceGenerator
 from g1_control.launch.schema import LaunchFile, Segment
 from g1_control.loop.control_loop import ControlLoop, LoopRates
-from g1_control.teleop.scripted import ScriptedInput, random_timeline
+from g1_control.launch.inputs import make_input
+from g1_control.teleop.scripted import random_timeline
 
 STEADY_STATE_SKIP_S = 2.0
 """Time after a segment starts before its velocity counts as steady state."""
@@ -65,9 +66,29 @@ class RunResult:
 
 
 def timeline_of(launch: LaunchFile) -> list[Segment]:
+    """The command timeline when it is known in advance (scripted or random), else []."""
     if launch.input.type == "random":
         return random_timeline(launch.input.random, launch.total_duration_s)
-    return list(launch.input.timeline)
+    if launch.input.type == "scripted":
+        return list(launch.input.timeline)
+    return []
+
+
+def segments_from_log(log: dict[str, np.ndarray], min_s: float = 1.0) -> list[Segment]:
+    """Stretches of constant operator command in a log (for live or device-driven runs)."""
+    t, cmd = log["t_s"], log["command"]
+    if len(t) == 0:
+        return []
+    change = np.nonzero(np.any(np.abs(np.diff(cmd, axis=0)) > 1e-6, axis=1))[0] + 1
+    bounds = np.concatenate([[0], change, [len(t)]])
+    dt = t[1] - t[0] if len(t) > 1 else 0.02
+    out = []
+    for a, b in zip(bounds[:-1], bounds[1:]):
+        if (b - a) * dt >= min_s:
+            vx, vy, wz = (float(v) for v in cmd[a])
+            out.append((float(t[a]), Segment(duration_s=float((b - a) * dt), vx_mps=vx, vy_mps=vy, wz_radps=wz,
+                                            label="held")))
+    return out
 
 
 def build_loop(launch: LaunchFile, segments: list[Segment]) -> ControlLoop:
@@ -81,7 +102,9 @@ def build_loop(launch: LaunchFile, segments: list[Segment]) -> ControlLoop:
     backend = MujocoBackend(MujocoConfig(physics_dt_s=launch.backend.physics_dt_s, lockstep=True))
     r, lim = launch.rates, launch.limits
     loop_box: list[ControlLoop] = []
-    device = ScriptedInput(segments, clock=lambda: loop_box[0].time_s)
+    device = make_input(launch, segments, clock=lambda: loop_box[0].time_s if loop_box else 0.0,
+                        command_ranges=spec.command_ranges,
+                        state_source=backend.read_state)
     loop = ControlLoop(
         backend, device, VelocityReferenceGenerator(lim.max_vx_mps, lim.max_vy_mps, lim.max_wz_radps),
         CopyRetargeter(), tracker,
@@ -97,14 +120,18 @@ def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentR
     log = loop.log.arrays()
     t = log["t_s"]
     achieved = log["velocity_true"] if not np.isnan(log["velocity_true"]).all() else log["velocity_est"]
-    out, start = [], 0.0
-    for seg in segments:
+    if segments:
+        starts = np.concatenate([[0.0], np.cumsum([s.duration_s for s in segments])[:-1]])
+        timed = list(zip(starts, segments))
+    else:
+        timed = segments_from_log(log)
+    out = []
+    for start, seg in timed:
         end = start + seg.duration_s
         window = (t >= start + min(STEADY_STATE_SKIP_S, seg.duration_s / 2)) & (t < end)
         mean = achieved[window].mean(axis=0) if window.any() else np.full(3, np.nan)
         out.append(SegmentResult(seg.label or "segment", start, end, (seg.vx_mps, seg.vy_mps, seg.wz_radps),
                                  tuple(float(x) for x in mean)))
-        start = end
     return out
 
 
@@ -140,6 +167,7 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
             bar.close()
         if view is not None:
             view.close()
+        loop.input.close()
         loop.backend.close()
     result = _result(launch, loop, segments, wall)
     if out_root is not None:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import yaml
 
@@ -77,15 +77,42 @@ class RandomTimelineConfig:
     stand_probability: float = 0.2
 
 
+TELEOP_DEVICES = ("gamepad", "keyboard", "unitree_remote")
+
+
 @dataclass
 class InputConfig:
-    type: Literal["scripted", "random"] = "scripted"
+    """Where commands come from.
+
+    scripted: `timeline` segments; random: seeded random segments; gamepad / keyboard /
+    unitree_remote: a teleop device configured by `device` (path, mapping; see
+    g1_control/teleop/README.md); gamepad_script: a timed gamepad sequence (`gamepad_script`)
+    played through the real evdev gamepad reader, for recorded demos and tests.
+    """
+
+    type: Literal["scripted", "random", "gamepad", "keyboard", "unitree_remote", "gamepad_script"] = "scripted"
     timeline: list[Segment] = field(default_factory=list)
     random: RandomTimelineConfig = field(default_factory=RandomTimelineConfig)
+    device: dict[str, Any] = field(default_factory=dict)
+    fallback: Literal["keyboard"] | None = None
+    """For a gamepad with path 'auto': use the keyboard when no gamepad is plugged in."""
+    gamepad_script: list[dict[str, Any]] = field(default_factory=list)
 
     def validate(self, where: str) -> None:
         if self.type == "scripted" and not self.timeline:
             raise LaunchFileError(f"{where}.timeline: a scripted input needs at least one segment")
+        if self.type == "gamepad_script":
+            from g1_control.teleop.gamepad_script import parse_gamepad_script
+
+            parse_gamepad_script(self.gamepad_script, f"{where}.gamepad_script")
+        if self.type in TELEOP_DEVICES + ("gamepad_script",):
+            from g1_control.teleop.layouts import LAYOUTS
+            from g1_control.teleop.mapping import MappingConfig
+
+            kind = "gamepad" if self.type == "gamepad_script" else self.type
+            if "type" in self.device:
+                raise LaunchFileError(f"{where}.device.type: the device type is input.type ({self.type})")
+            MappingConfig.from_dict(self.device.get("mapping"), f"{where}.device.mapping", layout=LAYOUTS[kind])
 
 
 @dataclass
@@ -138,6 +165,8 @@ class LaunchFile:
             return self.duration_s
         if self.input.type == "scripted":
             return sum(s.duration_s for s in self.input.timeline)
+        if self.input.type == "gamepad_script" and self.input.gamepad_script:
+            return float(self.input.gamepad_script[-1]["t_s"]) + 3.0
         return 60.0
 
 

@@ -133,6 +133,9 @@ class ControlLoop:
             self.invalid_commands += 1
             if self.invalid_commands == 1 or self.invalid_commands % 100 == 0:
                 self._event("invalid_command", str(exc))
+            return
+        if "estop" in command.buttons or "damp" in command.buttons:
+            self._fault(f"operator {'e-stop' if 'estop' in command.buttons else 'damp'}")
 
     def _read_state(self) -> RobotState | None:
         """The robot's state for this tick (read once per tick, shared by the stages)."""

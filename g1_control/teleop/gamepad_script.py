@@ -150,3 +150,25 @@ class GamepadScriptFeeder:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+class ScriptedGamepad:
+    """A gamepad script played through the real evdev reader: an InputDevice whose poll() first
+    writes the steps due by `clock()` into the FIFO, then reads them back as a pad would."""
+
+    def __init__(self, steps: list[GamepadStep], make_gamepad, clock) -> None:
+        self.feeder = GamepadScriptFeeder(steps)
+        self.gamepad = make_gamepad(self.feeder.path)
+        self.clock = clock
+
+    @property
+    def lost(self) -> bool:
+        return self.gamepad.lost
+
+    def poll(self):
+        self.feeder.advance(self.clock())
+        return self.gamepad.poll()
+
+    def close(self) -> None:
+        self.gamepad.close()
+        self.feeder.close()

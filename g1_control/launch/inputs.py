@@ -1,0 +1,43 @@
+"""The launch file's command source as an InputDevice."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from g1_control.errors import InputDeviceError
+from g1_control.interfaces import InputDevice
+from g1_control.launch.schema import TELEOP_DEVICES, LaunchFile, Segment
+from g1_control.teleop.scripted import ScriptedInput
+
+
+def make_input(launch: LaunchFile, segments: list[Segment], clock: Callable[[], float],
+               command_ranges: dict | None = None, state_source=None) -> InputDevice:
+    """Open the device `launch.input` names. Teleop devices get the tracker's command ranges as
+    limits and the loop's clock (sim time in lockstep), so slew rates follow simulated time."""
+    cfg = launch.input
+    if cfg.type in ("scripted", "random"):
+        return ScriptedInput(segments, clock=clock)
+    from g1_control.teleop.command_limits import CommandLimits
+    from g1_control.teleop.factory import make_input_device
+
+    limits = CommandLimits.from_tracker_metadata({"command_ranges": command_ranges}) if command_ranges else None
+    if cfg.type == "gamepad_script":
+        from g1_control.teleop.gamepad_script import ScriptedGamepad, parse_gamepad_script
+
+        steps = parse_gamepad_script(cfg.gamepad_script, "input.gamepad_script")
+
+        def open_pad(path: str):
+            return make_input_device(dict(cfg.device, type="gamepad", path=path), "input.device", limits=limits,
+                                     clock=clock)
+
+        return ScriptedGamepad(steps, open_pad, clock)
+    assert cfg.type in TELEOP_DEVICES
+    device_cfg = dict(cfg.device, type=cfg.type)
+    try:
+        return make_input_device(device_cfg, "input.device", limits=limits, state_source=state_source, clock=clock)
+    except InputDeviceError:
+        if cfg.type == "gamepad" and cfg.fallback == "keyboard":
+            keyboard_cfg = {"type": "keyboard"}
+            print("input: no gamepad found; using the keyboard (see g1_control/teleop/README.md for keys)")
+            return make_input_device(keyboard_cfg, "input.device", limits=limits, clock=clock)
+        raise
