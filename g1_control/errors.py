@@ -35,3 +35,35 @@ class InputDeviceError(G1ControlError, RuntimeError):
 
 class RemoteDecodeError(G1ControlError, ValueError):
     """Wireless-remote bytes that do not have the layout the G1 reports (40 bytes, see FACTS.md)."""
+
+
+class MalformedMessageError(G1ControlError, ValueError):
+    """A robot message (DDS sample, CAN/serial frame) that is short, truncated or of another type."""
+
+
+class CrcMismatchError(G1ControlError, ValueError):
+    """A robot message whose CRC/checksum does not match its contents."""
+
+
+class TransportError(G1ControlError, RuntimeError):
+    """A robot transport that cannot be opened or used (missing DDS library, port busy, ...)."""
+
+
+class NetworkInterfaceError(TransportError):
+    """A network interface that does not exist or is down; the message lists the ones that exist."""
+
+
+class RobotNotConnectedError(TransportError):
+    """No valid state arrived from the robot (not powered, wrong interface/domain, not running)."""
+
+
+class VariantMismatchError(G1ControlError, ValueError):
+    """The robot reports a DoF variant (mode_machine) other than the one the setup expects."""
+
+
+class MotionServiceError(TransportError):
+    """The robot's built-in motion service could not be released before low-level control."""
+
+
+class SafetyConfigError(G1ControlError, ValueError):
+    """A safety configuration with a missing, negative or non-finite threshold."""
