@@ -1,0 +1,33 @@
+"""SafetyEvent: one line of the safety log."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+
+class SafetyEventKind(str, Enum):
+    STALE_STATE = "stale_state"
+    CRC_BURST = "crc_burst"
+    TILT = "tilt"
+    JOINT_OVERSPEED = "joint_overspeed"
+    NONFINITE_STATE = "nonfinite_state"
+    NONFINITE_COMMAND = "nonfinite_command"
+    DEADLINE_OVERRUNS = "deadline_overruns"
+    INPUT_STALE = "input_stale"
+    """Not a trip: velocity commands zeroed while the operator input is late."""
+    INPUT_LOST = "input_lost"
+    OVER_TEMPERATURE = "over_temperature"
+    ESTOP = "estop"
+
+
+@dataclass(frozen=True)
+class SafetyEvent:
+    t_s: float
+    kind: SafetyEventKind
+    detail: str
+    trips: bool
+    """True when the event switched the robot to damping for good."""
+
+    def __str__(self) -> str:
+        return f"[{self.t_s:.3f} s] {self.kind.value}{' (damping)' if self.trips else ''}: {self.detail}"

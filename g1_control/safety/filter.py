@@ -1,0 +1,224 @@
+"""SafetyFilter: vets every MotorCommand before a backend sees it.
+
+Until it trips, commands are clamped to the G1's joint position, velocity and torque limits and to
+sane gains (every clamp counted per joint). It trips on the first of: stale state, a burst of bad
+CRCs, tilt (fall), joint over-speed, NaN/inf anywhere, repeated deadline overruns, lost operator
+input, an over-temperature motor, or an e-stop; from then on it returns the damping command
+(kp 0, kd > 0) for good. A new filter is the only way back: resuming control is an operator
+decision the deploy state machine makes, never this layer.
+
+All times (`now_s`, RobotState.t_s) are one clock: the backend's receive clock on the robot
+(time.monotonic), simulation time in lockstep.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import deque
+from dataclasses import dataclass, field, replace
+from typing import Callable
+
+import numpy as np
+
+from g1_control.robot import g1
+from g1_control.safety.config import SafetyConfig
+from g1_control.safety.events import SafetyEvent, SafetyEventKind
+from g1_control.types import Command, MotorCommand, RobotState
+
+log = logging.getLogger("g1_control.safety")
+
+CLAMPED_FIELDS = ("q_rad", "dq_radps", "tau_nm", "kp", "kd")
+
+
+def _inside_float32(lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Bounds that stay inside [lower, upper] after the wire's float32 rounding too."""
+    lo32, hi32 = lower.astype(np.float32), upper.astype(np.float32)
+    lo32 = np.where(lo32 < lower, np.nextafter(lo32, np.float32(np.inf)), lo32)
+    hi32 = np.where(hi32 > upper, np.nextafter(hi32, np.float32(-np.inf)), hi32)
+    return lo32.astype(np.float64), hi32.astype(np.float64)
+
+
+@dataclass
+class ClampCounts:
+    """How many commands had each joint's field clamped."""
+
+    per_joint: dict[str, np.ndarray] = field(
+        default_factory=lambda: {name: np.zeros(g1.NUM_JOINTS, dtype=np.int64) for name in CLAMPED_FIELDS})
+    commands: int = 0
+    """Commands that needed at least one clamp."""
+
+    @property
+    def total(self) -> int:
+        return int(sum(int(v.sum()) for v in self.per_joint.values()))
+
+
+def tilt_rad(quat_wxyz: np.ndarray) -> float:
+    """Angle between the body z axis and world up."""
+    w, x, y, z = np.asarray(quat_wxyz, dtype=float) / np.linalg.norm(quat_wxyz)
+    return float(np.arccos(np.clip(1.0 - 2.0 * (x * x + y * y), -1.0, 1.0)))
+
+
+class _Burst:
+    """True once `count` events fall within `window_s`."""
+
+    def __init__(self, count: int, window_s: float):
+        self.count, self.window_s = int(count), window_s
+        self.times: deque[float] = deque(maxlen=int(count))
+
+    def add(self, now_s: float, n: int = 1) -> bool:
+        for _ in range(min(n, self.count)):
+            self.times.append(now_s)
+        return len(self.times) == self.count and now_s - self.times[0] <= self.window_s
+
+
+class SafetyFilter:
+    def __init__(self, config: SafetyConfig | None = None,
+                 on_event: Callable[[SafetyEvent], None] | None = None):
+        self.config = config or SafetyConfig()
+        self.on_event = on_event
+        self.events: list[SafetyEvent] = []
+        self.trip_event: SafetyEvent | None = None
+        self.clamps = ClampCounts()
+        c = self.config
+        margin = c.position_margin_rad
+        self._q_lo, self._q_hi = _inside_float32(g1.Q_MIN_RAD + margin, g1.Q_MAX_RAD - margin)
+        self._dq_lo, self._dq_hi = _inside_float32(-g1.VELOCITY_LIMIT_RADPS, g1.VELOCITY_LIMIT_RADPS)
+        self._tau_lo, self._tau_hi = _inside_float32(-g1.EFFORT_LIMIT_NM, g1.EFFORT_LIMIT_NM)
+        self._damping = MotorCommand.damping(c.damping_kd)
+        self._crc_burst = _Burst(c.crc_burst_count, c.crc_burst_window_s)
+        self._overruns = _Burst(c.overrun_burst_count, c.overrun_window_s)
+        self._crc_total_seen: int | None = None
+        self._last_input_s: float | None = None
+        self._last_input: Command = Command()
+        self._input_stale = False
+
+    @property
+    def tripped(self) -> bool:
+        return self.trip_event is not None
+
+    # -- inputs that can trip ----------------------------------------------------------------------
+    def check(self, state: RobotState, now_s: float) -> bool:
+        """Vet `state` (and the input watchdog) at `now_s`; False once tripped."""
+        if self.tripped:
+            return False
+        c = self.config
+        arrays = {"q_rad": state.q_rad, "dq_radps": state.dq_radps, "imu_quat_wxyz": state.imu_quat_wxyz,
+                  "imu_gyro_radps": state.imu_gyro_radps, "motor_temperature_c": state.motor_temperature_c}
+        for name, arr in arrays.items():
+            arr = np.asarray(arr, dtype=float)
+            if not np.all(np.isfinite(arr)):
+                return self._trip(now_s, SafetyEventKind.NONFINITE_STATE, f"RobotState.{name} contains NaN or inf")
+        if not np.isfinite(state.t_s) or not np.isfinite(now_s):
+            return self._trip(now_s, SafetyEventKind.NONFINITE_STATE, f"time is not finite (state {state.t_s}, now {now_s})")
+        age = now_s - state.t_s
+        if age > c.stale_state_s:
+            return self._trip(now_s, SafetyEventKind.STALE_STATE,
+                              f"newest state is {age * 1000:.1f} ms old (limit {c.stale_state_s * 1000:.0f} ms)")
+        if np.linalg.norm(state.imu_quat_wxyz) < 1e-6:
+            return self._trip(now_s, SafetyEventKind.NONFINITE_STATE, "IMU quaternion is zero")
+        tilt = tilt_rad(state.imu_quat_wxyz)
+        if tilt > c.max_tilt_rad:
+            return self._trip(now_s, SafetyEventKind.TILT, f"pelvis tilted {tilt:.2f} rad (limit {c.max_tilt_rad:.2f})")
+        speed_ratio = np.abs(state.dq_radps) / g1.VELOCITY_LIMIT_RADPS
+        j = int(np.argmax(speed_ratio))
+        if speed_ratio[j] > c.overspeed_factor:
+            return self._trip(now_s, SafetyEventKind.JOINT_OVERSPEED,
+                              f"{g1.JOINT_NAMES[j]} moves at {state.dq_radps[j]:.1f} rad/s "
+                              f"(limit {c.overspeed_factor * g1.VELOCITY_LIMIT_RADPS[j]:.1f})")
+        j = int(np.argmax(state.motor_temperature_c))
+        if state.motor_temperature_c[j] > c.max_motor_temperature_c:
+            return self._trip(now_s, SafetyEventKind.OVER_TEMPERATURE,
+                              f"{g1.JOINT_NAMES[j]} motor at {state.motor_temperature_c[j]:.0f} °C "
+                              f"(limit {c.max_motor_temperature_c:.0f})")
+        if self._last_input_s is not None and now_s - self._last_input_s > c.input_lost_s:
+            return self._trip(now_s, SafetyEventKind.INPUT_LOST,
+                              f"no operator input for {now_s - self._last_input_s:.2f} s (limit {c.input_lost_s:.2f})")
+        return True
+
+    def report_crc_errors(self, bad_crc_total: int, now_s: float) -> bool:
+        """Feed the transport's running count of bad-CRC states; False once tripped."""
+        previous = self._crc_total_seen if self._crc_total_seen is not None else 0
+        self._crc_total_seen = bad_crc_total
+        new = bad_crc_total - previous
+        if new > 0 and self._crc_burst.add(now_s, new) and not self.tripped:
+            self._trip(now_s, SafetyEventKind.CRC_BURST,
+                       f"{self.config.crc_burst_count} bad-CRC states within {self.config.crc_burst_window_s * 1000:.0f} ms "
+                       f"({bad_crc_total} in total)")
+        return not self.tripped
+
+    def report_deadline(self, overran: bool, now_s: float, detail: str = "") -> bool:
+        """Tell the filter whether this tick missed its deadline; False once tripped."""
+        if overran and self._overruns.add(now_s) and not self.tripped:
+            self._trip(now_s, SafetyEventKind.DEADLINE_OVERRUNS,
+                       f"{self.config.overrun_burst_count} deadline overruns within {self.config.overrun_window_s:.1f} s"
+                       + (f" ({detail})" if detail else ""))
+        return not self.tripped
+
+    def estop(self, reason: str, now_s: float) -> None:
+        """Trip at once (e-stop button, SIGINT/SIGTERM, a fault found elsewhere)."""
+        self._trip(now_s, SafetyEventKind.ESTOP, reason)
+
+    def vet_input(self, command: Command | None, now_s: float) -> Command:
+        """The operator command to act on: `command` when fresh (None = nothing new from the device);
+        the last one with zero velocity once input is late; an e-stop button trips."""
+        c = self.config
+        if command is not None:
+            if "estop" in command.buttons:
+                self.estop("e-stop pressed on the operator input", now_s)
+            self._last_input_s, self._last_input = now_s, command
+            if self._input_stale:
+                self._input_stale = False
+            return command
+        if self._last_input_s is None:
+            return Command()
+        late = now_s - self._last_input_s
+        if late > c.input_zero_velocity_s:
+            if not self._input_stale:
+                self._input_stale = True
+                self._log(SafetyEvent(now_s, SafetyEventKind.INPUT_STALE,
+                                      f"no operator input for {late:.2f} s: velocity commands zeroed", trips=False))
+            return replace(self._last_input, vx_mps=0.0, vy_mps=0.0, wz_radps=0.0, buttons=frozenset())
+        return replace(self._last_input, buttons=frozenset())
+
+    # -- the filter ----------------------------------------------------------------------------------
+    def filter(self, command: MotorCommand, state: RobotState, now_s: float) -> MotorCommand:
+        """The command to send: clamped, or damping once tripped."""
+        if not self.check(state, now_s):
+            return self._damping.copy()
+        if not command.is_finite():
+            bad = [n for n in CLAMPED_FIELDS if not np.all(np.isfinite(getattr(command, n)))]
+            self._trip(now_s, SafetyEventKind.NONFINITE_COMMAND, f"MotorCommand.{', '.join(bad)} contain NaN or inf")
+            return self._damping.copy()
+        out = MotorCommand(
+            q_rad=np.clip(command.q_rad, self._q_lo, self._q_hi),
+            dq_radps=np.clip(command.dq_radps, self._dq_lo, self._dq_hi),
+            kp=np.clip(command.kp, 0.0, self.config.max_kp),
+            kd=np.clip(command.kd, 0.0, self.config.max_kd),
+            tau_nm=np.clip(command.tau_nm, self._tau_lo, self._tau_hi),
+            enable=np.asarray(command.enable, dtype=bool).copy(),
+        )
+        any_clamp = False
+        for name in CLAMPED_FIELDS:
+            changed = getattr(out, name) != getattr(command, name)
+            if changed.any():
+                any_clamp = True
+                self.clamps.per_joint[name] += changed
+        self.clamps.commands += any_clamp
+        return out
+
+    def damping(self) -> MotorCommand:
+        return self._damping.copy()
+
+    def _trip(self, now_s: float, kind: SafetyEventKind, detail: str) -> bool:
+        if self.tripped:
+            return False
+        event = SafetyEvent(float(now_s), kind, detail, trips=True)
+        self.trip_event = event
+        self._log(event)
+        return False
+
+    def _log(self, event: SafetyEvent) -> None:
+        self.events.append(event)
+        (log.error if event.trips else log.warning)("%s", event)
+        if self.on_event is not None:
+            self.on_event(event)
