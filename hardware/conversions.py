@@ -83,12 +83,12 @@ def motor_command_to_lowcmd(command: MotorCommand, mode_machine: int, mode_pr: i
     msg.mode_pr = mode_pr
     msg.mode_machine = int(mode_machine)
     msg.motor_mode[:] = MOTOR_DISABLED
-    msg.motor_mode[:n][on] = MOTOR_ENABLED
+    msg.motor_mode[:n] = on  # True -> 1 (MOTOR_ENABLED)
     for target, source in ((msg.motor_q_rad, command.q_rad), (msg.motor_dq_radps, command.dq_radps),
                            (msg.motor_tau_nm, command.tau_nm), (msg.motor_kp_nm_per_rad, command.kp),
                            (msg.motor_kd_nms_per_rad, command.kd)):
-        target[:] = 0.0
-        target[:n] = np.where(on, source, 0.0)
+        target.fill(0.0)
+        np.copyto(target[:n], source, casting="same_kind", where=on)
     return msg
 
 

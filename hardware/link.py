@@ -56,11 +56,16 @@ class Link(ABC):
     def encode(self, msg: LowCmd | LowState) -> bytes:
         return msg.to_dds() if self.wire == "dds" else msg.to_c_bytes()
 
-    def decode_command(self, payload: bytes) -> LowCmd:
-        return LowCmd.from_dds(payload) if self.wire == "dds" else LowCmd.from_c_bytes(payload)
+    def decode_command(self, payload: bytes, verify: bool = True) -> LowCmd:
+        """Decode a LowCmd_; raises MalformedMessageError, or CrcMismatchError when verify is set."""
+        if self.wire == "dds":
+            return LowCmd.from_dds(payload, verify=verify)
+        return LowCmd.from_c_bytes(payload, verify=verify)
 
-    def decode_state(self, payload: bytes) -> LowState:
-        return LowState.from_dds(payload) if self.wire == "dds" else LowState.from_c_bytes(payload)
+    def decode_state(self, payload: bytes, verify: bool = True) -> LowState:
+        if self.wire == "dds":
+            return LowState.from_dds(payload, verify=verify)
+        return LowState.from_c_bytes(payload, verify=verify)
 
     def _count(self, name: str, n: int = 1) -> None:
         with self._counter_lock:

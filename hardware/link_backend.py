@@ -26,7 +26,6 @@ from g1_control.errors import (
 )
 from g1_control.hardware.conversions import lowstate_to_robot_state, motor_command_to_lowcmd, variant_of
 from g1_control.hardware.link import Link
-from g1_control.hardware.unitree_hg import verify_crc
 from g1_control.interfaces import Backend
 from g1_control.robot import g1
 from g1_control.types import MotorCommand, RobotState
@@ -176,7 +175,6 @@ class LinkBackend(Backend):
             for payload in self.link.receive(0.05):
                 try:
                     msg = self.link.decode_state(payload)
-                    verify_crc(msg)
                 except CrcMismatchError:
                     with self._lock:
                         self._bad_crc += 1

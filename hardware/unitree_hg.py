@@ -57,6 +57,25 @@ _CMD_DDS = FieldCodec(flatten(LOW_CMD, "xcdr1"), base=4)
 _STATE_C = FieldCodec(flatten(LOW_STATE, "c"))
 _STATE_DDS = FieldCodec(flatten(LOW_STATE, "xcdr1"), base=4)
 
+
+
+def _c_from_dds(c: FieldCodec, dds: FieldCodec) -> np.ndarray:
+    """Index that gathers the C image from a DDS sample buffer (padding reads a zero byte placed
+    one past the sample), so the CRC of a sample costs one gather instead of a second packing."""
+    zero = dds.buffer_size
+    index = np.full(c.size, zero, dtype=np.intp)
+    for path, leaf in c.layout.leaves.items():
+        size = leaf.primitive.size
+        src = dds.layout.leaves[path].offsets.ravel() + dds.base
+        dst = leaf.offsets.ravel()
+        for k in range(size):
+            index[dst + k] = src + k
+    return index
+
+
+_CMD_GATHER = _c_from_dds(_CMD_C, _CMD_DDS)
+_STATE_GATHER = _c_from_dds(_STATE_C, _STATE_DDS)
+
 LOWCMD_C_SIZE = _CMD_C.size
 LOWSTATE_C_SIZE = _STATE_C.size
 LOWCMD_DDS_SIZE = _CMD_DDS.size
@@ -103,16 +122,22 @@ class LowCmd:
 
     def to_dds(self) -> bytes:
         """The DDS sample, with the CRC recomputed over the current contents."""
-        self.crc = compute_crc(self)
-        return _pack(self, _CMD_DDS, DDS_HEADER).tobytes()
+        return _seal_dds(self, _CMD_DDS, _CMD_GATHER)
 
     @classmethod
-    def from_dds(cls, data: bytes) -> LowCmd:
-        return _unpack(cls, _CMD_DDS, _check_dds(data, _CMD_DDS, "LowCmd_"))
+    def from_dds(cls, data: bytes, verify: bool = False) -> LowCmd:
+        """Decode a DDS sample; verify=True raises CrcMismatchError for a bad CRC."""
+        buf = _check_dds(data, _CMD_DDS, "LowCmd_")
+        if verify:
+            _verify_gathered(buf, _CMD_DDS, _CMD_GATHER, "LowCmd")
+        return _unpack(cls, _CMD_DDS, buf)
 
     @classmethod
-    def from_c_bytes(cls, data: bytes) -> LowCmd:
-        return _unpack(cls, _CMD_C, _check_c(data, _CMD_C, "LowCmd_"))
+    def from_c_bytes(cls, data: bytes, verify: bool = False) -> LowCmd:
+        buf = _check_c(data, _CMD_C, "LowCmd_")
+        if verify:
+            _verify_image(buf, _CMD_C.size, "LowCmd")
+        return _unpack(cls, _CMD_C, buf)
 
 
 @dataclass
@@ -163,16 +188,21 @@ class LowState:
         return buf.tobytes()
 
     def to_dds(self) -> bytes:
-        self.crc = compute_crc(self)
-        return _pack(self, _STATE_DDS, DDS_HEADER).tobytes()
+        return _seal_dds(self, _STATE_DDS, _STATE_GATHER)
 
     @classmethod
-    def from_dds(cls, data: bytes) -> LowState:
-        return _unpack(cls, _STATE_DDS, _check_dds(data, _STATE_DDS, "LowState_"))
+    def from_dds(cls, data: bytes, verify: bool = False) -> LowState:
+        buf = _check_dds(data, _STATE_DDS, "LowState_")
+        if verify:
+            _verify_gathered(buf, _STATE_DDS, _STATE_GATHER, "LowState")
+        return _unpack(cls, _STATE_DDS, buf)
 
     @classmethod
-    def from_c_bytes(cls, data: bytes) -> LowState:
-        return _unpack(cls, _STATE_C, _check_c(data, _STATE_C, "LowState_"))
+    def from_c_bytes(cls, data: bytes, verify: bool = False) -> LowState:
+        buf = _check_c(data, _STATE_C, "LowState_")
+        if verify:
+            _verify_image(buf, _STATE_C.size, "LowState")
+        return _unpack(cls, _STATE_C, buf)
 
 
 def compute_crc(msg: LowCmd | LowState) -> int:
@@ -186,10 +216,40 @@ def verify_crc(msg: LowCmd | LowState) -> None:
     """Raise CrcMismatchError unless msg.crc matches its contents."""
     expected = compute_crc(msg)
     if int(msg.crc) != expected:
-        raise CrcMismatchError(
-            f"{type(msg).__name__} CRC is 0x{int(msg.crc):08x} but its contents give 0x{expected:08x}; "
-            "the sample was corrupted or built by a sender that does not compute the G1 CRC"
-        )
+        raise _mismatch(type(msg).__name__, int(msg.crc), expected)
+
+
+def _mismatch(name: str, got: int, expected: int) -> CrcMismatchError:
+    return CrcMismatchError(
+        f"{name} CRC is 0x{got:08x} but its contents give 0x{expected:08x}; "
+        "the sample was corrupted or built by a sender that does not compute the G1 CRC"
+    )
+
+
+def _seal_dds(msg, codec: FieldCodec, gather: np.ndarray) -> bytes:
+    msg.crc = 0
+    full = np.zeros(codec.buffer_size + 1, dtype=np.uint8)  # +1: the zero byte padding gathers
+    buf = full[: codec.buffer_size]
+    _fill(msg, codec, buf, DDS_HEADER)
+    msg.crc = crc32_words(full[gather][:-4])
+    codec.put(buf, "crc", msg.crc)
+    return buf[: codec.size].tobytes()
+
+
+def _verify_gathered(buf: np.ndarray, codec: FieldCodec, gather: np.ndarray, name: str) -> None:
+    full = np.zeros(codec.buffer_size + 1, dtype=np.uint8)
+    full[: buf.size] = buf
+    expected = crc32_words(full[gather][:-4])
+    got = int(codec.get(buf, "crc"))
+    if got != expected:
+        raise _mismatch(name, got, expected)
+
+
+def _verify_image(buf: np.ndarray, size: int, name: str) -> None:
+    expected = crc32_words(buf[: size - 4])
+    got = int(buf[size - 4: size].view("<u4")[0])
+    if got != expected:
+        raise _mismatch(name, got, expected)
 
 
 def _seal(buf: np.ndarray) -> int:
@@ -200,6 +260,11 @@ def _seal(buf: np.ndarray) -> int:
 
 def _pack(msg, codec: FieldCodec, header: bytes = b"") -> np.ndarray:
     buf = np.zeros(codec.buffer_size, dtype=np.uint8)
+    _fill(msg, codec, buf, header)
+    return buf[: codec.size]
+
+
+def _fill(msg, codec: FieldCodec, buf: np.ndarray, header: bytes = b"") -> None:
     if header:
         buf[: len(header)] = np.frombuffer(header, dtype=np.uint8)
     for attr, path in msg._PATHS.items():
@@ -207,7 +272,6 @@ def _pack(msg, codec: FieldCodec, header: bytes = b"") -> np.ndarray:
         if isinstance(value, (bytes, bytearray)):
             value = np.frombuffer(value, dtype=np.uint8)
         codec.put(buf, path, value)
-    return buf[: codec.size]
 
 
 def _unpack(cls, codec: FieldCodec, buf: np.ndarray):

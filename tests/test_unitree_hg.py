@@ -155,6 +155,23 @@ def test_crc_catches_a_single_flipped_bit():
     wire[40] ^= 0x01
     with pytest.raises(CrcMismatchError, match="LowCmd CRC is 0x"):
         hgm.verify_crc(hgm.LowCmd.from_dds(bytes(wire)))
+    with pytest.raises(CrcMismatchError, match="LowCmd CRC is 0x.*corrupted"):
+        hgm.LowCmd.from_dds(bytes(wire), verify=True)
+    hgm.LowCmd.from_dds(msg.to_dds(), verify=True)
+
+
+def test_verified_decoding_of_both_forms_and_both_messages():
+    state = random_lowstate(RNG)
+    wire, image = state.to_dds(), state.to_c_bytes()
+    assert hgm.LowState.from_dds(wire, verify=True).crc == hgm.LowState.from_c_bytes(image, verify=True).crc
+    bad_image = bytearray(image)
+    bad_image[100] ^= 0x80
+    with pytest.raises(CrcMismatchError, match="LowState CRC"):
+        hgm.LowState.from_c_bytes(bytes(bad_image), verify=True)
+    bad_wire = bytearray(wire)
+    bad_wire[-1] ^= 0x01  # inside the CRC word itself
+    with pytest.raises(CrcMismatchError):
+        hgm.LowState.from_dds(bytes(bad_wire), verify=True)
 
 
 def test_short_and_foreign_samples_are_refused_by_name():
