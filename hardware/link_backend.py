@@ -142,6 +142,12 @@ class LinkBackend(Backend):
             self.link.close()
 
     # -- extras ----------------------------------------------------------------------------------
+    @property
+    def bad_crc(self) -> int:
+        """Running count of states dropped for a bad CRC (the safety layer watches its bursts)."""
+        with self._lock:
+            return self._bad_crc
+
     def wait_for_state(self, timeout_s: float) -> RobotState:
         if not self._state_event.wait(timeout_s):
             raise RobotNotConnectedError(self._no_state_message(timeout_s))

@@ -113,9 +113,12 @@ def release_motion_service(participant, partition: str | None = None, timeout_s:
 class MotionServiceEmulator:
     """Answers CheckMode/ReleaseMode/SelectMode like the robot's service (for the emulator and tests)."""
 
-    def __init__(self, participant, partition: str | None = None, active_mode: str = "ai"):
+    def __init__(self, participant, partition: str | None = None, active_mode: str = "ai",
+                 on_change=None):
+        """on_change(active_mode) is called whenever a call changes the active mode."""
         self._writer, self._reader = _endpoints(participant, partition, serving=True)
         self.active_mode = active_mode
+        self.on_change = on_change
         self.calls: list[int] = []
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._serve, name="motion-service", daemon=True)
@@ -131,6 +134,7 @@ class MotionServiceEmulator:
                 api_id = int(request.header.identity.api_id)
                 self.calls.append(api_id)
                 code, data = STATUS_OK, ""
+                before = self.active_mode
                 if api_id == API_CHECK_MODE:
                     data = json.dumps({"form": "0", "name": self.active_mode})
                 elif api_id == API_RELEASE_MODE:
@@ -139,6 +143,8 @@ class MotionServiceEmulator:
                     self.active_mode = request.parameter
                 else:
                     code = 3203  # Unitree RPC: API not implemented by the server
+                if self.active_mode != before and self.on_change is not None:
+                    self.on_change(self.active_mode)
                 header = ResponseHeader_(request.header.identity, ResponseStatus_(code))
                 self._writer.write(Response_(header, data, []))
 

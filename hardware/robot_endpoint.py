@@ -38,6 +38,8 @@ class EndpointCounters:
     wrong_mode_machine: int = 0
     damping_commands: int = 0
     """Valid commands with every enabled motor at kp 0 and kd > 0."""
+    ignored_while_builtin_active: int = 0
+    """Valid commands dropped because the robot's own controller still held the motors."""
 
 
 class RobotEndpoint:
@@ -49,6 +51,11 @@ class RobotEndpoint:
         self.counters = EndpointCounters()
         self.last_command: LowCmd | None = None
         self.last_command_time_s = float("nan")
+        self.first_damping_time_s = float("nan")
+        """time.monotonic() of the first damping command applied since the last mark_faults_clear()."""
+        self.builtin_active = False
+        """While True (the built-in controller runs), valid commands are ignored, as on the robot, and
+        the physics is paused at its standing pose (Unitree's controller itself is not emulated)."""
         self.publish = True
         self.freeze_state = False
         self.corrupt_state_crc = False
@@ -73,7 +80,7 @@ class RobotEndpoint:
         next_t = time.monotonic()
         while not self._stop.is_set() and time.monotonic() < end:
             self._apply_commands(self.link.receive(0.0))
-            if self.physics.lockstep:
+            if self.physics.lockstep and not self.builtin_active:
                 self.physics.step(self.period_s)
             self._publish_state()
             next_t += self.period_s
@@ -101,14 +108,24 @@ class RobotEndpoint:
             if msg.mode_machine != self.physics.read_state().mode_machine:
                 self.counters.wrong_mode_machine += 1
                 continue
+            if self.builtin_active:
+                self.counters.ignored_while_builtin_active += 1
+                continue
             command = lowcmd_to_motor_command(msg)
             if command.enable.any() and np.all(command.kp[command.enable] == 0) \
                     and np.all(command.kd[command.enable] > 0):
                 self.counters.damping_commands += 1
+                if self.first_damping_time_s != self.first_damping_time_s:  # still NaN
+                    self.first_damping_time_s = time.monotonic()
             self.physics.write_command(command)
             self.last_command = msg
             self.last_command_time_s = time.monotonic()
             self.counters.commands_applied += 1
+
+    def mark_faults_clear(self) -> None:
+        """Clear every fault switch and forget the last damping time (start of a fault trial)."""
+        self.publish, self.freeze_state, self.corrupt_state_crc = True, False, False
+        self.first_damping_time_s = float("nan")
 
     def _publish_state(self) -> None:
         if not self.publish:

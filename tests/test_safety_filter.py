@@ -11,8 +11,10 @@ from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter, tilt_
 from g1_control.types import Command, MotorCommand, RobotState
 
 
-def _state(t_s=0.0, **kw) -> RobotState:
-    return RobotState(t_s=t_s, q_rad=g1.DEFAULT_Q_RAD.copy(), motor_temperature_c=np.full(29, 40.0), **kw)
+def _state(t_s=0.0, tick=None, **kw) -> RobotState:
+    # By default every state is a new sample (its tick follows its time, 2 ms per robot tick).
+    tick = int(round(t_s * 500)) if tick is None else tick
+    return RobotState(t_s=t_s, q_rad=g1.DEFAULT_Q_RAD.copy(), motor_temperature_c=np.full(29, 40.0), tick=tick, **kw)
 
 
 def _cmd() -> MotorCommand:
@@ -77,6 +79,16 @@ def test_each_state_fault_trips_to_damping_for_good(mutate, now_s, kind, text):
     # A perfectly good state afterwards changes nothing: damping for good, one trip event.
     assert _is_damping(f.filter(_cmd(), _state(t_s=1.0), 1.0))
     assert [e.kind for e in f.events] == [kind]
+
+
+def test_frozen_tick_counts_as_stale_state():
+    f = SafetyFilter()
+    for i in range(3):  # fresh samples with an advancing tick
+        assert f.check(_state(t_s=i * 0.02, tick=i), i * 0.02)
+    assert f.check(_state(t_s=0.06, tick=2), 0.06)  # same tick, 20 ms: fine
+    assert not f.check(_state(t_s=0.10, tick=2), 0.10)  # same tick, 60 ms: frozen
+    assert f.trip_event.kind == SafetyEventKind.STALE_STATE
+    assert "tick frozen at 2 for 60.0 ms" in f.trip_event.detail
 
 
 def test_nonfinite_command_trips():

@@ -66,6 +66,7 @@ def test_no_unsafe_command_ever_leaves_the_filter(steps):
     for i, (cmd, state) in enumerate(steps):
         now = float(i) * 0.02
         state.t_s += now
+        state.tick = i
         out = f.filter(cmd, state, now)
         assert_safe(out, state.mode_machine)
         if tripped_before:

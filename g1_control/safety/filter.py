@@ -88,6 +88,8 @@ class SafetyFilter:
         self._crc_burst = _Burst(c.crc_burst_count, c.crc_burst_window_s)
         self._overruns = _Burst(c.overrun_burst_count, c.overrun_window_s)
         self._crc_total_seen: int | None = None
+        self._tick: int | None = None
+        self._tick_since_s = 0.0
         self._last_input_s: float | None = None
         self._last_input: Command = Command()
         self._input_stale = False
@@ -114,6 +116,13 @@ class SafetyFilter:
         if age > c.stale_state_s:
             return self._trip(now_s, SafetyEventKind.STALE_STATE,
                               f"newest state is {age * 1000:.1f} ms old (limit {c.stale_state_s * 1000:.0f} ms)")
+        # A robot whose samples keep arriving with the same tick is as stale as a silent one.
+        if state.tick != self._tick:
+            self._tick, self._tick_since_s = state.tick, now_s
+        elif now_s - self._tick_since_s > c.stale_state_s:
+            return self._trip(now_s, SafetyEventKind.STALE_STATE,
+                              f"state tick frozen at {state.tick} for {(now_s - self._tick_since_s) * 1000:.1f} ms "
+                              f"(limit {c.stale_state_s * 1000:.0f} ms)")
         if np.linalg.norm(state.imu_quat_wxyz) < 1e-6:
             return self._trip(now_s, SafetyEventKind.NONFINITE_STATE, "IMU quaternion is zero")
         tilt = tilt_rad(state.imu_quat_wxyz)
@@ -187,7 +196,7 @@ class SafetyFilter:
             return self._damping.copy()
         if not command.is_finite():
             bad = [n for n in CLAMPED_FIELDS if not np.all(np.isfinite(getattr(command, n)))]
-            self._trip(now_s, SafetyEventKind.NONFINITE_COMMAND, f"MotorCommand.{', '.join(bad)} contain NaN or inf")
+            self._trip(now_s, SafetyEventKind.NONFINITE_COMMAND, f"MotorCommand.{', '.join(bad)} {'contains' if len(bad) == 1 else 'contain'} NaN or inf")
             return self._damping.copy()
         out = MotorCommand(
             q_rad=np.clip(command.q_rad, self._q_lo, self._q_hi),
