@@ -1,7 +1,7 @@
 """MockG1: a stand-in for the robot's motors where hardware is absent (tests, bench, CAN/serial rigs).
 
 Each joint is a rotor-plus-link inertia driven by the robot's motor law, saturated at the joint's
-effort limit and stopped at its position limits; the base never moves (the robot hangs on a
+effort limit, capped at its motor's speed limit and stopped at its position limits; the base never moves (the robot hangs on a
 gantry). It is not a simulator of the G1 (that is the MuJoCo backend); it gives transports and the
 safety layer something physical-looking to close the loop on.
 """
@@ -57,6 +57,8 @@ class MockG1(Backend):
         h = dt_s / substeps
         for _ in range(substeps):
             self._dq += h * tau / self._inertia
+            # A motor cannot outrun its no-load speed: back-EMF caps it at the family's limit.
+            np.clip(self._dq, -g1.VELOCITY_LIMIT_RADPS, g1.VELOCITY_LIMIT_RADPS, out=self._dq)
             self._q += h * self._dq
             hit = (self._q < g1.Q_MIN_RAD) | (self._q > g1.Q_MAX_RAD)
             self._q = np.clip(self._q, g1.Q_MIN_RAD, g1.Q_MAX_RAD)
