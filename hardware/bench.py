@@ -13,7 +13,7 @@ import numpy as np
 
 from g1_control.hardware.conversions import lowstate_to_robot_state, motor_command_to_lowcmd
 from g1_control.hardware.crc import crc32_words, crc32_words_table
-from g1_control.hardware.unitree_hg import LowCmd, LowState, compute_crc
+from g1_control.hardware.unitree_hg import LowState, compute_crc
 from g1_control.robot import g1
 from g1_control.types import MotorCommand, RobotState
 

@@ -88,7 +88,7 @@ class DdsLink(Link):
         super().__init__(side)
         self.interface, self.domain_id, self.partition = interface, int(domain_id), partition
         participant = domain_participant(interface, self.domain_id)
-        from cyclonedds.core import ReadCondition, SampleState, ViewState, InstanceState, WaitSet
+        from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState, WaitSet
         from cyclonedds.pub import DataWriter, Publisher
         from cyclonedds.qos import Policy, Qos
         from cyclonedds.sub import DataReader, Subscriber

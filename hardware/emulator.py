@@ -105,7 +105,7 @@ class Gantry(Backend):
 
     def step(self, dt_s: float) -> None:
         d = self.inner.data
-        for _ in range(max(1, int(round(dt_s / self.dt)))):
+        for _ in range(max(1, round(dt_s / self.dt))):
             force = self.k * (self.anchor - d.qpos[0:3]) - self.c * d.qvel[0:3]
             force[2] = max(0.0, force[2] + self.weight_n * 0.9)  # a band pulls, never pushes
             self.inner.push(force, self.dt)

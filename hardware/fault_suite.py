@@ -130,7 +130,7 @@ def _wait_for_damping(emulator: _Emulator, timeout_s: float = 3.0) -> float:
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
         t = emulator.ask("report")["first_damping_time_s"]
-        if t == t:  # not NaN
+        if not math.isnan(t):
             return t
         time.sleep(0.02)
     return math.nan

@@ -11,7 +11,7 @@ Python loop over 35 motors.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal, Union
+from typing import Literal
 
 import numpy as np
 
@@ -39,7 +39,7 @@ class Struct:
     """A fixed-size IDL struct: (field name, element type, array length) in declaration order."""
 
     name: str
-    fields: tuple[tuple[str, Union[Primitive, "Struct"], int], ...]
+    fields: tuple[tuple[str, Primitive | Struct, int], ...]
 
     @property
     def alignment(self) -> int:

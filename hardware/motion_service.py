@@ -56,7 +56,12 @@ class MotionServiceClient:
 
     def call(self, api_id: int, parameter: str = "") -> tuple[int, str]:
         from g1_control.hardware.unitree_idl import (
-            Request_, RequestHeader_, RequestIdentity_, RequestLease_, RequestPolicy_)
+            Request_,
+            RequestHeader_,
+            RequestIdentity_,
+            RequestLease_,
+            RequestPolicy_,
+        )
 
         request_id = next(_ids)
         header = RequestHeader_(RequestIdentity_(request_id, api_id), RequestLease_(0), RequestPolicy_(0, False))

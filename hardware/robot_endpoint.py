@@ -161,8 +161,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     from g1_control.hardware.dds_link import DdsLink
-    from g1_control.hardware.motion_service import MotionServiceEmulator
     from g1_control.hardware.mock_robot import MockG1
+    from g1_control.hardware.motion_service import MotionServiceEmulator
 
     link = DdsLink("robot", args.interface, args.domain, partition=args.partition)
     service = MotionServiceEmulator(link._participant, args.partition, active_mode=args.motion_service)

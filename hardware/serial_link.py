@@ -57,7 +57,7 @@ def _has_fd(port) -> bool:
     try:
         port.fileno()
         return True
-    except Exception:  # loop:// and socket:// ports have no usable descriptor
+    except (AttributeError, OSError, ValueError, NotImplementedError):  # loop://, socket:// have none
         return False
 
 

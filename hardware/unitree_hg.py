@@ -12,6 +12,7 @@ The CRC is the last 32-bit word of the C image, computed over every word before 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
+from typing import ClassVar
 
 import numpy as np
 
@@ -105,7 +106,7 @@ class LowCmd:
     reserve: np.ndarray = field(default_factory=lambda: np.zeros(4, dtype=np.uint32))
     crc: int = 0
 
-    _PATHS = {
+    _PATHS: ClassVar[dict[str, str]] = {
         "mode_pr": "mode_pr", "mode_machine": "mode_machine",
         "motor_mode": "motor_cmd.mode", "motor_q_rad": "motor_cmd.q", "motor_dq_radps": "motor_cmd.dq",
         "motor_tau_nm": "motor_cmd.tau", "motor_kp_nm_per_rad": "motor_cmd.kp",
@@ -168,7 +169,7 @@ class LowState:
     reserve: np.ndarray = field(default_factory=lambda: np.zeros(4, dtype=np.uint32))
     crc: int = 0
 
-    _PATHS = {
+    _PATHS: ClassVar[dict[str, str]] = {
         "version": "version", "mode_pr": "mode_pr", "mode_machine": "mode_machine", "tick": "tick",
         "imu_quat_wxyz": "imu_state.quaternion", "imu_gyro_radps": "imu_state.gyroscope",
         "imu_acc_mps2": "imu_state.accelerometer", "imu_rpy_rad": "imu_state.rpy",

@@ -8,7 +8,6 @@ import time
 import uuid
 
 import can
-import numpy as np
 import pytest
 import serial
 

@@ -17,7 +17,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from g1_control.errors import MotionServiceError, NetworkInterfaceError, RobotNotConnectedError, VariantMismatchError
+from g1_control.errors import (
+    MotionServiceError,
+    NetworkInterfaceError,
+    RobotNotConnectedError,
+    VariantMismatchError,
+)
 from g1_control.hardware.dds_backend import UnitreeDDSBackend
 from g1_control.hardware.dds_link import DdsLink, cyclone_config
 from g1_control.hardware.mock_robot import MockG1
@@ -64,7 +69,7 @@ def test_two_processes_exchange_lowcmd_and_lowstate():
         time.sleep(1.0)
         stats = backend.stats()
         backend.close()
-        out, err = robot.communicate(timeout=15)
+        out, _ = robot.communicate(timeout=15)
     finally:
         if robot.poll() is None:
             robot.kill()

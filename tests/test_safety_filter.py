@@ -13,7 +13,7 @@ from g1_control.types import Command, MotorCommand, RobotState
 
 def _state(t_s=0.0, tick=None, **kw) -> RobotState:
     # By default every state is a new sample (its tick follows its time, 2 ms per robot tick).
-    tick = int(round(t_s * 500)) if tick is None else tick
+    tick = round(t_s * 500) if tick is None else tick
     return RobotState(t_s=t_s, q_rad=g1.DEFAULT_Q_RAD.copy(), motor_temperature_c=np.full(29, 40.0), tick=tick, **kw)
 
 

@@ -187,3 +187,27 @@ def test_short_and_foreign_samples_are_refused_by_name():
 def test_crc_input_must_be_whole_words():
     with pytest.raises(ValueError, match="whole 32-bit words; got 3 bytes"):
         crc32_words(b"abc")
+
+
+def test_our_dds_type_declarations_serialise_like_unitrees():
+    from g1_control.hardware import unitree_idl as ours
+    from tests.unitree_reference import api
+
+    msg = random_lowcmd(RNG)
+    wire = msg.to_dds()
+    assert ours.LowCmd_.deserialize(wire).serialize() == wire
+    state_wire = random_lowstate(RNG).to_dds()
+    assert ours.LowState_.deserialize(state_wire).serialize() == state_wire
+
+    def request(mod):
+        header = mod.RequestHeader_(mod.RequestIdentity_(123456789012, 1003), mod.RequestLease_(7),
+                                    mod.RequestPolicy_(2, False))
+        return mod.Request_(header, '{"name":"ai"}', [1, 2, 3])
+
+    def response(mod):
+        header = mod.ResponseHeader_(mod.RequestIdentity_(123456789012, 1001), mod.ResponseStatus_(3203))
+        return mod.Response_(header, '{"form":"0","name":""}', [])
+
+    assert request(ours).serialize() == request(api).serialize()
+    assert response(ours).serialize() == response(api).serialize()
+    assert ours.Request_.__idl_typename__ == api.Request_.__idl_typename__ == "unitree_api.msg.dds_.Request_"

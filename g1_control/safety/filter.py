@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import logging
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Callable
 
 import numpy as np
 
@@ -54,7 +54,7 @@ class ClampCounts:
 
 def tilt_rad(quat_wxyz: np.ndarray) -> float:
     """Angle between the body z axis and world up."""
-    w, x, y, z = np.asarray(quat_wxyz, dtype=float) / np.linalg.norm(quat_wxyz)
+    _, x, y, _ = np.asarray(quat_wxyz, dtype=float) / np.linalg.norm(quat_wxyz)
     return float(np.arccos(np.clip(1.0 - 2.0 * (x * x + y * y), -1.0, 1.0)))
 
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import signal
 import time
-from typing import Callable
+from collections.abc import Callable
 
 from g1_control.interfaces import Backend
 from g1_control.safety.config import SafetyConfig
