@@ -211,3 +211,25 @@ def test_motion_service_release_in_process():
         endpoint.stop()
         service.close()
         robot_link.close()
+
+
+def test_short_samples_are_counted_as_malformed_and_ignored(robot_in_process):
+    partition, endpoint = robot_in_process
+    backend = UnitreeDDSBackend(INTERFACE, DOMAIN, partition=partition, release_motion_service=False,
+                                connect_timeout_s=4.0)
+    try:
+        backend.reset()
+        endpoint.publish = False  # only the truncated samples below reach the host now
+        time.sleep(0.05)
+        tick = backend.read_state().tick
+        from g1_control.hardware.unitree_hg import LowState
+
+        short = LowState(mode_machine=5, tick=tick + 100).to_dds()[:600]
+        for _ in range(10):
+            endpoint.link.send(short)
+            time.sleep(0.005)
+        time.sleep(0.2)
+        assert backend.stats().malformed >= 5
+        assert backend.read_state().tick == tick
+    finally:
+        backend.close()
