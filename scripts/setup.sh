@@ -35,6 +35,20 @@ fi
 say "pip: g1-control$extras (editable)"
 $PY -m pip install -q --disable-pip-version-check -e ".$extras"
 
+# The real robot's DDS stack: Cyclone DDS 0.10.2 from Debian + the matching Python binding built
+# from source (see the script for why). Needs root with apt; without it the robot transports are
+# unavailable and the simulator still works.
+if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
+  say "dds: cyclonedds 0.10.2 (Debian library + Python binding)"
+  PYTHON=$PY bash scripts/install_cyclonedds.sh
+else
+  say "not root or no apt: skipping cyclonedds (needed for the real robot and g1 sim-robot)"
+fi
+if [ -n "$extras" ]; then
+  say "test reference: Unitree's official message definitions (unitree_sdk2, --no-deps)"
+  PYTHON=$PY bash scripts/install_unitree_reference.sh
+fi
+
 say "policies: fetching the pretrained G1 policies (holosoma-inference wheel, verified)"
 $PY -m g1_control.cli.main policies fetch >/dev/null
 say "ready: try 'g1 launch launch/sim_walk.yaml'"
