@@ -33,15 +33,28 @@ def make_loop(device, generator=None, **kw):
     return loop
 
 
-def test_nan_command_is_dropped_and_reported():
+def test_nan_command_is_dropped_then_stops_then_damps():
     good = Command(vx_mps=0.3)
-    device = SequenceInput([Command()] * 50 + [good] * 50 + [Command(vx_mps=float("nan"))] * 50)
+    device = SequenceInput([Command()] * 50 + [good] * 50 + [Command(vx_mps=float("nan"))] * 500)
     loop = make_loop(device)
-    loop.run(2.0)
-    assert loop.invalid_commands > 0
-    assert loop.command.vx_mps == 0.3  # the last good command stays in force
+    loop.run(1.1)  # NaN since 1.0 s: the last good command stays in force for a moment
+    assert loop.invalid_commands > 0 and loop.command.vx_mps == 0.3
     assert loop.events[0].kind == "invalid_command" and "vx_mps is nan" in loop.events[0].detail
-    assert not loop.fell and np.all(np.isfinite(loop.log.arrays()["q_target_rad"]))
+    loop.run(0.4)  # late input: velocity zeroed, robot still controlled
+    assert loop.command.vx_mps == 0.0 and not loop.faulted
+    assert np.all(np.isfinite(loop.log.arrays()["q_target_rad"]))
+    loop.run(0.7)  # over a second without valid input: damping for good
+    assert loop.faulted and loop.safety.trip_event.kind.value == "input_lost"
+    assert np.all(loop.motor_command.kp == 0) and np.all(loop.motor_command.kd > 0)
+
+
+def test_estop_button_damps_at_once():
+    device = SequenceInput([Command(vx_mps=0.2)] * 20 + [Command(buttons=frozenset({"estop"}))])
+    loop = make_loop(device)
+    loop.run(0.3)
+    assert loop.faulted and loop.safety.trip_event.kind.value == "estop"
+    assert abs(loop.safety.trip_event.t_s - 0.2) < 0.011
+    assert np.all(loop.motor_command.kp == 0)
 
 
 class WavingArms(Generator):

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import time
+
 import numpy as np
 
 from g1_control.errors import InvalidCommandError, InvalidStateError
@@ -12,6 +14,7 @@ from g1_control.estimation.estimator import StateEstimator, quat_to_rot, yaw_of
 from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, Tracker
 from g1_control.loop.scheduler import Scheduler, Stage
 from g1_control.robot import g1
+from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter
 from g1_control.types import Command, MotorCommand, RobotState
 
 
@@ -71,20 +74,27 @@ def tilt_of(quat_wxyz: np.ndarray) -> float:
 
 
 class ControlLoop:
+    """One tick: input -> estimator -> generator -> retargeter -> tracker -> safety -> low-level.
+
+    Every motor command passes the SafetyFilter (clamps to limits; damping for good on a fall,
+    stale or non-finite state, NaN output, e-stop, lost operator input, ...), in simulation as on
+    the robot. Time for the safety checks is the loop's own clock: simulated time in lockstep,
+    the monotonic clock otherwise (the robot's states are stamped with it on arrival).
+    """
+
     def __init__(self, backend: Backend, input_device: InputDevice, generator: Generator, retargeter: Retargeter,
                  tracker: Tracker, rates: LoopRates | None = None, *, estimator: StateEstimator | None = None,
-                 wallclock: bool = False, max_tilt_rad: float = 1.0, log_capacity: int = 0):
+                 wallclock: bool = False, max_tilt_rad: float = 1.0, log_capacity: int = 0,
+                 safety: SafetyFilter | None = None):
         self.backend, self.input, self.generator = backend, input_device, generator
         self.retargeter, self.tracker = retargeter, tracker
         self.rates = rates or LoopRates()
         self.estimator = estimator or StateEstimator()
-        self.max_tilt_rad = max_tilt_rad
+        self.safety = safety or SafetyFilter(SafetyConfig(max_tilt_rad=max_tilt_rad))
         self.command = Command()
         self.state = RobotState()
-        self.motor_command = MotorCommand.damping(g1.KD_DEFAULT)
-        self.damping = MotorCommand.damping(g1.KD_DEFAULT)
-        self.fell = False
-        self.faulted = False
+        self.motor_command = self.safety.damping()
+        self._tracker_command = self.motor_command
         self.invalid_commands = 0
         self.events: list[LoopEvent] = []
         self.log = RunLog(max(1, log_capacity))
@@ -95,7 +105,7 @@ class ControlLoop:
             Stage("generator", r.tracker_hz, self._generate),
             Stage("retargeter", r.tracker_hz, self._retarget),
             Stage("tracker", r.tracker_hz, self._track),
-            Stage("guard", r.tracker_hz, self._guard),
+            Stage("safety", r.tracker_hz, self._safety),
             Stage("lowlevel", r.lowlevel_hz, self._lowlevel),
             Stage("log", r.tracker_hz, self._log),
         ]
@@ -103,6 +113,8 @@ class ControlLoop:
         self._kin_ref = None
         self._joint_ref = None
         self._state_tick = -1
+        self._misses_seen = 0
+        self.safety.on_event = self._on_safety_event
 
     # -- lifecycle ---------------------------------------------------------------------------------
     def reset(self) -> RobotState:
@@ -123,19 +135,41 @@ class ControlLoop:
     def _event(self, kind: str, detail: str) -> None:
         self.events.append(LoopEvent(self.time_s, kind, detail))
 
+    def now_s(self) -> float:
+        return self.time_s if self.backend.lockstep else time.monotonic()
+
+    @property
+    def faulted(self) -> bool:
+        return self.safety.tripped
+
+    @property
+    def fell(self) -> bool:
+        trip = self.safety.trip_event
+        return trip is not None and trip.kind == SafetyEventKind.TILT
+
+    def _on_safety_event(self, event) -> None:
+        self._event(event.kind.value, event.detail + ("; damping" if event.trips else ""))
+
     # -- stages --------------------------------------------------------------------------------------
     def _input(self) -> None:
         command = self.input.poll()
+        now = self.now_s()
+        if getattr(self.input, "lost", False):
+            # A lost device is no input at all: the safety layer stops the robot, then damps it.
+            self.command = self.safety.vet_input(None, now)
+            return
         try:
-            self.command = command.validate()
+            command.validate()
         except InvalidCommandError as exc:
             # Keep the last good command; the bad one never reaches the tracker.
             self.invalid_commands += 1
             if self.invalid_commands == 1 or self.invalid_commands % 100 == 0:
                 self._event("invalid_command", str(exc))
+            self.command = self.safety.vet_input(None, now)
             return
-        if "estop" in command.buttons or "damp" in command.buttons:
-            self._fault(f"operator {'e-stop' if 'estop' in command.buttons else 'damp'}")
+        if "damp" in command.buttons:
+            self.safety.estop("damp pressed on the operator input", now)
+        self.command = self.safety.vet_input(command, now)
 
     def _read_state(self) -> RobotState | None:
         """The robot's state for this tick (read once per tick, shared by the stages)."""
@@ -170,23 +204,17 @@ class ControlLoop:
         state = self._read_state()
         if state is None:
             return
-        command = self.tracker.act(self._joint_ref, state)
-        if not command.is_finite():
-            self._fault("tracker produced a non-finite motor command")
-            return
-        self.motor_command = command
+        self._tracker_command = self.tracker.act(self._joint_ref, state)
 
-    def _guard(self) -> None:
-        tilt = tilt_of(self.state.imu_quat_wxyz)
-        if not self.fell and tilt > self.max_tilt_rad:
-            self.fell = True
-            self._fault(f"fall detected: pelvis tilt {tilt:.2f} rad > {self.max_tilt_rad} rad")
+    def _safety(self) -> None:
+        if self.scheduler.wallclock:
+            self.safety.report_deadline(self.scheduler.deadline_misses > self._misses_seen, self.now_s())
+            self._misses_seen = self.scheduler.deadline_misses
+        self.motor_command = self.safety.filter(self._tracker_command, self.state, self.now_s())
 
     def _fault(self, detail: str) -> None:
-        if not self.faulted:
-            self._event("fault", detail + "; damping")
-        self.faulted = True
-        self.motor_command = self.damping
+        self.safety.estop(detail, self.now_s())
+        self.motor_command = self.safety.damping()
 
     def _lowlevel(self) -> None:
         self.backend.write_command(self.motor_command)
