@@ -1,0 +1,61 @@
+"""Hold a foot (or any frame) where it touched down: an equality on the step that cancels the
+frame's drift from its anchor pose, so a stance foot neither slides nor twists.
+
+The anchor is set when contact begins (`set_anchor`); `release()` ends the contact.
+With `position_only` the frame may roll about the anchor point (a point contact, e.g. a toe).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from g1_control.ik.configuration import Configuration
+from g1_control.ik.limits.base import Limit, RowConstraint
+
+
+class ContactLimit(Limit):
+    def __init__(self, frame: str, position_only: bool = False) -> None:
+        self.frame = frame
+        self.position_only = position_only
+        self.anchor: pin.SE3 | None = None
+        self._fid: int | None = None
+
+    @property
+    def active(self) -> bool:
+        return self.anchor is not None
+
+    def set_anchor(self, pose_w: pin.SE3) -> None:
+        self.anchor = pin.SE3(pose_w)
+
+    def release(self) -> None:
+        self.anchor = None
+
+    def error(self, configuration: Configuration) -> np.ndarray:
+        """Drift of the frame from the anchor: position (m, world) and rotation (rad, frame axes)."""
+        assert self.anchor is not None
+        current = configuration.frame_placement(self._frame_id(configuration))
+        pos = current.translation - self.anchor.translation
+        if self.position_only:
+            return pos
+        return np.concatenate([pos, pin.log3(self.anchor.rotation.T @ current.rotation)])
+
+    def _frame_id(self, configuration: Configuration) -> int:
+        if self._fid is None:
+            self._fid = configuration.frame_id(self.frame)
+        return self._fid
+
+    def compute(self, configuration: Configuration, dt_s: float) -> RowConstraint | None:
+        if self.anchor is None:
+            return None
+        fid = self._frame_id(configuration)
+        current = configuration.frame_placement(fid)
+        jac = configuration.frame_jacobian(fid)
+        err = self.error(configuration)
+        if self.position_only:
+            matrix = jac[:3].copy()
+        else:
+            matrix = np.empty((6, configuration.nv))
+            matrix[:3] = jac[:3]
+            matrix[3:] = pin.Jlog3(self.anchor.rotation.T @ current.rotation) @ (current.rotation.T @ jac[3:])
+        return RowConstraint(matrix, -err, -err.copy(), equality=True)
