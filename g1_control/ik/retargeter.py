@@ -43,7 +43,8 @@ class IKConfig:
     """Costs of a frame target not listed in frame_costs."""
     com_cost: tuple[float, float, float] = (2.0, 2.0, 0.0)
     """Per world axis: CoM follows the CoM of the reference posture (x, y only by default)."""
-    posture_cost: float = 0.3
+    posture_cost: float | tuple[float, ...] = 0.3
+    """Scalar, or one cost per joint (29) in g1.JOINT_NAMES order."""
     damping_cost: float = 1e-3
     smoothness_cost: float = 0.05
     lm_damping: float = 0.0
@@ -90,7 +91,7 @@ class IKRetargeter(Retargeter):
         self.solver = QPSolver(nv, cfg.backend)
         self.root_task = FrameTask(g1.BASE_BODY, cfg.root_cost[0], cfg.root_cost[1], lm_damping=cfg.lm_damping)
         self.com_task = ComTask(np.asarray(cfg.com_cost))
-        self.posture_task = PostureTask(cfg.posture_cost)
+        self.posture_task = PostureTask(np.asarray(cfg.posture_cost, dtype=float))
         self.damping_task = DampingTask(cfg.damping_cost, nv)
         self.smoothness_task = SmoothnessTask(cfg.smoothness_cost, nv)
         self.frame_tasks: dict[str, FrameTask] = {}

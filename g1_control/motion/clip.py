@@ -66,11 +66,12 @@ class MotionClip:
         from g1_control.motion.kinematics import default_body_names, forward_kinematics
 
         root_pos = np.asarray(root_pos_w_m, dtype=float)
-        root_quat = quat.normalize(np.asarray(root_quat_wxyz, dtype=float))
+        # Stored as given (a file's values round-trip exactly); FK uses the normalised rotation.
+        root_quat = np.asarray(root_quat_wxyz, dtype=float)
         joints = np.asarray(joint_pos_rad, dtype=float)
         _check_frames("joint_pos_rad", joints, source)
         names = body_names or default_body_names()
-        body_pos, body_quat = forward_kinematics(root_pos, root_quat, joints, names)
+        body_pos, body_quat = forward_kinematics(root_pos, quat.normalize(root_quat), joints, names)
         if contacts is None:
             feet = [names.index(b) for b in g1.FOOT_BODIES]
             contacts = foot_contacts(body_pos[:, feet], fps)
