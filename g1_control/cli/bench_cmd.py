@@ -9,6 +9,7 @@ import importlib
 # name -> "module:function"; the function takes the parsed args and returns an exit code.
 BENCHMARKS = {
     "loop": ("g1_control.loop.bench:main", "full loop in lockstep: real-time factor, per-stage p50/p99"),
+    "ik": ("g1_control.ik.bench:main", "IK retargeter: online solve p50/p99, offline frames/s per core"),
 }
 
 

@@ -16,6 +16,7 @@ from g1_control.errors import G1ControlError
 
 SUBCOMMAND_MODULES = (
     "g1_control.cli.bench_cmd",
+    "g1_control.cli.retarget_cmd",
 )
 
 

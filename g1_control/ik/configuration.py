@@ -115,10 +115,11 @@ class Configuration:
             raise InvalidConfigurationError(f"base quaternion has norm {norm:.4f}; expected 1")
         return q
 
-    def update(self, q: np.ndarray | None = None) -> None:
-        """Recompute placements, joint Jacobians and the centre of mass (+ Jacobian) at q."""
+    def update(self, q: np.ndarray | None = None, check: bool = True) -> None:
+        """Recompute placements, joint Jacobians and the centre of mass (+ Jacobian) at q.
+        check=False skips validation, for configurations this module produced itself."""
         if q is not None:
-            self.q[:] = self.check_q(q)
+            self.q[:] = self.check_q(q) if check else q
             self.q[3:7] /= np.linalg.norm(self.q[3:7])
         pin.computeJointJacobians(self.model, self.data, self.q)
         pin.updateFramePlacements(self.model, self.data)
@@ -139,7 +140,7 @@ class Configuration:
         return pin.integrate(self.model, self.q, dq)
 
     def integrate_inplace(self, dq: np.ndarray) -> None:
-        self.update(pin.integrate(self.model, self.q, dq))
+        self.update(pin.integrate(self.model, self.q, dq), check=False)
 
     @property
     def joint_q_rad(self) -> np.ndarray:

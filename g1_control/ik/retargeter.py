@@ -134,13 +134,16 @@ class IKRetargeter(Retargeter):
 
     @staticmethod
     def _check_reference(ref: KinematicReference) -> None:
-        for name in ("root_pos_w_m", "root_quat_wxyz", "q_rad"):
-            arr = np.asarray(getattr(ref, name))
-            expected = {"root_pos_w_m": (3,), "root_quat_wxyz": (4,), "q_rad": (g1.NUM_JOINTS,)}[name]
-            if arr.shape != expected:
-                raise InvalidReferenceError(f"KinematicReference.{name} has shape {arr.shape}; expected {expected}")
-            if not np.all(np.isfinite(arr)):
-                raise InvalidReferenceError(f"KinematicReference.{name} contains NaN or inf (t = {ref.t_s} s)")
+        arrays = (ref.root_pos_w_m, ref.root_quat_wxyz, ref.q_rad)
+        shapes = tuple(np.shape(a) for a in arrays)
+        if shapes != ((3,), (4,), (g1.NUM_JOINTS,)) or not np.isfinite(np.concatenate(arrays)).all():
+            # Slow path only on failure: find the field to name.
+            for name, expected in (("root_pos_w_m", (3,)), ("root_quat_wxyz", (4,)), ("q_rad", (g1.NUM_JOINTS,))):
+                arr = np.asarray(getattr(ref, name))
+                if arr.shape != expected:
+                    raise InvalidReferenceError(f"KinematicReference.{name} has shape {arr.shape}; expected {expected}")
+                if not np.all(np.isfinite(arr)):
+                    raise InvalidReferenceError(f"KinematicReference.{name} contains NaN or inf (t = {ref.t_s} s)")
         if np.asarray(ref.contacts).shape != (2,):
             raise InvalidReferenceError(f"KinematicReference.contacts has shape {np.asarray(ref.contacts).shape}; "
                                         "expected (2,) = (left, right)")
@@ -190,7 +193,7 @@ class IKRetargeter(Retargeter):
     def _set_targets(self, ref: KinematicReference) -> list[Task]:
         cfg = self.config
         tasks: list[Task] = [self.posture_task, self.damping_task, self.smoothness_task]
-        self.posture_task.set_target(ref.q_rad)
+        self.posture_task.set_target(np.asarray(ref.q_rad, dtype=float), check=False)
         if any(cfg.root_cost) and g1.BASE_BODY not in ref.frame_targets_w:
             self.root_task.set_target(pose_from_vector(np.concatenate([ref.root_pos_w_m, ref.root_quat_wxyz]),
                                                        "KinematicReference root pose"))
@@ -202,7 +205,7 @@ class IKRetargeter(Retargeter):
         if any(cfg.com_cost):
             q_ref = description.pinocchio_q(ref.root_pos_w_m, ref.root_quat_wxyz / np.linalg.norm(ref.root_quat_wxyz),
                                             ref.q_rad)
-            self.com_task.set_target(pin.centerOfMass(self._ref_model, self._ref_data, q_ref, False))
+            self.com_task.set_target(pin.centerOfMass(self._ref_model, self._ref_data, q_ref, False), check=False)
             tasks.append(self.com_task)
         return tasks
 
@@ -233,7 +236,7 @@ class IKRetargeter(Retargeter):
         self.base_velocity_limit.set_anchor(q_start)
         self._update_contacts(ref)
         tasks = self._set_targets(ref)
-        self.smoothness_task.set_previous_step(self._last_step / cfg.iterations)
+        self.smoothness_task.set_previous_step(self._last_step / cfg.iterations, check=False)
         self.last_solve_soft_contacts = False
         for _ in range(cfg.iterations):
             try:

@@ -74,7 +74,7 @@ class Task(abc.ABC):
         linear += self.gain * (jw @ error)
         if self.lm_damping > 0.0:
             mu = self.lm_damping * float(w2 @ (error * error))
-            hessian[np.diag_indices_from(hessian)] += mu
+            hessian.flat[:: hessian.shape[0] + 1] += mu
 
     def compute_qp_objective(self, configuration: Configuration) -> tuple[np.ndarray, np.ndarray]:
         """(H, c) of this task alone."""

@@ -26,4 +26,4 @@ class DampingTask(Task):
         return self._jac
 
     def add_objective(self, configuration: Configuration, hessian: np.ndarray, linear: np.ndarray) -> None:
-        hessian[np.diag_indices_from(hessian)] += self.cost**2
+        hessian.flat[:: hessian.shape[0] + 1] += self._w2

@@ -22,7 +22,11 @@ class PostureTask(Task):
         self._error = np.zeros(g1.NUM_JOINTS)
         self._jac: np.ndarray | None = None
 
-    def set_target(self, q_rad: np.ndarray) -> None:
+    def set_target(self, q_rad: np.ndarray, check: bool = True) -> None:
+        """check=False skips validation (for callers that validated the whole reference already)."""
+        if not check:
+            self.target_q_rad = q_rad
+            return
         target = np.asarray(q_rad, dtype=float)
         if target.shape != (g1.NUM_JOINTS,) or not np.all(np.isfinite(target)):
             raise TaskDefinitionError(
@@ -46,8 +50,7 @@ class PostureTask(Task):
         error = self.compute_error(configuration)
         w2 = self.cost**2
         k = configuration.nv - g1.NUM_JOINTS
-        idx = np.arange(k, configuration.nv)
-        hessian[idx, idx] += w2
+        hessian.flat[k * (configuration.nv + 1):: configuration.nv + 1] += w2
         linear[k:] += self.gain * w2 * error
         if self.lm_damping > 0.0:
-            hessian[np.diag_indices_from(hessian)] += self.lm_damping * float(w2 @ (error * error))
+            hessian.flat[:: hessian.shape[0] + 1] += self.lm_damping * float(w2 @ (error * error))
