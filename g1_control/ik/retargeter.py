@@ -212,6 +212,11 @@ class IKRetargeter(Retargeter):
     def _limits(self, with_contacts: bool) -> list[Limit]:
         limits: list[Limit] = [self.joint_position_limit, self.joint_velocity_limit, self.base_velocity_limit]
         if self.ground_limit is not None:
+            # A held foot's anchor is on or above the ground (see _touchdown_anchor), so the hold
+            # keeps it there; its ground rows would be redundant and degenerate.
+            self.ground_limit.skip_links = frozenset(
+                c.frame for c in self.contacts if with_contacts and c.active and c.frame in g1.FOOT_BODIES
+                and c.anchor.translation[2] - self._sole_depth[c.frame] >= self.config.ground_height_m - 1e-9)
             limits.append(self.ground_limit)
         if with_contacts:
             limits += [c for c in self.contacts if c.active]

@@ -1,0 +1,35 @@
+import numpy as np
+import pinocchio as pin
+
+from g1_control.ik.limits import ContactLimit
+from test_ik_frame_task import random_configuration
+
+
+class _ErrorOf:
+    def __init__(self, limit):
+        self.limit = limit
+
+    def compute_error(self, conf):
+        return self.limit.error(conf)
+
+
+def test_contact_rows_are_the_jacobian_of_the_drift():
+    from test_ik_frame_task import fd_jacobian
+
+    conf = random_configuration(10)
+    limit = ContactLimit("left_ankle_roll_link")
+    limit.set_anchor(pin.SE3(pin.utils.rpyToMatrix(0.1, 0.0, 0.3), np.array([0.1, 0.1, 0.05])))
+    rows = limit.compute(conf, 0.02)
+    assert rows.equality
+    np.testing.assert_allclose(rows.matrix, fd_jacobian(_ErrorOf(limit), conf), atol=2e-6)
+    np.testing.assert_allclose(rows.lower, -limit.error(conf))
+
+
+def test_released_contact_adds_nothing():
+    conf = random_configuration(11)
+    limit = ContactLimit("left_ankle_roll_link", position_only=True)
+    assert limit.compute(conf, 0.02) is None
+    limit.set_anchor(pin.SE3.Identity())
+    assert limit.compute(conf, 0.02).matrix.shape == (3, conf.nv)
+    limit.release()
+    assert not limit.active and limit.compute(conf, 0.02) is None
