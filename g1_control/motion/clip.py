@@ -69,6 +69,11 @@ class MotionClip:
         # Stored as given (a file's values round-trip exactly); FK uses the normalised rotation.
         root_quat = np.asarray(root_quat_wxyz, dtype=float)
         joints = np.asarray(joint_pos_rad, dtype=float)
+        if joints.ndim != 2 or joints.shape[0] == 0:
+            where = f" '{source}'" if source else ""
+            raise InvalidClipError(f"clip{where} has zero frames; a clip needs at least one"
+                                   if joints.ndim == 2 else f"clip{where}: joint_pos_rad has shape {joints.shape}; "
+                                   "expected (T, 29)")
         _check_frames("joint_pos_rad", joints, source)
         names = body_names or default_body_names()
         body_pos, body_quat = forward_kinematics(root_pos, quat.normalize(root_quat), joints, names)
@@ -164,7 +169,7 @@ def differentiate(x: np.ndarray, fps: float) -> np.ndarray:
 
 
 def _check_frames(name: str, arr: np.ndarray, source: str) -> None:
-    finite = np.isfinite(arr.reshape(arr.shape[0], -1)).all(axis=1) if arr.ndim > 1 else np.isfinite(arr)
+    finite = np.isfinite(arr).reshape(arr.shape[0], -1).all(axis=1) if arr.ndim > 1 else np.isfinite(arr)
     if not finite.all():
         frame = int(np.flatnonzero(~finite)[0])
         where = f" in '{source}'" if source else ""

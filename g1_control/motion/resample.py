@@ -14,7 +14,9 @@ from g1_control.motion.exceptions import InvalidClipError
 def resample_times(num_frames: int, fps: float, new_fps: float) -> np.ndarray:
     """Sample times (s) at new_fps covering [0, duration] of a clip of num_frames at fps."""
     duration = (num_frames - 1) / fps
-    count = int(np.floor(duration * new_fps + 1e-9)) + 1
+    # Frame times in files are rounded (BVH "0.0333333"): a last sample within 1e-4 of a frame
+    # period of the end still counts, else 30 -> 30 fps would drop the last frame.
+    count = int(np.floor(duration * new_fps + 1e-4)) + 1
     return np.arange(count) / new_fps
 
 
