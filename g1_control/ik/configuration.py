@@ -83,8 +83,9 @@ class Configuration:
         self.data = self.model.createData()
         self.nq, self.nv = self.model.nq, self.model.nv
         self._frame_ids: dict[str, int] = {}
-        self.com_w_m = np.zeros(3)
-        self.com_jacobian = np.zeros((3, self.nv))
+        self._com_w_m = np.zeros(3)
+        self._com_jacobian = np.zeros((3, self.nv))
+        self._com_valid = False
         if q is None:
             q = description.pinocchio_q(np.array([0.0, 0.0, g1.DEFAULT_PELVIS_HEIGHT_M]),
                                         np.array([1.0, 0.0, 0.0, 0.0]), g1.DEFAULT_Q_RAD)
@@ -123,9 +124,27 @@ class Configuration:
             self.q[3:7] /= np.linalg.norm(self.q[3:7])
         pin.computeJointJacobians(self.model, self.data, self.q)
         pin.updateFramePlacements(self.model, self.data)
+        self._com_valid = False  # computed on first use: many IK setups have no CoM task
+
+    def _update_com(self) -> None:
         # jacobianCenterOfMass also fills data.com[0]; no second forward pass needed.
-        self.com_jacobian[:] = pin.jacobianCenterOfMass(self.model, self.data, self.q, False)
-        self.com_w_m[:] = self.data.com[0]
+        self._com_jacobian[:] = pin.jacobianCenterOfMass(self.model, self.data, self.q, False)
+        self._com_w_m[:] = self.data.com[0]
+        self._com_valid = True
+
+    @property
+    def com_w_m(self) -> np.ndarray:
+        """Whole-body centre of mass in the world (m)."""
+        if not self._com_valid:
+            self._update_com()
+        return self._com_w_m
+
+    @property
+    def com_jacobian(self) -> np.ndarray:
+        """(3, nv) Jacobian of the centre of mass."""
+        if not self._com_valid:
+            self._update_com()
+        return self._com_jacobian
 
     def frame_placement(self, frame_id: int) -> pin.SE3:
         return self.data.oMf[frame_id]

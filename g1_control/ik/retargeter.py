@@ -147,11 +147,19 @@ class IKRetargeter(Retargeter):
         if np.asarray(ref.contacts).shape != (2,):
             raise InvalidReferenceError(f"KinematicReference.contacts has shape {np.asarray(ref.contacts).shape}; "
                                         "expected (2,) = (left, right)")
-        for frame, pose in ref.frame_targets_w.items():
-            pose = np.asarray(pose, dtype=float)
-            if pose.shape != (7,) or not np.all(np.isfinite(pose)):
-                raise InvalidReferenceError(f"frame target '{frame}' must be 7 finite numbers (x y z qw qx qy qz); "
-                                            f"got shape {pose.shape} at t = {ref.t_s} s")
+        if ref.frame_targets_w:
+            try:
+                poses = np.array(list(ref.frame_targets_w.values()), dtype=float)
+                fine = poses.shape[1:] == (7,) and np.isfinite(poses).all()
+            except ValueError:  # ragged: one of them has the wrong length
+                fine = False
+            if not fine:
+                for frame, pose in ref.frame_targets_w.items():
+                    pose = np.asarray(pose, dtype=float)
+                    if pose.shape != (7,) or not np.all(np.isfinite(pose)):
+                        raise InvalidReferenceError(
+                            f"frame target '{frame}' must be 7 finite numbers (x y z qw qx qy qz); "
+                            f"got shape {pose.shape} at t = {ref.t_s} s")
 
     def _start_configuration(self, ref: KinematicReference, q_prev: np.ndarray) -> np.ndarray:
         q_prev = np.asarray(q_prev, dtype=float)
@@ -200,7 +208,10 @@ class IKRetargeter(Retargeter):
             tasks.append(self.root_task)
         for name, pose in ref.frame_targets_w.items():
             task = self._frame_task(name)
-            task.set_target(pose_from_vector(pose, f"frame target '{name}'"))
+            if task._track_orientation:
+                task.set_target(pose_from_vector(pose, f"frame target '{name}'"))
+            else:  # position only: no rotation to build (poses were checked in _check_reference)
+                task.set_target_position(pose[:3])
             tasks.append(task)
         if any(cfg.com_cost):
             q_ref = description.pinocchio_q(ref.root_pos_w_m, ref.root_quat_wxyz / np.linalg.norm(ref.root_quat_wxyz),

@@ -17,6 +17,7 @@ from g1_control.ik.configuration import Configuration
 from g1_control.ik.exceptions import IKError, NoSolutionFound
 from g1_control.ik.limits.base import INF, BoxBounds, Limit, RowConstraint
 from g1_control.ik.tasks.base import Task
+from g1_control.ik.tasks.frame_task import FrameTask, stack_frame_tasks
 
 BACKENDS = ("daqp", "proxqp")
 
@@ -48,11 +49,19 @@ class QPSolver:
         self.hessian.fill(0.0)
         self.linear.fill(0.0)
         jacs, errs, weights = [], [], []
+        frame_tasks = [t for t in tasks if type(t) is FrameTask and t.lm_damping == 0.0]
+        if frame_tasks:
+            jac_rows, err, w2 = stack_frame_tasks(configuration, frame_tasks)
+            jacs.append(jac_rows)
+            errs.append(err)
+            weights.append(w2)
         for task in tasks:
+            if type(task) is FrameTask and task.lm_damping == 0.0:
+                continue
             if task.stackable and task.lm_damping == 0.0:
                 # Gathered and multiplied once below: one (m, nv) product instead of one per task.
-                err = task.compute_error(configuration)
-                jacs.append(task.compute_jacobian(configuration))
+                err, jac_rows = task.compute_error_and_jacobian(configuration)
+                jacs.append(jac_rows)
                 errs.append(task.gain * err)
                 w2 = task._w2
                 weights.append(w2 if w2.shape == err.shape else np.broadcast_to(w2, err.shape))

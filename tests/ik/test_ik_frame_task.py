@@ -90,3 +90,21 @@ def test_pose_from_vector_checks_layout():
         pose_from_vector(np.zeros(6))
     with pytest.raises(TaskDefinitionError, match="quaternion is zero"):
         pose_from_vector(np.zeros(7))
+
+
+def test_stacked_frame_tasks_give_the_same_rows_as_each_task():
+    from g1_control.ik.tasks.frame_task import stack_frame_tasks
+
+    conf = random_configuration(13)
+    tasks = [FrameTask("left_rubber_hand", 2.0, 0.5, gain=0.5), FrameTask("right_toe", 3.0, 0.0),
+             FrameTask("torso_link", 0.0, 1.5)]
+    for i, t in enumerate(tasks):
+        t.set_target(pin.SE3(pin.utils.rpyToMatrix(0.1 * i, 0.2, -0.3), np.array([0.1, 0.2 * i, 0.4])))
+    jac, err, w2 = stack_frame_tasks(conf, tasks)
+    rows = [slice(0, 6), slice(6, 9), slice(9, 15)]
+    for task, r in zip(tasks, rows):
+        e, j = task.compute_error_and_jacobian(conf)
+        keep = slice(0, 6) if task._track_orientation else slice(0, 3)
+        np.testing.assert_allclose(jac[r], j[keep], atol=1e-12)
+        np.testing.assert_allclose(err[r], task.gain * e[keep], atol=1e-12)
+        np.testing.assert_allclose(w2[r], task.cost[keep] ** 2)

@@ -41,7 +41,8 @@ class BaseVelocityLimit(Limit):
         reach = np.array([self.max_linear_mps] * 3 + [self.max_angular_radps] * 3) * dt_s
         done = np.zeros(6)
         if self.anchor is not None:
-            done = pin.log6(self.anchor.actInv(_base_placement(configuration.q))).vector
+            # joint 1 is the free flyer: its placement is the base pose, already computed
+            done = pin.log6(self.anchor.actInv(configuration.data.oMi[1])).vector
         self._box.lower[:6] = -reach - done
         self._box.upper[:6] = reach - done
         return self._box

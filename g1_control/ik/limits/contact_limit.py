@@ -50,12 +50,14 @@ class ContactLimit(Limit):
             return None
         fid = self._frame_id(configuration)
         current = configuration.frame_placement(fid)
-        jac = configuration.frame_jacobian(fid)
-        err = self.error(configuration)
+        jac = configuration.frame_jacobian(fid)  # a fresh array: rows are rewritten in place
         if self.position_only:
-            matrix = jac[:3].copy()
-        else:
-            matrix = np.empty((6, configuration.nv))
-            matrix[:3] = jac[:3]
-            matrix[3:] = pin.Jlog3(self.anchor.rotation.T @ current.rotation) @ (current.rotation.T @ jac[3:])
-        return RowConstraint(matrix, -err, -err.copy(), equality=True)
+            err = self.anchor.translation - current.translation  # = -error
+            return RowConstraint(jac[:3], err, err, equality=True)
+        rot = current.rotation
+        rel = self.anchor.rotation.T @ rot
+        neg_err = np.empty(6)
+        neg_err[:3] = self.anchor.translation - current.translation
+        neg_err[3:] = -pin.log3(rel)
+        jac[3:] = pin.Jlog3(rel) @ (rot.T @ jac[3:])
+        return RowConstraint(jac, neg_err, neg_err, equality=True)

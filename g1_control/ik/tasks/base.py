@@ -64,10 +64,13 @@ class Task(abc.ABC):
     def compute_jacobian(self, configuration: Configuration) -> np.ndarray:
         """(len(e), nv) matrix J with e(q + dq) ~ e(q) + J dq."""
 
+    def compute_error_and_jacobian(self, configuration: Configuration) -> tuple[np.ndarray, np.ndarray]:
+        """Both at once; tasks override it when sharing the work is cheaper (the per-tick path)."""
+        return self.compute_error(configuration), self.compute_jacobian(configuration)
+
     def add_objective(self, configuration: Configuration, hessian: np.ndarray, linear: np.ndarray) -> None:
         """Add this task's quadratic cost to (H, c) in place."""
-        error = self.compute_error(configuration)
-        jac = self.compute_jacobian(configuration)
+        error, jac = self.compute_error_and_jacobian(configuration)
         w2 = self._w2 if self._w2.shape == error.shape else np.broadcast_to(self._w2, error.shape)
         jw = jac.T * w2
         hessian += jw @ jac
