@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import gc
 import json
+import os
 import time
 from pathlib import Path
 
@@ -65,21 +66,28 @@ def _time_online(backend: str, refs) -> dict:
     q = np.asarray(g1.DEFAULT_Q_RAD).copy()
     warm = 50
     times = np.empty(len(refs))
+    cpu = np.empty(len(refs))
+    soft = 0
     gc_was = gc.isenabled()
     gc.disable()  # a collection inside one tick would be the interpreter's pause, not the IK's
     try:
         for k, ref in enumerate(refs):
+            c0 = time.thread_time()
             t0 = time.perf_counter()
             out = ik.solve(ref, q)
             times[k] = time.perf_counter() - t0
+            cpu[k] = time.thread_time() - c0
+            soft += ik.last_solve_soft_contacts
             q = out.q_rad
     finally:
         if gc_was:
             gc.enable()
     times = times[warm:] * 1e3
+    cpu = cpu[warm:] * 1e3
     err = max(np.linalg.norm(t.compute_error(ik.configuration)[:3]) for t in ik.frame_tasks.values())
     return {"p50_ms": float(np.percentile(times, 50)), "p99_ms": float(np.percentile(times, 99)),
-            "max_ms": float(times.max()), "ticks": int(times.size), "soft_contact_ticks": 0,
+            "max_ms": float(times.max()), "cpu_p50_ms": float(np.percentile(cpu, 50)),
+            "cpu_p99_ms": float(np.percentile(cpu, 99)), "ticks": int(times.size), "soft_contact_ticks": int(soft),
             "last_max_position_error_m": float(err)}
 
 
@@ -122,13 +130,14 @@ def _time_offline(max_frames: int) -> dict:
 
     root = fetch("holosoma-demo-mocap") / "holosoma_retargeting" / "demo_data"
     files = [root / "OMOMO_new/sub3_largebox_003.pt", next(iter(sorted(root.glob("climb/*_0/*.npy"))))]
-    frames, ik_s, total_s = 0, 0.0, 0.0
+    frames, ik_s, total_s, cpu_s = 0, 0.0, 0.0, 0.0
     for f in files:
         motion = load_motion(f)
         keep = int(max_frames * motion.fps / 30.0)
         motion = HumanMotion(motion.positions_w_m[:keep], motion.joint_names, motion.fps, motion.height_m,
                              motion.source)
         count = [0]
+        c0 = time.process_time()
         t0 = time.perf_counter()
         first: list[float] = []
 
@@ -139,11 +148,19 @@ def _time_offline(max_frames: int) -> dict:
 
         clip = MocapRetargeter().retarget(motion, progress=tick)
         t_end = time.perf_counter()
+        cpu_s += time.process_time() - c0
         total_s += t_end - t0
         ik_s += t_end - first[0]
         frames += clip.num_frames
     return {"frames": frames, "frames_per_s_whole_pipeline": frames / total_s,
-            "frames_per_s_per_frame_loop": frames / ik_s}
+            "frames_per_s_per_frame_loop": frames / ik_s, "frames_per_cpu_s_whole_pipeline": frames / cpu_s}
+
+
+def _load_average() -> str:
+    try:
+        return Path("/proc/loadavg").read_text().split()[0]
+    except OSError:
+        return "?"
 
 
 def main(args) -> int:
@@ -155,10 +172,13 @@ def main(args) -> int:
     parts = _time_parts(refs)
     offline = _time_offline(max_frames=int(min(600, max(150, seconds * 15))))
     floor = parts["pinocchio_jacobians_ms"]
-    print("IK retargeter benchmark (one core)")
+    print(f"IK retargeter benchmark (one core; load average {_load_average()} on {os.cpu_count()} cores: "
+          "wall-clock percentiles include other processes' preemption, CPU-time ones do not)")
     print(f"online, {daqp['ticks']} ticks of 6 frame targets + CoM + posture + limits + both feet held:")
     print(f"  daqp   p50 {daqp['p50_ms']:.3f} ms  p99 {daqp['p99_ms']:.3f} ms  max {daqp['max_ms']:.3f} ms  "
           f"(goal p99 <= 0.5 ms: {'met' if daqp['p99_ms'] <= 0.5 else 'NOT met'})")
+    print(f"         CPU time p50 {daqp['cpu_p50_ms']:.3f} ms  p99 {daqp['cpu_p99_ms']:.3f} ms; "
+          f"ticks with the feet held softly: {daqp['soft_contact_ticks']}")
     print(f"  proxqp p50 {proxqp['p50_ms']:.3f} ms  p99 {proxqp['p99_ms']:.3f} ms  "
           f"(daqp is {proxqp['p50_ms'] / daqp['p50_ms']:.1f}x faster at p50)")
     print(f"  parts (median): pinocchio computeJointJacobians {floor:.3f} ms (baseline); kinematics update "
@@ -167,8 +187,9 @@ def main(args) -> int:
     print(f"  p50 solve = {daqp['p50_ms'] / floor:.0f}x one Jacobian pass")
     print(f"offline retargeting, {offline['frames']} output frames of demo mocap (OMOMO + climbing), one process:")
     print(f"  {offline['frames_per_s_per_frame_loop']:.0f} frames/s in the per-frame IK loop, "
-          f"{offline['frames_per_s_whole_pipeline']:.0f} frames/s whole pipeline (load, warm-up, FK, metrics-free) "
-          f"(goal >= 500: {'met' if offline['frames_per_s_whole_pipeline'] >= 500 else 'NOT met'})")
+          f"{offline['frames_per_s_whole_pipeline']:.0f} frames/s whole pipeline (load, warm-up, FK), "
+          f"{offline['frames_per_cpu_s_whole_pipeline']:.0f} frames per CPU second "
+          f"(goal >= 500 per core: {'met' if offline['frames_per_cpu_s_whole_pipeline'] >= 500 else 'NOT met'})")
     print("  anchors: GMR 35-70 frames/s; Unitree's arm IK ~5 ms per solve")
     if getattr(args, "json", None):
         Path(args.json).write_text(json.dumps({"online_daqp": daqp, "online_proxqp": proxqp, "parts": parts,
