@@ -136,15 +136,13 @@ def _time_offline(max_frames: int) -> dict:
         keep = int(max_frames * motion.fps / 30.0)
         motion = HumanMotion(motion.positions_w_m[:keep], motion.joint_names, motion.fps, motion.height_m,
                              motion.source)
-        count = [0]
         c0 = time.process_time()
         t0 = time.perf_counter()
-        first: list[float] = []
+        first: list[float] = []  # when the per-frame loop starts (after loading and warm-up)
 
-        def tick(n: int) -> None:
+        def tick(_: int, first: list[float] = first) -> None:
             if not first:
                 first.append(time.perf_counter())
-            count[0] += n
 
         clip = MocapRetargeter().retarget(motion, progress=tick)
         t_end = time.perf_counter()

@@ -15,13 +15,27 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from g1_control.interfaces import Retargeter
 from g1_control.ik.configuration import Configuration, foot_contact_points
 from g1_control.ik.exceptions import InvalidReferenceError, NoSolutionFound, TaskDefinitionError
-from g1_control.ik.limits import (BaseVelocityLimit, ContactLimit, GroundLimit, JointPositionLimit,
-                                  JointVelocityLimit, Limit)
+from g1_control.ik.limits import (
+    BaseVelocityLimit,
+    ContactLimit,
+    GroundLimit,
+    JointPositionLimit,
+    JointVelocityLimit,
+    Limit,
+)
 from g1_control.ik.solver import BACKENDS, QPSolver
-from g1_control.ik.tasks import ComTask, DampingTask, FrameTask, PostureTask, SmoothnessTask, Task, pose_from_vector
+from g1_control.ik.tasks import (
+    ComTask,
+    DampingTask,
+    FrameTask,
+    PostureTask,
+    SmoothnessTask,
+    Task,
+    pose_from_vector,
+)
+from g1_control.interfaces import Retargeter
 from g1_control.robot import description, g1
 from g1_control.types import JointReference, KinematicReference
 

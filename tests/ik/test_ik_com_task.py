@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
+from test_ik_frame_task import fd_jacobian, random_configuration
 
 from g1_control.ik.exceptions import TaskDefinitionError
 from g1_control.ik.tasks import ComTask
-from test_ik_frame_task import fd_jacobian, random_configuration
 
 
 def test_com_task_jacobian_matches_finite_differences():

@@ -1,8 +1,8 @@
 import numpy as np
 import pinocchio as pin
+from test_ik_frame_task import random_configuration
 
 from g1_control.ik.limits import ContactLimit
-from test_ik_frame_task import random_configuration
 
 
 class _ErrorOf:

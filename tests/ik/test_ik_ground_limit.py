@@ -1,10 +1,10 @@
 import numpy as np
 import pinocchio as pin
+from test_ik_frame_task import random_configuration
 
 from g1_control.ik.configuration import Configuration, foot_contact_points
 from g1_control.ik.limits import GroundLimit
 from g1_control.robot import g1
-from test_ik_frame_task import random_configuration
 
 
 def test_foot_spheres_come_from_the_urdf():

@@ -4,7 +4,12 @@ import numpy as np
 import pytest
 
 from g1_control.ik.exceptions import IKError
-from g1_control.ik.mocap_retarget import MocapRetargetConfig, MocapRetargeter, frame_from_left_up, prepare_targets
+from g1_control.ik.mocap_retarget import (
+    MocapRetargetConfig,
+    MocapRetargeter,
+    frame_from_left_up,
+    prepare_targets,
+)
 from g1_control.motion.exceptions import InvalidClipError, UnknownJointError
 from g1_control.motion.human import HumanMotion
 from g1_control.motion.metrics import compute_metrics

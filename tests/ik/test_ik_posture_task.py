@@ -1,10 +1,10 @@
 import numpy as np
 import pytest
+from test_ik_frame_task import fd_jacobian, random_configuration
 
 from g1_control.ik.exceptions import TaskDefinitionError
 from g1_control.ik.tasks import PostureTask, Task
 from g1_control.robot import g1
-from test_ik_frame_task import fd_jacobian, random_configuration
 
 
 def test_posture_jacobian_matches_finite_differences():

@@ -1,10 +1,10 @@
 import numpy as np
 import pinocchio as pin
 import pytest
+from test_ik_frame_task import fd_jacobian, random_configuration
 
 from g1_control.ik.exceptions import TaskDefinitionError
 from g1_control.ik.tasks import RelativeFrameTask
-from test_ik_frame_task import fd_jacobian, random_configuration
 
 
 @pytest.mark.parametrize("frame,root", [("left_rubber_hand", "torso_link"), ("left_ankle_roll_link", "right_toe")])

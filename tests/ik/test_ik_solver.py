@@ -3,7 +3,14 @@ import pytest
 
 from g1_control.ik.configuration import Configuration
 from g1_control.ik.exceptions import IKError, NoSolutionFound
-from g1_control.ik.limits import BoxBounds, GroundLimit, JointPositionLimit, JointVelocityLimit, Limit, RowConstraint
+from g1_control.ik.limits import (
+    BoxBounds,
+    GroundLimit,
+    JointPositionLimit,
+    JointVelocityLimit,
+    Limit,
+    RowConstraint,
+)
 from g1_control.ik.solver import QPSolver
 from g1_control.ik.tasks import DampingTask, FrameTask, PostureTask
 from g1_control.robot import g1

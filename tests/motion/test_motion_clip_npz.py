@@ -1,10 +1,10 @@
 import numpy as np
 import pytest
+from test_motion_clip import make_clip
 
 from g1_control.motion.exceptions import MotionFormatError
 from g1_control.motion.formats.clip_npz import read_clip_npz, write_clip_npz
 from g1_control.robot import g1
-from test_motion_clip import make_clip
 
 
 def test_npz_round_trip_is_exact(tmp_path):

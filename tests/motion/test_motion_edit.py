@@ -1,10 +1,10 @@
 import numpy as np
 import pytest
+from test_motion_clip import make_clip
 
 from g1_control.motion.edit import concatenate, slice_clip
 from g1_control.motion.exceptions import IncompatibleClipsError, InvalidClipError
 from g1_control.motion.resample import resample
-from test_motion_clip import make_clip
 
 
 def test_slice_takes_frames_like_python():

@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
+from test_motion_clip import make_clip
 
 from g1_control.motion.exceptions import MotionFormatError
 from g1_control.motion.formats.g1_csv import read_g1_csv, write_g1_csv
-from test_motion_clip import make_clip
 
 
 def _write_rows(path, rows):

@@ -1,9 +1,9 @@
 import numpy as np
+from test_motion_clip import make_clip
 
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.mirror import joint_mirror_map, mirror
 from g1_control.robot import g1
-from test_motion_clip import make_clip
 
 
 def test_mirror_twice_is_the_identity_exactly():

@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
+from test_motion_clip import make_clip
 
 from g1_control.motion.exceptions import InvalidClipError
 from g1_control.motion.resample import resample, resample_times
-from test_motion_clip import make_clip
 
 
 def test_double_rate_keeps_original_frames_and_interpolates_between():

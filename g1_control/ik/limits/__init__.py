@@ -7,5 +7,14 @@ from g1_control.ik.limits.ground_limit import GroundLimit
 from g1_control.ik.limits.joint_position_limit import JointPositionLimit
 from g1_control.ik.limits.joint_velocity_limit import JointVelocityLimit
 
-__all__ = ["INF", "BoxBounds", "Limit", "RowConstraint", "BaseVelocityLimit", "ContactLimit", "GroundLimit",
-           "JointPositionLimit", "JointVelocityLimit"]
+__all__ = [
+           "INF",
+           "BaseVelocityLimit",
+           "BoxBounds",
+           "ContactLimit",
+           "GroundLimit",
+           "JointPositionLimit",
+           "JointVelocityLimit",
+           "Limit",
+           "RowConstraint",
+]

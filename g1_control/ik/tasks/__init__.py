@@ -8,5 +8,13 @@ from g1_control.ik.tasks.posture_task import PostureTask
 from g1_control.ik.tasks.relative_frame_task import RelativeFrameTask
 from g1_control.ik.tasks.smoothness_task import SmoothnessTask
 
-__all__ = ["Task", "ComTask", "DampingTask", "FrameTask", "PostureTask", "RelativeFrameTask", "SmoothnessTask",
-           "pose_from_vector"]
+__all__ = [
+           "ComTask",
+           "DampingTask",
+           "FrameTask",
+           "PostureTask",
+           "RelativeFrameTask",
+           "SmoothnessTask",
+           "Task",
+           "pose_from_vector",
+]

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from g1_control.motion.clip import MotionClip
-from g1_control.motion.exceptions import MotionFormatError
+from g1_control.motion.exceptions import InvalidClipError, MotionFormatError
 from g1_control.robot import g1
 
 REQUIRED = ("fps", "joint_pos", "joint_vel", "body_pos_w", "body_quat_w", "body_lin_vel_w", "body_ang_vel_w")
@@ -74,7 +74,7 @@ def _read_named(path: Path, data) -> MotionClip:
         clip.contacts = foot_contacts(clip.body_pos_w_m[:, feet], clip.fps)
     try:
         return clip.validate()
-    except Exception as exc:
+    except InvalidClipError as exc:
         raise MotionFormatError(f"{path}: {exc}") from None
 
 

@@ -56,5 +56,4 @@ def write_g1_csv(clip: MotionClip, path: str | Path) -> None:
     q = clip.root_quat_wxyz
     data = np.concatenate([clip.root_pos_w_m, q[:, [1, 2, 3, 0]], clip.joint_pos_rad], axis=1)
     with Path(path).open("w") as fh:
-        for row in data.tolist():
-            fh.write(",".join(repr(v) for v in row) + "\n")
+        fh.writelines(",".join(repr(v) for v in row) + "\n" for row in data.tolist())

@@ -62,7 +62,7 @@ def read_omomo_pt(path: str | Path, height_m: float | None = None) -> HumanMotio
         heights = heights if heights.is_file() else path.parent / "height_dict.pkl"
         if heights.is_file():
             with heights.open("rb") as fh:
-                table = pickle.load(fh)  # noqa: S301 - the registry package's own data file
+                table = pickle.load(fh)
             subject = path.stem.split("_")[0]
             if subject in table:
                 height_m = float(table[subject])
