@@ -59,6 +59,9 @@ class MocapRetargetConfig:
     stance_speed_mps: float = 0.25
     """A human foot point slower than this (after scaling) is in stance."""
     velocity_limit_scale: float = 1.0
+    self_collision: bool = True
+    """Keep the arms out of the torso and the legs apart (human arms pass closer to the body than
+    the G1's wider torso allows)."""
 
     def validate(self) -> MocapRetargetConfig:
         if not self.fps > 0:
@@ -189,7 +192,7 @@ class MocapRetargeter:
             root_cost=(cfg.root_position_cost, cfg.pelvis_orientation_cost), frame_costs=costs,
             com_cost=(0.0, 0.0, 0.0),
             posture_cost=tuple(cfg.wrist_posture_cost if "wrist" in n else cfg.posture_cost for n in g1.JOINT_NAMES), smoothness_cost=cfg.smoothness_cost,
-            velocity_limit_scale=cfg.velocity_limit_scale,
+            velocity_limit_scale=cfg.velocity_limit_scale, self_collision=cfg.self_collision,
         )
 
     def retarget(self, motion: HumanMotion, skeleton: Skeleton | None = None,

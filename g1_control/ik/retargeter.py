@@ -24,6 +24,7 @@ from g1_control.ik.limits import (
     JointPositionLimit,
     JointVelocityLimit,
     Limit,
+    SelfCollisionLimit,
 )
 from g1_control.ik.solver import BACKENDS, QPSolver
 from g1_control.ik.tasks import (
@@ -73,6 +74,9 @@ class IKConfig:
     ground_height_m: float = 0.0
     ground_snap_m: float = 0.03
     """A foot touching down with its sole within this of the ground is put on it, level."""
+    self_collision: bool = False
+    """Keep arms out of the torso and the legs apart (SelfCollisionLimit); off online by default
+    (a generator's references rarely need it and it costs rows), on in offline retargeting."""
     soft_contact_cost: float = 100.0
     """Cost of the contact when the hard hold is infeasible in a tick (then held as a task)."""
 
@@ -114,6 +118,7 @@ class IKRetargeter(Retargeter):
         self.base_velocity_limit = BaseVelocityLimit(cfg.base_max_linear_mps, cfg.base_max_angular_radps)
         self.contacts = [ContactLimit(f) for f in cfg.contact_frames]
         self.ground_limit = GroundLimit(cfg.ground_height_m) if cfg.enforce_ground else None
+        self.self_collision_limit = SelfCollisionLimit() if cfg.self_collision else None
         spheres = foot_contact_points()
         # Height of a frame's origin above its sole when the foot is level (from the URDF spheres).
         self._sole_depth = {}
@@ -243,6 +248,8 @@ class IKRetargeter(Retargeter):
                 c.frame for c in self.contacts if with_contacts and c.active and c.frame in g1.FOOT_BODIES
                 and c.anchor.translation[2] - self._sole_depth[c.frame] >= self.config.ground_height_m - 1e-9)
             limits.append(self.ground_limit)
+        if self.self_collision_limit is not None:
+            limits.append(self.self_collision_limit)
         if with_contacts:
             limits += [c for c in self.contacts if c.active]
         return limits

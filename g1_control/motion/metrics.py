@@ -47,6 +47,9 @@ class ClipMetrics:
     max_sliding_m_per_frame: float
     joint_acc_rms_radps2: float
     """RMS joint acceleration: a jitter measure."""
+    self_collision_frames: int = 0
+    """Frames where a body-part sphere pair (arms vs torso, leg vs leg; ik.limits.self_collision_limit)
+    overlaps by more than `penetration_m`."""
 
     def passes(self, max_penetration_fraction: float = 0.01, max_sliding_fraction: float = 0.02) -> bool:
         return (self.joint_limit_violations == 0 and self.velocity_limit_violations == 0
@@ -104,6 +107,7 @@ def compute_metrics(clip: MotionClip, penetration_m: float = 0.01, sliding_m: fl
     sliding_frames = int(slides.any(axis=1).sum())
     stance_frames = int(stance.any(axis=1).sum())
     acc = np.diff(q, n=2, axis=0) * clip.fps**2 if clip.num_frames > 2 else np.zeros((1, q.shape[1]))
+    collisions = int((self_collision_distances(clip).min(axis=1) < -penetration_m).sum())
     return ClipMetrics(
         source=clip.source, num_frames=clip.num_frames, duration_s=clip.duration_s,
         joint_limit_violations=int(below.sum() + above.sum()),
@@ -115,15 +119,32 @@ def compute_metrics(clip: MotionClip, penetration_m: float = 0.01, sliding_m: fl
         sliding_fraction=float(sliding_frames / stance_frames) if stance_frames else 0.0,
         sliding_duration_s=float(sliding_frames / clip.fps),
         max_sliding_m_per_frame=float(feet.slide_m[stance].max()) if n_stance else 0.0,
-        joint_acc_rms_radps2=float(np.sqrt(np.mean(acc**2))),
+        joint_acc_rms_radps2=float(np.sqrt(np.mean(acc**2))), self_collision_frames=collisions,
     )
+
+
+def self_collision_distances(clip: MotionClip) -> np.ndarray:
+    """(T, pairs) surface distances (m) of the default self-collision sphere pairs."""
+    from g1_control.ik.configuration import Configuration
+    from g1_control.ik.limits.self_collision_limit import SelfCollisionLimit
+    from g1_control.robot import description
+
+    conf = Configuration()
+    limit = SelfCollisionLimit()
+    out = np.empty((clip.num_frames, len(limit.pairs)))
+    for k in range(clip.num_frames):
+        quat_k = clip.root_quat_wxyz[k] / np.linalg.norm(clip.root_quat_wxyz[k])
+        conf.update(description.pinocchio_q(clip.root_pos_w_m[k], quat_k, clip.joint_pos_rad[k]), check=False)
+        out[k] = limit.distances(conf)
+    return out
 
 
 TABLE_COLUMNS = (("source", "clip", "{}"), ("num_frames", "frames", "{:d}"),
                  ("joint_limit_violations", "jlim", "{:d}"), ("velocity_limit_violations", "vlim", "{:d}"),
                  ("max_velocity_ratio", "v/vmax", "{:.2f}"), ("penetration_fraction", "pen>1cm", "{:.2%}"),
                  ("max_penetration_m", "pen max m", "{:.4f}"), ("sliding_fraction", "slide>1cm", "{:.2%}"),
-                 ("max_sliding_m_per_frame", "slide max m", "{:.4f}"), ("joint_acc_rms_radps2", "acc rms", "{:.1f}"))
+                 ("max_sliding_m_per_frame", "slide max m", "{:.4f}"), ("self_collision_frames", "self-coll", "{:d}"),
+                 ("joint_acc_rms_radps2", "acc rms", "{:.1f}"))
 
 
 def format_table(rows: list[ClipMetrics]) -> str:

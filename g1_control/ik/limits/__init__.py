@@ -6,6 +6,7 @@ from g1_control.ik.limits.contact_limit import ContactLimit
 from g1_control.ik.limits.ground_limit import GroundLimit
 from g1_control.ik.limits.joint_position_limit import JointPositionLimit
 from g1_control.ik.limits.joint_velocity_limit import JointVelocityLimit
+from g1_control.ik.limits.self_collision_limit import SelfCollisionLimit, Sphere
 
 __all__ = [
            "INF",
@@ -17,4 +18,6 @@ __all__ = [
            "JointVelocityLimit",
            "Limit",
            "RowConstraint",
+           "SelfCollisionLimit",
+           "Sphere",
 ]
