@@ -114,6 +114,7 @@ class QPSolver:
         x, _, exitflag, info = self._daqp.solve(self.hessian, self.linear, a, bu, bl, sense,
                                                 primal_tol=self.tolerance)
         self.last_iterations = int(info.get("iterations", 0)) if isinstance(info, dict) else 0
+        self.last_exitflag = int(exitflag)
         if exitflag < 1:
             raise NoSolutionFound(f"daqp found no IK step (exit flag {exitflag}: "
                                   f"{'infeasible constraints' if exitflag == -1 else 'solver failure'})")

@@ -3,6 +3,8 @@ frame's drift from its anchor pose, so a stance foot neither slides nor twists.
 
 The anchor is set when contact begins (`set_anchor`); `release()` ends the contact.
 With `position_only` the frame may roll about the anchor point (a point contact, e.g. a toe).
+With `free_yaw` the sole stays flat where it was (position and tilt held) but may pivot about the
+vertical, so the body can turn over a stance foot instead of twisting the leg.
 """
 
 from __future__ import annotations
@@ -15,9 +17,10 @@ from g1_control.ik.limits.base import Limit, RowConstraint
 
 
 class ContactLimit(Limit):
-    def __init__(self, frame: str, position_only: bool = False) -> None:
+    def __init__(self, frame: str, position_only: bool = False, free_yaw: bool = False) -> None:
         self.frame = frame
         self.position_only = position_only
+        self.free_yaw = free_yaw
         self.anchor: pin.SE3 | None = None
         self._fid: int | None = None
 
@@ -38,6 +41,10 @@ class ContactLimit(Limit):
         pos = current.translation - self.anchor.translation
         if self.position_only:
             return pos
+        if self.free_yaw:
+            # the frame's z axis must stay orthogonal to the anchor's x and y axes (tilt held)
+            z_axis = current.rotation[:, 2]
+            return np.concatenate([pos, [self.anchor.rotation[:, 0] @ z_axis, self.anchor.rotation[:, 1] @ z_axis]])
         return np.concatenate([pos, pin.log3(self.anchor.rotation.T @ current.rotation)])
 
     def _frame_id(self, configuration: Configuration) -> int:
@@ -54,6 +61,17 @@ class ContactLimit(Limit):
         if self.position_only:
             err = self.anchor.translation - current.translation  # = -error
             return RowConstraint(jac[:3], err, err, equality=True)
+        if self.free_yaw:
+            z_axis = current.rotation[:, 2]
+            tilt = np.empty((2, configuration.nv))
+            neg_err = np.empty(5)
+            neg_err[:3] = self.anchor.translation - current.translation
+            for i in range(2):
+                axis = self.anchor.rotation[:, i]
+                neg_err[3 + i] = -(axis @ z_axis)
+                # d/dt (a . z) = a . (w x z) = (z x a) . w
+                tilt[i] = np.cross(z_axis, axis) @ jac[3:]
+            return RowConstraint(np.vstack([jac[:3], tilt]), neg_err, neg_err, equality=True)
         rot = current.rotation
         rel = self.anchor.rotation.T @ rot
         neg_err = np.empty(6)
