@@ -11,6 +11,7 @@ Frame Jacobians are LOCAL_WORLD_ALIGNED (linear rows give world-frame point velo
 
 from __future__ import annotations
 
+import functools
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -23,6 +24,7 @@ FOOT_POINT_FRAMES = ("left_toe", "right_toe", "left_heel", "right_heel", "left_s
 """Operational frames this module adds on the feet (see `foot_contact_points`)."""
 
 
+@functools.cache
 def foot_contact_points() -> dict[str, list[tuple[np.ndarray, float]]]:
     """Collision spheres (centre in the foot link frame, radius m) of each foot link, read from
     the URDF itself, so ground contact follows the description rather than a hard-coded offset."""
@@ -38,6 +40,7 @@ def foot_contact_points() -> dict[str, list[tuple[np.ndarray, float]]]:
                 continue
             origin = col.find("origin")
             xyz = np.array([float(v) for v in (origin.get("xyz") if origin is not None else "0 0 0").split()])
+            xyz.setflags(write=False)  # shared by every caller (cached)
             points.setdefault(name, []).append((xyz, float(sphere.get("radius"))))
     missing = [b for b in g1.FOOT_BODIES if b not in points]
     if missing:

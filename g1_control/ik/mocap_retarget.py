@@ -10,6 +10,7 @@ feet above the ground.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -55,7 +56,7 @@ class MocapRetargetConfig:
     wandering between equivalent solutions (measured: chatter at the wrist velocity limit)."""
     smoothness_cost: float = 0.2
     iterations: int = 2
-    warmup_iterations: int = 60
+    warmup_iterations: int = 30
     stance_speed_mps: float = 0.25
     """A human foot point slower than this (after scaling) is in stance."""
     velocity_limit_scale: float = 1.0
@@ -162,6 +163,7 @@ def prepare_targets(motion: HumanMotion, skeleton: Skeleton, config: MocapRetarg
     return PreparedTargets(config.fps, keypoints, root, pelvis_rot, torso_rot, foot_rot, contacts, scale)
 
 
+@functools.cache
 def _pelvis_above_hips() -> np.ndarray:
     """Pelvis origin relative to the midpoint of the hip pitch links, in the pelvis frame (G1 model)."""
     model = description.pinocchio_model()
