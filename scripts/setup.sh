@@ -47,6 +47,8 @@ fi
 if [ -n "$extras" ]; then
   say "test reference: Unitree's official message definitions (unitree_sdk2, --no-deps)"
   PYTHON=$PY bash scripts/install_unitree_reference.sh
+  say "test data: demo human motion capture (holosoma-retargeting wheel, verified; 102 MB once)"
+  $PY -m g1_control.cli.main policies fetch --asset holosoma-demo-mocap >/dev/null
 fi
 
 say "policies: fetching the pretrained G1 policies (holosoma-inference wheel, verified)"

@@ -11,6 +11,7 @@ BENCHMARKS = {
     "loop": ("g1_control.loop.bench:main", "full loop in lockstep: real-time factor, per-stage p50/p99"),
     "teleop": ("g1_control.teleop.bench:main", "input event -> Command latency p50/p99 per device vs bare os.read"),
     "transport": ("g1_control.hardware.bench:main", "robot link: CRC, LowCmd/LowState encode/decode, safety filter (us/call)"),
+    "ik": ("g1_control.ik.bench:main", "IK retargeter: online solve p50/p99, offline frames/s per core"),
 }
 
 

@@ -1,0 +1,23 @@
+"""IK limits: hard constraints on the step."""
+
+from g1_control.ik.limits.base import INF, BoxBounds, Limit, RowConstraint
+from g1_control.ik.limits.base_velocity_limit import BaseVelocityLimit
+from g1_control.ik.limits.contact_limit import ContactLimit
+from g1_control.ik.limits.ground_limit import GroundLimit
+from g1_control.ik.limits.joint_position_limit import JointPositionLimit
+from g1_control.ik.limits.joint_velocity_limit import JointVelocityLimit
+from g1_control.ik.limits.self_collision_limit import SelfCollisionLimit, Sphere
+
+__all__ = [
+           "INF",
+           "BaseVelocityLimit",
+           "BoxBounds",
+           "ContactLimit",
+           "GroundLimit",
+           "JointPositionLimit",
+           "JointVelocityLimit",
+           "Limit",
+           "RowConstraint",
+           "SelfCollisionLimit",
+           "Sphere",
+]

@@ -1,0 +1,84 @@
+"""No point of the feet below the ground: for each collision sphere of each foot (read from the
+URDF, see configuration.foot_contact_points), z_centre - radius after the step >= ground height.
+
+The ground height is a parameter (0 for a flat floor at the world origin), never a fudge offset:
+a sole resting on the floor sits exactly at the ground height.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from g1_control.ik.configuration import Configuration, foot_contact_points
+from g1_control.ik.limits.base import INF, Limit, RowConstraint
+from g1_control.robot import g1
+
+
+class GroundLimit(Limit):
+    def __init__(self, ground_height_m: float = 0.0, links: tuple[str, ...] = g1.FOOT_BODIES,
+                 tolerance_m: float = 1e-4) -> None:
+        self.ground_height_m = float(ground_height_m)
+        # Slack for linearisation: a foot held level on the ground (contact equality) and these
+        # rows linearise the same motion differently by ~1e-6 m; without slack the QP is infeasible.
+        self.tolerance_m = float(tolerance_m)
+        spheres = foot_contact_points()
+        self.points: list[tuple[str, np.ndarray, float]] = [
+            (link, centre, radius) for link in links for centre, radius in spheres[link]
+        ]
+        self._rows: RowConstraint | None = None
+        self.skip_links: frozenset[str] = frozenset()
+        """Links whose rows are left out this step: a foot held by a ContactLimit anchored on or
+        above the ground is already kept there, and its four rows would only duplicate the hold
+        (degenerate active constraints that make active-set solvers fail)."""
+
+    def _grouped(self) -> list[tuple[str, np.ndarray, np.ndarray, slice]]:
+        if not hasattr(self, "_groups"):
+            groups, start = [], 0
+            for link in dict.fromkeys(p[0] for p in self.points):
+                members = [p for p in self.points if p[0] == link]
+                centres = np.array([p[1] for p in members])
+                radii = np.array([p[2] for p in members])
+                groups.append((link, centres, radii, slice(start, start + len(members))))
+                start += len(members)
+            self._groups = groups
+        return self._groups
+
+    def point_heights(self, configuration: Configuration) -> np.ndarray:
+        """Height (m) of the lowest point of every sphere above the ground."""
+        out = np.empty(len(self.points))
+        for link, centres, radii, rows in self._grouped():
+            placement = configuration.frame_placement(configuration.frame_id(link))
+            out[rows] = centres @ placement.rotation[2] + placement.translation[2] - radii - self.ground_height_m
+        return out
+
+    def compute(self, configuration: Configuration, dt_s: float) -> RowConstraint | None:
+        m, nv = len(self.points), configuration.nv
+        if self._rows is None or self._rows.matrix.shape != (m, nv):
+            self._rows = RowConstraint(np.zeros((m, nv)), np.zeros(m), np.full(m, INF))
+        groups = self._grouped()
+        if self.skip_links:
+            groups = [g for g in groups if g[0] not in self.skip_links]
+            if not groups:
+                return None
+            count = sum(g[3].stop - g[3].start for g in groups)
+            out = RowConstraint(np.zeros((count, nv)), np.zeros(count), np.full(count, INF))
+            start = 0
+            for link, centres, radii, rows in groups:
+                k = rows.stop - rows.start
+                self._fill(configuration, link, centres, radii, out, slice(start, start + k))
+                start += k
+            return out
+        for link, centres, radii, rows in groups:
+            self._fill(configuration, link, centres, radii, self._rows, rows)
+        return self._rows
+
+    def _fill(self, configuration: Configuration, link: str, centres: np.ndarray, radii: np.ndarray,
+              out: RowConstraint, rows: slice) -> None:
+        fid = configuration.frame_id(link)
+        placement = configuration.frame_placement(fid)
+        jac = configuration.frame_jacobian(fid)
+        arms = centres @ placement.rotation.T
+        # z row of v_point = v_origin + w x arm: v_z + arm_y w_x - arm_x w_y
+        out.matrix[rows] = jac[2] + arms[:, 1:2] * jac[3] - arms[:, 0:1] * jac[4]
+        out.lower[rows] = (self.ground_height_m - self.tolerance_m + radii
+                           - (arms[:, 2] + placement.translation[2]))

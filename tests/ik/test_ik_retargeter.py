@@ -1,0 +1,139 @@
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from g1_control.ik.exceptions import InvalidFrameError, InvalidReferenceError, TaskDefinitionError
+from g1_control.ik.retargeter import IKConfig, IKRetargeter
+from g1_control.interfaces import Retargeter
+from g1_control.robot import g1
+from g1_control.types import JointReference, KinematicReference
+
+
+def _pose7(p: pin.SE3) -> np.ndarray:
+    q = pin.Quaternion(p.rotation)
+    return np.array([*p.translation, q.w, q.x, q.y, q.z])
+
+
+def _reference(ik: IKRetargeter, hand_offset=(0.0, 0.0, 0.0), contacts=(True, True)) -> KinematicReference:
+    conf = ik.configuration
+    hand = pin.SE3(conf.frame_placement(conf.frame_id("left_rubber_hand")))
+    hand.translation = hand.translation + np.asarray(hand_offset)
+    return KinematicReference(root_pos_w_m=np.array([0.0, 0.0, g1.DEFAULT_PELVIS_HEIGHT_M]),
+                              q_rad=np.asarray(g1.DEFAULT_Q_RAD).copy(),
+                              frame_targets_w={"left_rubber_hand": _pose7(hand)},
+                              contacts=np.array(contacts))
+
+
+def test_is_a_retargeter_and_returns_a_joint_reference():
+    ik = IKRetargeter()
+    assert isinstance(ik, Retargeter)
+    out = ik.solve(_reference(ik), np.asarray(g1.DEFAULT_Q_RAD))
+    assert isinstance(out, JointReference)
+    assert out.q_rad.shape == (29,) and out.dq_radps.shape == (29,)
+    assert abs(np.linalg.norm(out.root_quat_wxyz) - 1.0) < 1e-9
+    assert out.contacts.tolist() == [True, True]
+
+
+def test_reaches_a_hand_target_with_feet_held_and_on_the_ground():
+    ik = IKRetargeter(IKConfig(frame_costs={"left_rubber_hand": (50.0, 0.0)}))
+    q = np.asarray(g1.DEFAULT_Q_RAD).copy()
+    out = ik.solve(_reference(ik), q)  # touchdown: feet put level on the ground ...
+    for _ in range(4):  # ... reached over a few ticks (one QP step is a linearisation)
+        out = ik.solve(_reference(ik), out.q_rad)
+    feet = [pin.SE3(ik.configuration.frame_placement(ik.configuration.frame_id(f))) for f in g1.FOOT_BODIES]
+    ref = _reference(ik, hand_offset=(0.15, 0.0, 0.15))
+    for _ in range(60):
+        out = ik.solve(ref, out.q_rad)
+    conf = ik.configuration
+    hand = conf.frame_placement(conf.frame_id("left_rubber_hand")).translation
+    np.testing.assert_allclose(hand, ref.frame_targets_w["left_rubber_hand"][:3], atol=5e-3)
+    for foot, before in zip(g1.FOOT_BODIES, feet):
+        now = conf.frame_placement(conf.frame_id(foot))
+        np.testing.assert_allclose(now.translation, before.translation, atol=1e-5)
+    assert ik.ground_limit.point_heights(conf).min() > -1e-6
+    # touched down level on the ground: sole spheres at height 0
+    assert ik.ground_limit.point_heights(conf).max() < 1e-4
+
+
+def test_joint_speed_never_exceeds_the_motor_limits():
+    ik = IKRetargeter(IKConfig(velocity_limit_scale=0.2, hold_contacts=False))
+    q = np.asarray(g1.DEFAULT_Q_RAD).copy()
+    far = _reference(ik, hand_offset=(0.3, 0.2, 0.4), contacts=(False, False))
+    for _ in range(10):
+        out = ik.solve(far, q)
+        assert np.all(np.abs(out.q_rad - q) <= 0.2 * g1.VELOCITY_LIMIT_RADPS * 0.02 + 1e-7)
+        np.testing.assert_allclose(out.dq_radps, (out.q_rad - q) / 0.02, atol=1e-9)
+        q = out.q_rad
+
+
+def test_multiple_iterations_per_tick_share_one_velocity_budget():
+    ik = IKRetargeter(IKConfig(iterations=4, velocity_limit_scale=0.1, hold_contacts=False))
+    q = np.asarray(g1.DEFAULT_Q_RAD).copy()
+    out = ik.solve(_reference(ik, hand_offset=(0.3, 0.2, 0.4), contacts=(False, False)), q)
+    assert np.all(np.abs(out.q_rad - q) <= 0.1 * g1.VELOCITY_LIMIT_RADPS * 0.02 + 1e-7)
+
+
+def test_joint_limits_hold_for_unreachable_targets():
+    ik = IKRetargeter(IKConfig(hold_contacts=False))
+    q = np.asarray(g1.DEFAULT_Q_RAD).copy()
+    ref = _reference(ik, hand_offset=(2.0, 2.0, 2.0), contacts=(False, False))
+    for _ in range(40):
+        q = ik.solve(ref, q).q_rad
+        assert np.all(q >= g1.Q_MIN_RAD - 1e-9) and np.all(q <= g1.Q_MAX_RAD + 1e-9)
+
+
+def test_bad_references_are_refused_by_name():
+    ik = IKRetargeter()
+    ref = _reference(ik)
+    ref.q_rad[3] = np.nan
+    with pytest.raises(InvalidReferenceError, match="q_rad contains NaN"):
+        ik.solve(ref, np.asarray(g1.DEFAULT_Q_RAD))
+    ref = _reference(ik)
+    ref.frame_targets_w["left_hoof"] = ref.frame_targets_w["left_rubber_hand"]
+    with pytest.raises(InvalidFrameError, match="no frame 'left_hoof'"):
+        ik.solve(ref, np.asarray(g1.DEFAULT_Q_RAD))
+    with pytest.raises(InvalidReferenceError, match=r"q_prev has shape \(12,\)"):
+        ik.solve(_reference(ik), np.zeros(12))
+    ref = _reference(ik)
+    ref.frame_targets_w["left_rubber_hand"] = np.zeros(3)
+    with pytest.raises(InvalidReferenceError, match="frame target 'left_rubber_hand' must be 7 finite numbers"):
+        ik.solve(ref, np.asarray(g1.DEFAULT_Q_RAD))
+
+
+def test_config_is_validated():
+    with pytest.raises(TaskDefinitionError, match="backend must be one of"):
+        IKRetargeter(IKConfig(backend="osqp"))
+    with pytest.raises(TaskDefinitionError, match="iterations must be >= 1"):
+        IKRetargeter(IKConfig(iterations=0))
+
+
+def test_smoothness_reduces_jitter_on_a_noisy_target():
+    def jitter(cost):
+        ik = IKRetargeter(IKConfig(smoothness_cost=cost, hold_contacts=False))
+        rng = np.random.default_rng(0)
+        q = np.asarray(g1.DEFAULT_Q_RAD).copy()
+        qs = []
+        for _ in range(60):
+            q = ik.solve(_reference(ik, hand_offset=0.01 * rng.standard_normal(3), contacts=(False, False)), q).q_rad
+            qs.append(q)
+        return np.abs(np.diff(np.array(qs), n=2, axis=0)).mean()
+
+    assert jitter(1.0) < 0.8 * jitter(0.0)
+
+
+def test_projection_step_keeps_held_feet_in_place_on_big_steps():
+    def drift(tolerance):
+        ik = IKRetargeter(IKConfig(dt_s=0.1, contact_tolerance_m=tolerance, root_cost=(50.0, 5.0), com_cost=(0, 0, 0)))
+        ref = _reference(ik)
+        q = np.asarray(g1.DEFAULT_Q_RAD).copy()
+        for _ in range(5):  # settle the feet on the ground
+            q = ik.solve(ref, q).q_rad
+        conf = ik.configuration
+        before = conf.frame_placement(conf.frame_id("left_ankle_roll_link")).translation.copy()
+        crouch = _reference(ik)
+        crouch.root_pos_w_m = ref.root_pos_w_m - np.array([0.0, 0.0, 0.18])  # a deep crouch in one tick
+        ik.solve(crouch, q)
+        return np.linalg.norm(conf.frame_placement(conf.frame_id("left_ankle_roll_link")).translation - before)
+
+    assert drift(0.0) > 3e-3  # one linearised step alone lets the foot drift by millimetres
+    assert drift(1e-3) < 1e-3
