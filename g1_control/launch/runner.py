@@ -153,14 +153,17 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
     def on_tick(i: int) -> None:
         if bar is not None and (i + 1) % ticks_per_update == 0:
             bar.update(1.0)
-            if loop.fell:
-                bar.set_postfix_str("FELL")
-        if view is not None and (i + 1) % 10 == 0:
-            view.sync()
+            if loop.faulted:
+                bar.set_postfix_str("FELL" if loop.fell else "DAMPING")
+        if view is not None and (i + 1) % 10 == 0 and time.perf_counter() - last_sync[0] > 1 / 30:
+            _update_viewer(view, loop)  # at most 30 Hz: sync() waits for the viewer's render
+            last_sync[0] = time.perf_counter()
 
+    last_sync = [0.0]
     t0 = time.perf_counter()
+    stop = (lambda: not view.is_running()) if view is not None else None
     try:
-        loop.run(duration, progress=on_tick)
+        loop.scheduler.run(int(round(duration * loop.rates.lowlevel_hz)), stop=stop, progress=on_tick)
     finally:
         wall = time.perf_counter() - t0
         if bar is not None:
@@ -178,7 +181,22 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
 def _open_viewer(loop: ControlLoop):
     import mujoco.viewer
 
-    return mujoco.viewer.launch_passive(loop.backend.model, loop.backend.data)
+    view = mujoco.viewer.launch_passive(loop.backend.model, loop.backend.data, show_left_ui=False,
+                                        show_right_ui=False)
+    view.cam.type = mujoco.mjtCamera.mjCAMERA_TRACKING
+    view.cam.trackbodyid = loop.backend.model.body("pelvis").id
+    view.cam.distance, view.cam.elevation = 3.0, -15.0
+    return view
+
+
+def _update_viewer(view, loop: ControlLoop) -> None:
+    import mujoco
+
+    from g1_control.launch.overlay import overlay_lines
+
+    labels, values = overlay_lines(loop)
+    view.set_texts((mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_TOPLEFT, labels, values))
+    view.sync()
 
 
 def _result(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], wall: float) -> RunResult:
