@@ -35,3 +35,11 @@ class InputDeviceError(G1ControlError, RuntimeError):
 
 class RemoteDecodeError(G1ControlError, ValueError):
     """Wireless-remote bytes that do not have the layout the G1 reports (40 bytes, see FACTS.md)."""
+
+
+class WbcConfigError(G1ControlError, ValueError):
+    """A whole-body controller configuration or input that cannot be used (bad gains, shapes, geometry)."""
+
+
+class WbcSolveError(G1ControlError, RuntimeError):
+    """The whole-body inverse-dynamics QP found no solution for this tick."""
