@@ -48,6 +48,10 @@ class WbcConfig:
     swing_foot: TaskGains = TaskGains(400.0, 40.0, 100.0)
     hands: TaskGains = TaskGains(100.0, 20.0, 3.0)
     posture: TaskGains = TaskGains(100.0, 20.0, 1.0)
+    clip_cop_to_support: bool = True
+    """Clip the capture-point CoP into the support polygon before it becomes the CoM task. Off,
+    the QP gets the unclipped CoM acceleration and meets what the feet cannot give with angular
+    momentum (trunk and arm rotation), trading it against the orientation tasks."""
     contact_ramp_s: float = 0.06
     """After touchdown a foot's normal-force allowance grows from zero to full over this time."""
     kp_scale: float = 0.3
@@ -112,6 +116,7 @@ class WholeBodyTracker(Tracker):
         self._prev_stance = np.ones(2, dtype=bool)
         self._com_vel_ref_prev: np.ndarray | None = None
         self._com_acc_ref = np.zeros(3)
+        self._frame_vel_ref_prev: dict[int, np.ndarray] = {}
         self.diagnostics = WbcDiagnostics()
 
     def _start(self, reference: JointReference, state: RobotState) -> None:
@@ -202,7 +207,8 @@ class WholeBodyTracker(Tracker):
         cop = cp.desired_cop(com[:2], com_vel[:2], com_ref[:2], com_vel_ref[:2], cop_ref, omega,
                              cfg.capture_point_gain)
         hull = cp.support_polygon(sole_pos, sole_rot, self._corners, stance)
-        cop = cp.project_into_polygon(cop, hull)
+        if cfg.clip_cop_to_support:
+            cop = cp.project_into_polygon(cop, hull)
         h = cfg.com_height
         a_com = np.empty(3)
         a_com[:2] = omega**2 * (com[:2] - cop)
@@ -221,12 +227,17 @@ class WholeBodyTracker(Tracker):
             tasks.append(orientation_task("orientation", ft.jac_w[3:], ft.drift_w[3:], ft.rot_w, ft.vel_w[3:],
                                           ref_rot, ref_w, gains))
         for i, fid in enumerate(dyn.sole_ids):
+            ref_v = pin.getFrameVelocity(dyn.model, rd, fid, lwa)
+            # The swing foot's reference acceleration, by differencing its reference velocity
+            # (a JointReference carries no accelerations); without it the foot lags, then overshoots.
+            prev = self._frame_vel_ref_prev.get(fid)
+            acc_ref = np.zeros(3) if prev is None else (ref_v.linear - prev) / dt
+            self._frame_vel_ref_prev[fid] = ref_v.linear.copy()
             if stance[i]:
                 continue
             ft = dyn.frame(fid)
-            ref_v = pin.getFrameVelocity(dyn.model, rd, fid, lwa)
             tasks.append(position_task("swing_foot", ft.jac_w[:3], ft.drift_w[:3], ft.pos_w_m + shift,
-                                       ft.vel_w[:3], rd.oMf[fid].translation, ref_v.linear, np.zeros(3),
+                                       ft.vel_w[:3], rd.oMf[fid].translation, ref_v.linear, acc_ref,
                                        cfg.swing_foot))
             tasks.append(orientation_task("swing_foot_rot", ft.jac_w[3:], ft.drift_w[3:], ft.rot_w, ft.vel_w[3:],
                                           rd.oMf[fid].rotation, ref_v.angular, cfg.swing_foot))
