@@ -48,7 +48,7 @@ class WbcConfig:
     swing_foot: TaskGains = TaskGains(400.0, 40.0, 100.0)
     hands: TaskGains = TaskGains(100.0, 20.0, 3.0)
     posture: TaskGains = TaskGains(100.0, 20.0, 1.0)
-    clip_cop_to_support: bool = True
+    clip_cop_to_support: bool = False
     """Clip the capture-point CoP into the support polygon before it becomes the CoM task. Off,
     the QP gets the unclipped CoM acceleration and meets what the feet cannot give with angular
     momentum (trunk and arm rotation), trading it against the orientation tasks."""
