@@ -47,6 +47,7 @@ class TrackingFigures:
     base_drift_max_m: float
     wall_s: float
     qp_failures: int = 0
+    qp_unsolved: int = 0
     tracker_p50_us: float = 0.0
     tracker_p99_us: float = 0.0
 
@@ -54,11 +55,11 @@ class TrackingFigures:
         return (f"{self.reference:<14} {self.controller:<6} {'FELL' if self.fell else 'ok':<5} {self.duration_s:6.1f} "
                 f"{self.joint_rms_rad:9.4f} {self.pelvis_height_rms_m:9.4f} {self.pelvis_height_max_m:9.4f} "
                 f"{self.base_drift_final_m:9.4f} {self.base_drift_max_m:9.4f} {self.tracker_p50_us:8.0f} "
-                f"{self.tracker_p99_us:8.0f} {self.wall_s:7.1f}")
+                f"{self.tracker_p99_us:8.0f} {self.wall_s:7.1f} {self.qp_failures:4d}/{self.qp_unsolved}")
 
 
 HEADER = (f"{'reference':<14} {'ctrl':<6} {'fall':<5} {'sim s':>6} {'joint rms':>9} {'z rms':>9} {'z max':>9} "
-          f"{'drift end':>9} {'drift max':>9} {'p50 us':>8} {'p99 us':>8} {'wall s':>7}")
+          f"{'drift end':>9} {'drift max':>9} {'p50 us':>8} {'p99 us':>8} {'wall s':>7} relaxed/unsolved QPs")
 
 
 def run_wbc(trajectory, *, tracker_hz: float = DEFAULT_TRACKER_HZ, push_n: float = 0.0, push_at_s: float = 2.0,
@@ -88,6 +89,7 @@ def run_wbc(trajectory, *, tracker_hz: float = DEFAULT_TRACKER_HZ, push_n: float
     wall = time.perf_counter() - t0
     figures = figures_of(trajectory, loop, "wbc", wall)
     figures.qp_failures = tracker.diagnostics.solve_failures
+    figures.qp_unsolved = tracker.diagnostics.unsolved_ticks
     return figures, loop
 
 

@@ -98,9 +98,10 @@ class InverseDynamicsQP:
         return qp
 
     def solve(self, model: WbcModel, tasks: list[AccelerationTask], stance: np.ndarray,
-              load_fraction: np.ndarray) -> IdSolution:
+              load_fraction: np.ndarray, contact_damping_per_s: float | None = None) -> IdSolution:
         """Solve for the state last passed to model.update(). stance: (2,) bool; load_fraction:
-        (2,) 0..1, each stance foot's share of the full normal-force allowance (contact ramps)."""
+        (2,) 0..1, each stance foot's share of the full normal-force allowance (contact ramps);
+        contact_damping_per_s overrides the configured value for this solve."""
         nv, n = self.nv, self.n
         M, h, Jc = model.mass_matrix, model.bias, model.contact_jac_local
         H, g, A, b, C, l, u = self.H, self.g, self.A, self.b, self.C, self.l, self.u
@@ -126,7 +127,7 @@ class InverseDynamicsQP:
         l[:nv - 6] = -self.effort_limit - h[6:]
         u[:nv - 6] = self.effort_limit - h[6:]
         fC, fl, fu = self._foot_rows
-        kv = self.config.contact_damping_per_s
+        kv = self.config.contact_damping_per_s if contact_damping_per_s is None else contact_damping_per_s
         for i in range(2):
             eq = slice(6 + 6 * i, 12 + 6 * i)
             cols = slice(nv + 6 * i, nv + 6 * i + 6)

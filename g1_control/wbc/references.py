@@ -151,6 +151,11 @@ class TrajectoryRetargeter(Retargeter):
         return self.trajectory.sample(reference.t_s, self._out)
 
 
+LEG_LIGHT_POSTURE_WEIGHT = np.where(np.isin(np.arange(g1.NUM_JOINTS), g1.LEG_JOINTS), 0.002, 0.05)
+"""The legs are fixed by the feet and pelvis targets; a posture pull as strong as the upper body's
+would leave a 15 cm crouch 2 cm short."""
+
+
 # -- whole-body IK for the reference poses -------------------------------------------------------------------
 class WholeBodyIK:
     """Damped least squares on the floating-base configuration: soles at their targets, CoM xy,
@@ -183,8 +188,10 @@ class WholeBodyIK:
     def solve(self, q0: np.ndarray, soles: list[tuple[np.ndarray, np.ndarray]], com_xy: np.ndarray | None,
               pelvis_z: float | None, pelvis_rot: np.ndarray, posture: np.ndarray, *,
               hand: tuple[str, np.ndarray] | None = None, pelvis_rot_weight=(10.0, 10.0, 10.0),
-              posture_weight: np.ndarray | float = 0.05, iterations: int = 30, tol: float = 1e-6) -> np.ndarray:
+              posture_weight: np.ndarray | float | None = None, iterations: int = 30, tol: float = 1e-6) -> np.ndarray:
         pin, m, d = self.pin, self.model, self.data
+        if posture_weight is None:
+            posture_weight = LEG_LIGHT_POSTURE_WEIGHT
         q = q0.copy()
         lwa = pin.LOCAL_WORLD_ALIGNED
         nv = m.nv
@@ -303,7 +310,7 @@ def lean_reach(ahead_m: float = 0.5, height_m: float = 0.75, side_m: float = -0.
     for sk in s:
         goal = hand0 + sk * (target - hand0)
         q = ik.solve(q, soles, com_xy, None, np.eye(3), g1.DEFAULT_Q_RAD, hand=("right_hand", goal),
-                     pelvis_rot_weight=(10.0, 0.5, 10.0), iterations=10)
+                     pelvis_rot_weight=(10.0, 0.5, 10.0), posture_weight=0.05, iterations=10)
         qs.append(q)
     achieved, _ = ik.frame_pose(qs[int(np.argmax(s))], "right_hand")
     return _trajectory("lean_reach", t, np.array(qs), np.ones((len(t), 2), dtype=bool), hand_target_w_m=target,

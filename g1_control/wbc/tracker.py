@@ -54,6 +54,9 @@ class WbcConfig:
     momentum (trunk and arm rotation), trading it against the orientation tasks."""
     contact_ramp_s: float = 0.06
     """After touchdown a foot's normal-force allowance grows from zero to full over this time."""
+    liftoff_unload_s: float = 0.015
+    """After the schedule lifts a foot, it stays a (shrinking) contact this long: its normal-force
+    allowance falls to zero first, so the other leg's torques take the load without a jump."""
     kp_scale: float = 0.3
     kd_scale: float = 0.5
     """Motor-law gains as fractions of g1.KP_DEFAULT / KD_DEFAULT (10 Hz, damping ratio 2 on the
@@ -65,7 +68,7 @@ class WbcConfig:
     def __post_init__(self) -> None:
         if self.rate_hz <= 0:
             raise WbcConfigError(f"WbcConfig.rate_hz must be > 0; got {self.rate_hz}")
-        for name in ("kp_scale", "kd_scale", "contact_ramp_s", "capture_point_gain", "com_xy_weight"):
+        for name in ("kp_scale", "kd_scale", "contact_ramp_s", "liftoff_unload_s", "capture_point_gain", "com_xy_weight"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise WbcConfigError(f"WbcConfig.{name} must be a finite number >= 0; got {value}")
@@ -81,6 +84,9 @@ class WbcDiagnostics:
     cop_des_xy_m: np.ndarray = field(default_factory=lambda: np.zeros(2))
     solution: IdSolution | None = None
     solve_failures: int = 0
+    """Ticks whose first QP had no solution (then retried relaxed)."""
+    unsolved_ticks: int = 0
+    """Ticks where the relaxed QP failed too and the previous command was repeated."""
     ticks: int = 0
 
 
@@ -113,6 +119,7 @@ class WholeBodyTracker(Tracker):
         self._last_t: float | None = None
         self._started = False
         self._stance_since = np.zeros(2)
+        self._swing_since = np.full(2, -np.inf)
         self._prev_stance = np.ones(2, dtype=bool)
         self._com_vel_ref_prev: np.ndarray | None = None
         self._com_acc_ref = np.zeros(3)
@@ -143,15 +150,20 @@ class WholeBodyTracker(Tracker):
             self._start(reference, state)
         dt = 1.0 / cfg.rate_hz if self._last_t is None else max(1e-4, state.t_s - self._last_t)
         self._last_t = state.t_s
-        stance = np.asarray(reference.contacts, dtype=bool)
-        if not stance.any():
+        scheduled = np.asarray(reference.contacts, dtype=bool)
+        if not scheduled.any():
             raise WbcConfigError("JointReference.contacts has no foot in contact; the controller needs at "
                                  "least one stance foot (flight phases are not supported)")
         for i in range(2):
-            if stance[i] and not self._prev_stance[i]:
+            if scheduled[i] and not self._prev_stance[i]:
                 self._stance_since[i] = state.t_s
-        self._prev_stance[:] = stance
+            elif not scheduled[i] and self._prev_stance[i]:
+                self._swing_since[i] = state.t_s
+        self._prev_stance[:] = scheduled
         load = np.clip((state.t_s - self._stance_since) / max(cfg.contact_ramp_s, 1e-6), 0.0, 1.0)
+        unloading = ~scheduled & (state.t_s - self._swing_since < cfg.liftoff_unload_s)
+        load[unloading] = 1.0 - (state.t_s - self._swing_since[unloading]) / max(cfg.liftoff_unload_s, 1e-6)
+        stance = scheduled | unloading
 
         # 1. floating-base state
         est = self.estimator.update(state)
@@ -258,8 +270,15 @@ class WholeBodyTracker(Tracker):
         try:
             sol = self.qp.solve(dyn, tasks, stance, load)
         except WbcSolveError:
+            # Seen at touchdown: a foot landing fast cannot be stopped at once within the torque
+            # and force limits while its load is still ramping in. Retry with the contact
+            # allowed its full load and no velocity damping; failing that, keep the last command.
             diag.solve_failures += 1
-            return self._hold(state)
+            try:
+                sol = self.qp.solve(dyn, tasks, stance, np.ones(2), contact_damping_per_s=0.0)
+            except WbcSolveError:
+                diag.unsolved_ticks += 1
+                return self._command if diag.solution is not None else self._hold(state)
         diag.solution = sol
         out = self._command
         ddq = sol.ddq[6:]
