@@ -10,6 +10,7 @@ import importlib
 BENCHMARKS = {
     "loop": ("g1_control.loop.bench:main", "full loop in lockstep: real-time factor, per-stage p50/p99"),
     "teleop": ("g1_control.teleop.bench:main", "input event -> Command latency p50/p99 per device vs bare os.read"),
+    "wbc": ("g1_control.wbc.bench:main", "whole-body QP solve p50/p99 per tick vs RNEA+CRBA and cold solves; loop real-time factor"),
 }
 
 

@@ -83,9 +83,10 @@ class WholeBodyTrajectory:
             raise WbcConfigError("WholeBodyTrajectory needs at least 2 samples at increasing times")
         if not np.all(self.contacts.any(axis=1)):
             raise WbcConfigError("WholeBodyTrajectory has samples with no foot in contact")
-        self._pos = CubicSpline(self.t_s, self.root_pos_w_m, bc_type="clamped")
-        self._rpy = CubicSpline(self.t_s, self.root_rpy_rad, bc_type="clamped")
-        self._q = CubicSpline(self.t_s, self.q_rad, bc_type="clamped")
+        # One spline over all 35 columns (root xyz, root rpy, joints): two evaluations per sample.
+        self._spline = CubicSpline(self.t_s, np.hstack([self.root_pos_w_m, self.root_rpy_rad, self.q_rad]),
+                                   bc_type="clamped")
+        self._last: tuple[float, JointReference] | None = None
 
     @property
     def duration_s(self) -> float:
@@ -93,14 +94,18 @@ class WholeBodyTrajectory:
 
     def sample(self, t_s: float, out: JointReference | None = None) -> JointReference:
         out = out or JointReference()
+        if self._last is not None and self._last[0] == t_s:  # generator and retargeter ask for the same tick
+            _copy_reference(self._last[1], out)
+            return out
         t = float(np.clip(t_s, self.t_s[0], self.t_s[-1]))
+        x, dx = self._spline(t), self._spline(t, 1)
         out.t_s = t_s
-        out.q_rad[:] = self._q(t)
-        out.dq_radps[:] = self._q(t, 1)
-        out.root_pos_w_m[:] = self._pos(t)
-        rpy, drpy = self._rpy(t), self._rpy(t, 1)
+        out.q_rad[:] = x[6:]
+        out.dq_radps[:] = dx[6:]
+        out.root_pos_w_m[:] = x[:3]
+        rpy, drpy = x[3:6], dx[3:6]
         out.root_quat_wxyz[:] = _rpy_to_quat_wxyz(rpy)
-        vel_w = self._pos(t, 1)
+        vel_w = dx[:3]
         c, s = np.cos(rpy[2]), np.sin(rpy[2])
         out.root_linvel_b_mps[:] = (c * vel_w[0] + s * vel_w[1], -s * vel_w[0] + c * vel_w[1], vel_w[2])
         # ZYX Euler rates -> world angular velocity -> base frame
@@ -111,7 +116,19 @@ class WholeBodyTrajectory:
         out.root_angvel_b_radps[:] = _rpy_to_rot(rpy).T @ w_world
         k = int(np.searchsorted(self.t_s, t, side="right")) - 1
         out.contacts[:] = self.contacts[min(max(k, 0), len(self.t_s) - 1)]
+        if self._last is None:
+            self._last = (t_s, JointReference())
+        self._last = (t_s, self._last[1])
+        _copy_reference(out, self._last[1])
         return out
+
+
+def _copy_reference(src: JointReference, dst: JointReference) -> None:
+    dst.t_s = src.t_s
+    for name in ("q_rad", "dq_radps", "root_pos_w_m", "root_quat_wxyz", "root_linvel_b_mps", "root_angvel_b_radps",
+                 "contacts"):
+        getattr(dst, name)[:] = getattr(src, name)
+    dst.upper_body_override = src.upper_body_override
 
 
 class TrajectoryGenerator(Generator):
