@@ -3,6 +3,7 @@
     python -m g1_control.wbc.evaluate                       # every reference, stand for 60 s
     python -m g1_control.wbc.evaluate walk crouch --json out.json
     python -m g1_control.wbc.evaluate stand --push          # 50 N, 0.2 s push on the pelvis at t = 2 s
+    python -m g1_control.wbc.evaluate --compare-wbt         # and holosoma's WBT policy on the same references
 
 Figures per reference: fell or not; joint RMS error (rad, all 29 joints, every tracker tick);
 pelvis height error (RMS and max, m); base position drift (horizontal distance between the
@@ -63,17 +64,25 @@ HEADER = (f"{'reference':<14} {'ctrl':<6} {'fall':<5} {'sim s':>6} {'joint rms':
 
 
 def run_wbc(trajectory, *, tracker_hz: float = DEFAULT_TRACKER_HZ, push_n: float = 0.0, push_at_s: float = 2.0,
-            push_s: float = 0.2, duration_s: float | None = None, config=None):
-    """Run `trajectory` with the WholeBodyTracker; returns (TrackingFigures, loop)."""
+            push_s: float = 0.2, duration_s: float | None = None, config=None, controller: str = "wbc"):
+    """Run `trajectory` with the WholeBodyTracker (or, controller="wbt", holosoma's WBT policy at
+    50 Hz); returns (TrackingFigures, loop)."""
     from g1_control.loop.control_loop import ControlLoop, LoopRates
     from g1_control.sim.mujoco_backend import MujocoBackend
     from g1_control.wbc.references import TrajectoryGenerator, TrajectoryRetargeter
     from g1_control.wbc.tracker import WbcConfig, WholeBodyTracker
 
-    config = config or WbcConfig(rate_hz=tracker_hz)
     duration = trajectory.duration_s if duration_s is None else duration_s
+    if controller == "wbt":
+        from g1_control.wbc.wbt_baseline import RATE_HZ, WbtPolicyTracker
+
+        tracker_hz = RATE_HZ
+        tracker = WbtPolicyTracker()
+    elif controller == "wbc":
+        tracker = WholeBodyTracker(config or WbcConfig(rate_hz=tracker_hz))
+    else:
+        raise ValueError(f"controller must be 'wbc' or 'wbt'; got {controller!r}")
     rates = LoopRates(lowlevel_hz=500.0, tracker_hz=tracker_hz, input_hz=50.0, estimator_hz=100.0)
-    tracker = WholeBodyTracker(config)
     loop = ControlLoop(MujocoBackend(), _IdleInput(), TrajectoryGenerator(trajectory),
                        TrajectoryRetargeter(trajectory), tracker, rates,
                        log_capacity=int(duration * tracker_hz) + 2)
@@ -87,9 +96,10 @@ def run_wbc(trajectory, *, tracker_hz: float = DEFAULT_TRACKER_HZ, push_n: float
     t0 = time.perf_counter()
     loop.scheduler.run(int(round(duration * rates.lowlevel_hz)), stop=lambda: loop.fell, progress=on_tick)
     wall = time.perf_counter() - t0
-    figures = figures_of(trajectory, loop, "wbc", wall)
-    figures.qp_failures = tracker.diagnostics.solve_failures
-    figures.qp_unsolved = tracker.diagnostics.unsolved_ticks
+    figures = figures_of(trajectory, loop, controller, wall)
+    if controller == "wbc":
+        figures.qp_failures = tracker.diagnostics.solve_failures
+        figures.qp_unsolved = tracker.diagnostics.unsolved_ticks
     return figures, loop
 
 
@@ -120,6 +130,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--stand-seconds", type=float, default=60.0, help="length of the stand reference (default 60)")
     parser.add_argument("--push", action="store_true", help="push the pelvis with 50 N for 0.2 s at t = 2 s")
     parser.add_argument("--tracker-hz", type=float, default=DEFAULT_TRACKER_HZ)
+    parser.add_argument("--compare-wbt", action="store_true",
+                        help="also run holosoma's WBT dance policy (ppo) on each reference, for comparison")
     parser.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
     args = parser.parse_args(argv)
     unknown = [r for r in args.references if r not in REFERENCES]
@@ -129,11 +141,13 @@ def main(argv: list[str] | None = None) -> int:
     print(HEADER)
     for name in args.references:
         traj = build_reference(name, duration_s=args.stand_seconds) if name == "stand" else build_reference(name)
-        figures, _ = run_wbc(traj, tracker_hz=args.tracker_hz, push_n=50.0 if args.push else 0.0)
-        if args.push:
-            figures.reference += "+push"
-        rows.append(figures)
-        print(figures.row(), flush=True)
+        for controller in ("wbc", "wbt") if args.compare_wbt else ("wbc",):
+            figures, _ = run_wbc(traj, tracker_hz=args.tracker_hz, push_n=50.0 if args.push else 0.0,
+                                 controller=controller)
+            if args.push:
+                figures.reference += "+push"
+            rows.append(figures)
+            print(figures.row(), flush=True)
     if args.json:
         with open(args.json, "w") as fh:
             json.dump([asdict(r) for r in rows], fh, indent=2)
