@@ -51,6 +51,8 @@ class TrackingFigures:
     qp_unsolved: int = 0
     tracker_p50_us: float = 0.0
     tracker_p99_us: float = 0.0
+    hand_error_m: float | None = None
+    """lean_reach only: simulated right hand to the target point, mean over the hold."""
 
     def row(self) -> str:
         return (f"{self.reference:<14} {self.controller:<6} {'FELL' if self.fell else 'ok':<5} {self.duration_s:6.1f} "
@@ -113,12 +115,33 @@ def figures_of(trajectory, loop, controller: str, wall_s: float) -> TrackingFigu
     z_err = log["base_pos_m"][:, 2] - root_ref[:, 2]
     xy_err = np.linalg.norm(log["base_pos_m"][:, :2] - root_ref[:, :2], axis=1)
     timing = loop.scheduler.report()["tracker"]
+    hand_error = _hand_error(trajectory, log) if "hand_target_w_m" in trajectory.extras else None
     return TrackingFigures(
         reference=trajectory.name, controller=controller, fell=bool(loop.fell), duration_s=float(loop.time_s),
         joint_rms_rad=float(np.sqrt(np.mean(joint_err**2))),
         pelvis_height_rms_m=float(np.sqrt(np.mean(z_err**2))), pelvis_height_max_m=float(np.abs(z_err).max()),
         base_drift_final_m=float(xy_err[-1]), base_drift_max_m=float(xy_err.max()), wall_s=wall_s,
-        tracker_p50_us=timing["p50_us"], tracker_p99_us=timing["p99_us"])
+        tracker_p50_us=timing["p50_us"], tracker_p99_us=timing["p99_us"], hand_error_m=hand_error)
+
+
+def _hand_error(trajectory, log) -> float:
+    import pinocchio as pin
+
+    from g1_control.wbc.model import build_model
+
+    model = build_model()
+    data = model.createData()
+    fid = model.getFrameId("right_hand")
+    t0, t1 = trajectory.extras["hold_window_s"]
+    rows = np.flatnonzero((log["t_s"] >= t0) & (log["t_s"] <= t1))
+    if rows.size == 0:
+        return float("nan")
+    hands = []
+    for k in rows:
+        w, x, y, z = log["base_quat_wxyz"][k]
+        pin.framesForwardKinematics(model, data, np.concatenate([log["base_pos_m"][k], [x, y, z, w], log["q_rad"][k]]))
+        hands.append(data.oMf[fid].translation.copy())
+    return float(np.linalg.norm(np.mean(hands, axis=0) - trajectory.extras["hand_target_w_m"]))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -147,7 +170,8 @@ def main(argv: list[str] | None = None) -> int:
             if args.push:
                 figures.reference += "+push"
             rows.append(figures)
-            print(figures.row(), flush=True)
+            hand = "" if figures.hand_error_m is None else f"  hand to target {figures.hand_error_m:.3f} m"
+            print(figures.row() + hand, flush=True)
     if args.json:
         with open(args.json, "w") as fh:
             json.dump([asdict(r) for r in rows], fh, indent=2)

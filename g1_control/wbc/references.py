@@ -204,7 +204,8 @@ class WholeBodyIK:
 
     def solve(self, q0: np.ndarray, soles: list[tuple[np.ndarray, np.ndarray]], com_xy: np.ndarray | None,
               pelvis_z: float | None, pelvis_rot: np.ndarray, posture: np.ndarray, *,
-              hand: tuple[str, np.ndarray] | None = None, pelvis_rot_weight=(10.0, 10.0, 10.0),
+              hand: tuple[str, np.ndarray] | None = None, hand_weight: float = 10.0,
+              pelvis_rot_weight=(10.0, 10.0, 10.0),
               posture_weight: np.ndarray | float | None = None, iterations: int = 30, tol: float = 1e-6) -> np.ndarray:
         pin, m, d = self.pin, self.model, self.data
         if posture_weight is None:
@@ -238,7 +239,7 @@ class WholeBodyIK:
                 fid = m.getFrameId(hand[0])
                 rows.append(pin.getFrameJacobian(m, d, fid, lwa)[:3])
                 errs.append(hand[1] - d.oMf[fid].translation)
-                weights.append(np.full(3, 10.0))
+                weights.append(np.full(3, hand_weight))
             Jpost = np.zeros((g1.NUM_JOINTS, nv))
             Jpost[:, 6:] = np.eye(g1.NUM_JOINTS)
             rows.append(Jpost)
@@ -310,7 +311,7 @@ def crouch(depth_m: float = 0.15, down_s: float = 2.0, hold_s: float = 1.5) -> W
     return _trajectory("crouch", t, np.array(qs), np.ones((len(t), 2), dtype=bool), depth_m=depth_m)
 
 
-def lean_reach(ahead_m: float = 0.5, height_m: float = 0.75, side_m: float = -0.2,
+def lean_reach(ahead_m: float = 0.5, height_m: float = 0.8, side_m: float = -0.2,
                reach_s: float = 2.5, hold_s: float = 2.0) -> WholeBodyTrajectory:
     """Right hand to (ahead_m, side_m, height_m) in the start pelvis's ground frame, CoM kept over
     the feet (the hips move back as the torso leans), then back to the default pose."""
@@ -326,12 +327,12 @@ def lean_reach(ahead_m: float = 0.5, height_m: float = 0.75, side_m: float = -0.
     qs, q = [], q0
     for sk in s:
         goal = hand0 + sk * (target - hand0)
-        q = ik.solve(q, soles, com_xy, None, np.eye(3), g1.DEFAULT_Q_RAD, hand=("right_hand", goal),
+        q = ik.solve(q, soles, com_xy, None, np.eye(3), g1.DEFAULT_Q_RAD, hand=("right_hand", goal), hand_weight=100.0,
                      pelvis_rot_weight=(10.0, 0.5, 10.0), posture_weight=0.05, iterations=10)
         qs.append(q)
     achieved, _ = ik.frame_pose(qs[int(np.argmax(s))], "right_hand")
     return _trajectory("lean_reach", t, np.array(qs), np.ones((len(t), 2), dtype=bool), hand_target_w_m=target,
-                       hand_reference_w_m=achieved)
+                       hand_reference_w_m=achieved, hold_window_s=(float(t_events[1]), float(t_events[2])))
 
 
 def stepping(footsteps: list[tuple[int, np.ndarray]], *, single_support_s: float = 0.4,

@@ -26,8 +26,9 @@ def test_commands_never_depend_on_simulator_ground_truth():
                                     base_linvel_w_mps=np.array([1.0, 2.0, 3.0]))
         cmd_a = a.act(ref, robot_like).copy()
         cmd_b = b.act(ref, lying).copy()
-        np.testing.assert_array_equal(cmd_a.tau_nm, cmd_b.tau_nm)
-        np.testing.assert_array_equal(cmd_a.q_rad, cmd_b.q_rad)
+        # equal up to floating-point noise (the solver is not bitwise reproducible across instances)
+        np.testing.assert_allclose(cmd_a.tau_nm, cmd_b.tau_nm, atol=1e-8)
+        np.testing.assert_allclose(cmd_a.q_rad, cmd_b.q_rad, atol=1e-10)
         backend.write_command(cmd_a)
         backend.step(0.004)
     # and the odometry agrees with the truth it never saw
