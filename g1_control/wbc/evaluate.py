@@ -89,14 +89,14 @@ def run_wbc(trajectory, *, tracker_hz: float = DEFAULT_TRACKER_HZ, push_n: float
                        TrajectoryRetargeter(trajectory), tracker, rates,
                        log_capacity=int(duration * tracker_hz) + 2)
     loop.reset()
-    push_tick = int(round(push_at_s * rates.lowlevel_hz))
+    push_tick = round(push_at_s * rates.lowlevel_hz)
 
     def on_tick(i: int) -> None:
         if push_n and i == push_tick:
             loop.backend.push([push_n, 0.0, 0.0], push_s)
 
     t0 = time.perf_counter()
-    loop.scheduler.run(int(round(duration * rates.lowlevel_hz)), stop=lambda: loop.fell, progress=on_tick)
+    loop.scheduler.run(round(duration * rates.lowlevel_hz), stop=lambda: loop.fell, progress=on_tick)
     wall = time.perf_counter() - t0
     figures = figures_of(trajectory, loop, controller, wall)
     if controller == "wbc":

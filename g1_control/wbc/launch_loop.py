@@ -20,7 +20,12 @@ def build_wbc_loop(launch, segments):
     from g1_control.loop.control_loop import ControlLoop, LoopRates
     from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
     from g1_control.teleop.scripted import ScriptedInput
-    from g1_control.wbc.references import REFERENCES, TrajectoryGenerator, TrajectoryRetargeter, build_reference
+    from g1_control.wbc.references import (
+        REFERENCES,
+        TrajectoryGenerator,
+        TrajectoryRetargeter,
+        build_reference,
+    )
     from g1_control.wbc.tracker import WbcConfig, WholeBodyTracker
 
     r, lim = launch.rates, launch.limits

@@ -109,7 +109,7 @@ class WholeBodyTrajectory:
         c, s = np.cos(rpy[2]), np.sin(rpy[2])
         out.root_linvel_b_mps[:] = (c * vel_w[0] + s * vel_w[1], -s * vel_w[0] + c * vel_w[1], vel_w[2])
         # ZYX Euler rates -> world angular velocity -> base frame
-        r, p, y = rpy
+        _, p, y = rpy
         w_world = np.array([-np.sin(y) * drpy[1] + np.cos(y) * np.cos(p) * drpy[0],
                             np.cos(y) * drpy[1] + np.sin(y) * np.cos(p) * drpy[0],
                             drpy[2] - np.sin(p) * drpy[0]])
@@ -382,7 +382,7 @@ def stepping(footsteps: list[tuple[int, np.ndarray]], *, single_support_s: float
     # The pelvis lowers during the initial stand, so the first sample is the nominal pose.
     pelvis_z = q0[2] - pelvis_drop_m * smoothstep(t / start_s)
     preview = ZmpPreviewController(dt_s, com0[2] - pelvis_drop_m)
-    com_xy, _, com_acc = preview.plan(zmp, com0[:2])
+    com_xy, _, _ = preview.plan(zmp, com0[:2])
     rot0 = soles0[0][1]
     qs, q = [], q0
     for k in range(n):

@@ -31,23 +31,22 @@ from g1_control.wbc import capture_point as cp
 from g1_control.wbc.model import WbcModel
 from g1_control.wbc.odometry import BaseOdometry
 from g1_control.wbc.qp import IdSolution, InverseDynamicsQP, QpConfig
-from g1_control.wbc.tasks import (AccelerationTask, TaskGains, orientation_task, position_task,
-                                  posture_task)
+from g1_control.wbc.tasks import AccelerationTask, TaskGains, orientation_task, position_task, posture_task
 
 
 @dataclass(frozen=True)
 class WbcConfig:
     rate_hz: float = 250.0
     """The loop's tracker rate; used only for the first tick's time step."""
-    com_height: TaskGains = TaskGains(100.0, 20.0, 100.0)
+    com_height: TaskGains = field(default_factory=lambda: TaskGains(100.0, 20.0, 100.0))
     com_xy_weight: float = 100.0
     capture_point_gain: float = 2.0
     """k in p = p_ref + (1 + k)(xi - xi_ref): capture-point error decays as exp(-k w t)."""
-    pelvis_orientation: TaskGains = TaskGains(150.0, 25.0, 30.0)
-    torso_orientation: TaskGains = TaskGains(100.0, 20.0, 10.0)
-    swing_foot: TaskGains = TaskGains(400.0, 40.0, 100.0)
-    hands: TaskGains = TaskGains(100.0, 20.0, 3.0)
-    posture: TaskGains = TaskGains(100.0, 20.0, 1.0)
+    pelvis_orientation: TaskGains = field(default_factory=lambda: TaskGains(150.0, 25.0, 30.0))
+    torso_orientation: TaskGains = field(default_factory=lambda: TaskGains(100.0, 20.0, 10.0))
+    swing_foot: TaskGains = field(default_factory=lambda: TaskGains(400.0, 40.0, 100.0))
+    hands: TaskGains = field(default_factory=lambda: TaskGains(100.0, 20.0, 3.0))
+    posture: TaskGains = field(default_factory=lambda: TaskGains(100.0, 20.0, 1.0))
     clip_cop_to_support: bool = False
     """Clip the capture-point CoP into the support polygon before it becomes the CoM task. Off,
     the QP gets the unclipped CoM acceleration and meets what the feet cannot give with angular

@@ -19,7 +19,6 @@ import json
 import numpy as np
 
 from g1_control.errors import PolicyMismatchError
-from g1_control.estimation.estimator import quat_to_rot
 from g1_control.interfaces import Tracker
 from g1_control.robot import g1
 from g1_control.types import JointReference, MotorCommand, RobotState

@@ -35,7 +35,7 @@ class ZmpPreviewController:
         inv = 1.0 / (R + self.B.T @ P @ self.B)[0, 0]
         self.K = inv * (self.B.T @ P @ self.A)  # (1, 3)
         Ac = self.A - self.B @ self.K
-        self.n_preview = int(round(preview_s / dt_s))
+        self.n_preview = round(preview_s / dt_s)
         f = np.zeros(self.n_preview)
         X = self.C.T * zmp_weight  # (3, 1): (Ac^T)^(j-1) C^T Q
         for j in range(self.n_preview):

@@ -7,7 +7,8 @@ from g1_control.errors import WbcConfigError
 from g1_control.wbc.contacts import FootGeometry, cop_of, normal_force_bounds, wrench_constraint_rows
 
 
-def admitted(wrench, foot=FootGeometry()):
+def admitted(wrench, foot=None):
+    foot = foot or FootGeometry()
     C, l, u = wrench_constraint_rows(foot)
     r = C @ wrench
     return bool(np.all(r >= l - 1e-9) and np.all(r <= u + 1e-9))
@@ -49,10 +50,10 @@ def test_normal_force_ramp_is_monotone_and_capped():
 
 
 @pytest.mark.parametrize("kwargs, text", [
-    (dict(x_min_m=0.01), "must contain the sole origin"),
-    (dict(cop_margin=0.0), "cop_margin must be in"),
-    (dict(friction=-1.0), "friction must be > 0"),
-    (dict(fz_min_n=900.0), "fz_min_n < fz_max_n"),
+    ({"x_min_m": 0.01}, "must contain the sole origin"),
+    ({"cop_margin": 0.0}, "cop_margin must be in"),
+    ({"friction": -1.0}, "friction must be > 0"),
+    ({"fz_min_n": 900.0}, "fz_min_n < fz_max_n"),
 ])
 def test_bad_geometry_is_refused(kwargs, text):
     with pytest.raises(WbcConfigError, match=text):

@@ -3,7 +3,6 @@ and walking without a fall, with tracking figures held to bounds measured when t
 (they are deterministic: lockstep physics, no wall-clock dependence)."""
 
 import numpy as np
-import pytest
 
 from g1_control.wbc import references as R
 from g1_control.wbc.evaluate import run_wbc
@@ -11,7 +10,7 @@ from g1_control.wbc.tracker import WholeBodyTracker
 
 
 def test_stands_still_with_millimetre_drift():
-    figures, loop = run_wbc(R.stand(4.0))
+    figures, _ = run_wbc(R.stand(4.0))
     assert not figures.fell and figures.qp_failures == 0 and figures.qp_unsolved == 0
     assert figures.joint_rms_rad < 0.01
     assert figures.pelvis_height_max_m < 0.01
@@ -60,7 +59,7 @@ def test_steps_in_place_and_contact_switches_do_not_jump(monkeypatch):
     created = []
     monkeypatch.setattr(tracker_module, "WholeBodyTracker",
                         lambda config=None: created.append(RecordingTracker()) or created[-1])
-    figures, loop = run_wbc(R.step_in_place())
+    figures, _ = run_wbc(R.step_in_place())
     assert not figures.fell and figures.joint_rms_rad < 0.02 and figures.base_drift_max_m < 0.03
     rec = created[0]
     tau, contacts = np.array(rec.tau), np.array(rec.contacts)

@@ -59,9 +59,9 @@ def test_reference_without_any_contact_is_refused():
         WholeBodyTracker().act(ref, state)
 
 
-@pytest.mark.parametrize("kwargs, text", [(dict(rate_hz=0.0), "rate_hz must be > 0"),
-                                          (dict(kp_scale=-0.1), "kp_scale must be a finite number >= 0"),
-                                          (dict(contact_ramp_s=float("nan")), "contact_ramp_s")])
+@pytest.mark.parametrize("kwargs, text", [({"rate_hz": 0.0}, "rate_hz must be > 0"),
+                                          ({"kp_scale": -0.1}, "kp_scale must be a finite number >= 0"),
+                                          ({"contact_ramp_s": float("nan")}, "contact_ramp_s")])
 def test_bad_config_is_refused(kwargs, text):
     with pytest.raises(WbcConfigError, match=text):
         WbcConfig(**kwargs)
