@@ -67,3 +67,11 @@ class MotionServiceError(TransportError):
 
 class SafetyConfigError(G1ControlError, ValueError):
     """A safety configuration with a missing, negative or non-finite threshold."""
+
+
+class WbcConfigError(G1ControlError, ValueError):
+    """A whole-body controller configuration or input that cannot be used (bad gains, shapes, geometry)."""
+
+
+class WbcSolveError(G1ControlError, RuntimeError):
+    """The whole-body inverse-dynamics QP found no solution for this tick."""

@@ -12,6 +12,7 @@ BENCHMARKS = {
     "teleop": ("g1_control.teleop.bench:main", "input event -> Command latency p50/p99 per device vs bare os.read"),
     "transport": ("g1_control.hardware.bench:main", "robot link: CRC, LowCmd/LowState encode/decode, safety filter (us/call)"),
     "ik": ("g1_control.ik.bench:main", "IK retargeter: online solve p50/p99, offline frames/s per core"),
+    "wbc": ("g1_control.wbc.bench:main", "whole-body QP solve p50/p99 per tick vs RNEA+CRBA and cold solves; loop real-time factor"),
 }
 
 

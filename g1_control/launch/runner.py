@@ -92,6 +92,10 @@ def segments_from_log(log: dict[str, np.ndarray], min_s: float = 1.0) -> list[Se
 
 
 def build_loop(launch: LaunchFile, segments: list[Segment]) -> ControlLoop:
+    if launch.tracker.type == "wbc":
+        from g1_control.wbc.launch_loop import build_wbc_loop
+
+        return build_wbc_loop(launch, segments)
     from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
     from g1_control.trackers.locomotion import LocomotionPolicyTracker, VelocityCorrectionConfig
     from g1_control.trackers.policy_spec import load_spec

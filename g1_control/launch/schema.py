@@ -45,10 +45,12 @@ class RatesConfig:
 
 @dataclass
 class TrackerConfig:
-    type: Literal["policy"] = "policy"
+    type: Literal["policy", "wbc"] = "policy"
     policy: str = "holosoma_loco_ppo"
     """Built-in spec name (g1 policies list) or a path to a spec YAML."""
     velocity_correction: bool = True
+    wbc_reference: str = "stand"
+    """type wbc: the scripted whole-body reference to track (see g1_control.wbc.launch_loop)."""
 
 
 @dataclass

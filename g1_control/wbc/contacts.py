@@ -1,0 +1,103 @@
+"""Contact wrench constraints of a flat rectangular foot.
+
+The wrench (fx, fy, fz, tx, ty, tz) acts at the sole frame's origin, in the sole's own axes
+(z normal to the ground). For forces spread over the sole plane, tx = py * fz and
+ty = -px * fz, so the centre of pressure (px, py) = (-ty / fz, tx / fz). Every constraint below is
+linear in the wrench because each bound is scaled by fz:
+  friction pyramid   |fx| <= mu fz,  |fy| <= mu fz     (inner pyramid of the Coulomb cone)
+  centre of pressure x_min fz <= -ty <= x_max fz,  y_min fz <= tx <= y_max fz
+  yaw torque         |tz| <= mu r fz                  (r: a conservative torsion radius)
+  normal force       fz_min <= fz <= fz_max
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from g1_control.errors import WbcConfigError
+
+ROWS_PER_FOOT = 11
+
+
+@dataclass(frozen=True)
+class FootGeometry:
+    """Sole rectangle relative to the sole frame origin (m) and friction."""
+
+    x_min_m: float = -0.085
+    x_max_m: float = 0.085
+    y_min_m: float = -0.025
+    y_max_m: float = 0.025
+    """The URDF's contact spheres sit at x -0.05..0.12, y +-0.025 (rear) / +-0.03 (front) in the
+    ankle-roll link; the sole frame is at x 0.035, so the rectangle is x +-0.085, y +-0.025."""
+    cop_margin: float = 0.8
+    """Fraction of the rectangle the centre of pressure may use (the edge is a tipping point)."""
+    friction: float = 0.7
+    """Below MuJoCo's 1.0 floor friction: the pyramid is an inner approximation with margin."""
+    torsion_radius_m: float = 0.02
+    fz_min_n: float = 5.0
+    """A stance foot presses with at least this much, so it is not on the verge of lifting."""
+    fz_max_n: float = 800.0
+
+    def __post_init__(self) -> None:
+        if not (self.x_min_m < 0 < self.x_max_m and self.y_min_m < 0 < self.y_max_m):
+            raise WbcConfigError(f"FootGeometry must contain the sole origin; got x [{self.x_min_m}, "
+                                 f"{self.x_max_m}] y [{self.y_min_m}, {self.y_max_m}]")
+        if not 0 < self.cop_margin <= 1:
+            raise WbcConfigError(f"FootGeometry.cop_margin must be in (0, 1]; got {self.cop_margin}")
+        if self.friction <= 0:
+            raise WbcConfigError(f"FootGeometry.friction must be > 0; got {self.friction}")
+        if not 0 <= self.fz_min_n < self.fz_max_n:
+            raise WbcConfigError(f"FootGeometry needs 0 <= fz_min_n < fz_max_n; got {self.fz_min_n}, {self.fz_max_n}")
+
+    def corners_local_m(self) -> np.ndarray:
+        """(4, 2) usable sole corners (after the CoP margin) in the sole frame."""
+        s = self.cop_margin
+        return s * np.array([[self.x_min_m, self.y_min_m], [self.x_max_m, self.y_min_m],
+                             [self.x_max_m, self.y_max_m], [self.x_min_m, self.y_max_m]])
+
+
+def wrench_constraint_rows(foot: FootGeometry) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(C, l, u) with l <= C @ wrench <= u for one stance foot (rows: ROWS_PER_FOOT)."""
+    mu, s = foot.friction, foot.cop_margin
+    inf = 1e20  # proxsuite crashes on true infinities; it treats 1e20 as unbounded
+    C = np.zeros((ROWS_PER_FOOT, 6))
+    l = np.full(ROWS_PER_FOOT, -inf)
+    u = np.zeros(ROWS_PER_FOOT)
+    # friction: fx - mu fz <= 0, -fx - mu fz <= 0, same for fy
+    C[0, [0, 2]] = (1.0, -mu)
+    C[1, [0, 2]] = (-1.0, -mu)
+    C[2, [1, 2]] = (1.0, -mu)
+    C[3, [1, 2]] = (-1.0, -mu)
+    # CoP x: -ty - x_max fz <= 0 and x_min fz + ty <= 0
+    C[4, [4, 2]] = (-1.0, -s * foot.x_max_m)
+    C[5, [4, 2]] = (1.0, s * foot.x_min_m)
+    # CoP y: tx - y_max fz <= 0 and y_min fz - tx <= 0
+    C[6, [3, 2]] = (1.0, -s * foot.y_max_m)
+    C[7, [3, 2]] = (-1.0, s * foot.y_min_m)
+    # yaw torque
+    C[8, [5, 2]] = (1.0, -mu * foot.torsion_radius_m)
+    C[9, [5, 2]] = (-1.0, -mu * foot.torsion_radius_m)
+    # normal force (bounds set per tick by normal_force_bounds)
+    C[10, 2] = 1.0
+    l[10], u[10] = foot.fz_min_n, foot.fz_max_n
+    return C, l, u
+
+
+def normal_force_bounds(foot: FootGeometry, load_fraction: float) -> tuple[float, float]:
+    """(fz_min, fz_max) for a foot carrying up to `load_fraction` (0..1) of its full allowance.
+
+    Ramping the upper bound after touchdown moves the weight onto the new foot over a few
+    ticks instead of in one, so torques do not jump when the contact set changes."""
+    frac = float(np.clip(load_fraction, 0.0, 1.0))
+    fz_max = max(foot.fz_min_n + 1.0, frac * foot.fz_max_n)
+    return foot.fz_min_n * min(1.0, frac * 4.0), fz_max
+
+
+def cop_of(wrench: np.ndarray) -> np.ndarray:
+    """Centre of pressure (x, y) in the sole frame of a wrench with fz > 0."""
+    fz = wrench[2]
+    if fz <= 0:
+        raise WbcConfigError(f"centre of pressure is undefined for a wrench with fz = {fz} N <= 0")
+    return np.array([-wrench[4] / fz, wrench[3] / fz])

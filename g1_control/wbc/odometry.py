@@ -1,0 +1,51 @@
+"""Floating-base position from leg odometry: a stance foot does not move, so the base sits at the
+foot's anchor minus the foot's offset from the base (forward kinematics with the IMU's
+orientation). Between anchors the estimator's velocity (IMU + leg kinematics) carries the
+position, and a first-order correction pulls it to the anchored value, so a change in the set of
+stance feet never makes the position jump.
+
+Nothing here reads simulator ground truth: it is the same computation on the robot.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from g1_control.errors import WbcConfigError
+
+
+class BaseOdometry:
+    def __init__(self, correction_tau_s: float = 0.05):
+        if correction_tau_s <= 0:
+            raise WbcConfigError(f"odometry correction_tau_s must be > 0; got {correction_tau_s}")
+        self.correction_tau_s = correction_tau_s
+        self.base_pos_w_m = np.zeros(3)
+        self.anchors_w_m = np.zeros((2, 3))
+        self._anchored = np.zeros(2, dtype=bool)
+
+    def reset(self, base_pos_w_m: np.ndarray, sole_offsets_w_m: np.ndarray) -> None:
+        """Start at `base_pos_w_m` with both feet anchored where the kinematics put them."""
+        self.base_pos_w_m = np.array(base_pos_w_m, dtype=float)
+        self.anchors_w_m = self.base_pos_w_m + np.asarray(sole_offsets_w_m, dtype=float)
+        self._anchored[:] = True
+
+    def update(self, dt_s: float, base_linvel_w_mps: np.ndarray, sole_offsets_w_m: np.ndarray,
+               stance: np.ndarray) -> np.ndarray:
+        """Advance by dt_s; sole_offsets_w_m: (2, 3) sole positions minus base position, world axes."""
+        p = self.base_pos_w_m
+        p += base_linvel_w_mps * dt_s
+        kin, n = np.zeros(3), 0
+        for i in range(2):
+            if not stance[i]:
+                self._anchored[i] = False
+                continue
+            if not self._anchored[i]:
+                # Touchdown: anchor the foot where the current estimate puts it (continuity).
+                self.anchors_w_m[i] = p + sole_offsets_w_m[i]
+                self._anchored[i] = True
+            kin += self.anchors_w_m[i] - sole_offsets_w_m[i]
+            n += 1
+        if n:
+            gain = dt_s / (self.correction_tau_s + dt_s)
+            p += gain * (kin / n - p)
+        return p
