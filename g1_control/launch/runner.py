@@ -74,7 +74,7 @@ def timeline_of(launch: LaunchFile) -> list[Segment]:
     return []
 
 
-def segments_from_log(log: dict[str, np.ndarray], min_s: float = 1.0) -> list[Segment]:
+def segments_from_log(log: dict[str, np.ndarray], min_s: float = 1.0) -> list[tuple[float, Segment]]:
     """Stretches of constant operator command in a log (for live or device-driven runs)."""
     t, cmd = log["t_s"], log["command"]
     if len(t) == 0:
