@@ -20,9 +20,9 @@ import numpy as np
 import yaml
 
 from g1_control.generator.velocity import CopyRetargeter, VelocityReferenceGenerator
-from g1_control.launch.schema import LaunchFile, Segment
-from g1_control.loop.control_loop import ControlLoop, LoopRates
 from g1_control.launch.inputs import make_input
+from g1_control.launch.schema import LaunchFile, Segment
+from g1_control.loop.control_loop import ControlLoop
 from g1_control.teleop.scripted import random_timeline
 
 STEADY_STATE_SKIP_S = 2.0
@@ -112,7 +112,7 @@ def build_loop(launch: LaunchFile, segments: list[Segment]) -> ControlLoop:
     loop = ControlLoop(
         backend, device, VelocityReferenceGenerator(lim.max_vx_mps, lim.max_vy_mps, lim.max_wz_radps),
         CopyRetargeter(), tracker,
-        LoopRates(r.lowlevel_hz, r.tracker_hz, r.input_hz, r.estimator_hz),
+        r,
         wallclock=wallclock, max_tilt_rad=lim.max_tilt_rad,
         log_capacity=int(launch.total_duration_s * r.tracker_hz) + 2,
     )

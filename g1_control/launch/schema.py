@@ -13,6 +13,7 @@ import yaml
 
 from g1_control.config import from_dict
 from g1_control.errors import LaunchFileError
+from g1_control.loop.rates import LoopRates
 
 
 @dataclass
@@ -25,22 +26,6 @@ class BackendConfig:
         if not 0.0005 <= self.physics_dt_s <= 0.005:
             raise LaunchFileError(f"{where}.physics_dt_s: {self.physics_dt_s} is outside [0.0005, 0.005] s "
                                   "(physics must run at 200 Hz or faster)")
-
-
-@dataclass
-class RatesConfig:
-    lowlevel_hz: float = 500.0
-    tracker_hz: float = 50.0
-    input_hz: float = 100.0
-    estimator_hz: float = 100.0
-
-    def validate(self, where: str) -> None:
-        for name in ("tracker_hz", "input_hz", "estimator_hz"):
-            rate = getattr(self, name)
-            ratio = self.lowlevel_hz / rate if rate > 0 else 0
-            if rate <= 0 or abs(ratio - round(ratio)) > 1e-9:
-                raise LaunchFileError(f"{where}.{name}: {rate} Hz must divide the low-level rate "
-                                      f"{self.lowlevel_hz} Hz into a whole number of ticks")
 
 
 @dataclass
@@ -142,7 +127,7 @@ class LaunchFile:
     duration_s: float | None = None
     """Run length; defaults to the timeline's total."""
     backend: BackendConfig = field(default_factory=BackendConfig)
-    rates: RatesConfig = field(default_factory=RatesConfig)
+    rates: LoopRates = field(default_factory=LoopRates)
     tracker: TrackerConfig = field(default_factory=TrackerConfig)
     input: InputConfig = field(default_factory=InputConfig)
     limits: LimitsConfig = field(default_factory=LimitsConfig)

@@ -3,27 +3,19 @@ guard -> low-level stream, as scheduler stages at their own rates (see scheduler
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import time
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from g1_control.errors import InvalidCommandError, InvalidStateError
 from g1_control.estimation.estimator import StateEstimator, quat_to_rot, yaw_of
 from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, Tracker
+from g1_control.loop.rates import LoopRates
 from g1_control.loop.scheduler import Scheduler, Stage
 from g1_control.robot import g1
 from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter
-from g1_control.types import Command, MotorCommand, RobotState
-
-
-@dataclass
-class LoopRates:
-    lowlevel_hz: float = 500.0
-    tracker_hz: float = 50.0
-    input_hz: float = 100.0
-    estimator_hz: float = 100.0
+from g1_control.types import Command, RobotState
 
 
 @dataclass

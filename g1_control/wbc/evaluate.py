@@ -69,7 +69,8 @@ def run_wbc(trajectory, *, tracker_hz: float = DEFAULT_TRACKER_HZ, push_n: float
             push_s: float = 0.2, duration_s: float | None = None, config=None, controller: str = "wbc"):
     """Run `trajectory` with the WholeBodyTracker (or, controller="wbt", holosoma's WBT policy at
     50 Hz); returns (TrackingFigures, loop)."""
-    from g1_control.loop.control_loop import ControlLoop, LoopRates
+    from g1_control.loop.control_loop import ControlLoop
+    from g1_control.loop.rates import LoopRates
     from g1_control.sim.mujoco_backend import MujocoBackend
     from g1_control.wbc.references import TrajectoryGenerator, TrajectoryRetargeter
     from g1_control.wbc.tracker import WbcConfig, WholeBodyTracker

@@ -17,7 +17,7 @@ MIN_TRACKER_HZ = 200.0
 
 
 def build_wbc_loop(launch, segments):
-    from g1_control.loop.control_loop import ControlLoop, LoopRates
+    from g1_control.loop.control_loop import ControlLoop
     from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
     from g1_control.teleop.scripted import ScriptedInput
     from g1_control.wbc.references import (
@@ -42,7 +42,7 @@ def build_wbc_loop(launch, segments):
     loop = ControlLoop(
         backend, device, TrajectoryGenerator(trajectory), TrajectoryRetargeter(trajectory),
         WholeBodyTracker(WbcConfig(rate_hz=r.tracker_hz)),
-        LoopRates(r.lowlevel_hz, r.tracker_hz, r.input_hz, r.estimator_hz),
+        r,
         wallclock=launch.backend.mode == "wallclock", max_tilt_rad=lim.max_tilt_rad,
         log_capacity=int(launch.total_duration_s * r.tracker_hz) + 2,
     )
