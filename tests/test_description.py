@@ -18,7 +18,8 @@ def test_models_have_the_g1_joints_in_order():
     assert abs(pin.computeTotalMass(pm) - mj.body_subtreemass[1]) < 1e-6
 
 
-def test_forward_kinematics_agree(rng=np.random.default_rng(0)):
+def test_forward_kinematics_agree():
+    rng = np.random.default_rng(0)
     mj = description.mujoco_model()
     data = mujoco.MjData(mj)
     pm = description.pinocchio_model()

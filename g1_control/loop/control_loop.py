@@ -14,7 +14,7 @@ from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, T
 from g1_control.loop.rates import LoopRates
 from g1_control.loop.scheduler import Scheduler, Stage
 from g1_control.robot import g1
-from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter
+from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter, tilt_rad
 from g1_control.types import Command, RobotState
 
 
@@ -57,12 +57,6 @@ class RunLog:
         names = ("t_s", "command", "policy_command", "velocity_est", "velocity_true", "base_pos_m", "base_quat_wxyz", "yaw_rad",
                  "tilt_rad", "q_rad", "q_target_rad", "tau_nm")
         return {name: getattr(self, name)[: self.n] for name in names}
-
-
-def tilt_of(quat_wxyz: np.ndarray) -> float:
-    """Angle between the body z axis and the world vertical (rad)."""
-    w, x, y, z = quat_wxyz
-    return float(np.arccos(np.clip(1 - 2 * (x * x + y * y), -1.0, 1.0)))
 
 
 class ControlLoop:
@@ -227,7 +221,7 @@ class ControlLoop:
         yaw = yaw_of(s.imu_quat_wxyz)
         log.yaw_rad[i] = yaw
         log.base_quat_wxyz[i] = s.imu_quat_wxyz
-        log.tilt_rad[i] = tilt_of(s.imu_quat_wxyz)
+        log.tilt_rad[i] = tilt_rad(s.imu_quat_wxyz)
         if s.base_linvel_w_mps is not None:
             c, sn = np.cos(yaw), np.sin(yaw)
             v = s.base_linvel_w_mps

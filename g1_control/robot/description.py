@@ -27,12 +27,6 @@ def description_dir() -> Path:
     for key in ("purelib", "platlib", "data"):
         root = Path(sysconfig.get_paths()[key])
         candidates += [root / "cmeel.prefix/share/example-robot-data", root / "share/example-robot-data"]
-    try:  # newer example-robot-data ships a small python helper exposing its data dir
-        import example_robot_data  # type: ignore[import-not-found]
-
-        candidates.insert(0, Path(example_robot_data.getModelPath(URDF_RELATIVE)))
-    except Exception:  # noqa: BLE001 - absent or old helper: fall back to the known layout
-        pass
     for cand in candidates:
         if (cand / URDF_RELATIVE).is_file():
             return cand
