@@ -3,7 +3,8 @@ pinocchio and MuJoCo models built from it. Nothing is downloaded at run time.
 
 MuJoCo gets the same URDF through MjSpec, then what a URDF cannot say: a free joint on the
 pelvis, armature and motors from g1.py, an IMU site, a floor, and collisions restricted to
-robot-vs-floor (the G1 URDF's feet are four small spheres each, as in Menagerie).
+robot-vs-floor (the G1 URDF's feet are four small spheres each, as in Menagerie; the other
+collision meshes only matter once the robot is down).
 """
 
 from __future__ import annotations
@@ -98,15 +99,16 @@ def mujoco_spec(floor: bool = True, timestep_s: float = 0.005):
         motor.ctrlrange = [-limit, limit]
         motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
 
-    # Collisions: robot geoms touch the floor only (contype 0 / conaffinity 1 vs floor 1 / 0).
+    # Collisions: robot geoms touch the floor only (contype 0 / conaffinity 1 vs floor 1 / 0), so a
+    # fallen robot lies on the floor instead of sinking through it. The URDF importer marks visual
+    # geoms group 1 without contacts; collision geoms go to group 3 (hidden: they repeat the visuals).
     for geom in spec.geoms:
-        if geom.type == mujoco.mjtGeom.mjGEOM_MESH:
-            geom.contype, geom.conaffinity = 0, 0
-            geom.group = 2
-        else:
-            geom.contype, geom.conaffinity = 0, 1
-            geom.condim = 3
-            geom.friction = [1.0, 0.005, 0.0001]
+        if geom.contype == 0 and geom.conaffinity == 0:
+            continue  # visual
+        geom.contype, geom.conaffinity = 0, 1
+        geom.condim = 3
+        geom.friction = [1.0, 0.005, 0.0001]
+        geom.group = 3
 
     pelvis.add_site(name="imu", pos=[0.0, 0.0, 0.0])
     spec.add_sensor(name="imu_gyro", type=mujoco.mjtSensor.mjSENS_GYRO,
