@@ -19,10 +19,12 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from g1_control.errors import LaunchFileError
 from g1_control.generator.velocity import CopyRetargeter, VelocityReferenceGenerator
 from g1_control.launch.schema import LaunchFile, Segment
 from g1_control.loop.control_loop import ControlLoop, LoopRates
 from g1_control.launch.inputs import make_input
+from g1_control.safety import SafetyConfig, SafetyFilter
 from g1_control.teleop.scripted import random_timeline
 
 STEADY_STATE_SKIP_S = 2.0
@@ -91,6 +93,12 @@ def segments_from_log(log: dict[str, np.ndarray], min_s: float = 1.0) -> list[Se
     return out
 
 
+def safety_config(launch: LaunchFile) -> SafetyConfig:
+    """The launch file's safety section, with limits.max_tilt_rad as a further cap on the tilt."""
+    return dataclasses.replace(launch.safety, max_tilt_rad=min(launch.safety.max_tilt_rad,
+                                                               launch.limits.max_tilt_rad))
+
+
 def build_loop(launch: LaunchFile, segments: list[Segment]) -> ControlLoop:
     from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
     from g1_control.trackers.locomotion import LocomotionPolicyTracker, VelocityCorrectionConfig
@@ -109,7 +117,7 @@ def build_loop(launch: LaunchFile, segments: list[Segment]) -> ControlLoop:
         backend, device, VelocityReferenceGenerator(lim.max_vx_mps, lim.max_vy_mps, lim.max_wz_radps),
         CopyRetargeter(), tracker,
         LoopRates(r.lowlevel_hz, r.tracker_hz, r.input_hz, r.estimator_hz),
-        wallclock=wallclock, max_tilt_rad=lim.max_tilt_rad,
+        wallclock=wallclock, safety=SafetyFilter(safety_config(launch)),
         log_capacity=int(launch.total_duration_s * r.tracker_hz) + 2,
     )
     loop_box.append(loop)
@@ -138,6 +146,9 @@ def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentR
 def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None = None,
         progress: bool = True, viewer: bool = False) -> RunResult:
     """Run `launch` to the end (or a fall); write the run folder when `out_root` is given."""
+    if launch.backend.type != "mujoco":
+        raise LaunchFileError(f"launch file '{launch.name}' drives a robot (backend.type {launch.backend.type}); "
+                              "run it with `g1 deploy`, which checks the robot before anything moves")
     segments = timeline_of(launch)
     loop = build_loop(launch, segments)
     loop.reset()

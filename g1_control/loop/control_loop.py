@@ -207,6 +207,10 @@ class ControlLoop:
         self._tracker_command = self.tracker.act(self._joint_ref, state)
 
     def _safety(self) -> None:
+        # Robot links count states dropped for a bad CRC; a burst of them trips the filter.
+        bad_crc = getattr(self.backend, "bad_crc", None)
+        if bad_crc is not None:
+            self.safety.report_crc_errors(bad_crc, self.now_s())
         if self.scheduler.wallclock:
             self.safety.report_deadline(self.scheduler.deadline_misses > self._misses_seen, self.now_s())
             self._misses_seen = self.scheduler.deadline_misses
