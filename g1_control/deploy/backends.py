@@ -56,9 +56,9 @@ def _serial_ports() -> list[str]:
 
 def open_robot_backend(config: BackendConfig, *, damping_kd: float = 2.0, release_motion_service: bool | None = None):
     """The host side of the robot link `config` describes (a LinkBackend; threads running, silent)."""
-    common = dict(command_rate_hz=config.command_rate_hz, mode_pr=config.mode_pr,
-                  expected_mode_machine=expected_mode_machine(config), connect_timeout_s=config.connect_timeout_s,
-                  damping_kd=damping_kd)
+    common = {"command_rate_hz": config.command_rate_hz, "mode_pr": config.mode_pr,
+              "expected_mode_machine": expected_mode_machine(config), "connect_timeout_s": config.connect_timeout_s,
+              "damping_kd": damping_kd}
     if config.type == "unitree_dds":
         from g1_control.hardware.dds_backend import UnitreeDDSBackend
 

@@ -258,7 +258,8 @@ class Preflight:
                 f"file's rates ({result.wall_s:.1f} s wall)" + (f"; {moved}" if moved else ""))
         if result.fell:
             trip = next((e for e in result.events if e["kind"] == "tilt"), None)
-            return self.record("dry_run", FAIL, f"FELL in simulation{' at %.1f s' % trip['t_s'] if trip else ''}: "
+            when = f" at {trip['t_s']:.1f} s" if trip else ""
+            return self.record("dry_run", FAIL, f"FELL in simulation{when}: "
                                f"{what}; do not run this policy/launch file on the robot")
         faults = [e for e in result.events if "damping" in e["detail"]]
         if faults:

@@ -164,10 +164,9 @@ class DeployTracker(Tracker):
                 self.policy.reset(state)
                 self.control_started_s = now
                 self._go(DeployState.CONTROL, "operator run" if "run" in pressed else "run (--yes)", now)
-        elif self.state == DeployState.CONTROL:
-            if self.control_s is not None and in_state >= self.control_s:
-                self.safety.estop(f"control time over ({self.control_s:.1f} s, launch duration_s)", now)
-                self._go(DeployState.DAMPING, f"control time over ({self.control_s:.1f} s)", now)
+        elif self.state == DeployState.CONTROL and self.control_s is not None and in_state >= self.control_s:
+            self.safety.estop(f"control time over ({self.control_s:.1f} s, launch duration_s)", now)
+            self._go(DeployState.DAMPING, f"control time over ({self.control_s:.1f} s)", now)
 
     def act(self, reference: JointReference, state: RobotState) -> MotorCommand:
         now = self.clock()

@@ -21,9 +21,9 @@ import yaml
 
 from g1_control.errors import LaunchFileError
 from g1_control.generator.velocity import CopyRetargeter, VelocityReferenceGenerator
+from g1_control.launch.inputs import make_input
 from g1_control.launch.schema import LaunchFile, Segment
 from g1_control.loop.control_loop import ControlLoop, LoopRates
-from g1_control.launch.inputs import make_input
 from g1_control.safety import SafetyConfig, SafetyFilter
 from g1_control.teleop.scripted import random_timeline
 

@@ -15,7 +15,6 @@ from g1_control.config import from_dict
 from g1_control.errors import LaunchFileError, SafetyConfigError
 from g1_control.safety.config import SafetyConfig
 
-
 ROBOT_BACKENDS = ("unitree_dds", "can", "serial")
 """Backends that drive a robot (real, or `g1 sim-robot`) through a robot link; `g1 deploy` runs them."""
 
