@@ -1,7 +1,7 @@
 """The deploy state machine, as the Tracker of the control loop (so every command it makes still
 passes the loop's SafetyFilter):
 
-    zero_torque --start--> ramp (to the policy's default pose, >= 2 s) --> hold --run--> control
+    zero_torque --start--> ramp (to the policy's default pose, >= 2 s) --> hold (>= min_hold_s) --run--> control
          any state --stop / e-stop / damp / safety trip / signal / exit--> damping (for good)
 
 Operator buttons come from the launch file's input device (Unitree remote: start, A = run,
@@ -100,6 +100,7 @@ class DeployTracker(Tracker):
         self._pose = MotorCommand(q_rad=self.default_q_rad.copy(), kp=np.asarray(kp, float).copy(),
                                   kd=np.asarray(kd, float).copy())
         self._ramp_from = self.default_q_rad.copy()
+        self._run_requested = False
         self.ignored: list[str] = []
 
     # The loop feeds the estimator's velocity to the tracker and logs the policy's command.
@@ -160,10 +161,12 @@ class DeployTracker(Tracker):
             elif "run" in pressed:
                 self.ignored.append("run ignored during the ramp: wait for hold")
         elif self.state == DeployState.HOLD:
-            if "run" in pressed or (self.auto and in_state >= cfg.auto_run_s):
+            # A run pressed early waits for min_hold_s: the robot settles on the pose before the policy.
+            self._run_requested |= "run" in pressed
+            if in_state >= cfg.min_hold_s and (self._run_requested or (self.auto and in_state >= cfg.auto_run_s)):
                 self.policy.reset(state)
                 self.control_started_s = now
-                self._go(DeployState.CONTROL, "operator run" if "run" in pressed else "run (--yes)", now)
+                self._go(DeployState.CONTROL, "operator run" if self._run_requested else "run (--yes)", now)
         elif self.state == DeployState.CONTROL and self.control_s is not None and in_state >= self.control_s:
             self.safety.estop(f"control time over ({self.control_s:.1f} s, launch duration_s)", now)
             self._go(DeployState.DAMPING, f"control time over ({self.control_s:.1f} s)", now)

@@ -87,6 +87,8 @@ class DeployConfig:
     """With --yes: time in zero torque before start is answered."""
     auto_run_s: float = 1.0
     """With --yes: time holding the default pose before run is answered."""
+    min_hold_s: float = 0.5
+    """The default pose is held at least this long before the policy starts (an earlier run waits)."""
     exit_damping_s: float = 1.0
     """Damping keeps streaming this long before the program exits."""
     min_state_rate_hz: float = 400.0
@@ -111,7 +113,7 @@ class DeployConfig:
                                   "at least 2 s")
         if self.dry_run_s < 10.0:
             raise LaunchFileError(f"{where}.dry_run_s: {self.dry_run_s} s; the simulated dry run lasts at least 10 s")
-        for name in ("auto_start_s", "auto_run_s", "exit_damping_s", "state_window_s", "input_check_s"):
+        for name in ("auto_start_s", "auto_run_s", "min_hold_s", "exit_damping_s", "state_window_s", "input_check_s"):
             if getattr(self, name) < 0 or (name in ("state_window_s", "input_check_s") and getattr(self, name) == 0):
                 raise LaunchFileError(f"{where}.{name}: must be positive, got {getattr(self, name)}")
         if self.min_state_rate_hz <= 0 or self.max_start_tilt_rad <= 0 or self.joint_limit_tolerance_rad < 0:

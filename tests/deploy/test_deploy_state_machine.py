@@ -96,9 +96,16 @@ def test_operator_sequence_zero_torque_ramp_hold_control_then_stop_damps():
     assert 2.0 <= hold - ramp <= 2.05, "the ramp takes ramp_s (>= 2 s), no less"
     np.testing.assert_allclose(cmd.q_rad, g1.DEFAULT_Q_RAD)
 
-    _press(device, buttons, "run")
+    _press(device, buttons, "run")  # pressed at once: waits until the pose was held min_hold_s
     cmd = _act(tracker, clock)
+    assert tracker.state == DeployState.HOLD
+    hold_ticks = 1
+    while tracker.state == DeployState.HOLD and hold_ticks < 100:
+        cmd = _act(tracker, clock)
+        hold_ticks += 1
     assert tracker.state == DeployState.CONTROL and policy.resets == 1
+    assert tracker.transitions[-1].t_s - tracker.transitions[-2].t_s == pytest.approx(0.5, abs=0.021)
+    assert tracker.transitions[-1].reason == "operator run"
     assert np.all(cmd.q_rad == 0.123), "the policy's command goes out in control"
     assert tracker.control_elapsed_s() == 0.0
     _act(tracker, clock, dt=1.0)
@@ -160,7 +167,8 @@ def test_a_safety_trip_in_any_state_ends_in_damping(state_before):
         for _ in range(120):
             _act(tracker, clock)
         _press(device, buttons, "run")
-        _act(tracker, clock)
+        for _ in range(30):
+            _act(tracker, clock)
     assert tracker.state == state_before
     tilted = _state()
     tilted.t_s = clock.t
@@ -206,6 +214,8 @@ def test_unitree_remote_buttons_drive_the_machine():
         tick()
     assert tracker.state == DeployState.HOLD
     tick("A")
+    for _ in range(25):  # min_hold_s 0.5 s
+        tick()
     assert tracker.state == DeployState.CONTROL
     tick()
     tick("L1", "R1")  # e-stop chord
