@@ -219,3 +219,17 @@ def test_unknown_override_name_is_refused():
 
     with pytest.raises(G1ControlError, match="--override temperature: no such check; checks: launch_file, "):
         Preflight(frozenset({"temperature"}))
+
+
+def test_a_dry_run_that_falls_refuses(tmp_path):
+    """A fall in the simulated dry run (here: a tilt limit no walking robot can keep) fails the check."""
+    from g1_control.deploy.preflight import Preflight
+    from g1_control.launch.schema import load_launch
+
+    launch = load_launch(write_launch(tmp_path, {"limits": {"max_tilt_rad": 0.01}}))
+    pf = Preflight()
+    assert not pf.check_dry_run(launch)
+    reason = pf.results["dry_run"].reason
+    assert reason.startswith("FELL in simulation at ") and reason.endswith("do not run this policy/launch file on "
+                                                                         "the robot")
+    assert pf.dry_run.fell

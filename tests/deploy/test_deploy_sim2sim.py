@@ -17,7 +17,6 @@ import threading
 import time
 
 import pytest
-
 from deploy_test_helpers import ROOT, write_launch
 
 ENV = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
