@@ -8,8 +8,8 @@ import os
 import uuid
 
 import pytest
-
 from deploy_test_helpers import write_launch
+
 from g1_control.deploy.backends import check_link_endpoint, open_robot_backend
 from g1_control.deploy.session import DeployOptions, deploy
 from g1_control.errors import TransportError
