@@ -227,7 +227,8 @@ def _control(launch: LaunchFile, spec, backend, device, options: DeployOptions, 
         exit_s = launch.deploy.exit_damping_s
 
         def finished() -> bool:
-            return tracker.state == DeployState.DAMPING and time.monotonic() - tracker.entered_s >= exit_s
+            now = time.monotonic()
+            return tracker.observe_safety(now) and now - tracker.entered_s >= exit_s
 
         t_loop0 = time.monotonic()
         loop.scheduler.run(1 << 40, stop=finished)

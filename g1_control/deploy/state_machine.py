@@ -134,14 +134,18 @@ class DeployTracker(Tracker):
         if self.on_transition is not None:
             self.on_transition(transition)
 
+    def observe_safety(self, now: float) -> bool:
+        """Enter damping if the safety layer tripped; True once in damping. The loop stops calling
+        act() after a trip (it sends damping itself), so its driver calls this every tick."""
+        if self.state != DeployState.DAMPING and self.safety.tripped:
+            trip = self.safety.trip_event
+            self._go(DeployState.DAMPING, f"{trip.kind.value}: {trip.detail}", now)
+        return self.state == DeployState.DAMPING
+
     def _step_machine(self, state: RobotState, now: float) -> None:
         if self.entered_s is None:
             self.entered_s = now
-        if self.state == DeployState.DAMPING:
-            return
-        if self.safety.tripped:
-            trip = self.safety.trip_event
-            self._go(DeployState.DAMPING, f"{trip.kind.value}: {trip.detail}", now)
+        if self.observe_safety(now):
             return
         pressed = self.buttons.take() if self.buttons is not None else frozenset()
         in_state = now - self.entered_s

@@ -233,3 +233,17 @@ def test_a_dry_run_that_falls_refuses(tmp_path):
     assert reason.startswith("FELL in simulation at ") and reason.endswith("do not run this policy/launch file on "
                                                                          "the robot")
     assert pf.dry_run.fell
+
+
+def test_robot_launch_file_names_no_interface_until_the_operator_does(tmp_path, partition, mock_robot):
+    """launch/robot.yaml refuses to guess a NIC; pointed at an emulated robot on lo it passes."""
+    from deploy_test_helpers import ROOT
+
+    report, refused, _ = _preflight(ROOT / "launch" / "robot.yaml", partition)
+    assert refused is not None
+    assert "network interface 'CHANGE_ME' does not exist" in _reason(report, "interface")
+    mock_robot().start()
+    fast = write_launch(tmp_path, FAST, base=ROOT / "launch" / "robot.yaml")
+    report, refused, text = _preflight(fast, partition, interface="lo", domain=1)
+    assert refused is None, text
+    assert _reason(report, "estop_input") == "unitree_remote answering; e-stop on L1+R1"

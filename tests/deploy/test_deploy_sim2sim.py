@@ -31,11 +31,18 @@ class Proc:
                                      stderr=subprocess.PIPE, text=True, bufsize=1)
         self.lines: queue.Queue[str] = queue.Queue()
         self.seen: list[str] = []
+        self.errors: list[str] = []
         threading.Thread(target=self._pump, daemon=True).start()
+        # stderr is drained too: a full pipe would block the process on its next log line.
+        threading.Thread(target=lambda: self.errors.extend(self.proc.stderr), daemon=True).start()
 
     def _pump(self) -> None:
         for line in self.proc.stdout:
             self.lines.put(line.rstrip("\n"))
+
+    @property
+    def stderr(self) -> str:
+        return "".join(self.errors)
 
     def wait_for(self, pattern: str, timeout_s: float) -> str:
         deadline = time.monotonic() + timeout_s
@@ -50,7 +57,7 @@ class Proc:
             if re.search(pattern, line):
                 return line
         raise AssertionError(f"no line matching {pattern!r} within {timeout_s} s; got:\n" + "\n".join(self.seen)
-                             + "\nstderr:\n" + (self.proc.stderr.read() if self.proc.poll() is not None else ""))
+                             + "\nstderr:\n" + self.stderr)
 
     def kill(self) -> None:
         if self.proc.poll() is None:
@@ -95,7 +102,7 @@ def test_sim2sim_walks_forward_and_ends_in_damping(tmp_path, partition, processe
     processes.append(host)
     host.wait_for(r"zero torque: the robot is limp", 90)
     host.wait_for(r"control -> damping: control time over", 60)
-    assert host.proc.wait(timeout=30) == 0, host.proc.stderr.read()
+    assert host.proc.wait(timeout=30) == 0, host.stderr
     report = json.loads(report_path.read_text())
     wire = robot.ask("report")
 
@@ -148,7 +155,7 @@ def test_operator_drives_with_the_unitree_remote_and_stops_with_b(tmp_path, part
     robot.ask("stick ly 0.0")
     robot.ask("press B")
     host.wait_for(r"control -> damping: operator stop", 10)
-    assert host.proc.wait(timeout=30) == 0, host.proc.stderr.read()
+    assert host.proc.wait(timeout=30) == 0, host.stderr
     wire = robot.ask("report")
     assert wire["first_damping_base_pos_w_m"][0] - wire["gantry_lowered_base_pos_w_m"][0] > 0.8
     assert wire["first_damping_base_pos_w_m"][2] > 0.6 and wire["last_command_is_damping"] is True
@@ -174,3 +181,25 @@ def test_sigterm_during_control_puts_damping_on_the_wire(partition, processes):
     print(f"\nSIGTERM -> first damping LowCmd_ at the robot: {to_wire_ms:.1f} ms")
     assert 0 < to_wire_ms < 100, "damping reaches the robot within a few ticks of the signal"
     assert wire["last_command_is_damping"] is True and wire["damping_commands"] > 200
+
+
+def test_a_fault_during_control_damps_and_exits_3_in_debug_mode(partition, processes):
+    """Robot already in debug mode (no built-in controller, --no-release-motion-service); the robot
+    reports a 1.3 rad tilt during control: the deploy trips, damping reaches the robot, exit 3."""
+    robot = Emulator(partition, "--physics", "mock", "--no-builtin")
+    processes.append(robot)
+    host = Proc("deploy", "launch/sim2sim.yaml", "--yes", "--no-release-motion-service", "--partition", partition,
+                "--duration", "60")
+    processes.append(host)
+    line = host.wait_for(r"zero torque: the robot is limp", 90)
+    assert not any("releasing the robot's built-in motion service" in s for s in host.seen), line
+    host.wait_for(r"hold -> control", 30)
+    time.sleep(0.3)
+    t_inject = robot.ask("tilt")["t_s"]
+    host.wait_for(r"control -> damping: tilt: pelvis tilted 1.30 rad", 10)
+    assert host.proc.wait(timeout=30) == 3, "a safety fault ends the deploy with exit status 3"
+    wire = robot.ask("report")
+    to_wire_ms = (wire["first_damping_time_s"] - t_inject) * 1000
+    print(f"\ntilt injected -> first damping LowCmd_ at the robot: {to_wire_ms:.1f} ms")
+    assert 0 < to_wire_ms < 200, "tilt seen within a few 50 Hz ticks, damping on the wire right after"
+    assert wire["last_command_is_damping"] is True and wire["ignored_while_builtin_active"] == 0

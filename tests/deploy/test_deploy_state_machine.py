@@ -222,3 +222,13 @@ def test_unitree_remote_buttons_drive_the_machine():
     tick()
     assert tracker.state == DeployState.DAMPING
     assert safety.trip_event.detail == "e-stop pressed on the operator input"
+
+
+def test_a_trip_the_loop_handled_alone_is_observed_without_act():
+    """After a trip the control loop stops calling the tracker; its driver still sees the damping."""
+    tracker, clock, safety, _, _, _ = _machine()
+    _act(tracker, clock)
+    safety.estop("e-stop pressed on the operator input", clock.t)
+    assert tracker.observe_safety(clock.t + 0.01)
+    assert tracker.state == DeployState.DAMPING
+    assert tracker.transitions[-1].reason == "estop: e-stop pressed on the operator input"
