@@ -164,31 +164,34 @@ def test_operator_drives_with_the_unitree_remote_and_stops_with_b(tmp_path, part
     assert report["end_reason"] == "operator stop" and not report["fault"]
 
 
-def test_sigterm_during_control_puts_damping_on_the_wire(partition, processes):
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGINT"])
+def test_a_signal_during_control_puts_damping_on_the_wire(tmp_path, partition, processes, sig):
     robot = Emulator(partition, "--physics", "mock")
     processes.append(robot)
-    host = Proc("deploy", "launch/sim2sim.yaml", "--yes", "--partition", partition, "--duration", "60")
+    launch = write_launch(tmp_path, {"deploy": {"state_window_s": 0.3}})
+    host = Proc("deploy", str(launch), "--yes", "--partition", partition, "--duration", "60")
     processes.append(host)
     host.wait_for(r"hold -> control: run \(--yes\)", 90)
     time.sleep(0.5)
     assert robot.ask("report")["damping_commands"] == 0
     t_signal = time.monotonic()
-    host.proc.send_signal(signal.SIGTERM)
-    host.wait_for(r"control -> damping: estop: SIGTERM received", 10)
-    assert host.proc.wait(timeout=30) == 0
+    host.proc.send_signal(getattr(signal, sig))
+    host.wait_for(rf"control -> damping: estop: {sig} received", 10)
+    assert host.proc.wait(timeout=30) == 0, "a signal is a planned ending (damping first)"
     wire = robot.ask("report")
     to_wire_ms = (wire["first_damping_time_s"] - t_signal) * 1000
-    print(f"\nSIGTERM -> first damping LowCmd_ at the robot: {to_wire_ms:.1f} ms")
+    print(f"\n{sig} -> first damping LowCmd_ at the robot: {to_wire_ms:.1f} ms")
     assert 0 < to_wire_ms < 100, "damping reaches the robot within a few ticks of the signal"
     assert wire["last_command_is_damping"] is True and wire["damping_commands"] > 200
 
 
-def test_a_fault_during_control_damps_and_exits_3_in_debug_mode(partition, processes):
+def test_a_fault_during_control_damps_and_exits_3_in_debug_mode(tmp_path, partition, processes):
     """Robot already in debug mode (no built-in controller, --no-release-motion-service); the robot
     reports a 1.3 rad tilt during control: the deploy trips, damping reaches the robot, exit 3."""
     robot = Emulator(partition, "--physics", "mock", "--no-builtin")
     processes.append(robot)
-    host = Proc("deploy", "launch/sim2sim.yaml", "--yes", "--no-release-motion-service", "--partition", partition,
+    launch = write_launch(tmp_path, {"deploy": {"state_window_s": 0.3}})
+    host = Proc("deploy", str(launch), "--yes", "--no-release-motion-service", "--partition", partition,
                 "--duration", "60")
     processes.append(host)
     line = host.wait_for(r"zero torque: the robot is limp", 90)
