@@ -25,8 +25,8 @@ Bring a G1 (or `g1 sim-robot`) under the control loop a launch file describes, s
    time or an error -> damping (kp 0, kd > 0), streamed continuously until the program exits.
    Unitree remote: start = start, A = run, B = stop, L1+R1 = e-stop, select = damp.
    Gamepad: start / A / B, LB+RB = e-stop. Keyboard: Enter / r / o, Esc = e-stop.
-   --yes answers start and run automatically (unattended sim2sim only: keep a hand on the
-   e-stop on a real robot, or better, do not use it there).
+   --yes answers start and run automatically: unattended sim2sim only, refused unless the link
+   is `g1 sim-robot` on lo (or a virtual CAN bus).
 
 Exit status: 0 ended as planned (stop, control time over, signal); 1 refused or error; 3 a
 safety fault or e-stop ended the run.
@@ -53,7 +53,7 @@ def register(subparsers) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("file", type=Path, help="launch file with a robot backend (unitree_dds, can or serial)")
     parser.add_argument("--yes", action="store_true",
-                        help="answer start and run automatically once the preflight passed (unattended sim2sim)")
+                        help="answer start and run automatically once the preflight passed (sim2sim on lo only)")
     parser.add_argument("--override", action="append", default=[], metavar="CHECK", choices=list(CHECKS),
                         help="let a failed preflight check pass (repeatable; printed and logged loudly)")
     parser.add_argument("--no-release-motion-service", dest="release", action="store_false", default=None,

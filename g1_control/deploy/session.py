@@ -23,6 +23,7 @@ from pathlib import Path
 from g1_control.deploy.preflight import CHECKS, FAIL, Preflight
 from g1_control.deploy.state_machine import DeployState, DeployTracker, OperatorButtons, Transition
 from g1_control.errors import G1ControlError, LaunchFileError
+from g1_control.hardware.network import LOOPBACK
 from g1_control.launch.schema import LaunchFile
 
 log = logging.getLogger("g1_control.deploy")
@@ -89,6 +90,10 @@ def _apply_cli(launch: LaunchFile, options: DeployOptions) -> None:
     if options.release_motion_service is not None:
         b.release_motion_service = options.release_motion_service
     b.validate("backend")
+    simulated = (b.type == "unitree_dds" and b.interface == LOOPBACK) or (b.type == "can" and b.can_interface == "virtual")
+    if options.yes and not simulated:
+        raise LaunchFileError("--yes answers start and run with nobody watching; it is only for g1 sim-robot on "
+                              f"'{LOOPBACK}' (or a virtual CAN bus). On a robot the operator presses start and run")
 
 
 def _open_input(launch: LaunchFile, backend, command_ranges, scripted_clock: Callable[[], float]):
@@ -214,6 +219,7 @@ def _control(launch: LaunchFile, spec, backend, device, options: DeployOptions, 
 
     previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     error: BaseException | None = None
+    t_loop0 = time.monotonic()
     try:
         if getattr(backend, "release_motion_service", False):
             say("releasing the robot's built-in motion service ...")
@@ -245,7 +251,7 @@ def _control(launch: LaunchFile, spec, backend, device, options: DeployOptions, 
             time.sleep(launch.deploy.exit_damping_s)  # damping keeps streaming before the link closes
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-    _fill_report(report, loop, tracker, backend, safety, t_loop0 if "t_loop0" in locals() else t_start)
+    _fill_report(report, loop, tracker, backend, safety, t_loop0)
     _print_summary(report, say)
     if error is not None:
         raise error

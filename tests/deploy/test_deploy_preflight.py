@@ -247,3 +247,10 @@ def test_robot_launch_file_names_no_interface_until_the_operator_does(tmp_path, 
     report, refused, text = _preflight(fast, partition, interface="lo", domain=1)
     assert refused is None, text
     assert _reason(report, "estop_input") == "unitree_remote answering; e-stop on L1+R1"
+
+
+def test_yes_is_refused_off_loopback(tmp_path, partition):
+    report, refused, _ = _preflight(write_launch(tmp_path, FAST), partition, interface="eth9", yes=True)
+    assert refused is not None and _status(report)["interface"] == "not run"
+    assert "--yes answers start and run with nobody watching; it is only for g1 sim-robot on 'lo'" \
+        in _reason(report, "launch_file")
