@@ -16,6 +16,7 @@ import json
 import sys
 import threading
 import time
+from collections import deque
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -53,6 +54,10 @@ class RobotEndpoint:
         self.last_command_time_s = float("nan")
         self.first_damping_time_s = float("nan")
         """time.monotonic() of the first damping command applied since the last mark_faults_clear()."""
+        self.first_damping_base_pos_w_m: list[float] | None = None
+        """Simulated base position when that damping command arrived (None on MockG1)."""
+        self.command_times: deque[float] = deque(maxlen=60_000)
+        """time.monotonic() of every valid LowCmd_ taken off the link (two minutes at 500 Hz)."""
         self.builtin_active = False
         """While True (the built-in controller runs), valid commands are ignored, as on the robot, and
         the physics is paused at its standing pose (Unitree's controller itself is not emulated)."""
@@ -105,7 +110,9 @@ class RobotEndpoint:
             except MalformedMessageError:
                 self.counters.malformed += 1
                 continue
-            if msg.mode_machine != self.physics.read_state().mode_machine:
+            self.command_times.append(time.monotonic())
+            state = self.physics.read_state()
+            if msg.mode_machine != state.mode_machine:
                 self.counters.wrong_mode_machine += 1
                 continue
             if self.builtin_active:
@@ -117,10 +124,26 @@ class RobotEndpoint:
                 self.counters.damping_commands += 1
                 if self.first_damping_time_s != self.first_damping_time_s:  # still NaN
                     self.first_damping_time_s = time.monotonic()
+                    pos = state.base_pos_w_m
+                    self.first_damping_base_pos_w_m = None if pos is None else [float(v) for v in pos]
             self.physics.write_command(command)
             self.last_command = msg
             self.last_command_time_s = time.monotonic()
             self.counters.commands_applied += 1
+
+    def command_wire_stats(self, window_s: float | None = None) -> dict:
+        """Rate and period percentiles of the LowCmd_ stream as this end took it off the link (the
+        robot's view of the host's 500 Hz stream: sender jitter + transport + this loop's wake-ups)."""
+        times = np.array(self.command_times)
+        if window_s is not None and times.size:
+            times = times[times >= times[-1] - window_s]
+        if times.size < 3:
+            return {"lowcmd_count": int(times.size)}
+        periods = np.diff(times)
+        p50, p99 = np.percentile(periods, [50, 99])
+        return {"lowcmd_count": int(times.size), "lowcmd_rate_hz": float((times.size - 1) / (times[-1] - times[0])),
+                "lowcmd_period_p50_ms": float(p50 * 1e3), "lowcmd_period_p99_ms": float(p99 * 1e3),
+                "lowcmd_period_max_ms": float(periods.max() * 1e3), "lowcmd_window_s": float(times[-1] - times[0])}
 
     def mark_faults_clear(self) -> None:
         """Clear every fault switch and forget the last damping time (start of a fault trial)."""

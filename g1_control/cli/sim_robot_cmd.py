@@ -18,7 +18,8 @@ def register(subparsers) -> None:
         "it with the same interface and domain (e.g. `g1 deploy launch/sim2sim.yaml`).",
         epilog="examples:\n  g1 sim-robot                      # lo, domain 1, until Ctrl-C\n"
         "  g1 sim-robot --seconds 30 --physics mock\n"
-        "  g1 sim-robot --control-stdin      # faults by name on stdin (test harnesses)",
+        "  g1 sim-robot --control-stdin      # faults / remote buttons by name on stdin (test harnesses)\n"
+        "  g1 sim-robot --lower-gantry-on-policy   # sim2sim with g1 deploy launch/sim2sim.yaml --yes",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--interface", default="lo", help="network interface; loopback only (default lo)")
@@ -29,12 +30,17 @@ def register(subparsers) -> None:
     parser.add_argument("--gantry", action="store_true",
                         help="hang the MuJoCo robot from an elastic band (first-run practice; a plain PD hold "
                         "falls without it)")
+    parser.add_argument("--lower-gantry-on-policy", action="store_true",
+                        help="hang the robot on the gantry (as --gantry) and lower it when the policy takes over: "
+                        "when stiff leg targets held still for 0.3 s (the deploy's hold) start to move. For sim2sim "
+                        "with `g1 deploy`, whose zero-torque/ramp/hold phases need the gantry")
     parser.add_argument("--mode-machine", type=int, default=5, help="variant to report with --physics mock (4/5/6)")
     parser.add_argument("--no-builtin", action="store_true",
                         help="start with no built-in controller (as after debug mode on the remote)")
     parser.add_argument("--seconds", type=float, help="stop after this long (default: until Ctrl-C)")
     parser.add_argument("--control-stdin", action="store_true",
-                        help="read fault names from stdin, answer JSON lines (see hardware/emulator.py)")
+                        help="read fault names and remote commands ('press start', 'press A', 'stick ly 0.5', "
+                        "'press L1+R1') from stdin, answer JSON lines (see hardware/emulator.py)")
     parser.set_defaults(func=_run)
 
 
@@ -45,10 +51,11 @@ def _run(args) -> int:
         from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
 
         physics = MujocoBackend(MujocoConfig(lockstep=True))
-        if args.gantry:
+        if args.gantry or args.lower_gantry_on_policy:
             from g1_control.hardware.emulator import Gantry
 
-            physics = Gantry(physics, physics_dt_s=physics.config.physics_dt_s)
+            physics = Gantry(physics, physics_dt_s=physics.config.physics_dt_s,
+                             lower_on_policy=args.lower_gantry_on_policy)
     else:
         from g1_control.hardware.mock_robot import MockG1
 

@@ -19,10 +19,12 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from g1_control.errors import LaunchFileError
 from g1_control.generator.velocity import CopyRetargeter, VelocityReferenceGenerator
 from g1_control.launch.inputs import make_input
 from g1_control.launch.schema import LaunchFile, Segment
 from g1_control.loop.control_loop import ControlLoop
+from g1_control.safety import SafetyConfig, SafetyFilter
 from g1_control.teleop.scripted import random_timeline
 
 STEADY_STATE_SKIP_S = 2.0
@@ -91,6 +93,12 @@ def segments_from_log(log: dict[str, np.ndarray], min_s: float = 1.0) -> list[tu
     return out
 
 
+def safety_config(launch: LaunchFile) -> SafetyConfig:
+    """The launch file's safety section, with limits.max_tilt_rad as a further cap on the tilt."""
+    return dataclasses.replace(launch.safety, max_tilt_rad=min(launch.safety.max_tilt_rad,
+                                                               launch.limits.max_tilt_rad))
+
+
 def build_loop(launch: LaunchFile, segments: list[Segment]) -> ControlLoop:
     if launch.tracker.type == "wbc":
         from g1_control.wbc.launch_loop import build_wbc_loop
@@ -113,7 +121,7 @@ def build_loop(launch: LaunchFile, segments: list[Segment]) -> ControlLoop:
         backend, device, VelocityReferenceGenerator(lim.max_vx_mps, lim.max_vy_mps, lim.max_wz_radps),
         CopyRetargeter(), tracker,
         r,
-        wallclock=wallclock, max_tilt_rad=lim.max_tilt_rad,
+        wallclock=wallclock, safety=SafetyFilter(safety_config(launch)),
         log_capacity=int(launch.total_duration_s * r.tracker_hz) + 2,
     )
     loop_box.append(loop)
@@ -142,6 +150,9 @@ def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentR
 def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None = None,
         progress: bool = True, viewer: bool = False) -> RunResult:
     """Run `launch` to the end (or a fall); write the run folder when `out_root` is given."""
+    if launch.backend.type != "mujoco":
+        raise LaunchFileError(f"launch file '{launch.name}' drives a robot (backend.type {launch.backend.type}); "
+                              "run it with `g1 deploy`, which checks the robot before anything moves")
     segments = timeline_of(launch)
     loop = build_loop(launch, segments)
     loop.reset()

@@ -12,20 +12,114 @@ from typing import Any, Literal
 import yaml
 
 from g1_control.config import from_dict
-from g1_control.errors import LaunchFileError
+from g1_control.errors import LaunchFileError, SafetyConfigError
 from g1_control.loop.rates import LoopRates
+from g1_control.safety.config import SafetyConfig
+
+ROBOT_BACKENDS = ("unitree_dds", "can", "serial")
+"""Backends that drive a robot (real, or `g1 sim-robot`) through a robot link; `g1 deploy` runs them."""
+
+VARIANT_NAMES = ("g1_23dof", "g1_29dof", "g1_29dof_locked_waist")
 
 
 @dataclass
 class BackendConfig:
-    type: Literal["mujoco"] = "mujoco"
+    """mujoco: the simulator (g1 launch). unitree_dds / can / serial: a robot link (g1 deploy).
+
+    unitree_dds needs `interface` (the NIC cabled to the robot, or `lo` for `g1 sim-robot`) and
+    `domain` (0 on the robot, 1 in simulation); `partition` only isolates concurrent runs on one
+    host. can needs `can_interface` + `channel` (python-can: socketcan/can0, virtual/NAME); serial
+    needs `port` (+ `baudrate`). `expected_variant` is the G1 the launch file is written for: a
+    robot reporting another mode_machine is refused.
+    """
+
+    type: Literal["mujoco", "unitree_dds", "can", "serial"] = "mujoco"
     mode: Literal["lockstep", "wallclock"] = "lockstep"
     physics_dt_s: float = 0.002
+    interface: str | None = None
+    domain: int = 0
+    partition: str | None = None
+    release_motion_service: bool = True
+    """Release the robot's built-in controller first (false: the operator used the remote's debug mode)."""
+    expected_variant: Literal["g1_23dof", "g1_29dof", "g1_29dof_locked_waist"] = "g1_29dof"
+    connect_timeout_s: float = 3.0
+    command_rate_hz: float = 500.0
+    mode_pr: int = 0
+    can_interface: str | None = None
+    channel: str | None = None
+    can_fd: bool = True
+    port: str | None = None
+    baudrate: int = 921600
 
     def validate(self, where: str) -> None:
         if not 0.0005 <= self.physics_dt_s <= 0.005:
             raise LaunchFileError(f"{where}.physics_dt_s: {self.physics_dt_s} is outside [0.0005, 0.005] s "
                                   "(physics must run at 200 Hz or faster)")
+        if self.type == "mujoco":
+            return
+        if self.type == "unitree_dds":
+            if not self.interface:
+                raise LaunchFileError(f"{where}.interface: a unitree_dds backend must name its network interface "
+                                      "(the NIC on 192.168.123.0/24 for the robot, 'lo' for g1 sim-robot)")
+            if not 0 <= self.domain <= 232:
+                raise LaunchFileError(f"{where}.domain: {self.domain} is not a DDS domain id (0..232; the robot "
+                                      "uses 0, simulation 1)")
+        if self.type == "can" and not (self.can_interface and self.channel):
+            raise LaunchFileError(f"{where}: a can backend needs can_interface and channel "
+                                  "(e.g. socketcan + can0, or virtual + a bus name for tests)")
+        if self.type == "serial" and not self.port:
+            raise LaunchFileError(f"{where}.port: a serial backend needs the port of the bridge (e.g. /dev/ttyUSB0)")
+        if self.mode_pr not in (0, 1):
+            raise LaunchFileError(f"{where}.mode_pr: {self.mode_pr} must be 0 (pitch/roll) or 1 (parallel motors)")
+        if not 50.0 <= self.command_rate_hz <= 1000.0:
+            raise LaunchFileError(f"{where}.command_rate_hz: {self.command_rate_hz} is outside [50, 1000] Hz "
+                                  "(the robot expects a steady stream; Unitree's examples use 500)")
+        if self.connect_timeout_s <= 0:
+            raise LaunchFileError(f"{where}.connect_timeout_s: must be > 0, got {self.connect_timeout_s}")
+
+
+@dataclass
+class DeployConfig:
+    """How `g1 deploy` brings a robot up: preflight thresholds and the state machine's timing."""
+
+    ramp_s: float = 3.0
+    """Zero torque -> default pose over this long (at least 2 s)."""
+    auto_start_s: float = 0.5
+    """With --yes: time in zero torque before start is answered."""
+    auto_run_s: float = 1.0
+    """With --yes: time holding the default pose before run is answered."""
+    min_hold_s: float = 0.5
+    """The default pose is held at least this long before the policy starts (an earlier run waits)."""
+    exit_damping_s: float = 1.0
+    """Damping keeps streaming this long before the program exits."""
+    min_state_rate_hz: float = 400.0
+    state_window_s: float = 1.0
+    """Preflight listens to LowState this long to measure its rate and CRC health."""
+    max_start_tilt_rad: float = 0.3
+    """IMU upright: the pelvis may lean at most this much at start."""
+    joint_limit_tolerance_rad: float = 0.02
+    """Measured joints may sit this far outside their limits (encoder noise at an end stop)."""
+    max_start_temperature_c: float = 70.0
+    """Every motor must be cooler than this to start (the runtime trip is safety.max_motor_temperature_c)."""
+    min_battery_v: float = 40.0
+    """Checked when the transport reports a battery voltage (the G1's LowState_ does not)."""
+    dry_run_s: float = 10.0
+    """Lockstep MuJoCo run of the same launch file before the robot moves; it must not fall."""
+    input_check_s: float = 0.3
+    """The operator input is polled this long and must not be lost."""
+
+    def validate(self, where: str) -> None:
+        if self.ramp_s < 2.0:
+            raise LaunchFileError(f"{where}.ramp_s: {self.ramp_s} s is too fast; ramp to the default pose over "
+                                  "at least 2 s")
+        if self.dry_run_s < 10.0:
+            raise LaunchFileError(f"{where}.dry_run_s: {self.dry_run_s} s; the simulated dry run lasts at least 10 s")
+        for name in ("auto_start_s", "auto_run_s", "min_hold_s", "exit_damping_s", "state_window_s", "input_check_s"):
+            if getattr(self, name) < 0 or (name in ("state_window_s", "input_check_s") and getattr(self, name) == 0):
+                raise LaunchFileError(f"{where}.{name}: must be positive, got {getattr(self, name)}")
+        if self.min_state_rate_hz <= 0 or self.max_start_tilt_rad <= 0 or self.joint_limit_tolerance_rad < 0:
+            raise LaunchFileError(f"{where}: min_state_rate_hz and max_start_tilt_rad must be positive, "
+                                  "joint_limit_tolerance_rad not negative")
 
 
 @dataclass
@@ -132,6 +226,9 @@ class LaunchFile:
     input: InputConfig = field(default_factory=InputConfig)
     limits: LimitsConfig = field(default_factory=LimitsConfig)
     output: OutputConfig = field(default_factory=OutputConfig)
+    safety: SafetyConfig = field(default_factory=SafetyConfig)
+    """Runtime safety thresholds (g1_control.safety.SafetyConfig); limits.max_tilt_rad still caps the tilt."""
+    deploy: DeployConfig = field(default_factory=DeployConfig)
     viewer: bool | Literal["auto"] = "auto"
     """true/false, or auto: open the MuJoCo viewer when a display exists."""
     description: str = ""
@@ -162,6 +259,8 @@ def parse_launch(data, source: str = "<launch>") -> LaunchFile:
         return from_dict(LaunchFile, data, "")
     except LaunchFileError as exc:
         raise LaunchFileError(f"{source}: {exc}") from None
+    except SafetyConfigError as exc:
+        raise LaunchFileError(f"{source}: safety: {exc}") from None
 
 
 def load_launch(path: str | Path) -> LaunchFile:

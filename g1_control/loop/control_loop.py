@@ -193,6 +193,10 @@ class ControlLoop:
         self._tracker_command = self.tracker.act(self._joint_ref, state)
 
     def _safety(self) -> None:
+        # Robot links count states dropped for a bad CRC; a burst of them trips the filter.
+        bad_crc = getattr(self.backend, "bad_crc", None)
+        if bad_crc is not None:
+            self.safety.report_crc_errors(bad_crc, self.now_s())
         # Missed deadlines endanger a robot that runs on its own; a simulator we step just slows down.
         if self.scheduler.wallclock and not self.backend.lockstep:
             self.safety.report_deadline(self.scheduler.deadline_misses > self._misses_seen, self.now_s())

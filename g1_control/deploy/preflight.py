@@ -1,0 +1,320 @@
+"""The preflight checklist of `g1 deploy`: every check runs (so the operator sees everything that
+is wrong at once), the table prints, and any failure refuses to start.
+
+A failed check can be overridden with `--override NAME`; the override is printed in the table,
+logged at ERROR level and recorded in the deploy report. Some failures cannot be overridden,
+because nothing can run safely past them: an invalid launch file or policy, a missing interface,
+no robot state at all, a robot of another DoF variant, an operator input that cannot be opened
+or is lost.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from g1_control.errors import G1ControlError, RobotNotConnectedError, VariantMismatchError
+from g1_control.launch.schema import InputConfig, LaunchFile, Segment
+from g1_control.robot import g1
+from g1_control.safety import tilt_rad
+
+log = logging.getLogger("g1_control.deploy")
+
+CHECKS: dict[str, str] = {
+    "launch_file": "the launch file parses and validates",
+    "policy": "policy metadata fits the G1 (joint order, gains, default pose) and its ONNX file",
+    "interface": "the robot link's network interface (or port) exists and is up",
+    "variant": "the robot's mode_machine is the DoF variant the launch file and policy are for",
+    "state_stream": "LowState arrives at >= deploy.min_state_rate_hz with valid CRCs",
+    "imu_upright": "the pelvis leans less than deploy.max_start_tilt_rad",
+    "joint_limits": "every joint reads inside its limits",
+    "temperatures": "every motor is cooler than deploy.max_start_temperature_c",
+    "battery": "battery voltage above deploy.min_battery_v (when the robot reports it)",
+    "estop_input": "the operator input opens, has an e-stop, and is not lost",
+    "dry_run": "a lockstep MuJoCo run of the same launch file does not fall",
+}
+"""Check name -> what it asserts (the names --override takes)."""
+
+PASS, FAIL, SKIP, NOT_RUN = "pass", "fail", "skip", "not run"
+
+
+class PreflightRefused(G1ControlError):
+    """A preflight check failed and was not overridden: nothing was sent to the robot."""
+
+
+@dataclass
+class CheckResult:
+    name: str
+    status: str
+    reason: str
+    overridable: bool = True
+    overridden: bool = False
+
+    @property
+    def blocks(self) -> bool:
+        return self.status in (FAIL, NOT_RUN) and not self.overridden
+
+
+@dataclass
+class Preflight:
+    overrides: frozenset[str] = frozenset()
+    results: dict[str, CheckResult] = field(default_factory=dict)
+    dry_run: object | None = None
+    """The dry run's RunResult (g1_control.launch.runner), when it ran."""
+
+    def __post_init__(self) -> None:
+        unknown = set(self.overrides) - set(CHECKS)
+        if unknown:
+            raise G1ControlError(f"--override {', '.join(sorted(unknown))}: no such check; checks: {', '.join(CHECKS)}")
+        for name in CHECKS:
+            self.results[name] = CheckResult(name, NOT_RUN, "not run")
+
+    def record(self, name: str, status: str, reason: str, *, overridable: bool = True) -> bool:
+        result = CheckResult(name, status, reason, overridable)
+        if status == FAIL and name in self.overrides:
+            if overridable:
+                result.overridden = True
+                log.error("PREFLIGHT OVERRIDE: check '%s' failed (%s) and is overridden by --override %s",
+                          name, reason, name)
+            else:
+                result.reason += f" (--override {name} refused: this failure cannot be overridden)"
+        self.results[name] = result
+        return status != FAIL
+
+    def not_run(self, names, why: str) -> None:
+        for name in names:
+            if self.results[name].status == NOT_RUN:
+                self.results[name] = CheckResult(name, NOT_RUN, f"not run: {why}")
+
+    # -- the checks ----------------------------------------------------------------------------------
+    def check_launch_file(self, path: Path) -> LaunchFile | None:
+        from g1_control.launch.schema import load_launch
+
+        try:
+            launch = load_launch(path)
+        except G1ControlError as exc:
+            self.record("launch_file", FAIL, str(exc), overridable=False)
+            return None
+        if launch.backend.type == "mujoco":
+            self.record("launch_file", FAIL, f"{path}: backend.type is mujoco; g1 deploy drives a robot link "
+                        "(unitree_dds, can, serial). Simulate with `g1 launch`", overridable=False)
+            return None
+        self.record("launch_file", PASS, f"{path}: {launch.name} ({launch.backend.type}, input {launch.input.type})")
+        return launch
+
+    def check_policy(self, launch: LaunchFile):
+        from g1_control.trackers.policy_spec import load_spec, resolve_spec_path
+
+        try:
+            spec = load_spec(launch.tracker.policy)
+            variant = (yaml.safe_load(resolve_spec_path(launch.tracker.policy).read_text()) or {}).get("variant")
+        except G1ControlError as exc:
+            self.record("policy", FAIL, str(exc), overridable=False)
+            return None, None
+        if variant is not None and variant != launch.backend.expected_variant:
+            self.record("policy", FAIL, f"policy '{spec.name}' is for the {variant} G1 but backend.expected_variant "
+                        f"is {launch.backend.expected_variant}; use a policy made for this robot", overridable=False)
+            return None, variant
+        self.record("policy", PASS, f"{spec.name}: {len(spec.joint_names)} joints in G1 order, gains and default pose "
+                    f"match the robot, ONNX {spec.onnx_path.name}" + (f", for {variant}" if variant else ""))
+        return spec, variant
+
+    def check_interface(self, launch: LaunchFile) -> bool:
+        from g1_control.deploy.backends import check_link_endpoint
+
+        try:
+            what = check_link_endpoint(launch.backend)
+        except G1ControlError as exc:
+            return self.record("interface", FAIL, str(exc), overridable=False)
+        return self.record("interface", PASS, what)
+
+    def check_robot(self, backend, launch: LaunchFile, policy_variant: str | None):
+        """variant, state_stream, imu_upright, joint_limits, temperatures, battery; the state or None."""
+        from g1_control.hardware.conversions import variant_of
+
+        cfg = launch.deploy
+        try:
+            state = backend.wait_for_state(launch.backend.connect_timeout_s)
+        except RobotNotConnectedError as exc:
+            self.record("state_stream", FAIL, str(exc), overridable=False)
+            self.not_run(("variant", "imu_upright", "joint_limits", "temperatures", "battery"), "no robot state")
+            return None
+        # Rate and CRC health over a window, from the transport's own counters.
+        before, t0 = backend.stats(), time.monotonic()
+        time.sleep(cfg.state_window_s)
+        after, elapsed = backend.stats(), time.monotonic() - t0
+        rate = (after.states_received - before.states_received) / elapsed
+        bad, malformed = after.bad_crc - before.bad_crc, after.malformed - before.malformed
+        bad_frames = after.bad_frames - before.bad_frames
+        where = backend.link.describe()
+        detail = (f"{rate:.0f} Hz over {elapsed:.1f} s, {bad} bad CRC, {malformed} malformed"
+                  + (f", {bad_frames} bad frames" if bad_frames else ""))
+        if rate < cfg.min_state_rate_hz:
+            self.record("state_stream", FAIL, f"{detail}; need >= {cfg.min_state_rate_hz:.0f} Hz on {where}: check the "
+                        "cable/switch and that nothing else loads this host")
+        elif bad or malformed or bad_frames:
+            self.record("state_stream", FAIL, f"{detail}; corrupted samples on {where}: check the cable, the switch "
+                        "and that only one robot publishes on this domain")
+        else:
+            self.record("state_stream", PASS, detail)
+        state = backend.read_state()
+
+        try:
+            variant = variant_of(state.mode_machine)
+        except VariantMismatchError as exc:
+            self.record("variant", FAIL, str(exc), overridable=False)
+            variant = None
+        if variant is not None:
+            if variant.name != launch.backend.expected_variant:
+                self.record("variant", FAIL, f"the robot reports mode_machine {state.mode_machine} ({variant.name}, "
+                            f"{variant.num_dof} DoF) but the launch file expects {launch.backend.expected_variant}"
+                            + (f" and the policy is for {policy_variant}" if policy_variant else "")
+                            + "; use a launch file and policy made for this robot", overridable=False)
+            else:
+                self.record("variant", PASS, f"mode_machine {state.mode_machine} ({variant.name}, {variant.num_dof} DoF)")
+        active = variant.active_mask if variant is not None else np.ones(g1.NUM_JOINTS, dtype=bool)
+
+        tilt = tilt_rad(state.imu_quat_wxyz) if np.all(np.isfinite(state.imu_quat_wxyz)) else float("nan")
+        if np.isfinite(tilt) and tilt <= cfg.max_start_tilt_rad:
+            self.record("imu_upright", PASS, f"tilt {tilt:.3f} rad (limit {cfg.max_start_tilt_rad:.2f})")
+        else:
+            self.record("imu_upright", FAIL, f"tilt {tilt:.3f} rad > {cfg.max_start_tilt_rad:.2f}: stand the robot up "
+                        "or hang it on its gantry before starting")
+
+        tol = cfg.joint_limit_tolerance_rad
+        q = state.q_rad
+        out = [j for j in np.nonzero(active & ((q < g1.Q_MIN_RAD - tol) | (q > g1.Q_MAX_RAD + tol)))[0]]
+        if out:
+            listed = ", ".join(f"{g1.JOINT_NAMES[j]} {q[j]:+.3f} rad [{g1.Q_MIN_RAD[j]:+.3f}, {g1.Q_MAX_RAD[j]:+.3f}]"
+                               for j in out[:3])
+            self.record("joint_limits", FAIL, f"{len(out)} joints outside their limits: {listed}"
+                        + (" ..." if len(out) > 3 else "") + "; move them back by hand with the motors off")
+        else:
+            self.record("joint_limits", PASS, f"{int(active.sum())} joints inside their limits (±{tol:.2f} rad)")
+
+        temps = np.where(active, state.motor_temperature_c, -np.inf)
+        j = int(np.argmax(temps))
+        if not np.isfinite(temps[j]) or temps[j] >= cfg.max_start_temperature_c:
+            self.record("temperatures", FAIL, f"{g1.JOINT_NAMES[j]} motor at {temps[j]:.0f} °C (limit "
+                        f"{cfg.max_start_temperature_c:.0f} °C): let the motors cool down")
+        else:
+            self.record("temperatures", PASS, f"hottest {g1.JOINT_NAMES[j]} at {temps[j]:.0f} °C "
+                        f"(limit {cfg.max_start_temperature_c:.0f} °C)")
+
+        battery = getattr(state, "battery_v", None)
+        if battery is None:
+            self.record("battery", SKIP, "not reported: the G1's LowState_ carries no battery voltage (its BMS "
+                        "publishes on its own topic); check the charge on the robot's display")
+        elif battery < cfg.min_battery_v:
+            self.record("battery", FAIL, f"battery at {battery:.1f} V (limit {cfg.min_battery_v:.1f} V): charge it")
+        else:
+            self.record("battery", PASS, f"battery at {battery:.1f} V")
+        return state
+
+    def check_input(self, device, launch: LaunchFile, open_error: str | None = None) -> bool:
+        """The operator's device: opened, bound to an e-stop, not lost while polled."""
+        if open_error is not None:
+            return self.record("estop_input", FAIL, open_error, overridable=False)
+        kind = launch.input.type
+        if kind in ("scripted", "random", "gamepad_script"):
+            if launch.backend.type == "unitree_dds" and launch.backend.interface == "lo":
+                return self.record("estop_input", PASS, f"{kind} input against the emulator on lo (sim2sim): no "
+                                   "operator e-stop; Ctrl-C or SIGTERM damps")
+            return self.record("estop_input", FAIL, f"input.type {kind} has no operator e-stop; a robot needs "
+                               "unitree_remote, gamepad or keyboard")
+        mapper = getattr(device, "mapper", None)
+        bound = [("+".join(sorted(chord))) for chord, action in mapper.config.buttons.items()
+                 if action == "estop"] if mapper is not None else []
+        deadline = time.monotonic() + launch.deploy.input_check_s
+        while time.monotonic() < deadline and not getattr(device, "lost", False):
+            device.poll()
+            time.sleep(0.02)
+        device.poll()
+        if getattr(device, "lost", False):
+            return self.record("estop_input", FAIL, f"{kind} lost: {getattr(device, 'lost_reason', '?')}; reconnect it "
+                               "and start again", overridable=False)
+        if not bound:
+            return self.record("estop_input", FAIL, f"{kind} mapping binds no button to estop; bind one in "
+                               "input.device.mapping.buttons")
+        return self.record("estop_input", PASS, f"{kind} answering; e-stop on {', '.join(bound)}")
+
+    def check_dry_run(self, launch: LaunchFile) -> bool:
+        from g1_control.launch.runner import run as run_sim
+
+        sim = dry_run_launch(launch)
+        try:
+            result = run_sim(sim, progress=False)
+        except G1ControlError as exc:
+            return self.record("dry_run", FAIL, f"the simulated dry run could not run: {exc}")
+        self.dry_run = result
+        moved = ", ".join(f"{s.label} {s.achieved[0]:+.2f} m/s" for s in result.segments if abs(s.commanded[0]) > 0)
+        what = (f"{result.duration_s:.1f} s lockstep MuJoCo of policy {launch.tracker.policy} at the launch "
+                f"file's rates ({result.wall_s:.1f} s wall)" + (f"; {moved}" if moved else ""))
+        if result.fell:
+            trip = next((e for e in result.events if e["kind"] == "tilt"), None)
+            when = f" at {trip['t_s']:.1f} s" if trip else ""
+            return self.record("dry_run", FAIL, f"FELL in simulation{when}: "
+                               f"{what}; do not run this policy/launch file on the robot")
+        faults = [e for e in result.events if "damping" in e["detail"]]
+        if faults:
+            return self.record("dry_run", FAIL, f"the safety layer tripped in simulation: {faults[0]['kind']}: "
+                               f"{faults[0]['detail']}")
+        return self.record("dry_run", PASS, f"no fall: {what}")
+
+    # -- verdict -----------------------------------------------------------------------------------------
+    @property
+    def passed(self) -> bool:
+        return not any(r.blocks for r in self.results.values())
+
+    def refusal(self) -> PreflightRefused:
+        blocking = [r for r in self.results.values() if r.blocks]
+        fixable = [r.name for r in blocking if r.overridable and r.status == FAIL]
+        hint = (f"; fix them, or override a check you have verified yourself with --override NAME "
+                f"(overridable here: {', '.join(fixable)})") if fixable else "; fix them first"
+        return PreflightRefused(f"preflight failed ({', '.join(r.name for r in blocking)}): nothing was sent to "
+                                f"the robot{hint}")
+
+    def table(self) -> str:
+        return format_table(list(self.results.values()))
+
+    def as_dict(self) -> list[dict]:
+        return [dataclasses.asdict(r) for r in self.results.values()]
+
+
+def format_table(results: list[CheckResult]) -> str:
+    width = max(len(r.name) for r in results)
+    lines = [f"{'check':<{width}}  {'result':<10}  reason", f"{'-' * width}  {'-' * 10}  {'-' * 40}"]
+    for r in results:
+        status = "OVERRIDDEN" if r.overridden else r.status.upper()
+        lines.append(f"{r.name:<{width}}  {status:<10}  {r.reason}")
+    return "\n".join(lines)
+
+
+DRY_RUN_EXERCISE = (("stand", 2.0, 0.0, 0.0), ("forward", 4.0, 0.5, 0.0), ("turn", 2.0, 0.0, 0.5),
+                    ("stand", 2.0, 0.0, 0.0))
+"""(label, seconds, vx fraction of limits.max_vx_mps, wz fraction of limits.max_wz_radps) for a
+dry run of a launch file whose commands come from an operator (unknown in advance)."""
+
+
+def dry_run_launch(launch: LaunchFile) -> LaunchFile:
+    """The same launch file on lockstep MuJoCo: same policy, rates, limits and safety thresholds; the
+    scripted timeline when there is one, else a stand-walk-turn-stand exercise."""
+    from g1_control.launch.schema import BackendConfig
+
+    duration = launch.deploy.dry_run_s
+    if launch.input.type == "scripted":
+        timeline = list(launch.input.timeline)
+    else:
+        lim = launch.limits
+        timeline = [Segment(duration_s=s, vx_mps=round(fx * lim.max_vx_mps, 3), wz_radps=round(fw * lim.max_wz_radps, 3),
+                            label=label) for label, s, fx, fw in DRY_RUN_EXERCISE]
+    return dataclasses.replace(
+        launch, name=f"{launch.name}-dry-run", duration_s=duration,
+        backend=BackendConfig(type="mujoco", mode="lockstep", physics_dt_s=launch.backend.physics_dt_s),
+        input=InputConfig(type="scripted", timeline=timeline), viewer=False)

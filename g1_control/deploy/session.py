@@ -1,0 +1,308 @@
+"""One `g1 deploy` session: preflight, then the state machine on the control loop, then damping.
+
+    report = deploy(Path("launch/robot.yaml"), DeployOptions())
+
+Nothing is sent to the robot before the preflight passed: opening the link only listens, and the
+robot's built-in motion service is released only after the checklist (a refused deploy leaves the
+robot as it found it). From the first command on, the loop's SafetyFilter vets everything, and
+every way out (operator stop, e-stop, fault, SIGINT/SIGTERM, end of the control time, an error)
+ends in damping streamed for DeployConfig.exit_damping_s before the link closes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+import signal
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from g1_control.deploy.preflight import CHECKS, FAIL, Preflight
+from g1_control.deploy.state_machine import DeployState, DeployTracker, OperatorButtons, Transition
+from g1_control.errors import G1ControlError, LaunchFileError
+from g1_control.hardware.network import LOOPBACK
+from g1_control.launch.schema import LaunchFile
+
+log = logging.getLogger("g1_control.deploy")
+
+ROBOT_CHECKS = ("variant", "state_stream", "imu_upright", "joint_limits", "temperatures", "battery")
+CLEAN_ENDINGS = ("operator stop", "control time over", "SIGINT received", "SIGTERM received")
+"""Trip details that end a deploy as planned (exit code 0); any other trip is a fault (exit code 3)."""
+
+
+@dataclass
+class DeployOptions:
+    yes: bool = False
+    """Answer start and run automatically once the preflight passed (unattended sim2sim)."""
+    overrides: frozenset[str] = frozenset()
+    release_motion_service: bool | None = None
+    """None: the launch file's backend.release_motion_service."""
+    interface: str | None = None
+    domain: int | None = None
+    partition: str | None = None
+    duration_s: float | None = None
+    """Length of the control phase (None: the launch file's duration_s, or until stopped)."""
+    preflight_only: bool = False
+
+
+@dataclass
+class DeployReport:
+    launch: str
+    refused: bool = False
+    preflight: list[dict] = field(default_factory=list)
+    overridden: list[str] = field(default_factory=list)
+    sequence: list[str] = field(default_factory=list)
+    transitions: list[dict] = field(default_factory=list)
+    end_reason: str = ""
+    fault: bool = False
+    safety_events: list[dict] = field(default_factory=list)
+    released_modes: list[str] = field(default_factory=list)
+    link: dict = field(default_factory=dict)
+    control: dict = field(default_factory=dict)
+    loop: dict = field(default_factory=dict)
+
+    def to_json(self) -> str:
+        return json.dumps(dataclasses.asdict(self), indent=2, default=float)
+
+
+def _say(text: str) -> None:
+    print(text, flush=True)
+
+
+def _keys_for(device, action: str) -> str:
+    mapper = getattr(device, "mapper", None)
+    if mapper is None:
+        return ""
+    return " or ".join("+".join(sorted(chord)) for chord, a in mapper.config.buttons.items() if a == action)
+
+
+def _apply_cli(launch: LaunchFile, options: DeployOptions) -> None:
+    b = launch.backend
+    if options.interface is not None:
+        b.interface = options.interface
+    if options.domain is not None:
+        b.domain = options.domain
+    if options.partition is not None:
+        b.partition = options.partition
+    if options.release_motion_service is not None:
+        b.release_motion_service = options.release_motion_service
+    b.validate("backend")
+    simulated = (b.type == "unitree_dds" and b.interface == LOOPBACK) or (b.type == "can" and b.can_interface == "virtual")
+    if options.yes and not simulated:
+        raise LaunchFileError("--yes answers start and run with nobody watching; it is only for g1 sim-robot on "
+                              f"'{LOOPBACK}' (or a virtual CAN bus). On a robot the operator presses start and run")
+
+
+def _open_input(launch: LaunchFile, backend, command_ranges, scripted_clock: Callable[[], float]):
+    """(device, None) or (None, why it cannot be opened)."""
+    from g1_control.launch.inputs import make_input
+    from g1_control.launch.runner import timeline_of
+
+    kind = launch.input.type
+    clock = scripted_clock if kind in ("scripted", "random", "gamepad_script") else time.monotonic
+    try:
+        device = make_input(launch, timeline_of(launch), clock=clock, command_ranges=command_ranges,
+                            state_source=backend.read_state if backend is not None else None)
+    except G1ControlError as exc:
+        return None, f"{kind} cannot be opened: {exc}"
+    except OSError as exc:
+        return None, f"{kind} cannot be opened: {exc}"
+    return device, None
+
+
+def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say) -> DeployReport:
+    """Run one deploy session; raise PreflightRefused (after printing the table) when refused."""
+    report = DeployReport(launch=str(path))
+    pf = Preflight(frozenset(options.overrides))
+    launch = pf.check_launch_file(path)
+    if launch is not None:
+        try:
+            _apply_cli(launch, options)
+        except LaunchFileError as exc:
+            pf.record("launch_file", FAIL, f"command-line override: {exc}", overridable=False)
+            launch = None
+    if launch is None:
+        pf.not_run([n for n in CHECKS if n != "launch_file"], "no valid launch file")
+        return _refuse(pf, report, say)
+
+    spec, policy_variant = pf.check_policy(launch)
+    backend = device = None
+    clock_box: list[Callable[[], float]] = [lambda: 0.0]
+    try:
+        if pf.check_interface(launch):
+            from g1_control.deploy.backends import open_robot_backend
+
+            try:
+                backend = open_robot_backend(launch.backend, damping_kd=launch.safety.damping_kd)
+            except G1ControlError as exc:
+                pf.record("interface", FAIL, str(exc), overridable=False)
+        if backend is not None:
+            say(f"listening to the robot on {backend.link.describe()} ...")
+            pf.check_robot(backend, launch, policy_variant)
+        else:
+            pf.not_run(ROBOT_CHECKS, "no link to the robot")
+        device, open_error = _open_input(launch, backend, spec.command_ranges if spec else None,
+                                         lambda: clock_box[0]())
+        if launch.input.type == "unitree_remote" and pf.results["variant"].status == "not run":
+            pf.not_run(["estop_input"], "the remote's bytes ride in the robot's LowState_, and none arrived")
+        else:
+            pf.check_input(device, launch, open_error)
+        if spec is not None:
+            say(f"simulated dry run ({launch.deploy.dry_run_s:.0f} s lockstep MuJoCo) ...")
+            pf.check_dry_run(launch)
+        else:
+            pf.not_run(["dry_run"], "no valid policy")
+        report.preflight = pf.as_dict()
+        report.overridden = [r.name for r in pf.results.values() if r.overridden]
+        if not pf.passed:
+            return _refuse(pf, report, say)
+        say("\npreflight\n" + pf.table())
+        for name in report.overridden:
+            say(f"!!! WARNING: preflight check '{name}' FAILED and was OVERRIDDEN (--override {name}): "
+                f"{pf.results[name].reason}")
+        if options.preflight_only:
+            say("preflight passed (--preflight-only): nothing was sent to the robot")
+            return report
+        _control(launch, spec, backend, device, options, clock_box, report, say)
+        return report
+    finally:
+        if device is not None:
+            device.close()
+        if backend is not None:
+            backend.close()
+
+
+def _refuse(pf: Preflight, report: DeployReport, say) -> DeployReport:
+    report.refused = True
+    report.preflight = pf.as_dict()
+    say("\npreflight\n" + pf.table())
+    refusal = pf.refusal()
+    refusal.report = report  # type: ignore[attr-defined]  # for --json
+    raise refusal
+
+
+def _control(launch: LaunchFile, spec, backend, device, options: DeployOptions, clock_box, report: DeployReport,
+             say) -> None:
+    from g1_control.generator.velocity import CopyRetargeter, VelocityReferenceGenerator
+    from g1_control.launch.runner import safety_config
+    from g1_control.loop.control_loop import ControlLoop
+    from g1_control.safety import SafetyFilter
+    from g1_control.trackers.locomotion import LocomotionPolicyTracker, VelocityCorrectionConfig
+
+    safety = SafetyFilter(safety_config(launch))
+    policy = LocomotionPolicyTracker(spec, VelocityCorrectionConfig(enabled=launch.tracker.velocity_correction))
+    buttons = OperatorButtons(device)
+    t_start = time.monotonic()
+
+    def on_transition(t: Transition) -> None:
+        say(f"[{t.t_s - t_start:7.2f} s] {t}")
+        if t.target == DeployState.HOLD and not options.yes:
+            say(f"holding the default pose: press {_keys_for(device, 'run') or 'run'} to start the policy")
+
+    control_s = options.duration_s if options.duration_s is not None else launch.duration_s
+    tracker = DeployTracker(policy, spec.default_q_rad, spec.kp, spec.kd, safety, time.monotonic, launch.deploy,
+                            buttons=buttons, auto=options.yes, control_s=control_s, on_transition=on_transition)
+    clock_box[0] = tracker.control_elapsed_s
+    r, lim = launch.rates, launch.limits
+    expected_s = (control_s or 600.0) + launch.deploy.ramp_s + 60.0
+    loop = ControlLoop(backend, buttons, VelocityReferenceGenerator(lim.max_vx_mps, lim.max_vy_mps, lim.max_wz_radps),
+                       CopyRetargeter(), tracker, r,
+                       wallclock=True, safety=safety, log_capacity=int(expected_s * r.tracker_hz))
+
+    def on_signal(signum, frame):
+        safety.estop(f"{signal.Signals(signum).name} received", time.monotonic())
+        backend.damp()  # damping on the wire now, not at the next tick
+        raise KeyboardInterrupt
+
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
+    error: BaseException | None = None
+    t_loop0 = time.monotonic()
+    try:
+        if getattr(backend, "release_motion_service", False):
+            say("releasing the robot's built-in motion service ...")
+        loop.reset()
+        report.released_modes = list(getattr(backend, "released_modes", []))
+        say(f"zero torque: the robot is limp. Press {_keys_for(device, 'start') or 'start'} to ramp to the default "
+            f"pose over {launch.deploy.ramp_s:.1f} s"
+            + (f"; e-stop: {_keys_for(device, 'estop')}" if _keys_for(device, "estop") else "")
+            + (f"; stop (damping): {_keys_for(device, 'stop')}" if _keys_for(device, "stop") else "")
+            + (" (--yes: answered automatically)" if options.yes else ""))
+        exit_s = launch.deploy.exit_damping_s
+
+        def finished() -> bool:
+            now = time.monotonic()
+            return tracker.observe_safety(now) and now - tracker.entered_s >= exit_s
+
+        t_loop0 = time.monotonic()
+        loop.scheduler.run(1 << 40, stop=finished)
+    except KeyboardInterrupt:
+        pass
+    except G1ControlError as exc:
+        error = exc
+        safety.estop(f"error: {exc}", time.monotonic())
+    finally:
+        backend.damp()
+        if tracker.state != DeployState.DAMPING:
+            trip = safety.trip_event
+            tracker._go(DeployState.DAMPING, f"{trip.kind.value}: {trip.detail}" if trip else "exit", time.monotonic())
+            time.sleep(launch.deploy.exit_damping_s)  # damping keeps streaming before the link closes
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    _fill_report(report, loop, tracker, backend, safety, t_loop0)
+    _print_summary(report, say)
+    if error is not None:
+        raise error
+
+
+def _fill_report(report: DeployReport, loop, tracker: DeployTracker, backend, safety, t_loop0: float) -> None:
+    report.sequence = tracker.sequence
+    report.transitions = [{"t_s": t.t_s, "from": t.source.value, "to": t.target.value, "reason": t.reason}
+                          for t in tracker.transitions]
+    trip = safety.trip_event
+    report.end_reason = trip.detail if trip else "exit"
+    report.fault = trip is None or not any(trip.detail.startswith(c) for c in CLEAN_ENDINGS)
+    report.safety_events = [{"t_s": e.t_s, "kind": e.kind.value, "detail": e.detail, "trips": e.trips}
+                            for e in safety.events]
+    report.link = dataclasses.asdict(backend.stats())
+    log_arrays = loop.log.arrays()
+    control = [t for t in tracker.transitions if t.target == DeployState.CONTROL]
+    if control:
+        start = control[0].t_s
+        end = next((t.t_s for t in tracker.transitions if t.source == DeployState.CONTROL), time.monotonic())
+        t_mono = t_loop0 + log_arrays["t_s"]
+        # Skip the first 2 s (the gait starting up) when there is enough control time for it.
+        steady_from = start + (2.0 if end - start > 4.0 else 0.0)
+        window = (t_mono >= steady_from) & (t_mono < end)
+        est = log_arrays["velocity_est"][window]
+        cmd = log_arrays["command"][window]
+        report.control = {"duration_s": end - start, "steady_window_s": max(0.0, end - steady_from),
+                          "velocity_est_mean": est.mean(axis=0).tolist() if len(est) else None,
+                          "command_mean": cmd.mean(axis=0).tolist() if len(cmd) else None}
+    report.loop = {"deadline_misses": loop.scheduler.deadline_misses, "ticks": loop.scheduler.tick_index,
+                   "tick_p99_us": loop.scheduler.report()["tick"]["p99_us"],
+                   "clamped_commands": safety.clamps.commands}
+
+
+def _print_summary(report: DeployReport, say) -> None:
+    link = report.link
+    say(f"deploy ended in damping: {report.end_reason}" + (" (FAULT)" if report.fault else ""))
+    say(f"states: {' -> '.join(report.sequence)}")
+    say(f"lowcmd sent {link['commands_sent']} ({link['command_rate_hz']:.0f} Hz, p99 period "
+        f"{link['command_period_p99_s'] * 1000:.2f} ms at the sender); lowstate received {link['states_received']}, "
+        f"{link['bad_crc']} bad CRC, {link['malformed']} malformed")
+    v = report.control.get("velocity_est_mean") if report.control else None
+    if v is not None:
+        c = report.control["command_mean"]
+        say(f"control {report.control['duration_s']:.1f} s: estimated velocity vx {v[0]:+.2f} m/s, vy {v[1]:+.2f}, "
+            f"wz {v[2]:+.2f} (commanded {c[0]:+.2f}, {c[1]:+.2f}, {c[2]:+.2f})")
+    say(f"loop: {report.loop['ticks']} ticks, {report.loop['deadline_misses']} deadline misses, "
+        f"{report.loop['clamped_commands']} commands clamped by the safety layer")
+
+
+def write_report(report: DeployReport, path: Path) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(report.to_json())
+
