@@ -104,12 +104,15 @@ class SafetyFilter:
         if self.tripped:
             return False
         c = self.config
-        arrays = {"q_rad": state.q_rad, "dq_radps": state.dq_radps, "imu_quat_wxyz": state.imu_quat_wxyz,
-                  "imu_gyro_radps": state.imu_gyro_radps, "motor_temperature_c": state.motor_temperature_c}
-        for name, arr in arrays.items():
-            arr = np.asarray(arr, dtype=float)
-            if not np.all(np.isfinite(arr)):
-                return self._trip(now_s, SafetyEventKind.NONFINITE_STATE, f"RobotState.{name} contains NaN or inf")
+        # One finite test over everything first (this runs every tick); name the culprit only on failure.
+        total = (np.sum(state.q_rad) + np.sum(state.dq_radps) + np.sum(state.imu_quat_wxyz)
+                 + np.sum(state.imu_gyro_radps) + np.sum(state.motor_temperature_c))
+        if not np.isfinite(total):
+            arrays = {"q_rad": state.q_rad, "dq_radps": state.dq_radps, "imu_quat_wxyz": state.imu_quat_wxyz,
+                      "imu_gyro_radps": state.imu_gyro_radps, "motor_temperature_c": state.motor_temperature_c}
+            for name, arr in arrays.items():
+                if not np.all(np.isfinite(np.asarray(arr, dtype=float))):
+                    return self._trip(now_s, SafetyEventKind.NONFINITE_STATE, f"RobotState.{name} contains NaN or inf")
         if not np.isfinite(state.t_s) or not np.isfinite(now_s):
             return self._trip(now_s, SafetyEventKind.NONFINITE_STATE, f"time is not finite (state {state.t_s}, now {now_s})")
         age = now_s - state.t_s
@@ -198,13 +201,14 @@ class SafetyFilter:
             bad = [n for n in CLAMPED_FIELDS if not np.all(np.isfinite(getattr(command, n)))]
             self._trip(now_s, SafetyEventKind.NONFINITE_COMMAND, f"MotorCommand.{', '.join(bad)} {'contains' if len(bad) == 1 else 'contain'} NaN or inf")
             return self._damping.copy()
+        # minimum/maximum rather than np.clip: the same result at a third of the cost per call.
         out = MotorCommand(
-            q_rad=np.clip(command.q_rad, self._q_lo, self._q_hi),
-            dq_radps=np.clip(command.dq_radps, self._dq_lo, self._dq_hi),
-            kp=np.clip(command.kp, 0.0, self.config.max_kp),
-            kd=np.clip(command.kd, 0.0, self.config.max_kd),
-            tau_nm=np.clip(command.tau_nm, self._tau_lo, self._tau_hi),
-            enable=np.asarray(command.enable, dtype=bool).copy(),
+            q_rad=np.minimum(np.maximum(command.q_rad, self._q_lo), self._q_hi),
+            dq_radps=np.minimum(np.maximum(command.dq_radps, self._dq_lo), self._dq_hi),
+            kp=np.minimum(np.maximum(command.kp, 0.0), self.config.max_kp),
+            kd=np.minimum(np.maximum(command.kd, 0.0), self.config.max_kd),
+            tau_nm=np.minimum(np.maximum(command.tau_nm, self._tau_lo), self._tau_hi),
+            enable=np.array(command.enable, dtype=bool),
         )
         any_clamp = False
         for name in CLAMPED_FIELDS:
