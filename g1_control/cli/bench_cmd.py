@@ -12,6 +12,8 @@ BENCHMARKS = {
     "teleop": ("g1_control.teleop.bench:main", "input event -> Command latency p50/p99 per device vs bare os.read"),
     "transport": ("g1_control.hardware.bench:main", "robot link: CRC, LowCmd/LowState encode/decode, safety filter (us/call)"),
     "ik": ("g1_control.ik.bench:main", "IK retargeter: online solve p50/p99, offline frames/s per core"),
+    "generator": ("g1_control.generator.bench:main",
+                  "in-betweening L2P/L2Q/NPSS vs interpolation + motion matching; replan p50/p99; frames/s; 10-min rollout"),
 }
 
 

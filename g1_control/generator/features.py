@@ -47,12 +47,17 @@ def rot_z(yaw: np.ndarray) -> np.ndarray:
 
 
 def rot6d_to_matrix(r6: np.ndarray) -> np.ndarray:
-    """Gram-Schmidt of the two stored columns -> (..., 3, 3)."""
-    a, b = r6[..., 0:3], r6[..., 3:6]
-    x = a / np.maximum(np.linalg.norm(a, axis=-1, keepdims=True), 1e-9)
-    b = b - np.sum(x * b, axis=-1, keepdims=True) * x
-    y = b / np.maximum(np.linalg.norm(b, axis=-1, keepdims=True), 1e-9)
-    return np.stack([x, y, np.cross(x, y)], axis=-1)
+    """Gram-Schmidt of the two stored columns -> (..., 3, 3). Written out (no np.cross /
+    np.linalg.norm): this runs several times per replan."""
+    a0, a1, a2, b0, b1, b2 = (r6[..., i] for i in range(6))
+    na = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2) + 1e-12
+    x0, x1, x2 = a0 / na, a1 / na, a2 / na
+    d = x0 * b0 + x1 * b1 + x2 * b2
+    b0, b1, b2 = b0 - d * x0, b1 - d * x1, b2 - d * x2
+    nb = np.sqrt(b0 * b0 + b1 * b1 + b2 * b2) + 1e-12
+    y0, y1, y2 = b0 / nb, b1 / nb, b2 / nb
+    z0, z1, z2 = x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0
+    return np.stack([np.stack([x0, y0, z0], -1), np.stack([x1, y1, z1], -1), np.stack([x2, y2, z2], -1)], -2)
 
 
 def world_features(root_pos: np.ndarray, root_rot: np.ndarray, joints: np.ndarray,
@@ -128,3 +133,24 @@ def fix_effectors(features: np.ndarray) -> np.ndarray:
     idx = effector_indices(default_body_names())
     out[..., EFFECTORS] = pos[..., idx, :].reshape(features.shape[:-1] + (12,))
     return out
+
+
+def matrix_to_quat(rot: np.ndarray) -> np.ndarray:
+    """One rotation matrix -> (w, x, y, z) with w >= 0 (Shepperd's method; scipy's batched
+    converter costs ~50x more for a single matrix in the per-tick path)."""
+    m = rot
+    tr = m[0, 0] + m[1, 1] + m[2, 2]
+    if tr > 0:
+        s = 2.0 * np.sqrt(tr + 1.0)
+        q = np.array([0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s])
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = 2.0 * np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
+        q = np.array([(m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s])
+    elif m[1, 1] > m[2, 2]:
+        s = 2.0 * np.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
+        q = np.array([(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s])
+    else:
+        s = 2.0 * np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
+        q = np.array([(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s])
+    q /= np.linalg.norm(q)
+    return -q if q[0] < 0 else q

@@ -179,6 +179,10 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | N
         (out / "loss_history.json").write_text(json.dumps(history))
         plot_losses(history, out / "loss.png")
         export_onnx(model, out / "backbone.onnx")
+        from g1_control.generator.style_stats import write_style_stats
+        from g1_control.library.builder import default_library_dir
+
+        write_style_stats(library_root or default_library_dir(), out / "style_stats.json")
     if world > 1:
         dist.destroy_process_group()
     return result
