@@ -31,6 +31,9 @@ def register(subparsers) -> None:
                      help="stop after this many minutes, keeping the best model (default 25)")
     gen.add_argument("--threads", type=int, default=1, help="torch threads per process (default 1: fastest here)")
     gen.add_argument("--seed", type=int, default=0)
+    gen.add_argument("--eval-every", type=int, default=250, help="steps between held-out evaluations (default 250)")
+    gen.add_argument("--model", metavar="JSON", default="{}",
+                     help='backbone size overrides, e.g. \'{"d_model": 96, "layers": 4}\' (default: BackboneConfig)')
     gen.set_defaults(func=_generator)
 
 
@@ -42,8 +45,16 @@ def _generator(args) -> int:
     library = args.library or default_library_dir()
     if args.library is None:
         build_library(library)  # a no-op when the cached library matches
+    import json
+
+    from g1_control.errors import G1ControlError
+
+    try:
+        model = json.loads(args.model)
+    except json.JSONDecodeError as exc:
+        raise G1ControlError(f"--model must be a JSON object of BackboneConfig fields: {exc}") from None
     config = TrainConfig(steps=args.steps, batch=args.batch, lr=args.lr, time_limit_s=args.time_limit * 60,
-                         threads=args.threads, seed=args.seed)
+                         threads=args.threads, seed=args.seed, eval_every=args.eval_every, model=model)
     out = args.output or SHIPPED_DIR
     result = train(out, config, library)
     if result.get("best_val_loss") is not None:
