@@ -54,32 +54,28 @@ def spring_root_trajectory(start: RootState, v_cmd_heading: np.ndarray, wz_cmd: 
     Heading with an absolute target: critically damped x(t) = x_d + (j0 + j1 t) e^{-y t}, y = 2 ln2 / half-life.
     """
     n = max(1, int(round(horizon_s / dt_s)))
-    lam = LN2 / cfg.velocity_halflife_s
-    decay = math.exp(-lam * dt_s)
-    pos = start.pos_xy.astype(float).copy()
-    vel = start.vel_xy.astype(float).copy()
-    yaw, rate = float(start.yaw), float(start.yaw_rate)
+    k = np.arange(1, n + 1)
+    t = k * dt_s
+    decay = math.exp(-LN2 / cfg.velocity_halflife_s * dt_s)
     v_cmd = np.clip(v_cmd_heading, [-cfg.max_vx_mps, -cfg.max_vy_mps], [cfg.max_vx_mps, cfg.max_vy_mps])
     wz_cmd = float(np.clip(wz_cmd, -cfg.max_wz_radps, cfg.max_wz_radps))
-    y = 2.0 * LN2 / cfg.heading_halflife_s
-    out_p, out_y = np.empty((n, 2)), np.empty(n)
-    for k in range(n):
-        if heading_cmd is None:
-            rate = wz_cmd + (rate - wz_cmd) * decay
-            yaw += rate * dt_s
-        else:
-            err = (yaw - heading_cmd + math.pi) % (2 * math.pi) - math.pi
-            j1 = rate + err * y
-            e = math.exp(-y * dt_s)
-            new_err = (err + j1 * dt_s) * e
-            rate = (rate - j1 * y * dt_s) * e
-            yaw = heading_cmd + new_err
-        c, s = math.cos(yaw), math.sin(yaw)
-        target_w = np.array([c * v_cmd[0] - s * v_cmd[1], s * v_cmd[0] + c * v_cmd[1]])
-        vel = target_w + (vel - target_w) * decay
-        pos = pos + vel * dt_s
-        out_p[k], out_y[k] = pos, yaw
-    return out_p, out_y
+    # Closed forms evaluated at every frame (vectorized: this runs on every replan).
+    if heading_cmd is None:
+        rate = wz_cmd + (start.yaw_rate - wz_cmd) * decay ** k
+        yaw = start.yaw + np.cumsum(rate) * dt_s
+    else:
+        y = 2.0 * LN2 / cfg.heading_halflife_s
+        err0 = (start.yaw - heading_cmd + math.pi) % (2 * math.pi) - math.pi
+        j1 = start.yaw_rate + err0 * y
+        yaw = heading_cmd + (err0 + j1 * t) * np.exp(-y * t)
+    c, s = np.cos(yaw), np.sin(yaw)
+    target_w = np.stack([c * v_cmd[0] - s * v_cmd[1], s * v_cmd[0] + c * v_cmd[1]], axis=1)
+    # v_k = d v_{k-1} + (1 - d) target_k  =>  v = d^k v0 + W @ target with W[k, j] = (1 - d) d^(k - j), j <= k
+    lag = k[:, None] - k[None, :]
+    weights = np.where(lag >= 0, (1 - decay) * decay ** np.maximum(lag, 0), 0.0)
+    vel = decay ** k[:, None] * start.vel_xy[None, :] + weights @ target_w
+    pos = start.pos_xy[None, :] + np.cumsum(vel, axis=0) * dt_s
+    return pos, yaw
 
 
 def root_features(pos_xy: np.ndarray, height: float, yaw: float, tilt_rot: np.ndarray | None = None) -> np.ndarray:

@@ -36,11 +36,15 @@ class TrainConfig:
     time_limit_s: float = 25 * 60
     """Stops early (keeping the best model) past this wall time: the 30-minute CPU budget."""
     fk_weight: float = 1.0
+    normalized_position_weight: float = 0.5
+    """Weight of the FK position error divided by each body coordinate's spread over training
+    windows - what L2P measures. Measured: without it the model left L2P above motion matching
+    (vertical errors, small in metres, dominate the normalized metric)."""
     model: dict = field(default_factory=dict)
     """Overrides of BackboneConfig fields (d_model, layers, ...)."""
 
 
-def _fk_terms(pred, truth):
+def _fk_terms(pred, truth, pos_scale=None):
     import torch
 
     from g1_control.generator.fk import fk_torch
@@ -55,10 +59,11 @@ def _fk_terms(pred, truth):
 
     pp, pr = bodies(pred)
     tp, tr = bodies(truth)
-    return (pp - tp).abs().mean(), (pr - tr).abs().mean()
+    norm = ((pp - tp).abs() / pos_scale).mean() if pos_scale is not None else torch.zeros(())
+    return (pp - tp).abs().mean(), (pr - tr).abs().mean(), norm
 
 
-def loss_fn(model, batch, fk_weight: float, subsample: bool = True):
+def loss_fn(model, batch, fk_weight: float, subsample: bool = True, pos_scale=None, norm_weight: float = 0.0):
     import torch
 
     pred, duration = model(batch["context"], batch["target"], batch["given"], batch["base"], batch["style"])
@@ -72,9 +77,11 @@ def loss_fn(model, batch, fk_weight: float, subsample: bool = True):
     # FK through 29 joints is the costliest part of a step: a random quarter of the frames suffices.
     b, g = truth.shape[:2]
     pick = torch.randperm(b * g)[: max(1, b * g // 4)] if subsample else torch.arange(b * g)
-    pos, rot = _fk_terms(pred.reshape(b * g, -1)[pick], truth.reshape(b * g, -1)[pick])
+    pos, rot, norm = _fk_terms(pred.reshape(b * g, -1)[pick], truth.reshape(b * g, -1)[pick], pos_scale)
     terms["fk_pos"] = pos * 2.0 * fk_weight
     terms["fk_rot"] = rot * fk_weight
+    if pos_scale is not None:
+        terms["fk_pos_norm"] = norm * norm_weight
     gap = float(truth.shape[1])
     terms["duration"] = 0.1 * (torch.log(duration + 1.0) - np.log(gap + 1.0)).abs().mean()
     return sum(terms.values()), terms
@@ -126,6 +133,10 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | N
     stats = np.concatenate([sampler.sample(256)["truth"].reshape(-1, F.DIM) for _ in range(8)])
     model.feat_mean.copy_(torch.as_tensor(stats.mean(0), dtype=torch.float32))
     model.feat_std.copy_(torch.as_tensor(stats.std(0) + 1e-3, dtype=torch.float32))
+    from g1_control.generator.fk import fk_numpy
+
+    body_pos, _ = fk_numpy(stats[:, :3], F.rot6d_to_matrix(stats[:, 3:9]), stats[:, 9:38])
+    pos_scale = torch.as_tensor(body_pos.std(axis=0) + 1e-3, dtype=torch.float32)
     net = torch.nn.parallel.DistributedDataParallel(model) if world > 1 else model
     opt = torch.optim.AdamW(model.parameters(), lr=config.lr, weight_decay=config.weight_decay)
     sched = torch.optim.lr_scheduler.LambdaLR(opt, lambda s: min(1.0, (s + 1) / config.warmup_steps) * 0.5 * (
@@ -141,7 +152,8 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | N
     def held_out_loss() -> float:
         model.eval()
         with torch.no_grad():
-            return float(np.mean([loss_fn(model, b, config.fk_weight, subsample=False)[0].item() for b in val_batches]))
+            return float(np.mean([loss_fn(model, b, config.fk_weight, False, pos_scale,
+                                                   config.normalized_position_weight)[0].item() for b in val_batches]))
 
     # the untrained model is exactly interpolation (zero-initialized output heads): the reference
     initial_val = held_out_loss()
@@ -155,7 +167,7 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | N
     for step in range(config.steps):
         batch = _to_torch(sampler.sample(config.batch // world))
         model.train()
-        loss, terms = loss_fn(net, batch, config.fk_weight)
+        loss, terms = loss_fn(net, batch, config.fk_weight, True, pos_scale, config.normalized_position_weight)
         opt.zero_grad(set_to_none=True)
         loss.backward()
         torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
