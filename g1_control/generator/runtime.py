@@ -40,7 +40,8 @@ from g1_control.robot import g1
 from g1_control.types import Command, KinematicReference, RobotState
 
 OBJECT_GOALS = ("box_pick", "box_climb")
-"""EffectorGoal.frame values that name an object goal instead of a robot frame."""
+"""EffectorGoal.frame values that name an object goal instead of a robot frame; pos_w_m is then
+the centre of a box standing on the floor."""
 
 
 @dataclass
@@ -93,6 +94,7 @@ class InbetweeningGenerator(Generator):
         self._last_cmd: Command | None = None
         self._frame_targets: dict[str, np.ndarray] = {}
         self._style = "default"
+        self._object: list | None = None
         self._t = 0.0
 
     # ------------------------------------------------------------------ lifecycle
@@ -109,6 +111,7 @@ class InbetweeningGenerator(Generator):
         self.plan_t0 = state.t_s
         self._t = state.t_s
         self._last_cmd = None
+        self._object = None
         self.stats = PlanStats()
 
     # ------------------------------------------------------------------ planning
@@ -138,11 +141,20 @@ class InbetweeningGenerator(Generator):
         v_cmd = np.array([command.vx_mps, command.vy_mps])
         wz, heading = command.wz_radps, command.heading_rad
         pose = st.upper_pose_rad
-        if obj is not None:
+        if obj is None:
+            self._object = None
+        else:
             box = np.asarray(obj.pos_w_m, float)
-            spot, face = box_approach(box, root.pos_xy, cfg.box_standoff_m)
+            key_obj = (obj.frame, tuple(np.round(box, 3)))
+            if self._object is None or self._object[0] != key_obj:
+                spot, face = box_approach(box, root.pos_xy, cfg.box_standoff_m)
+                self._object = [key_obj, spot, face, False]
+            _, spot, face, acting = self._object
             dist = float(np.linalg.norm(spot - root.pos_xy))
-            if dist > 0.15:  # walk there: a velocity toward the spot, heading facing the box
+            # Once at the spot, the object phase is latched: approaching the box from there
+            # must not send the robot back to a spot recomputed from its new position.
+            acting = self._object[3] = acting or dist <= 0.15
+            if not acting:  # walk there: a velocity toward the spot, heading facing the box
                 c, s = math.cos(root.yaw), math.sin(root.yaw)
                 d = (spot - root.pos_xy) / dist * min(cfg.spring.max_vx_mps, dist)
                 v_cmd = np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1]])
@@ -156,7 +168,9 @@ class InbetweeningGenerator(Generator):
             elif obj.frame == "box_climb":
                 style = "climb"
                 v_cmd, wz, heading = np.zeros(2), 0.0, face
-                root = RootState(box[:2] - (spot - box[:2]) * 0.0, np.zeros(2), face, 0.0)
+                # the keyframe stands on the box: centre of its top face (pos_w_m is the centre of a
+                # box resting on the floor, so the top is at twice its height)
+                root = RootState(box[:2].copy(), np.zeros(2), face, 0.0)
                 height = float(box[2]) * 2.0 + self._style_stats("default").pelvis_height_m[1]
         path, yaws = spring_root_trajectory(root, v_cmd, wz, heading, gap / cfg.fps, 1.0 / cfg.fps, cfg.spring)
         values[F.ROOT] = root_features(path[-1], height, float(yaws[-1]))

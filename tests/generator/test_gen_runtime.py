@@ -121,6 +121,14 @@ def test_box_goal_walks_to_the_box_then_crouches_with_hands_on_it():
     assert np.linalg.norm(ref.frame_targets_w["left_wrist_yaw_link"][:3] - box) == pytest.approx(0.2)
 
 
+def test_climb_goal_ends_standing_on_the_box():
+    gen, state = _generator()
+    box = np.array([1.5, 0.0, 0.15])
+    ref = _run(gen, state, Command(goals=[EffectorGoal("box_climb", box)]), 10.0)
+    assert np.linalg.norm(ref.root_pos_w_m[:2] - box[:2]) < 0.1
+    assert ref.root_pos_w_m[2] == pytest.approx(0.30 + 0.76, abs=0.02) and ref.style == "climb"
+
+
 def test_effector_goal_becomes_a_frame_target():
     gen, state = _generator()
     goal = np.array([0.4, -0.2, 1.0])
