@@ -24,7 +24,7 @@ def register(subparsers) -> None:
                          description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     gen.add_argument("-o", "--output", help="output folder (default: policies/generator, the shipped model)")
     gen.add_argument("--library", help="motion library folder (default: the user cache; built when missing)")
-    gen.add_argument("--steps", type=int, default=4500, help="optimizer steps (default 4500)")
+    gen.add_argument("--steps", type=int, default=7000, help="optimizer steps (default 7000)")
     gen.add_argument("--batch", type=int, default=128, help="windows per step over all processes (default 128)")
     gen.add_argument("--lr", type=float, default=1e-3, help="peak learning rate (default 1e-3)")
     gen.add_argument("--time-limit", type=float, default=25.0, metavar="MIN",

@@ -35,9 +35,13 @@ class BackboneConfig:
     layers: int = 3
     heads: int = 4
     ff: int = 192
-    root_d_model: int = 32
+    root_d_model: int = 48
     root_layers: int = 2
     dropout: float = 0.0
+    pose_refines_root: bool = True
+    """The pose module also adds a correction to the root module's pelvis path. Measured with the
+    first shipped model (False): the small root module left the lateral pelvis sway of walking at
+    interpolation's error (2.0 vs 2.3 cm; motion matching 0.9 cm), which dominated L2P."""
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -105,7 +109,7 @@ class Backbone(nn.Module):
         self.root_out = nn.Linear(c.root_d_model, 9)
         self.duration_out = nn.Linear(c.root_d_model, 1)
         self.pose = _TokenModule(F.DIM, c.d_model, c.heads, c.ff, c.layers, c.num_styles, c.dropout)
-        self.pose_out = nn.Linear(c.d_model, F.DIM - 9)
+        self.pose_out = nn.Linear(c.d_model, F.DIM if c.pose_refines_root else F.DIM - 9)
         for head in (self.root_out, self.pose_out):
             nn.init.zeros_(head.weight)
             nn.init.zeros_(head.bias)
@@ -134,6 +138,9 @@ class Backbone(nn.Module):
         pv = torch.cat([ctx, gap_vals, tgt[:, None]], dim=1)
         pg = torch.cat([ones_c, gap_given, target_given[:, None]], dim=1)
         ph = self.pose(pv, pg, style, gap)
-        rest = bas[..., 9:] + self.pose_out(ph[:, CONTEXT_FRAMES:CONTEXT_FRAMES + gap])
-        out = torch.cat([root, rest], dim=-1) * std + mean
+        delta = self.pose_out(ph[:, CONTEXT_FRAMES:CONTEXT_FRAMES + gap])
+        if self.config.pose_refines_root:
+            root = root + delta[..., :9]
+            delta = delta[..., 9:]
+        out = torch.cat([root, bas[..., 9:] + delta], dim=-1) * std + mean
         return out, duration

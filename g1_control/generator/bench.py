@@ -123,10 +123,17 @@ def long_rollout(generator, seconds: float = 600.0, fps: float = 30.0, seed: int
         tilt[i] = np.arccos(np.clip(1 - 2 * (x * x + y * y), -1, 1))
         q[i] = ref.q_rad
     finite = bool(np.isfinite(z).all() and np.isfinite(q).all())
+    # Collapse shows as motion dying out (a frozen or jittering pose): compare leg joint speed
+    # (rad/s, mean over joints) in the first and the last minute.
+    minute = int(60 * fps)
+    legs = list(g1.LEG_JOINTS)
+    speed_first = float(np.abs(np.diff(q[:minute, legs], axis=0)).mean() * fps)
+    speed_last = float(np.abs(np.diff(q[-minute:, legs], axis=0)).mean() * fps)
     return {"seconds": seconds, "finite": finite, "pelvis_min_m": float(np.nanmin(z)), "pelvis_max_m": float(np.nanmax(z)),
             "tilt_max_deg": float(np.degrees(np.nanmax(tilt))),
             "joint_limit_violations": int(((q < g1.Q_MIN_RAD - 1e-6) | (q > g1.Q_MAX_RAD + 1e-6)).sum()),
-            "replans": generator.stats.replans, "fallbacks": generator.stats.fallbacks}
+            "replans": generator.stats.replans, "fallbacks": generator.stats.fallbacks,
+            "leg_speed_first_min_radps": speed_first, "leg_speed_last_min_radps": speed_last}
 
 
 def main(args) -> int:
@@ -187,7 +194,8 @@ def main(args) -> int:
     figures["rollout"] = roll
     print(f"  finite {roll['finite']}; pelvis {roll['pelvis_min_m']:.3f}-{roll['pelvis_max_m']:.3f} m; "
           f"max tilt {roll['tilt_max_deg']:.1f} deg; joint-limit violations {roll['joint_limit_violations']}; "
-          f"{roll['replans']} replans, {roll['fallbacks']} fallbacks; {time.perf_counter() - t0:.1f} s wall "
+          f"{roll['replans']} replans, {roll['fallbacks']} fallbacks; mean leg joint speed first/last minute "
+          f"{roll['leg_speed_first_min_radps']:.2f}/{roll['leg_speed_last_min_radps']:.2f} rad/s; {time.perf_counter() - t0:.1f} s wall "
           f"({600.0 / (time.perf_counter() - t0):.0f}x real time)")
     print(f"\ntotal {time.perf_counter() - t_start:.0f} s")
     if getattr(args, "json", None):

@@ -221,7 +221,9 @@ def load_checkpoint(path: str | Path):
     from g1_control.generator.backbone import Backbone, BackboneConfig
 
     blob = torch.load(path, map_location="cpu", weights_only=True)
-    model = Backbone(BackboneConfig(**blob["model_config"]))
+    config = dict(blob["model_config"])
+    config.setdefault("pose_refines_root", False)  # checkpoints from before the option
+    model = Backbone(BackboneConfig(**config))
     model.load_state_dict(blob["state_dict"])
     model.eval()
     return model

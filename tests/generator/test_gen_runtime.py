@@ -144,3 +144,4 @@ def test_long_rollout_under_random_commands_stays_healthy():
     assert result["finite"] and result["joint_limit_violations"] == 0
     assert 0.5 < result["pelvis_min_m"] and result["pelvis_max_m"] < 0.9
     assert result["replans"] > 60 and result["fallbacks"] == 0
+    assert result["leg_speed_last_min_radps"] > 0.0
