@@ -21,7 +21,8 @@ def register(subparsers) -> None:
     parser = subparsers.add_parser("library", help="build or show the generator's G1 motion library",
                                    description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="library_command", metavar="ACTION", required=True)
-    build = sub.add_parser("build", help="build the library (cached)")
+    build = sub.add_parser("build", help="build the library (cached)", description=__doc__,
+                           formatter_class=argparse.RawDescriptionHelpFormatter)
     build.add_argument("-o", "--output", help="library folder (default: the user cache)")
     build.add_argument("--force", action="store_true", help="rebuild even when the cached index matches")
     build.add_argument("--rollout-seconds", type=float, default=45.0, help="seconds per rollout (default 45)")
