@@ -45,6 +45,38 @@ def _partial_keyframes(method, windows: E.Windows) -> tuple[float, float, float]
     return float((hand < 0.10).mean()), float(hand.mean()), float(root.mean())
 
 
+def effector_goals_through_ik(generator_factory, goals: int = 12, seconds: float = 2.0, seed: int = 0) -> dict:
+    """Right-hand goals in front of a standing robot, given as Command effector goals: the
+    generator passes them as a partial keyframe and a frame target, the IK retargeter solves
+    (as in the loop, 50 Hz). Returns success within 10 cm and the mean final hand distance."""
+    from g1_control.generator.fk import fk_numpy
+    from g1_control.generator.retarget import GeneratorRetargeter
+    from g1_control.motion import quaternion as quat
+    from g1_control.motion.kinematics import default_body_names
+    from g1_control.robot import g1
+    from g1_control.types import Command, EffectorGoal, RobotState
+
+    rng = np.random.default_rng(seed)
+    hand = default_body_names().index("right_wrist_yaw_link")
+    dists = []
+    for _ in range(goals):
+        gen = generator_factory()
+        ik = GeneratorRetargeter()
+        state = RobotState(q_rad=g1.DEFAULT_Q_RAD.copy(), base_pos_w_m=np.array([0.0, 0.0, g1.DEFAULT_PELVIS_HEIGHT_M]))
+        gen.reset(state)
+        goal = np.array([rng.uniform(0.25, 0.45), rng.uniform(-0.4, -0.1), g1.DEFAULT_PELVIS_HEIGHT_M + rng.uniform(0.0, 0.35)])
+        cmd = Command(goals=[EffectorGoal("right_wrist_yaw_link", goal)])
+        q = state.q_rad
+        for i in range(int(seconds * 50)):
+            state.t_s = i / 50
+            out = ik.solve(gen.update(cmd, state), q)
+            q = out.q_rad
+        pos, _ = fk_numpy(out.root_pos_w_m, quat.to_matrix(out.root_quat_wxyz), out.q_rad)
+        dists.append(float(np.linalg.norm(pos[hand] - goal)))
+    d = np.array(dists)
+    return {"goals": goals, "success": float((d < 0.10).mean()), "mean_m": float(d.mean()), "max_m": float(d.max())}
+
+
 def _codebook_floor(train_feats, windows: E.Windows, stats: E.PositionStats, codes: int = 512) -> E.Scores:
     from scipy.cluster.vq import kmeans2
 
@@ -176,6 +208,10 @@ def main(args) -> int:
         figures["partial"][m.name] = {"success": s, "hand_m": hd, "root_m": rd}
         print(f"  {m.name:<16} success {100 * s:5.1f} %   hand {hd:.3f} m   root {rd:.3f} m")
     styles = load_style_stats(SHIPPED_DIR / "style_stats.json")
+    eff = effector_goals_through_ik(lambda: InbetweeningGenerator(backbone, styles))
+    figures["effector_goals_ik"] = eff
+    print(f"  runtime + IK, right-hand goals in front of a standing robot: success {100 * eff['success']:.0f} % "
+          f"of {eff['goals']}, distance to goal mean {eff['mean_m']:.3f} m, max {eff['max_m']:.3f} m")
     print("\nspeed (this CPU, 1 inference thread)")
     for m in (interp, backbone):
         lat, cpu = _latency(lambda: _fresh(InbetweeningGenerator(m, styles)))

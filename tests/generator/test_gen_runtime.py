@@ -145,3 +145,10 @@ def test_long_rollout_under_random_commands_stays_healthy():
     assert 0.5 < result["pelvis_min_m"] and result["pelvis_max_m"] < 0.9
     assert result["replans"] > 60 and result["fallbacks"] == 0
     assert result["leg_speed_last_min_radps"] > 0.0
+
+
+def test_effector_goals_are_reached_through_the_ik():
+    from g1_control.generator.bench import effector_goals_through_ik
+
+    result = effector_goals_through_ik(lambda: InbetweeningGenerator(InterpolationInbetweener(), _styles()), goals=4)
+    assert result["success"] == 1.0 and result["mean_m"] < 0.05
