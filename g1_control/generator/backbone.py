@@ -131,7 +131,13 @@ class Backbone(nn.Module):
         rg = torch.cat([ones_c[..., :9], zeros_g[..., :9], target_given[:, None, :9]], dim=1)
         rh = self.root(rv, rg, style, gap)
         root = bas[..., :9] + self.root_out(rh[:, CONTEXT_FRAMES:CONTEXT_FRAMES + gap])
-        duration = nn.functional.softplus(self.duration_out(rh[:, -1]))[:, 0] * 10.0
+        # Duration from context + target alone: in the pass above the target token's position
+        # is the gap itself (measured: the head then just read it back, 0.02 frames "error").
+        # Here the target sits right after the context, so the time must come from the motion.
+        dv = torch.cat([ctx[..., :9], tgt[:, None, :9]], dim=1)
+        dg = torch.cat([ones_c[..., :9], target_given[:, None, :9]], dim=1)
+        dh = self.root(dv, dg, style, 0)
+        duration = nn.functional.softplus(self.duration_out(dh[:, -1]))[:, 0] * 10.0
         # pose module: the planned root counts as given on the gap tokens
         gap_vals = torch.cat([root, bas[..., 9:]], dim=-1)
         gap_given = torch.cat([torch.ones_like(root), zeros_g[..., 9:]], dim=-1)

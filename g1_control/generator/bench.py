@@ -202,6 +202,16 @@ def main(args) -> int:
         print(f"  backbone / interpolation: L2P {b.l2p / i.l2p:.2f}x, L2Q {b.l2q / i.l2q:.2f}x;  "
               f"backbone / motion matching: L2P {b.l2p / m.l2p:.2f}x, L2Q {b.l2q / m.l2q:.2f}x "
               f"({'beats both' if b.l2p < min(i.l2p, m.l2p) and b.l2q < min(i.l2q, m.l2q) else 'DOES NOT beat both'})\n")
+    # the root module's duration head: how many frames a transition to this keyframe takes
+    errs = []
+    for gap, w in windows.items():
+        n = min(256, len(w.frames))
+        backbone.infill(w.context[:n], w.target[:n], np.ones((n, F.DIM), bool), gap, w.style[:n])
+        errs.append(np.abs(backbone.last_duration - gap))
+    mae = float(np.concatenate(errs).mean())
+    figures["duration_mae_frames"] = mae
+    print(f"duration head on held-out 15- and 30-frame transitions: mean error {mae:.1f} frames "
+          f"(a constant guess of 22.5 frames: 7.5)\n")
     print("partial keyframes (root + right hand only), 30-frame gap: success within 10 cm, hand / root distance")
     for m in (interp, mm, backbone):
         s, hd, rd = _partial_keyframes(m, windows[30])

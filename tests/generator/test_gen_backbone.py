@@ -105,3 +105,18 @@ def test_cli_help_explains_and_bad_model_json_is_named(capsys):
     assert "torchrun" in capsys.readouterr().out
     assert main(["train", "generator", "--model", "{bad", "--library", "/nonexistent"]) == 1
     assert "--model must be a JSON object" in capsys.readouterr().err
+
+
+def test_duration_head_cannot_read_the_gap_from_the_token_layout(trained):
+    import torch
+
+    out, _ = trained
+    model = load_checkpoint(out / "backbone.pt")
+    rng = np.random.default_rng(1)
+    ctx = torch.tensor(rng.normal(size=(3, 10, 50)), dtype=torch.float32)
+    tgt = torch.tensor(rng.normal(size=(3, 50)), dtype=torch.float32)
+    given, style = torch.ones(3, 50), torch.zeros(3, dtype=torch.long)
+    with torch.no_grad():
+        _, d10 = model(ctx, tgt, given, torch.zeros(3, 10, 50), style)
+        _, d25 = model(ctx, tgt, given, torch.zeros(3, 25, 50), style)
+    assert torch.allclose(d10, d25)  # the same context and target: the same predicted duration
