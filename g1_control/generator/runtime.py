@@ -56,6 +56,9 @@ class RuntimeConfig:
     box_standoff_m: float = 0.45
     box_half_width_m: float = 0.2
     command_tolerance: float = 0.02
+    velocity_window_frames: int = 30
+    velocity_deadband_mps: float = 0.06
+    yaw_rate_deadband_radps: float = 0.06
 
 
 @dataclass
@@ -271,16 +274,26 @@ class InbetweeningGenerator(Generator):
         ref.root_pos_w_m = frame[F.ROOT_POS].copy()
         ref.root_quat_wxyz = F.matrix_to_quat(rot)
         ref.q_rad = frame[F.JOINTS].copy()
-        # velocities from the plan's next frame difference, in the heading frame (what the
-        # locomotion tracker takes as its command)
-        nxt = self.plan[1] if len(self.plan) > 1 else f1
-        vel_w = (nxt[F.ROOT_POS] - f1[F.ROOT_POS] if len(self.plan) > 1 else f1[F.ROOT_POS] - f0[F.ROOT_POS]) * self.config.fps
+        # The tracker's velocity command: the plan's mean root velocity over up to one gait
+        # cycle ahead, in the heading frame. Frame-to-frame differences carry the pelvis sway
+        # (measured +-0.04 m/s sideways while standing), which a velocity-command policy takes
+        # as a request to step; averaging over a cycle cancels it, and a small deadband keeps a
+        # standing plan standing.
+        m = min(len(self.plan), self.config.velocity_window_frames)
+        ahead = self.plan[m - 1]
+        span = (m - a) / self.config.fps
+        vel_w = (ahead[F.ROOT_POS] - frame[F.ROOT_POS]) / max(span, 1e-3)
         yaw = float(F.yaw_of_matrix(rot))
+        yaw_ahead = float(F.yaw_of_matrix(F.rot6d_to_matrix(ahead[F.ROOT_ROT])))
+        wz = ((yaw_ahead - yaw + math.pi) % (2 * math.pi) - math.pi) / max(span, 1e-3)
         c, s = math.cos(yaw), math.sin(yaw)
-        ref.root_linvel_b_mps = np.array([c * vel_w[0] + s * vel_w[1], -s * vel_w[0] + c * vel_w[1], vel_w[2]])
-        y0 = float(F.yaw_of_matrix(F.rot6d_to_matrix(f1[F.ROOT_ROT] if len(self.plan) > 1 else f0[F.ROOT_ROT])))
-        y1 = float(F.yaw_of_matrix(F.rot6d_to_matrix(nxt[F.ROOT_ROT] if len(self.plan) > 1 else f1[F.ROOT_ROT])))
-        ref.root_angvel_b_radps = np.array([0.0, 0.0, ((y1 - y0 + math.pi) % (2 * math.pi) - math.pi) * self.config.fps])
+        v = np.array([c * vel_w[0] + s * vel_w[1], -s * vel_w[0] + c * vel_w[1], 0.0])
+        if math.hypot(v[0], v[1]) < self.config.velocity_deadband_mps:
+            v[:2] = 0.0
+        if abs(wz) < self.config.yaw_rate_deadband_radps:
+            wz = 0.0
+        ref.root_linvel_b_mps = v
+        ref.root_angvel_b_radps = np.array([0.0, 0.0, wz])
         feet = frame[F.EFFECTORS].reshape(4, 3)[2:]
         ref.contacts = feet[:, 2] < 0.034 + 0.025
         ref.frame_targets_w = dict(self._frame_targets)
