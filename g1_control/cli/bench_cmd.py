@@ -13,6 +13,8 @@ BENCHMARKS = {
     "transport": ("g1_control.hardware.bench:main", "robot link: CRC, LowCmd/LowState encode/decode, safety filter (us/call)"),
     "ik": ("g1_control.ik.bench:main", "IK retargeter: online solve p50/p99, offline frames/s per core"),
     "wbc": ("g1_control.wbc.bench:main", "whole-body QP solve p50/p99 per tick vs RNEA+CRBA and cold solves; loop real-time factor"),
+    "generator": ("g1_control.generator.bench:main",
+                  "in-betweening L2P/L2Q/NPSS vs interpolation + motion matching; replan p50/p99; frames/s; 10-min rollout"),
 }
 
 

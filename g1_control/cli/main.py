@@ -22,6 +22,8 @@ SUBCOMMAND_MODULES = (
     "g1_control.cli.sim_robot_cmd",
     "g1_control.cli.retarget_cmd",
     "g1_control.cli.deploy_cmd",
+    "g1_control.cli.library_cmd",
+    "g1_control.cli.train_cmd",
 )
 
 

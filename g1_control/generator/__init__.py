@@ -1,1 +1,14 @@
-"""Motion generators: operator Command -> KinematicReference."""
+"""Motion generators: operator Command -> KinematicReference.
+
+velocity.py      the trivial generator (velocity at the default pose), the loop's default
+runtime.py       InbetweeningGenerator: smart primitives -> keyframe -> in-betweener, replanning
+                 on command change / low buffer, cross-fade, plan stabilization
+primitives.py    critically damped springs (root, heading), style poses, height, box, effectors
+inbetween.py     the Inbetweener interface (canonical frames, partial keyframes)
+baselines.py     interpolation and motion matching
+backbone.py      the learned root + pose modules (torch); train.py / dataset.py train them
+learned.py       the trained backbone through ONNX Runtime (policies/generator/backbone.onnx)
+features.py, fk.py   the 50-D frame representation and batched forward kinematics
+evaluation.py, bench.py   Harvey et al. protocol (L2P, L2Q, NPSS) and `g1 bench generator`
+retarget.py, factory.py   the IK path to the locomotion tracker; generators by name for launch files
+"""

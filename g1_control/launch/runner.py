@@ -20,7 +20,6 @@ import numpy as np
 import yaml
 
 from g1_control.errors import LaunchFileError
-from g1_control.generator.velocity import CopyRetargeter, VelocityReferenceGenerator
 from g1_control.launch.inputs import make_input
 from g1_control.launch.schema import LaunchFile, Segment
 from g1_control.loop.control_loop import ControlLoop
@@ -117,9 +116,11 @@ def build_loop(launch: LaunchFile, segments: list[Segment]) -> ControlLoop:
     device = make_input(launch, segments, clock=lambda: loop_box[0].time_s if loop_box else 0.0,
                         command_ranges=spec.command_ranges,
                         state_source=backend.read_state)
+    from g1_control.generator.factory import make_generator
+
+    generator, retargeter = make_generator(launch.generator.type, model=launch.generator.model or None, limits=lim)
     loop = ControlLoop(
-        backend, device, VelocityReferenceGenerator(lim.max_vx_mps, lim.max_vy_mps, lim.max_wz_radps),
-        CopyRetargeter(), tracker,
+        backend, device, generator, retargeter, tracker,
         r,
         wallclock=wallclock, safety=SafetyFilter(safety_config(launch)),
         log_capacity=int(launch.total_duration_s * r.tracker_hz) + 2,

@@ -133,6 +133,15 @@ class TrackerConfig:
 
 
 @dataclass
+class GeneratorConfig:
+    """Which motion generator makes the reference (g1_control/generator/factory.py)."""
+
+    type: Literal["velocity", "backbone", "interpolation", "motion_matching"] = "velocity"
+    model: str = ""
+    """Backbone ONNX file; empty: the shipped policies/generator/backbone.onnx."""
+
+
+@dataclass
 class Segment:
     """One piece of a scripted command timeline."""
 
@@ -223,6 +232,7 @@ class LaunchFile:
     backend: BackendConfig = field(default_factory=BackendConfig)
     rates: LoopRates = field(default_factory=LoopRates)
     tracker: TrackerConfig = field(default_factory=TrackerConfig)
+    generator: GeneratorConfig = field(default_factory=GeneratorConfig)
     input: InputConfig = field(default_factory=InputConfig)
     limits: LimitsConfig = field(default_factory=LimitsConfig)
     output: OutputConfig = field(default_factory=OutputConfig)

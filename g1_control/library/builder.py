@@ -1,0 +1,163 @@
+"""Build the motion library (see __init__.py): sources -> clips cut into pieces -> mirrored ->
+split by clip -> written with an index. Cached: a build whose configuration matches the
+index on disk is skipped unless forced."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from g1_control.library.index import INDEX_NAME, LibraryError, MotionLibrary
+from g1_control.motion.clip import MotionClip
+
+BUILD_VERSION = 1
+"""Bumped when the builder's output changes for the same configuration (invalidates caches)."""
+
+LICENSES = {
+    "rollout": "generated here (g1-control) with holosoma-inference 0.1.3's loco policy (Apache-2.0 upstream)",
+    "wbt": "reference clip read out of holosoma-inference 0.1.3's WBT ONNX (Apache-2.0 upstream)",
+    "demo": "retargeted here from holosoma-retargeting 0.1.0 demo mocap (Apache-2.0 upstream)",
+}
+
+
+@dataclass
+class LibraryConfig:
+    fps: float = 30.0
+    rollout_seconds: float = 45.0
+    rollouts_per_style: int = 2
+    rollout_styles: tuple[str, ...] | None = None
+    """None: every style in styles.ROLLOUT_STYLES."""
+    dance: bool = True
+    demo: bool = True
+    mirror: bool = True
+    clip_seconds: float = 8.0
+    test_every: int = 5
+    """Every test_every-th piece of each source (offset 2) is held out."""
+
+    def key(self) -> str:
+        blob = json.dumps({"v": BUILD_VERSION, **asdict(self)}, sort_keys=True)
+        return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+
+def default_library_dir() -> Path:
+    from g1_control.assets import cache_dir
+
+    return cache_dir() / "library"
+
+
+def _rollout_job(args) -> tuple[MotionClip | None, dict]:
+    from g1_control.library.rollouts import RolloutConfig, record_rollout
+    from g1_control.library.styles import ROLLOUT_STYLES
+
+    style, seed, seconds, fps = args
+    return record_rollout(ROLLOUT_STYLES[style], RolloutConfig(duration_s=seconds, seed=seed, fps=fps))
+
+
+def _demo_clips(fps: float) -> list[MotionClip]:
+    from g1_control.assets import fetch
+    from g1_control.ik.mocap_retarget import MocapRetargetConfig, MocapRetargeter
+    from g1_control.motion.formats.dispatch import load_motion
+
+    root = fetch("holosoma-demo-mocap") / "holosoma_retargeting" / "demo_data"
+    out = []
+    for path in sorted(root.glob("climb/*/*.npy")) + sorted(root.glob("OMOMO_new/*.pt")):
+        clip = MocapRetargeter(MocapRetargetConfig(fps=fps)).retarget(load_motion(str(path)))
+        clip.style = "climb" if "climb" in str(path) else "lift"
+        clip.source = path.stem
+        clip.tags = ("demo", "retargeted")
+        out.append(clip)
+    return out
+
+
+def cut(clip: MotionClip, seconds: float) -> list[MotionClip]:
+    """Consecutive pieces of about `seconds`; a short tail joins the last piece."""
+    from g1_control.motion.edit import slice_clip
+
+    n = max(1, int(round(seconds * clip.fps)))
+    count = max(1, clip.num_frames // n)
+    bounds = [i * n for i in range(count)] + [clip.num_frames]
+    return [slice_clip(clip, a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+
+
+def build_library(out_dir: str | Path, config: LibraryConfig | None = None, *, force: bool = False,
+                  jobs: int = 1, progress: bool = True) -> MotionLibrary:
+    from tqdm import tqdm
+
+    from g1_control.library.styles import ROLLOUT_STYLES
+    from g1_control.motion.formats.clip_npz import write_clip_npz
+    from g1_control.motion.mirror import mirror
+
+    config = config or LibraryConfig()
+    out = Path(out_dir)
+    index_path = out / INDEX_NAME
+    if index_path.is_file() and not force:
+        try:
+            if json.loads(index_path.read_text()).get("key") == config.key():
+                return MotionLibrary(out)
+        except json.JSONDecodeError:
+            pass
+    styles = config.rollout_styles or tuple(ROLLOUT_STYLES)
+    unknown = [s for s in styles if s not in ROLLOUT_STYLES]
+    if unknown:
+        raise LibraryError(f"unknown rollout styles {unknown}; known: {', '.join(ROLLOUT_STYLES)}")
+    started = time.perf_counter()
+    sources: list[MotionClip] = []
+    infos: list[dict] = []
+    tasks = [(s, 100 + k, config.rollout_seconds, config.fps) for s in styles for k in range(config.rollouts_per_style)]
+    bar = tqdm(total=len(tasks) + int(config.dance) + int(config.demo), desc="library sources", unit="src",
+               file=sys.stderr, disable=not progress)
+    if jobs > 1 and len(tasks) > 1:
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            for clip, info in pool.map(_rollout_job, tasks):
+                sources += [clip] if clip is not None else []
+                infos.append(info)
+                bar.update()
+    else:
+        for task in tasks:
+            clip, info = _rollout_job(task)
+            sources += [clip] if clip is not None else []
+            infos.append(info)
+            bar.update()
+    if config.dance:
+        from g1_control.library.dance import extract_dance
+
+        sources.append(extract_dance(fps=config.fps))
+        bar.update()
+    if config.demo:
+        sources += _demo_clips(config.fps)
+        bar.update()
+    bar.close()
+    (out / "clips").mkdir(parents=True, exist_ok=True)
+    for old in (out / "clips").glob("*.npz"):
+        old.unlink()
+    cut_sources = [(source, cut(source, config.clip_seconds)) for source in sources]
+    # Sources too short to give 3 pieces are held out whole: the second of each style (when a
+    # style has at least 3 such sources), so every split holds whole, unseen performances.
+    short: dict[str, list[str]] = {}
+    for source, pieces in cut_sources:
+        if len(pieces) < 3:
+            short.setdefault(source.style, []).append(source.source)
+    held_out_sources = {names[1] for names in short.values() if len(names) >= 3}
+    entries = []
+    for source, pieces in tqdm(cut_sources, desc="mirror, write", unit="src", file=sys.stderr, disable=not progress):
+        for k, piece in enumerate(pieces):
+            long_held = len(pieces) >= 3 and k % config.test_every == 2
+            split = "test" if long_held or source.source in held_out_sources else "train"
+            variants = [(piece, False)] + ([(mirror(piece), True)] if config.mirror else [])
+            for clip, mirrored in variants:
+                name = f"{source.source}_{k:02d}{'_mirror' if mirrored else ''}"
+                clip.source = name
+                write_clip_npz(clip, out / "clips" / f"{name}.npz")
+                entries.append({"name": name, "file": f"clips/{name}.npz", "style": clip.style, "split": split,
+                                "source": source.source, "mirrored": mirrored, "num_frames": clip.num_frames})
+    index = {"key": config.key(), "version": BUILD_VERSION, "fps": config.fps, "config": asdict(config),
+             "licenses": LICENSES, "rollouts": infos, "build_s": round(time.perf_counter() - started, 1),
+             "clips": entries}
+    index_path.write_text(json.dumps(index, indent=1))
+    return MotionLibrary(out)
+
