@@ -17,7 +17,9 @@ MIN_TRACKER_HZ = 200.0
 
 
 def build_wbc_loop(launch, segments):
+    from g1_control.launch.runner import safety_config
     from g1_control.loop.control_loop import ControlLoop
+    from g1_control.safety import SafetyFilter
     from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
     from g1_control.teleop.scripted import ScriptedInput
     from g1_control.wbc.references import (
@@ -43,7 +45,7 @@ def build_wbc_loop(launch, segments):
         backend, device, TrajectoryGenerator(trajectory), TrajectoryRetargeter(trajectory),
         WholeBodyTracker(WbcConfig(rate_hz=r.tracker_hz)),
         r,
-        wallclock=launch.backend.mode == "wallclock", max_tilt_rad=lim.max_tilt_rad,
+        wallclock=launch.backend.mode == "wallclock", safety=SafetyFilter(safety_config(launch)),
         log_capacity=int(launch.total_duration_s * r.tracker_hz) + 2,
     )
     loop_box.append(loop)
