@@ -30,7 +30,7 @@ def build_wbc_loop(launch, segments):
     )
     from g1_control.wbc.tracker import WbcConfig, WholeBodyTracker
 
-    r, lim = launch.rates, launch.limits
+    r = launch.rates
     if r.tracker_hz < MIN_TRACKER_HZ:
         raise LaunchFileError(f"rates.tracker_hz: {r.tracker_hz} Hz is too slow for tracker.type wbc "
                               f"(the whole-body controller needs >= {MIN_TRACKER_HZ:.0f} Hz, e.g. 250)")
