@@ -87,8 +87,43 @@ def _slots(dtype) -> np.ndarray:
     return np.zeros(NUM_MOTOR_SLOTS, dtype=dtype)
 
 
+class _Message:
+    """Encoding shared by LowCmd and LowState; each sets its layouts and names as class attributes."""
+
+    _C: ClassVar[FieldCodec]
+    _DDS: ClassVar[FieldCodec]
+    _GATHER: ClassVar[np.ndarray]
+    _IDL_NAME: ClassVar[str]
+
+    def to_c_bytes(self, with_crc: bool = True) -> bytes:
+        """The C struct image (LowCmd_ 1004 bytes); with_crc stores the freshly computed CRC in it."""
+        buf = _pack(self, self._C)
+        if with_crc:
+            self.crc = _seal(buf)
+        return buf.tobytes()
+
+    def to_dds(self) -> bytes:
+        """The DDS sample, with the CRC recomputed over the current contents."""
+        return _seal_dds(self, self._DDS, self._GATHER)
+
+    @classmethod
+    def from_dds(cls, data: bytes, verify: bool = False):
+        """Decode a DDS sample; verify=True raises CrcMismatchError for a bad CRC."""
+        buf = _check_dds(data, cls._DDS, cls._IDL_NAME)
+        if verify:
+            _verify_gathered(buf, cls._DDS, cls._GATHER, cls.__name__)
+        return _unpack(cls, cls._DDS, buf)
+
+    @classmethod
+    def from_c_bytes(cls, data: bytes, verify: bool = False):
+        buf = _check_c(data, cls._C, cls._IDL_NAME)
+        if verify:
+            _verify_image(buf, cls._C.size, cls.__name__)
+        return _unpack(cls, cls._C, buf)
+
+
 @dataclass
-class LowCmd:
+class LowCmd(_Message):
     """LowCmd_: one command for all 35 motor slots (the G1 uses the first 29)."""
 
     mode_pr: int = 0
@@ -114,35 +149,14 @@ class LowCmd:
         "reserve": "reserve", "crc": "crc",
     }
 
-    def to_c_bytes(self, with_crc: bool = True) -> bytes:
-        """The C struct image (1004 bytes); with_crc stores the freshly computed CRC in it."""
-        buf = _pack(self, _CMD_C)
-        if with_crc:
-            self.crc = _seal(buf)
-        return buf.tobytes()
-
-    def to_dds(self) -> bytes:
-        """The DDS sample, with the CRC recomputed over the current contents."""
-        return _seal_dds(self, _CMD_DDS, _CMD_GATHER)
-
-    @classmethod
-    def from_dds(cls, data: bytes, verify: bool = False) -> LowCmd:
-        """Decode a DDS sample; verify=True raises CrcMismatchError for a bad CRC."""
-        buf = _check_dds(data, _CMD_DDS, "LowCmd_")
-        if verify:
-            _verify_gathered(buf, _CMD_DDS, _CMD_GATHER, "LowCmd")
-        return _unpack(cls, _CMD_DDS, buf)
-
-    @classmethod
-    def from_c_bytes(cls, data: bytes, verify: bool = False) -> LowCmd:
-        buf = _check_c(data, _CMD_C, "LowCmd_")
-        if verify:
-            _verify_image(buf, _CMD_C.size, "LowCmd")
-        return _unpack(cls, _CMD_C, buf)
+    _C: ClassVar[FieldCodec] = _CMD_C
+    _DDS: ClassVar[FieldCodec] = _CMD_DDS
+    _GATHER: ClassVar[np.ndarray] = _CMD_GATHER
+    _IDL_NAME: ClassVar[str] = "LowCmd_"
 
 
 @dataclass
-class LowState:
+class LowState(_Message):
     """LowState_: what the robot reports at 500 Hz."""
 
     version: np.ndarray = field(default_factory=lambda: np.zeros(2, dtype=np.uint32))
@@ -182,28 +196,10 @@ class LowState:
         "reserve": "reserve", "crc": "crc",
     }
 
-    def to_c_bytes(self, with_crc: bool = True) -> bytes:
-        buf = _pack(self, _STATE_C)
-        if with_crc:
-            self.crc = _seal(buf)
-        return buf.tobytes()
-
-    def to_dds(self) -> bytes:
-        return _seal_dds(self, _STATE_DDS, _STATE_GATHER)
-
-    @classmethod
-    def from_dds(cls, data: bytes, verify: bool = False) -> LowState:
-        buf = _check_dds(data, _STATE_DDS, "LowState_")
-        if verify:
-            _verify_gathered(buf, _STATE_DDS, _STATE_GATHER, "LowState")
-        return _unpack(cls, _STATE_DDS, buf)
-
-    @classmethod
-    def from_c_bytes(cls, data: bytes, verify: bool = False) -> LowState:
-        buf = _check_c(data, _STATE_C, "LowState_")
-        if verify:
-            _verify_image(buf, _STATE_C.size, "LowState")
-        return _unpack(cls, _STATE_C, buf)
+    _C: ClassVar[FieldCodec] = _STATE_C
+    _DDS: ClassVar[FieldCodec] = _STATE_DDS
+    _GATHER: ClassVar[np.ndarray] = _STATE_GATHER
+    _IDL_NAME: ClassVar[str] = "LowState_"
 
 
 def compute_crc(msg: LowCmd | LowState) -> int:
