@@ -12,6 +12,7 @@ Frame Jacobians are LOCAL_WORLD_ALIGNED (linear rows give world-frame point velo
 from __future__ import annotations
 
 import functools
+import math
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -86,6 +87,9 @@ class Configuration:
         self.data = self.model.createData()
         self.nq, self.nv = self.model.nq, self.model.nv
         self._frame_ids: dict[str, int] = {}
+        self._support_masks: dict[tuple[int, ...], np.ndarray] = {}
+        self.layout_cache: dict[tuple, object] = {}
+        """Per-task-set data (row layouts) that tasks keep between ticks; keyed by the tasks."""
         self._com_w_m = np.zeros(3)
         self._com_jacobian = np.zeros((3, self.nv))
         self._com_valid = False
@@ -112,9 +116,10 @@ class Configuration:
         if q.shape != (self.nq,):
             raise InvalidConfigurationError(f"configuration has shape {q.shape}; expected ({self.nq},) "
                                             "(pinocchio layout: x y z, qx qy qz qw, 29 joints)")
-        if not np.all(np.isfinite(q)):
+        if not np.isfinite(q).all():
             raise InvalidConfigurationError("configuration contains NaN or inf")
-        norm = float(np.linalg.norm(q[3:7]))
+        quat = q[3:7]
+        norm = math.sqrt(quat @ quat)
         if abs(norm - 1.0) > 1e-3:
             raise InvalidConfigurationError(f"base quaternion has norm {norm:.4f}; expected 1")
         return q
@@ -124,7 +129,8 @@ class Configuration:
         check=False skips validation, for configurations this module produced itself."""
         if q is not None:
             self.q[:] = self.check_q(q) if check else q
-            self.q[3:7] /= np.linalg.norm(self.q[3:7])
+            quat = self.q[3:7]
+            quat /= math.sqrt(quat @ quat)
         pin.computeJointJacobians(self.model, self.data, self.q)
         pin.updateFramePlacements(self.model, self.data)
         self._com_valid = False  # computed on first use: many IK setups have no CoM task
@@ -151,6 +157,32 @@ class Configuration:
 
     def frame_placement(self, frame_id: int) -> pin.SE3:
         return self.data.oMf[frame_id]
+
+    def placements(self, frame_ids: list[int]) -> np.ndarray:
+        """(K, 4, 4) world placements of the frames (homogeneous matrices)."""
+        oMf = self.data.oMf
+        return np.array([oMf[f].homogeneous for f in frame_ids])
+
+    def support_masks(self, frame_ids: tuple[int, ...]) -> np.ndarray:
+        """(K, nv): 1.0 for the velocity coordinates that move each frame (the supporting joints of
+        its parent joint, the floating base included), 0.0 for the rest. With these, a frame's
+        Jacobian is read off the world joint Jacobians `data.J` (see ik/kernels.py)."""
+        masks = self._support_masks.get(frame_ids)
+        if masks is None:
+            masks = np.zeros((len(frame_ids), self.nv))
+            for k, fid in enumerate(frame_ids):
+                for joint in self.model.supports[self.model.frames[fid].parentJoint]:
+                    if joint > 0:  # 0 is the universe
+                        jm = self.model.joints[joint]
+                        masks[k, jm.idx_v:jm.idx_v + jm.nv] = 1.0
+            self._support_masks[frame_ids] = masks  # shared: callers must not write to it
+        return masks
+
+    @property
+    def joint_jacobians_w(self) -> np.ndarray:
+        """(6, nv) pinocchio's data.J: each column the spatial velocity (world axes, at the world
+        origin) its velocity coordinate produces on the joint it belongs to."""
+        return self.data.J
 
     def frame_jacobian(self, frame_id: int) -> np.ndarray:
         """(6, nv) Jacobian, LOCAL_WORLD_ALIGNED: rows 0-2 world linear velocity of the frame

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from g1_control.ik import kernels
 from g1_control.ik.configuration import Configuration, foot_contact_points
 from g1_control.ik.exceptions import InvalidReferenceError, NoSolutionFound, TaskDefinitionError
 from g1_control.ik.limits import (
@@ -34,7 +35,6 @@ from g1_control.ik.tasks import (
     PostureTask,
     SmoothnessTask,
     Task,
-    pose_from_vector,
 )
 from g1_control.interfaces import Retargeter
 from g1_control.robot import description, g1
@@ -107,6 +107,7 @@ class IKRetargeter(Retargeter):
     def __init__(self, config: IKConfig | None = None) -> None:
         self.config = (config or IKConfig()).validate()
         cfg = self.config
+        kernels.warm_up()
         self.configuration = Configuration()
         self._ref_model = self.configuration.model
         self._ref_data = self._ref_model.createData()
@@ -164,8 +165,12 @@ class IKRetargeter(Retargeter):
     @staticmethod
     def _check_reference(ref: KinematicReference) -> None:
         arrays = (ref.root_pos_w_m, ref.root_quat_wxyz, ref.q_rad)
-        shapes = tuple(np.shape(a) for a in arrays)
-        if shapes != ((3,), (4,), (g1.NUM_JOINTS,)) or not np.isfinite(np.concatenate(arrays)).all():
+        try:
+            flat = np.concatenate(arrays)
+        except ValueError:  # one of them is not one-dimensional
+            flat = None
+        if flat is None or flat.shape != (7 + g1.NUM_JOINTS,) or not np.isfinite(flat).all() \
+                or (np.shape(arrays[0]), np.shape(arrays[1])) != ((3,), (4,)):
             # Slow path only on failure: find the field to name.
             for name, expected in (("root_pos_w_m", (3,)), ("root_quat_wxyz", (4,)), ("q_rad", (g1.NUM_JOINTS,))):
                 arr = np.asarray(getattr(ref, name))
@@ -173,13 +178,16 @@ class IKRetargeter(Retargeter):
                     raise InvalidReferenceError(f"KinematicReference.{name} has shape {arr.shape}; expected {expected}")
                 if not np.all(np.isfinite(arr)):
                     raise InvalidReferenceError(f"KinematicReference.{name} contains NaN or inf (t = {ref.t_s} s)")
+        if not flat[3:7].any():
+            raise InvalidReferenceError(f"KinematicReference.root_quat_wxyz is zero at t = {ref.t_s} s; "
+                                        "expected a unit quaternion (qw qx qy qz)")
         if np.asarray(ref.contacts).shape != (2,):
             raise InvalidReferenceError(f"KinematicReference.contacts has shape {np.asarray(ref.contacts).shape}; "
                                         "expected (2,) = (left, right)")
         if ref.frame_targets_w:
             try:
                 poses = np.array(list(ref.frame_targets_w.values()), dtype=float)
-                fine = poses.shape[1:] == (7,) and np.isfinite(poses).all()
+                fine = poses.shape[1:] == (7,) and np.isfinite(poses).all() and poses[:, 3:].any(axis=1).all()
             except ValueError:  # ragged: one of them has the wrong length
                 fine = False
             if not fine:
@@ -189,6 +197,10 @@ class IKRetargeter(Retargeter):
                         raise InvalidReferenceError(
                             f"frame target '{frame}' must be 7 finite numbers (x y z qw qx qy qz); "
                             f"got shape {pose.shape} at t = {ref.t_s} s")
+                    if not pose[3:].any():
+                        raise InvalidReferenceError(
+                            f"frame target '{frame}' has a zero quaternion at t = {ref.t_s} s; "
+                            "expected a unit quaternion (qw qx qy qz)")
 
     def _start_configuration(self, ref: KinematicReference, q_prev: np.ndarray) -> np.ndarray:
         q_prev = np.asarray(q_prev, dtype=float)
@@ -237,15 +249,11 @@ class IKRetargeter(Retargeter):
         tasks: list[Task] = [self.posture_task, self.damping_task, self.smoothness_task]
         self.posture_task.set_target(np.asarray(ref.q_rad, dtype=float), check=False)
         if any(cfg.root_cost) and g1.BASE_BODY not in ref.frame_targets_w:
-            self.root_task.set_target(pose_from_vector(np.concatenate([ref.root_pos_w_m, ref.root_quat_wxyz]),
-                                                       "KinematicReference root pose"))
+            self.root_task.set_target_vector(np.concatenate([ref.root_pos_w_m, ref.root_quat_wxyz]))
             tasks.append(self.root_task)
         for name, pose in ref.frame_targets_w.items():
-            task = self._frame_task(name)
-            if task._track_orientation:
-                task.set_target(pose_from_vector(pose, f"frame target '{name}'"))
-            else:  # position only: no rotation to build (poses were checked in _check_reference)
-                task.set_target_position(pose[:3])
+            task = self.frame_tasks.get(name) or self._frame_task(name)
+            task.set_target_vector(pose)  # checked in _check_reference
             tasks.append(task)
         if any(cfg.com_cost):
             q_ref = description.pinocchio_q(ref.root_pos_w_m, ref.root_quat_wxyz / np.linalg.norm(ref.root_quat_wxyz),
@@ -284,8 +292,7 @@ class IKRetargeter(Retargeter):
         exceeds `contact_tolerance_m`, take one more step with no task but a small-motion cost,
         under the same limits: a Newton projection back onto the contacts."""
         tol = self.config.contact_tolerance_m
-        if tol <= 0 or not any(c.active and np.abs(c.error(self.configuration)[:3]).max() > tol
-                               for c in self.contacts):
+        if tol <= 0 or not any(c.active and c.position_drift(self.configuration) > tol for c in self.contacts):
             return
         try:
             dq = self.solver.solve(self.configuration, [self._projection_task], self._limits(True), self.config.dt_s)

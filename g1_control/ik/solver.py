@@ -34,6 +34,7 @@ class QPSolver:
         self.lower = np.zeros(nv)
         self.upper = np.zeros(nv)
         self.last_iterations = 0
+        self._senses: dict[tuple[int, int], np.ndarray] = {}
         if backend == "daqp":
             import daqp
 
@@ -68,7 +69,7 @@ class QPSolver:
             else:
                 task.add_objective(configuration, self.hessian, self.linear)
         if jacs:
-            jac = np.vstack(jacs)
+            jac = np.concatenate(jacs)
             jw = jac.T * np.concatenate(weights)
             self.hessian += jw @ jac
             self.linear += jw @ np.concatenate(errs)
@@ -102,15 +103,18 @@ class QPSolver:
     def _solve_daqp(self, rows: list[RowConstraint], eqs: list[RowConstraint]) -> np.ndarray:
         cons = eqs + rows
         if cons:
-            a = np.vstack([c.matrix for c in cons])
+            a = np.concatenate([c.matrix for c in cons])
             bu = np.concatenate([self.upper] + [c.upper for c in cons])
             bl = np.concatenate([self.lower] + [c.lower for c in cons])
         else:
             a = np.zeros((0, self.nv))
             bu, bl = self.upper.copy(), self.lower.copy()
-        sense = np.zeros(bu.shape[0], dtype=np.int32)
-        n_eq = sum(c.matrix.shape[0] for c in eqs)
-        sense[self.nv:self.nv + n_eq] = 5  # daqp: 5 marks an equality row
+        n_eq = sum([c.matrix.shape[0] for c in eqs])
+        sense = self._senses.get((bu.shape[0], n_eq))
+        if sense is None:  # daqp's row kinds: 0 inequality, 5 equality (read-only: reused every tick)
+            sense = np.zeros(bu.shape[0], dtype=np.int32)
+            sense[self.nv:self.nv + n_eq] = 5
+            self._senses[(bu.shape[0], n_eq)] = sense
         x, _, exitflag, info = self._daqp.solve(self.hessian, self.linear, a, bu, bl, sense,
                                                 primal_tol=self.tolerance)
         self.last_iterations = int(info.get("iterations", 0)) if isinstance(info, dict) else 0

@@ -45,7 +45,7 @@ def test_frame_task_error_is_zero_at_its_own_pose_and_grows_with_offset():
     task = FrameTask("left_rubber_hand")
     task.set_target_from_configuration(conf)
     np.testing.assert_allclose(task.compute_error(conf), 0.0, atol=1e-12)
-    task.target.translation = task.target.translation + np.array([0.1, 0.0, 0.0])
+    task.set_target_position(task.target.translation + np.array([0.1, 0.0, 0.0]))
     np.testing.assert_allclose(task.compute_error(conf)[:3], [-0.1, 0.0, 0.0], atol=1e-12)
 
 

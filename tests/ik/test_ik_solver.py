@@ -20,7 +20,7 @@ def _problem():
     conf = Configuration()
     hand = FrameTask("left_rubber_hand", 1.0, 0.0)
     hand.set_target_from_configuration(conf)
-    hand.target.translation = hand.target.translation + np.array([0.3, 0.0, 0.2])
+    hand.set_target_position(hand.target.translation + np.array([0.3, 0.0, 0.2]))
     posture = PostureTask(0.05)
     posture.set_target(np.asarray(g1.DEFAULT_Q_RAD))
     return conf, [hand, posture, DampingTask(1e-3)], [JointPositionLimit(), JointVelocityLimit(), GroundLimit()]

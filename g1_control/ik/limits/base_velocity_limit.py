@@ -16,8 +16,10 @@ from g1_control.ik.limits.base import INF, BoxBounds, Limit
 
 
 def _base_placement(q: np.ndarray) -> pin.SE3:
-    x, y, z, w = q[3:7]
-    return pin.SE3(pin.Quaternion(w, x, y, z).normalized().toRotationMatrix(), q[:3].copy())
+    """Base pose from a pinocchio configuration (x y z, qx qy qz qw; the quaternion normalised)."""
+    pose = q[:7].copy()
+    pose[3:] /= np.linalg.norm(pose[3:])
+    return pin.XYZQUATToSE3(pose)
 
 
 class BaseVelocityLimit(Limit):
@@ -27,6 +29,7 @@ class BaseVelocityLimit(Limit):
                                        f"Got {max_linear_mps} m/s and {max_angular_radps} rad/s")
         self.max_linear_mps = float(max_linear_mps)
         self.max_angular_radps = float(max_angular_radps)
+        self._reach = np.array([self.max_linear_mps] * 3 + [self.max_angular_radps] * 3)
         self.anchor: pin.SE3 | None = None
         self._box: BoxBounds | None = None
 
@@ -38,11 +41,13 @@ class BaseVelocityLimit(Limit):
         nv = configuration.nv
         if self._box is None or self._box.lower.shape[0] != nv:
             self._box = BoxBounds(np.full(nv, -INF), np.full(nv, INF))
-        reach = np.array([self.max_linear_mps] * 3 + [self.max_angular_radps] * 3) * dt_s
-        done = np.zeros(6)
+        reach = self._reach * dt_s
         if self.anchor is not None:
             # joint 1 is the free flyer: its placement is the base pose, already computed
             done = pin.log6(self.anchor.actInv(configuration.data.oMi[1])).vector
-        self._box.lower[:6] = -reach - done
-        self._box.upper[:6] = reach - done
+            np.subtract(-reach, done, out=self._box.lower[:6])
+            np.subtract(reach, done, out=self._box.upper[:6])
+        else:
+            self._box.lower[:6] = -reach
+            self._box.upper[:6] = reach
         return self._box
