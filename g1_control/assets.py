@@ -52,9 +52,9 @@ ASSETS: dict[str, WheelAsset] = {
         package="holosoma-retargeting",
         version="0.1.0",
         sha256="3dcdcc06c6705c091478808024298dfcc684d9eb49e890cc6b11fc03fa246cb4",
-        patterns=("holosoma_retargeting/demo_data/*",),
+        patterns=("holosoma_retargeting/demo_data/*", "holosoma_retargeting/models/largebox/largebox.obj"),
         license="Apache-2.0 (as stated upstream by Amazon FAR)",
-        description="demo human mocap: five box-climbing and two OMOMO box-lifting sequences",
+        description="demo human mocap: five box-climbing and two OMOMO box-lifting sequences (+ the box's mesh)",
     ),
 }
 
@@ -67,8 +67,15 @@ def asset_dir(name: str) -> Path:
     return cache_dir() / name / ASSETS[name].version
 
 
+def _marker(asset: WheelAsset) -> str:
+    """What `.complete` says once an asset is extracted: the wheel and the files taken from it, so a
+    cache extracted for a shorter file list is extracted again."""
+    return f"{asset.package}=={asset.version} sha256={asset.sha256} files={' '.join(asset.patterns)}\n"
+
+
 def is_fetched(name: str) -> bool:
-    return (asset_dir(name) / ".complete").is_file()
+    marker = asset_dir(name) / ".complete"
+    return marker.is_file() and marker.read_text() == _marker(ASSETS[name])
 
 
 def _sha256(path: Path) -> str:
@@ -98,7 +105,7 @@ def extract(asset: WheelAsset, wheel: Path, dest: Path) -> list[Path]:
             written.append(target)
     if not written:
         raise PolicyFetchError(f"{wheel.name} contains no file matching {asset.patterns}")
-    (dest / ".complete").write_text(f"{asset.package}=={asset.version} sha256={asset.sha256}\n")
+    (dest / ".complete").write_text(_marker(asset))
     return written
 
 

@@ -117,7 +117,8 @@ def process_one(path: str, out_path: str, options: dict, show_frames: bool = Fal
         metrics = compute_metrics(clip)
         if options.get("plot"):
             plot_metrics(clip, Path(out_path).with_suffix(".png"), metrics)
-        return {"input": path, "output": out_path, **asdict(metrics)}
+        return {"input": path, "output": out_path, **asdict(metrics),
+                "object_contact_preserved_fraction": metrics.object_contact_preserved_fraction}
     except G1ControlError as exc:
         return {"input": path, "error": str(exc)}
     except Exception as exc:  # noqa: BLE001 - a batch reports every failure and goes on

@@ -23,6 +23,7 @@ from g1_control.motion import quaternion as quat
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.contacts import stance_from_trajectory
 from g1_control.motion.human import HumanMotion
+from g1_control.motion.objects import ObjectTrack
 from g1_control.motion.resample import interpolate_positions, resample_times
 from g1_control.motion.skeletons import Skeleton, detect_skeleton
 from g1_control.robot import description, g1
@@ -32,6 +33,7 @@ G1_HEIGHT_M = 1.32
 """Standing height of the G1 (Unitree's specification: 1320 mm)."""
 FALLBACK_HUMAN_HEIGHT_M = 1.75
 LIMBS = ("left_arm", "right_arm", "left_leg", "right_leg")
+HAND_FRAMES = ("left_rubber_hand", "right_rubber_hand")
 
 
 @dataclass
@@ -59,6 +61,10 @@ class MocapRetargetConfig:
     warmup_iterations: int = 30
     stance_speed_mps: float = 0.25
     """A human foot point slower than this (after scaling) is in stance."""
+    object_contact_m: float = 0.06
+    """A frame is a hand-object contact when the human's hand keypoint (the joint mapped to the
+    G1's hand, a wrist) is within this of the object's surface, robot scale (a gripping wrist
+    sits 2-5 cm from a box's face)."""
     velocity_limit_scale: float = 1.0
     free_yaw_stance: bool = False
     """Stance feet may pivot about the vertical (IKConfig.contact_free_yaw). Off: on the demo
@@ -73,6 +79,8 @@ class MocapRetargetConfig:
         unknown = set(self.limb_scale) - set(LIMBS)
         if unknown:
             raise IKError(f"MocapRetargetConfig.limb_scale has unknown limbs {sorted(unknown)}; known: {LIMBS}")
+        if not self.object_contact_m > 0:
+            raise IKError(f"MocapRetargetConfig.object_contact_m must be > 0 m. Got {self.object_contact_m}")
         if self.human_height_m is not None and not self.human_height_m > 0:
             raise IKError(f"human height must be > 0 m. Got {self.human_height_m}")
         return self
@@ -113,6 +121,8 @@ class PreparedTargets:
     foot_rot: tuple[np.ndarray, np.ndarray]
     contacts: np.ndarray
     scale: float
+    object: ObjectTrack | None = None
+    """The handled object at the output rate and robot scale, hand contacts labelled."""
 
 
 def _stance_height(z: np.ndarray, stance: np.ndarray) -> float:
@@ -160,7 +170,13 @@ def prepare_targets(motion: HumanMotion, skeleton: Skeleton, config: MocapRetarg
     root = hip_mid + np.einsum("tij,j->ti", pelvis_rot, _pelvis_above_hips())
     foot_rot = (_yaw_frames(p(skeleton.left_toe) - p(skeleton.left_ankle)),
                 _yaw_frames(p(skeleton.right_toe) - p(skeleton.right_ankle)))
-    return PreparedTargets(config.fps, keypoints, root, pelvis_rot, torso_rot, foot_rot, contacts, scale)
+    track = None
+    if motion.object is not None:
+        track = motion.object.resampled(motion.fps, times).scaled(scale)
+        hands = [next((h for h, f in skeleton.frame_map.items() if f == frame), None) for frame in HAND_FRAMES]
+        if None not in hands:
+            track.hand_contacts = track.distance(np.stack([p(h) for h in hands], axis=1)) < config.object_contact_m
+    return PreparedTargets(config.fps, keypoints, root, pelvis_rot, torso_rot, foot_rot, contacts, scale, track)
 
 
 @functools.cache
@@ -237,4 +253,4 @@ class MocapRetargeter:
                 progress(1)
         return MotionClip.from_joint_trajectory(
             targets.fps, qs[:, :3], qs[:, [6, 3, 4, 5]], qs[:, 7:], contacts=robot_contacts, source=motion.source,
-            style="default", tags=("retargeted", skeleton.name, f"scale={targets.scale:.4f}"))
+            style="default", tags=("retargeted", skeleton.name, f"scale={targets.scale:.4f}"), object=targets.object)

@@ -20,6 +20,8 @@ Fields (T frames, J = 29 joints in `joint_names` order, B bodies in `body_names`
     source                  where it came from (file name, dataset)
     style                   style label for the generator ("default", "climb", ...)
     tags                    free labels
+    object                  the object the motion handles (motion/objects.py ObjectTrack: shape, pose per
+                            frame, source hand-contact labels), or None
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ import numpy as np
 
 from g1_control.motion import quaternion as quat
 from g1_control.motion.exceptions import InvalidClipError
+from g1_control.motion.objects import ObjectTrack
 from g1_control.robot import g1
 
 ARRAY_FIELDS = ("root_pos_w_m", "root_quat_wxyz", "joint_pos_rad", "joint_vel_radps", "body_pos_w_m",
@@ -53,13 +56,15 @@ class MotionClip:
     source: str = ""
     style: str = "default"
     tags: tuple[str, ...] = field(default_factory=tuple)
+    object: ObjectTrack | None = None
 
     # ------------------------------------------------------------------ construction
     @classmethod
     def from_joint_trajectory(cls, fps: float, root_pos_w_m: np.ndarray, root_quat_wxyz: np.ndarray,
                               joint_pos_rad: np.ndarray, contacts: np.ndarray | None = None, source: str = "",
                               style: str = "default", tags: tuple[str, ...] = (),
-                              body_names: tuple[str, ...] | None = None) -> MotionClip:
+                              body_names: tuple[str, ...] | None = None,
+                              object: ObjectTrack | None = None) -> MotionClip:
         """Build a full clip from root pose + joint angles: velocities by differences, body poses by
         forward kinematics, contacts from foot motion when not given."""
         from g1_control.motion.contacts import foot_contacts
@@ -87,7 +92,7 @@ class MotionClip:
             body_pos_w_m=body_pos, body_quat_wxyz=body_quat,
             body_lin_vel_w_mps=differentiate(body_pos, fps),
             body_ang_vel_w_radps=quat.angular_velocity_w(body_quat, fps),
-            contacts=np.asarray(contacts, dtype=bool), source=source, style=style, tags=tuple(tags),
+            contacts=np.asarray(contacts, dtype=bool), source=source, style=style, tags=tuple(tags), object=object,
         )
         return clip.validate()
 
@@ -112,6 +117,8 @@ class MotionClip:
                 raise InvalidClipError(f"clip{where}: {name} has shape {arr.shape}; expected {shape}")
             if name != "contacts":
                 _check_frames(name, arr, self.source)
+        if self.object is not None:
+            self.object.validate(t, f"clip{where}")
         norms = np.linalg.norm(self.root_quat_wxyz, axis=-1)
         bad = np.flatnonzero(np.abs(norms - 1.0) > 1e-3)
         if bad.size:
@@ -142,12 +149,17 @@ class MotionClip:
         kwargs = {f.name: getattr(self, f.name) for f in fields(self)}
         for name in ARRAY_FIELDS:
             kwargs[name] = np.array(kwargs[name], copy=True)
+        if self.object is not None:
+            kwargs["object"] = self.object.take(slice(None))
         return MotionClip(**kwargs)
 
     def equals(self, other: MotionClip, atol: float = 0.0) -> bool:
         """Same names, fps, tags and arrays (exactly, or within atol)."""
         if (self.fps, self.joint_names, self.body_names, self.source, self.style, tuple(self.tags)) != (
                 other.fps, other.joint_names, other.body_names, other.source, other.style, tuple(other.tags)):
+            return False
+        if (self.object is None) != (other.object is None) or (
+                self.object is not None and not self.object.equals(other.object)):
             return False
         for name in ARRAY_FIELDS:
             a, b = np.asarray(getattr(self, name)), np.asarray(getattr(other, name))

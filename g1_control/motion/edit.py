@@ -9,6 +9,7 @@ import numpy as np
 from g1_control.motion import quaternion as quat
 from g1_control.motion.clip import ARRAY_FIELDS, MotionClip
 from g1_control.motion.exceptions import IncompatibleClipsError, InvalidClipError
+from g1_control.motion.objects import ObjectTrack
 
 
 def slice_clip(clip: MotionClip, start: int = 0, stop: int | None = None) -> MotionClip:
@@ -19,6 +20,8 @@ def slice_clip(clip: MotionClip, start: int = 0, stop: int | None = None) -> Mot
     out = clip.copy()
     for name in ARRAY_FIELDS:
         setattr(out, name, np.array(getattr(clip, name)[frames.start:frames.stop], copy=True))
+    if clip.object is not None:
+        out.object = clip.object.take(slice(frames.start, frames.stop))
     return out.validate()
 
 
@@ -40,6 +43,8 @@ def transform_clip(clip: MotionClip, yaw_rad: float, translation_xy_m: np.ndarra
     out.body_quat_wxyz = quat.multiply(q_yaw, clip.body_quat_wxyz)
     out.body_lin_vel_w_mps = clip.body_lin_vel_w_mps @ rot.T
     out.body_ang_vel_w_radps = clip.body_ang_vel_w_radps @ rot.T
+    if clip.object is not None:
+        out.object = clip.object.transformed(rot, q_yaw, shift)
     return out
 
 
@@ -67,6 +72,15 @@ def concatenate(clips: Sequence[MotionClip], align_root: bool = True) -> MotionC
     out = first.copy()
     for name in ARRAY_FIELDS:
         setattr(out, name, np.concatenate([getattr(p, name) for p in parts], axis=0))
+    # One object track only when every part handles the same object; otherwise the result has none
+    # (a clip has at most one object).
+    objects = [p.object for p in parts]
+    if all(o is not None and o.shape.equals(objects[0].shape) for o in objects):
+        out.object = ObjectTrack(objects[0].shape, np.concatenate([o.pos_w_m for o in objects]),
+                                 np.concatenate([o.quat_wxyz for o in objects]),
+                                 np.concatenate([o.hand_contacts for o in objects]))
+    else:
+        out.object = None
     out.source = " + ".join(p.source for p in parts if p.source)
     out.tags = tuple(dict.fromkeys(t for p in parts for t in p.tags))
     return out.validate()

@@ -5,6 +5,7 @@
     fps             frames per second (Hz)
     height_m        the performer's height when known (for scaling to the G1), else None
     source          file name
+    object          the handled object's track (motion/objects.py), or None
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from g1_control.motion.exceptions import InvalidClipError
+from g1_control.motion.objects import ObjectTrack
 
 
 @dataclass
@@ -23,6 +25,8 @@ class HumanMotion:
     fps: float
     height_m: float | None = None
     source: str = ""
+    object: ObjectTrack | None = None
+    """The object the performer handles (pose per frame), when the data has one."""
 
     def validate(self) -> HumanMotion:
         where = f"'{self.source}'" if self.source else "human motion"
@@ -38,6 +42,8 @@ class HumanMotion:
             raise InvalidClipError(f"{where}: NaN or inf at frame {int(np.flatnonzero(~finite)[0])}")
         if not (np.isfinite(self.fps) and self.fps > 0):
             raise InvalidClipError(f"{where}: fps is {self.fps}; expected a positive number")
+        if self.object is not None:
+            self.object.validate(pos.shape[0], where)
         return self
 
     @property

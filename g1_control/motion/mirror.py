@@ -63,4 +63,5 @@ def mirror(clip: MotionClip) -> MotionClip:
         body_ang_vel_w_radps=clip.body_ang_vel_w_radps[:, bperm] * _PSEUDO,
         contacts=clip.contacts[:, ::-1].copy(),
         source=clip.source, style=clip.style, tags=tuple(clip.tags),
+        object=None if clip.object is None else clip.object.mirrored(),
     )

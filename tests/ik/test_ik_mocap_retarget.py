@@ -90,3 +90,22 @@ def test_frame_from_left_up_is_a_rotation_with_y_left():
     np.testing.assert_allclose(rot.T @ rot, np.eye(3), atol=1e-12)
     np.testing.assert_allclose(rot[:, 1], [0, 1, 0], atol=1e-12)
     assert np.linalg.det(rot) == pytest.approx(1.0)
+
+
+def test_omomo_box_contacts_are_kept_through_retargeting(monkeypatch):
+    """OMOMO box lifting: the file carries the box's pose; the G1's hands stay at the box on the
+    frames where the performer's hands are on it."""
+    from g1_control.motion.formats.joint_positions import read_omomo_pt
+
+    motion = read_omomo_pt(demo_root(monkeypatch) / "OMOMO_new" / "sub3_largebox_003.pt")
+    assert motion.object is not None and motion.object.shape.name == "largebox"
+    short = HumanMotion(motion.positions_w_m[:120], motion.joint_names, motion.fps, motion.height_m, motion.source,
+                        motion.object.take(slice(0, 120)))
+    clip = MocapRetargeter().retarget(short)
+    assert clip.object is not None and clip.object.num_frames == clip.num_frames
+    scale = 1.32 / motion.height_m
+    np.testing.assert_allclose(clip.object.pos_w_m, short.object.pos_w_m * scale, atol=1e-9)
+    m = compute_metrics(clip)
+    assert m.object_contact_frames > 100, "the performer holds the box with both hands for most of the slice"
+    assert m.object_contact_preserved_fraction >= 0.95 and m.max_object_penetration_m < 0.02
+    assert m.passes()

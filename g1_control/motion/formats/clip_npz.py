@@ -3,7 +3,8 @@
 Keys read and written by those projects: fps, joint_pos, joint_vel (T, 29), body_pos_w (T, B, 3),
 body_quat_w (T, B, 4, w x y z), body_lin_vel_w, body_ang_vel_w. Their files store no names, and
 the two projects order bodies differently. This module always writes joint_names and
-body_names (and root_pos_w, root_quat_w, contacts, source, style, tags). Reading a file without
+body_names (and root_pos_w, root_quat_w, contacts, source, style, tags; and, for a clip that handles
+an object, object_name, object_planes, object_pos_w, object_quat_w, object_hand_contacts). Reading a file without
 names, it takes the joints in g1.JOINT_NAMES order and the root from body 0 (the pelvis in both
 projects), recomputes the bodies by forward kinematics and identifies each stored body by matching
 it to the nearest recomputed one, refusing a file whose bodies match none (wrong joint order).
@@ -17,6 +18,7 @@ import numpy as np
 
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.exceptions import InvalidClipError, MotionFormatError
+from g1_control.motion.objects import ObjectShape, ObjectTrack
 from g1_control.robot import g1
 
 REQUIRED = ("fps", "joint_pos", "joint_vel", "body_pos_w", "body_quat_w", "body_lin_vel_w", "body_ang_vel_w")
@@ -24,8 +26,13 @@ BODY_MATCH_TOLERANCE_M = 0.01
 
 
 def write_clip_npz(clip: MotionClip, path: str | Path) -> None:
+    extra = {}
+    if clip.object is not None:
+        o = clip.object
+        extra = {"object_name": np.array(o.shape.name), "object_planes": o.shape.planes, "object_pos_w": o.pos_w_m,
+                 "object_quat_w": o.quat_wxyz, "object_hand_contacts": o.hand_contacts}
     np.savez(
-        path, fps=np.array(clip.fps), joint_pos=clip.joint_pos_rad, joint_vel=clip.joint_vel_radps,
+        path, **extra, fps=np.array(clip.fps), joint_pos=clip.joint_pos_rad, joint_vel=clip.joint_vel_radps,
         body_pos_w=clip.body_pos_w_m, body_quat_w=clip.body_quat_wxyz, body_lin_vel_w=clip.body_lin_vel_w_mps,
         body_ang_vel_w=clip.body_ang_vel_w_radps, joint_names=np.array(clip.joint_names),
         body_names=np.array(clip.body_names), root_pos_w=clip.root_pos_w_m, root_quat_w=clip.root_quat_wxyz,
@@ -66,6 +73,7 @@ def _read_named(path: Path, data) -> MotionClip:
         source=str(data["source"]) if "source" in data.files else path.name,
         style=str(data["style"]) if "style" in data.files else "default",
         tags=tuple(str(t) for t in data["tags"]) if "tags" in data.files else (),
+        object=_read_object(path, data),
     )
     if "contacts" not in data.files:
         from g1_control.motion.contacts import foot_contacts
@@ -76,6 +84,21 @@ def _read_named(path: Path, data) -> MotionClip:
         return clip.validate()
     except InvalidClipError as exc:
         raise MotionFormatError(f"{path}: {exc}") from None
+
+
+def _read_object(path: Path, data) -> ObjectTrack | None:
+    keys = ("object_name", "object_planes", "object_pos_w", "object_quat_w", "object_hand_contacts")
+    present = [k for k in keys if k in data.files]
+    if not present:
+        return None
+    if len(present) != len(keys):
+        raise MotionFormatError(f"{path}: has {present} but not {[k for k in keys if k not in present]}; "
+                                "an object track needs all of them")
+    planes = data["object_planes"]
+    if planes.ndim != 2 or planes.shape[1] != 4:
+        raise MotionFormatError(f"{path}: object_planes has shape {planes.shape}; expected (F, 4)")
+    return ObjectTrack(ObjectShape(str(data["object_name"]), planes), data["object_pos_w"], data["object_quat_w"],
+                       data["object_hand_contacts"])
 
 
 def _read_unnamed(path: Path, data) -> MotionClip:

@@ -10,6 +10,8 @@ Facts about the layouts are from holosoma_retargeting's loaders.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import pickle
 from pathlib import Path
 
@@ -20,8 +22,14 @@ from g1_control.motion.human import HumanMotion
 from g1_control.motion.skeletons import SMPLH, skeleton_for_count
 
 MOCAP_FPS = 120.0
+if TYPE_CHECKING:
+    from g1_control.motion.objects import ObjectTrack
+
 OMOMO_FPS = 30.0
 OMOMO_JOINT_COLUMNS = slice(162, 162 + 52 * 3)
+OMOMO_OBJECT_COLUMNS = slice(318, 325)
+"""Object position (x y z) then orientation (qx qy qz qw), world, as holosoma-retargeting's
+InterMimic loader reads them (load_intermimic_data)."""
 
 
 def read_npy(path: str | Path, joint_names: tuple[str, ...] | None = None, fps: float = MOCAP_FPS,
@@ -66,4 +74,17 @@ def read_omomo_pt(path: str | Path, height_m: float | None = None) -> HumanMotio
             subject = path.stem.split("_")[0]
             if subject in table:
                 height_m = float(table[subject])
-    return HumanMotion(pos, SMPLH.joints, OMOMO_FPS, height_m, path.name).validate()
+    return HumanMotion(pos, SMPLH.joints, OMOMO_FPS, height_m, path.name, _omomo_object(path, arr)).validate()
+
+
+def _omomo_object(path: Path, arr: np.ndarray) -> ObjectTrack | None:
+    """The manipulated object's track, when the file has the columns and names a known object
+    (OMOMO file names read subject_object_take, e.g. sub3_largebox_003)."""
+    from g1_control.motion.objects import KNOWN_OBJECTS, ObjectTrack, load_object_shape
+
+    parts = path.stem.split("_")
+    name = parts[1] if len(parts) > 2 else ""
+    if name not in KNOWN_OBJECTS or arr.shape[1] < OMOMO_OBJECT_COLUMNS.stop:
+        return None
+    pose = arr[:, OMOMO_OBJECT_COLUMNS].astype(float)
+    return ObjectTrack(load_object_shape(name), pose[:, :3], pose[:, [6, 3, 4, 5]])
