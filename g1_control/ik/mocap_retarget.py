@@ -10,6 +10,7 @@ feet above the ground.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -23,7 +24,7 @@ from g1_control.motion import quaternion as quat
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.contacts import stance_from_trajectory
 from g1_control.motion.human import HumanMotion
-from g1_control.motion.objects import ObjectTrack
+from g1_control.motion.objects import ObjectShape, ObjectTrack
 from g1_control.motion.resample import interpolate_positions, resample_times
 from g1_control.motion.skeletons import Skeleton, detect_skeleton
 from g1_control.robot import description, g1
@@ -123,6 +124,8 @@ class PreparedTargets:
     scale: float
     object: ObjectTrack | None = None
     """The handled object at the output rate and robot scale, hand contacts labelled."""
+    scene: tuple[ObjectShape, ...] = ()
+    """Static shapes around the motion, robot scale."""
 
 
 def _stance_height(z: np.ndarray, stance: np.ndarray) -> float:
@@ -176,7 +179,9 @@ def prepare_targets(motion: HumanMotion, skeleton: Skeleton, config: MocapRetarg
         hands = [next((h for h, f in skeleton.frame_map.items() if f == frame), None) for frame in HAND_FRAMES]
         if None not in hands:
             track.hand_contacts = track.distance(np.stack([p(h) for h in hands], axis=1)) < config.object_contact_m
-    return PreparedTargets(config.fps, keypoints, root, pelvis_rot, torso_rot, foot_rot, contacts, scale, track)
+    scene = tuple(shape.scaled(scale) for shape in motion.scene)
+    return PreparedTargets(config.fps, keypoints, root, pelvis_rot, torso_rot, foot_rot, contacts, scale, track,
+                           scene)
 
 
 @functools.cache
@@ -226,6 +231,8 @@ class MocapRetargeter:
         sole = {f: ik._sole_depth.get(f, 0.0) for f in g1.FOOT_BODIES}
         sole.update({"left_toe": 0.0, "right_toe": 0.0})
         targets = prepare_targets(motion, skeleton, self.config, sole)
+        if targets.scene:  # the boxes' tops are floor too (ground limit, touchdowns)
+            ik = IKRetargeter(dataclasses.replace(self.ik_config(skeleton), scene=targets.scene))
         n = targets.root_pos_w_m.shape[0]
         root_quats = quat.from_matrix(targets.pelvis_rot)
         refs = []
@@ -253,4 +260,5 @@ class MocapRetargeter:
                 progress(1)
         return MotionClip.from_joint_trajectory(
             targets.fps, qs[:, :3], qs[:, [6, 3, 4, 5]], qs[:, 7:], contacts=robot_contacts, source=motion.source,
-            style="default", tags=("retargeted", skeleton.name, f"scale={targets.scale:.4f}"), object=targets.object)
+            style="default", tags=("retargeted", skeleton.name, f"scale={targets.scale:.4f}"), object=targets.object,
+            scene=targets.scene)

@@ -37,6 +37,7 @@ from g1_control.ik.tasks import (
     Task,
 )
 from g1_control.interfaces import Retargeter
+from g1_control.motion.objects import support_height
 from g1_control.robot import description, g1
 from g1_control.types import JointReference, KinematicReference
 
@@ -75,6 +76,9 @@ class IKConfig:
     enforce_ground: bool = True
     ground_height_m: float = 0.0
     ground_snap_m: float = 0.03
+    scene: tuple = ()
+    """Static shapes (motion.objects.ObjectShape, world coordinates) the feet stand on besides the
+    floor: the ground limit keeps feet on their tops and a touchdown snaps onto them."""
     """A foot touching down with its sole within this of the ground is put on it, level."""
     self_collision: bool = False
     """Keep arms out of the torso and the legs apart (SelfCollisionLimit); off online by default
@@ -124,7 +128,8 @@ class IKRetargeter(Retargeter):
         self.joint_velocity_limit = JointVelocityLimit(scale=cfg.velocity_limit_scale)
         self.base_velocity_limit = BaseVelocityLimit(cfg.base_max_linear_mps, cfg.base_max_angular_radps)
         self.contacts = [ContactLimit(f, free_yaw=cfg.contact_free_yaw) for f in cfg.contact_frames]
-        self.ground_limit = GroundLimit(cfg.ground_height_m) if cfg.enforce_ground else None
+        self.ground_limit = GroundLimit(cfg.ground_height_m, scene=cfg.scene) if cfg.enforce_ground else None
+        self._anchored_on_support: dict[str, bool] = {}
         self.self_collision_limit = SelfCollisionLimit() if cfg.self_collision else None
         spheres = foot_contact_points()
         # Height of a frame's origin above its sole when the foot is level (from the URDF spheres).
@@ -226,14 +231,48 @@ class IKRetargeter(Retargeter):
         depth = self._sole_depth[frame]
         centre = self._sole_centre[frame]
         sole_height = (pose.rotation @ centre + pose.translation)[2] - (depth + centre[2])
-        if self.config.enforce_ground and sole_height - self.config.ground_height_m < self.config.ground_snap_m:
+        centre_w = pose.rotation @ centre + pose.translation
+        support = self._support_under(centre_w, sole_height)
+        self._anchored_on_support[frame] = sole_height >= support - 1e-9
+        if self.config.enforce_ground and sole_height - support < self.config.ground_snap_m:
             yaw = np.arctan2(pose.rotation[1, 0], pose.rotation[0, 0])
             level = pin.utils.rpyToMatrix(0.0, 0.0, yaw)
-            centre_w = pose.rotation @ centre + pose.translation
             origin = centre_w - level @ centre
-            origin[2] = self.config.ground_height_m + depth
+            origin[2] = support + depth
             pose = pin.SE3(level, origin)
+            self._anchored_on_support[frame] = True
+        return self._out_of_scene(frame, pose)
+
+    def _out_of_scene(self, frame: str, pose: pin.SE3) -> pin.SE3:
+        """Move a touchdown anchor out of the scene shapes: a held foot keeps no ground rows, so an
+        anchor that starts 1 cm inside a box's side would stay there for the whole stance."""
+        spheres = foot_contact_points().get(frame)
+        if not self.config.scene or spheres is None:
+            return pose
+        centres = np.array([c for c, _ in spheres])
+        radii = np.array([r for _, r in spheres])
+        for _ in range(3):  # a corner can need one push per face
+            world = centres @ pose.rotation.T + pose.translation
+            worst, push = -1e-6, None  # touching (clearance 0 to rounding) is fine
+            for shape in self.config.scene:
+                values = world @ shape.planes[:, :3].T + shape.planes[:, 3]
+                face = values.argmax(axis=1)
+                clearance = values[np.arange(len(face)), face] - radii
+                k = int(clearance.argmin())
+                if clearance[k] < worst:
+                    worst, push = float(clearance[k]), shape.planes[face[k], :3]
+            if push is None:
+                break
+            pose = pin.SE3(pose.rotation, pose.translation - (worst - 1e-4) * push)
         return pose
+
+    def _support_under(self, point_w: np.ndarray, sole_height: float) -> float:
+        """Height of the floor, or of a scene shape's top, under a sole at (point x, y, sole_height)."""
+        if not self.config.scene:
+            return self.config.ground_height_m
+        bottom = np.array([[point_w[0], point_w[1], sole_height]])
+        return float(support_height(self.config.scene, bottom, self.config.ground_height_m,
+                                    self.ground_limit.reach_m if self.ground_limit else 0.05)[0])
 
     def _update_contacts(self, ref: KinematicReference) -> None:
         if not self.config.hold_contacts:
@@ -269,7 +308,7 @@ class IKRetargeter(Retargeter):
             # keeps it there; its ground rows would be redundant and degenerate.
             self.ground_limit.skip_links = frozenset(
                 c.frame for c in self.contacts if with_contacts and c.active and c.frame in g1.FOOT_BODIES
-                and c.anchor.translation[2] - self._sole_depth[c.frame] >= self.config.ground_height_m - 1e-9)
+                and self._anchored_on_support.get(c.frame, False))
             limits.append(self.ground_limit)
         if self.self_collision_limit is not None:
             limits.append(self.self_collision_limit)

@@ -22,6 +22,8 @@ Fields (T frames, J = 29 joints in `joint_names` order, B bodies in `body_names`
     tags                    free labels
     object                  the object the motion handles (motion/objects.py ObjectTrack: shape, pose per
                             frame, source hand-contact labels), or None
+    scene                   static shapes around the motion (ObjectShape, world coordinates: climbing
+                            boxes); the metrics count foot penetration into them
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ import numpy as np
 
 from g1_control.motion import quaternion as quat
 from g1_control.motion.exceptions import InvalidClipError
-from g1_control.motion.objects import ObjectTrack
+from g1_control.motion.objects import ObjectShape, ObjectTrack
 from g1_control.robot import g1
 
 ARRAY_FIELDS = ("root_pos_w_m", "root_quat_wxyz", "joint_pos_rad", "joint_vel_radps", "body_pos_w_m",
@@ -57,6 +59,7 @@ class MotionClip:
     style: str = "default"
     tags: tuple[str, ...] = field(default_factory=tuple)
     object: ObjectTrack | None = None
+    scene: tuple[ObjectShape, ...] = ()
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -64,7 +67,8 @@ class MotionClip:
                               joint_pos_rad: np.ndarray, contacts: np.ndarray | None = None, source: str = "",
                               style: str = "default", tags: tuple[str, ...] = (),
                               body_names: tuple[str, ...] | None = None,
-                              object: ObjectTrack | None = None) -> MotionClip:
+                              object: ObjectTrack | None = None,
+                              scene: tuple[ObjectShape, ...] = ()) -> MotionClip:
         """Build a full clip from root pose + joint angles: velocities by differences, body poses by
         forward kinematics, contacts from foot motion when not given."""
         from g1_control.motion.contacts import foot_contacts
@@ -93,6 +97,7 @@ class MotionClip:
             body_lin_vel_w_mps=differentiate(body_pos, fps),
             body_ang_vel_w_radps=quat.angular_velocity_w(body_quat, fps),
             contacts=np.asarray(contacts, dtype=bool), source=source, style=style, tags=tuple(tags), object=object,
+            scene=tuple(scene),
         )
         return clip.validate()
 
@@ -157,6 +162,8 @@ class MotionClip:
         """Same names, fps, tags and arrays (exactly, or within atol)."""
         if (self.fps, self.joint_names, self.body_names, self.source, self.style, tuple(self.tags)) != (
                 other.fps, other.joint_names, other.body_names, other.source, other.style, tuple(other.tags)):
+            return False
+        if len(self.scene) != len(other.scene) or not all(a.equals(b) for a, b in zip(self.scene, other.scene)):
             return False
         if (self.object is None) != (other.object is None) or (
                 self.object is not None and not self.object.equals(other.object)):

@@ -45,6 +45,7 @@ def transform_clip(clip: MotionClip, yaw_rad: float, translation_xy_m: np.ndarra
     out.body_ang_vel_w_radps = clip.body_ang_vel_w_radps @ rot.T
     if clip.object is not None:
         out.object = clip.object.transformed(rot, q_yaw, shift)
+    out.scene = tuple(shape.transformed(rot, shift) for shape in clip.scene)
     return out
 
 
@@ -81,6 +82,11 @@ def concatenate(clips: Sequence[MotionClip], align_root: bool = True) -> MotionC
                                  np.concatenate([o.hand_contacts for o in objects]))
     else:
         out.object = None
+    scene: list = []  # every part's shapes where that part put them (shared ones once)
+    for shape in (shape for p in parts for shape in p.scene):
+        if not any(shape.equals(known) for known in scene):
+            scene.append(shape)
+    out.scene = tuple(scene)
     out.source = " + ".join(p.source for p in parts if p.source)
     out.tags = tuple(dict.fromkeys(t for p in parts for t in p.tags))
     return out.validate()

@@ -6,6 +6,7 @@
     height_m        the performer's height when known (for scaling to the G1), else None
     source          file name
     object          the handled object's track (motion/objects.py), or None
+    scene           static shapes around the motion (climbing boxes), world coordinates
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from g1_control.motion.exceptions import InvalidClipError
-from g1_control.motion.objects import ObjectTrack
+from g1_control.motion.objects import ObjectShape, ObjectTrack
 
 
 @dataclass
@@ -27,6 +28,8 @@ class HumanMotion:
     source: str = ""
     object: ObjectTrack | None = None
     """The object the performer handles (pose per frame), when the data has one."""
+    scene: tuple[ObjectShape, ...] = ()
+    """Static shapes the performer moves on (climbing boxes), world coordinates, human scale."""
 
     def validate(self) -> HumanMotion:
         where = f"'{self.source}'" if self.source else "human motion"

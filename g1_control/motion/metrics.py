@@ -3,7 +3,8 @@ violations, smoothness; a PNG plot per clip and a table for a batch.
 
 Definitions (thresholds are parameters, defaults as in the project's acceptance figures):
 - penetration depth of a frame: how far the lowest foot collision sphere (from the URDF) is below
-  the ground z = 0; a frame "penetrates" when deeper than `penetration_m` (1 cm).
+  the ground z = 0, or how deep a foot sphere is inside a static scene shape (clip.scene, e.g. the
+  boxes of a climb), whichever is more; a frame "penetrates" when deeper than `penetration_m` (1 cm).
 - sliding of a stance foot: horizontal displacement of its sole point between two consecutive
   frames that are both labelled stance; a stance frame "slides" when that exceeds `sliding_m`
   (1 cm per frame).
@@ -86,6 +87,8 @@ class FootSeries:
     """(T, 2, 2) sole point of each foot, horizontal."""
     slide_m: np.ndarray
     """(T, 2) horizontal sole displacement from the previous frame (0 at frame 0)."""
+    scene_depth_m: np.ndarray
+    """(T, 2) deepest point of each foot inside a scene shape (clip.scene; 0 when none)."""
 
 
 def foot_series(clip: MotionClip) -> FootSeries:
@@ -95,6 +98,7 @@ def foot_series(clip: MotionClip) -> FootSeries:
     t = clip.num_frames
     lowest = np.empty((t, 2))
     sole = np.empty((t, 2, 2))
+    inside = np.zeros((t, 2))
     for side, link in enumerate(g1.FOOT_BODIES):
         b = clip.body_index(link)
         rot = quat.to_matrix(clip.body_quat_wxyz[:, b])
@@ -104,9 +108,11 @@ def foot_series(clip: MotionClip) -> FootSeries:
         world = np.einsum("tij,kj->tki", rot, centres) + pos[:, None, :]
         lowest[:, side] = (world[:, :, 2] - radii).min(axis=1)
         sole[:, side] = world[:, :, :2].mean(axis=1)
+        for shape in clip.scene:  # a sphere is inside a shape by its radius minus its centre's distance
+            inside[:, side] = np.maximum(inside[:, side], (radii - shape.signed_distance(world)).max(axis=1))
     slide = np.zeros((t, 2))
     slide[1:] = np.linalg.norm(np.diff(sole, axis=0), axis=-1)
-    return FootSeries(lowest, sole, slide)
+    return FootSeries(lowest, sole, slide, inside)
 
 
 def compute_metrics(clip: MotionClip, penetration_m: float = 0.01, sliding_m: float = 0.01,
@@ -118,7 +124,7 @@ def compute_metrics(clip: MotionClip, penetration_m: float = 0.01, sliding_m: fl
     ratio = speed / g1.VELOCITY_LIMIT_RADPS
     vel_viol = speed > g1.VELOCITY_LIMIT_RADPS * (1 + tolerance)
     feet = foot_series(clip)
-    depth = np.maximum(0.0, -feet.lowest_height_m.min(axis=1))
+    depth = np.maximum(0.0, np.maximum(-feet.lowest_height_m.min(axis=1), feet.scene_depth_m.max(axis=1)))
     pen = depth > penetration_m
     stance = clip.contacts.copy()
     stance[0] = False

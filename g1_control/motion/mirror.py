@@ -64,4 +64,5 @@ def mirror(clip: MotionClip) -> MotionClip:
         contacts=clip.contacts[:, ::-1].copy(),
         source=clip.source, style=clip.style, tags=tuple(clip.tags),
         object=None if clip.object is None else clip.object.mirrored(),
+        scene=tuple(shape.mirrored() for shape in clip.scene),
     )

@@ -9,6 +9,9 @@ Trajectory: world pose per frame (position, quaternion w x y z), at the motion's
 Hand contacts: (T, 2) labels (left, right), true where the *source* motion's hand is at the
 object's surface; the retargeted clip keeps them so the metrics can check that the G1's hands are
 still there on those frames (contact preservation).
+
+Scene: static shapes in world coordinates (the boxes of the climbing sequences): the IK keeps the
+feet on and above them (GroundLimit) and the metrics count penetration into them.
 """
 
 from __future__ import annotations
@@ -66,6 +69,23 @@ class ObjectShape:
         planes = self.planes.copy()
         planes[:, 1] *= -1.0
         return ObjectShape(self.name, planes)
+
+    def top_height(self, xy: np.ndarray) -> np.ndarray:
+        """(N, 2) world-aligned points -> (N,) height of the shape's upper surface above each, or
+        -inf where the point is outside its footprint. For a shape whose frame is the world's (a
+        static scene object): what a foot standing there rests on."""
+        n, d = self.planes[:, :3], self.planes[:, 3]
+        up, down, side = n[:, 2] > 1e-6, n[:, 2] < -1e-6, np.abs(n[:, 2]) <= 1e-6
+        lin = xy @ n[:, :2].T + d  # (N, F): n_xy . xy + d
+        top = (-lin[:, up] / n[up, 2]).min(axis=1) if up.any() else np.full(xy.shape[0], np.inf)
+        bottom = (-lin[:, down] / n[down, 2]).max(axis=1) if down.any() else np.full(xy.shape[0], -np.inf)
+        inside = (lin[:, side] <= 0.0).all(axis=1) & (top >= bottom)
+        return np.where(inside, top, -np.inf)
+
+    def transformed(self, rot: np.ndarray, shift_m: np.ndarray) -> ObjectShape:
+        """The shape moved by x -> rot x + shift (for a static scene object in world coordinates)."""
+        normals = self.planes[:, :3] @ rot.T
+        return ObjectShape(self.name, np.c_[normals, self.planes[:, 3] - normals @ shift_m])
 
     def equals(self, other: ObjectShape) -> bool:
         return self.name == other.name and self.planes.shape == other.planes.shape and np.array_equal(
@@ -180,3 +200,31 @@ def load_object_shape(name: str) -> ObjectShape:
         raise MotionFormatError(f"unknown object '{name}'; known: {', '.join(sorted(KNOWN_OBJECTS))}")
     asset, member = KNOWN_OBJECTS[name]
     return ObjectShape.from_points(name, read_obj_vertices(fetch(asset, quiet=True) / member))
+
+
+def support_height(scene: tuple[ObjectShape, ...], points_w: np.ndarray, ground_m: float = 0.0,
+                   reach_m: float = np.inf) -> np.ndarray:
+    """(N, 3) points -> (N,) height of what each would stand on: the ground, or the top of a scene
+    shape under it when that top is at most `reach_m` above the point (a foot beside a box, far
+    below its top, is not on it)."""
+    out = np.full(points_w.shape[0], float(ground_m))
+    for shape in scene:
+        top = shape.top_height(points_w[:, :2])
+        on = np.isfinite(top) & (top <= points_w[:, 2] + reach_m)
+        out = np.where(on, np.maximum(out, top), out)
+    return out
+
+
+def scene_depth(scene: tuple[ObjectShape, ...], points_w: np.ndarray) -> np.ndarray:
+    """(..., 3) world points -> (...) deepest penetration (m, >= 0) into any scene shape."""
+    depth = np.zeros(points_w.shape[:-1])
+    for shape in scene:
+        depth = np.maximum(depth, -shape.signed_distance(points_w))
+    return depth
+
+
+def load_scene(folder: str | Path) -> tuple[ObjectShape, ...]:
+    """Static shapes from the OBJ meshes in `folder` (one convex shape per file, world coordinates):
+    the holosoma climbing sequences' box_models/."""
+    files = sorted(Path(folder).glob("*.obj"))
+    return tuple(ObjectShape.from_points(f.stem, read_obj_vertices(f)) for f in files)

@@ -52,5 +52,5 @@ def resample(clip: MotionClip, new_fps: float) -> MotionClip:
         interpolate_positions(clip.joint_pos_rad, clip.fps, times),
         contacts=clip.contacts[nearest], source=clip.source, style=clip.style, tags=clip.tags,
         body_names=clip.body_names,
-        object=None if clip.object is None else clip.object.resampled(clip.fps, times),
+        object=None if clip.object is None else clip.object.resampled(clip.fps, times), scene=clip.scene,
     )

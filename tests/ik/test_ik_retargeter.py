@@ -137,3 +137,25 @@ def test_projection_step_keeps_held_feet_in_place_on_big_steps():
 
     assert drift(0.0) > 3e-3  # one linearised step alone lets the foot drift by millimetres
     assert drift(1e-3) < 1e-3
+
+
+def test_touchdown_on_a_box_top_snaps_the_foot_onto_it():
+    """A stance foot landing 1.5 cm inside a low box is anchored on the box's top, not in it."""
+    from g1_control.ik.limits import GroundLimit
+    from g1_control.motion.objects import ObjectShape
+
+    probe = IKRetargeter()
+    foot = probe.configuration.frame_placement(probe.configuration.frame_id("left_ankle_roll_link")).translation
+    top = 0.015
+    box = ObjectShape.box("plate", (0.2, 0.1, top / 2)).transformed(np.eye(3), np.array([foot[0], foot[1], top / 2]))
+    ik = IKRetargeter(IKConfig(scene=(box,)))
+    out = ik.solve(_reference(ik), np.asarray(g1.DEFAULT_Q_RAD))
+    for _ in range(10):
+        out = ik.solve(_reference(ik), out.q_rad)
+    left = ik.contacts[0]
+    assert left.active
+    np.testing.assert_allclose(left.anchor.translation[2] - ik._sole_depth["left_ankle_roll_link"], top, atol=1e-9)
+    clearance = GroundLimit(scene=(box,)).scene_clearances(ik.configuration)
+    assert clearance.min() > -1e-3  # the left foot came up out of the plate
+    heights = ik.ground_limit.point_heights(ik.configuration)
+    assert heights[:4].min() == pytest.approx(top, abs=2e-3) and heights[4:].max() < 1e-4  # right foot on the floor

@@ -126,3 +126,33 @@ def test_object_track_of_the_wrong_length_is_refused():
 def test_plot_has_the_object_panel(tmp_path):
     out = plot_metrics(_clip_with_object(), tmp_path / "p.png")
     assert out.stat().st_size > 10_000
+
+
+def test_top_height_and_support_follow_the_footprint():
+    from g1_control.motion.objects import support_height
+
+    step = ObjectShape.box("step", (0.2, 0.2, 0.15)).transformed(np.eye(3), np.array([1.0, 0.0, 0.15]))
+    np.testing.assert_allclose(step.top_height(np.array([[1.0, 0.0], [1.19, 0.1], [1.3, 0.0]])), [0.3, 0.3, -np.inf])
+    points = np.array([[1.0, 0.0, 0.31], [1.0, 0.0, 0.28], [1.0, 0.0, 0.05], [0.5, 0.0, 0.0]])
+    np.testing.assert_allclose(support_height((step,), points, 0.0, reach_m=0.05), [0.3, 0.3, 0.0, 0.0])
+
+
+def test_scene_penetration_is_counted_and_scenes_survive_edits(tmp_path):
+    clip = _clip_with_object()
+    clip.object = None
+    foot = clip.body_pos_w_m[0, clip.body_index("left_ankle_roll_link")]
+    clean = compute_metrics(clip)
+    # a 10 cm plate under the left foot: its sole spheres (3.5 cm below the ankle frame) end up inside
+    plate = ObjectShape.box("plate", (0.2, 0.1, 0.05)).transformed(np.eye(3), np.array([foot[0], foot[1], 0.05]))
+    clip.scene = (plate,)
+    m = compute_metrics(clip)
+    assert m.penetration_fraction == 1.0 and m.max_penetration_m > 0.02 > clean.max_penetration_m
+    path = tmp_path / "s.npz"
+    write_clip_npz(clip, path)
+    back = read_clip_npz(path)
+    assert back.equals(clip) and back.scene[0].name == "plate"
+    assert mirror(mirror(clip)).equals(clip)
+    assert compute_metrics(mirror(clip)).max_penetration_m == pytest.approx(m.max_penetration_m, abs=1e-9)
+    joined = concatenate([clip, clip])  # the second part starts where the first ended: same place here
+    assert len(joined.scene) == 1
+    assert resample(clip, 60.0).scene[0].equals(plate)

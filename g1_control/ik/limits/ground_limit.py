@@ -2,7 +2,9 @@
 URDF, see configuration.foot_contact_points), z_centre - radius after the step >= ground height.
 
 The ground height is a parameter (0 for a flat floor at the world origin), never a fudge offset:
-a sole resting on the floor sits exactly at the ground height.
+a sole resting on the floor sits exactly at the ground height. Static convex scene shapes (the
+boxes a climbing sequence steps onto) are kept out of too: each sphere near a shape stays outside
+the face nearest to it, so a foot stands on a box's top and does not pass through its sides.
 """
 
 from __future__ import annotations
@@ -11,13 +13,19 @@ import numpy as np
 
 from g1_control.ik.configuration import Configuration, foot_contact_points
 from g1_control.ik.limits.base import INF, Limit, RowConstraint
+from g1_control.motion.objects import ObjectShape
 from g1_control.robot import g1
 
 
 class GroundLimit(Limit):
     def __init__(self, ground_height_m: float = 0.0, links: tuple[str, ...] = g1.FOOT_BODIES,
-                 tolerance_m: float = 1e-4) -> None:
+                 tolerance_m: float = 1e-4, scene: tuple[ObjectShape, ...] = (), reach_m: float = 0.05) -> None:
         self.ground_height_m = float(ground_height_m)
+        self.scene = tuple(scene)
+        """Static convex shapes (world coordinates) the foot spheres must stay out of."""
+        self.reach_m = float(reach_m)
+        """A sphere whose surface is within this of a scene shape gets a row for it (nearer ones only:
+        far shapes cost nothing)."""
         # Slack for linearisation: a foot held level on the ground (contact equality) and these
         # rows linearise the same motion differently by ~1e-6 m; without slack the QP is infeasible.
         self.tolerance_m = float(tolerance_m)
@@ -51,7 +59,58 @@ class GroundLimit(Limit):
             out[rows] = centres @ placement.rotation[2] + placement.translation[2] - radii - self.ground_height_m
         return out
 
+    def scene_clearances(self, configuration: Configuration) -> np.ndarray:
+        """(points, shapes) distance (m) from each sphere's surface to each scene shape (< 0: inside)."""
+        out = np.empty((len(self.points), len(self.scene)))
+        for link, centres, radii, rows in self._grouped():
+            placement = configuration.frame_placement(configuration.frame_id(link))
+            world = centres @ placement.rotation.T + placement.translation
+            for k, shape in enumerate(self.scene):
+                out[rows, k] = shape.signed_distance(world) - radii
+        return out
+
     def compute(self, configuration: Configuration, dt_s: float) -> RowConstraint | None:
+        floor = self._floor_rows(configuration)
+        if not self.scene:
+            return floor
+        scene = self._scene_rows(configuration)
+        if scene is None or floor is None:
+            return scene if floor is None else floor
+        return RowConstraint(np.concatenate([floor.matrix, scene.matrix]), np.concatenate([floor.lower, scene.lower]),
+                             np.concatenate([floor.upper, scene.upper]))
+
+    def _scene_rows(self, configuration: Configuration) -> RowConstraint | None:
+        """One row per (sphere, nearby shape): the sphere's centre stays at least its radius out of
+        the shape, linearised on the shape's face nearest to it (the face whose plane is furthest
+        from the centre; for a convex shape that plane gives the signed distance)."""
+        matrices, lowers = [], []
+        for link, centres, radii, _ in self._grouped():
+            if link in self.skip_links:
+                continue
+            fid = configuration.frame_id(link)
+            placement = configuration.frame_placement(fid)
+            arms = centres @ placement.rotation.T
+            world = arms + placement.translation
+            jac = None
+            for shape in self.scene:
+                values = world @ shape.planes[:, :3].T + shape.planes[:, 3]  # (spheres, faces)
+                face = values.argmax(axis=1)
+                clearance = values[np.arange(len(face)), face] - radii
+                near = np.flatnonzero(clearance < self.reach_m)
+                if near.size == 0:
+                    continue
+                if jac is None:
+                    jac = configuration.frame_jacobian(fid)
+                normals = shape.planes[face[near], :3]
+                # n . v_point = n . (v_origin + w x arm) = n . v_origin - (n x arm) . w
+                matrices.append(normals @ jac[:3] - np.cross(normals, arms[near]) @ jac[3:])
+                lowers.append(-clearance[near] - self.tolerance_m)
+        if not matrices:
+            return None
+        lower = np.concatenate(lowers)
+        return RowConstraint(np.concatenate(matrices), lower, np.full(lower.shape, INF))
+
+    def _floor_rows(self, configuration: Configuration) -> RowConstraint | None:
         m, nv = len(self.points), configuration.nv
         if self._rows is None or self._rows.matrix.shape != (m, nv):
             self._rows = RowConstraint(np.zeros((m, nv)), np.zeros(m), np.full(m, INF))

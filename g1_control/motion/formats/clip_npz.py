@@ -4,7 +4,8 @@ Keys read and written by those projects: fps, joint_pos, joint_vel (T, 29), body
 body_quat_w (T, B, 4, w x y z), body_lin_vel_w, body_ang_vel_w. Their files store no names, and
 the two projects order bodies differently. This module always writes joint_names and
 body_names (and root_pos_w, root_quat_w, contacts, source, style, tags; and, for a clip that handles
-an object, object_name, object_planes, object_pos_w, object_quat_w, object_hand_contacts). Reading a file without
+an object, object_name, object_planes, object_pos_w, object_quat_w, object_hand_contacts; for one with
+static scene shapes, scene_names, scene_plane_counts, scene_planes). Reading a file without
 names, it takes the joints in g1.JOINT_NAMES order and the root from body 0 (the pelvis in both
 projects), recomputes the bodies by forward kinematics and identifies each stored body by matching
 it to the nearest recomputed one, refusing a file whose bodies match none (wrong joint order).
@@ -31,6 +32,10 @@ def write_clip_npz(clip: MotionClip, path: str | Path) -> None:
         o = clip.object
         extra = {"object_name": np.array(o.shape.name), "object_planes": o.shape.planes, "object_pos_w": o.pos_w_m,
                  "object_quat_w": o.quat_wxyz, "object_hand_contacts": o.hand_contacts}
+    if clip.scene:
+        extra.update(scene_names=np.array([shape.name for shape in clip.scene]),
+                     scene_plane_counts=np.array([shape.planes.shape[0] for shape in clip.scene]),
+                     scene_planes=np.concatenate([shape.planes for shape in clip.scene]))
     np.savez(
         path, **extra, fps=np.array(clip.fps), joint_pos=clip.joint_pos_rad, joint_vel=clip.joint_vel_radps,
         body_pos_w=clip.body_pos_w_m, body_quat_w=clip.body_quat_wxyz, body_lin_vel_w=clip.body_lin_vel_w_mps,
@@ -73,7 +78,7 @@ def _read_named(path: Path, data) -> MotionClip:
         source=str(data["source"]) if "source" in data.files else path.name,
         style=str(data["style"]) if "style" in data.files else "default",
         tags=tuple(str(t) for t in data["tags"]) if "tags" in data.files else (),
-        object=_read_object(path, data),
+        object=_read_object(path, data), scene=_read_scene(path, data),
     )
     if "contacts" not in data.files:
         from g1_control.motion.contacts import foot_contacts
@@ -99,6 +104,17 @@ def _read_object(path: Path, data) -> ObjectTrack | None:
         raise MotionFormatError(f"{path}: object_planes has shape {planes.shape}; expected (F, 4)")
     return ObjectTrack(ObjectShape(str(data["object_name"]), planes), data["object_pos_w"], data["object_quat_w"],
                        data["object_hand_contacts"])
+
+
+def _read_scene(path: Path, data) -> tuple[ObjectShape, ...]:
+    if "scene_names" not in data.files:
+        return ()
+    names, counts, planes = data["scene_names"], data["scene_plane_counts"], data["scene_planes"]
+    if counts.shape != names.shape or planes.ndim != 2 or planes.shape[1] != 4 or counts.sum() != planes.shape[0]:
+        raise MotionFormatError(f"{path}: scene_names {names.shape}, scene_plane_counts {counts.shape} and "
+                                f"scene_planes {planes.shape} do not fit together")
+    ends = np.cumsum(counts)
+    return tuple(ObjectShape(str(n), planes[e - c:e]) for n, c, e in zip(names, counts, ends))
 
 
 def _read_unnamed(path: Path, data) -> MotionClip:

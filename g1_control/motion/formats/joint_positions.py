@@ -1,7 +1,8 @@
 """World joint positions (T, J, 3), the holosoma_retargeting demo format.
 
 - `.npy` with (T, J, 3) float positions in m, z-up (the five climbing sequences: 53 joints of the
-  holosoma "mocap" skeleton, captured at 120 fps; holosoma downsamples them by 4 to 30 fps).
+  holosoma "mocap" skeleton, captured at 120 fps; holosoma downsamples them by 4 to 30 fps). The
+  boxes climbed on are the OBJ meshes in `box_models/` beside the file (world coordinates).
 - `.pt` (torch) OMOMO / InterMimic sequences: (T, 591) rows at 30 fps whose columns 162:318 hold
   the 52 SMPL-H joint positions (m, z-up). The performer's height comes from `height_dict.pkl`
   next to the file (subject id = file name prefix, e.g. 'sub3').
@@ -49,7 +50,12 @@ def read_npy(path: str | Path, joint_names: tuple[str, ...] | None = None, fps: 
         height_m = height_m or skeleton.default_height_m
     if len(joint_names) != pos.shape[1]:
         raise MotionFormatError(f"{path}: {pos.shape[1]} joints in the file but {len(joint_names)} names in the joint map")
-    return HumanMotion(pos.astype(float), tuple(joint_names), fps, height_m, path.name).validate()
+    scene = ()
+    if (path.parent / "box_models").is_dir():  # the holosoma climbing layout: the boxes next to the data
+        from g1_control.motion.objects import load_scene
+
+        scene = load_scene(path.parent / "box_models")
+    return HumanMotion(pos.astype(float), tuple(joint_names), fps, height_m, path.name, scene=scene).validate()
 
 
 def read_omomo_pt(path: str | Path, height_m: float | None = None) -> HumanMotion:
