@@ -154,6 +154,19 @@ def _time_offline(max_frames: int) -> dict:
             "frames_per_s_per_frame_loop": frames / ik_s, "frames_per_cpu_s_whole_pipeline": frames / cpu_s}
 
 
+def _kernel_start_s() -> float:
+    """Seconds a fresh process spends loading the compiled IK kernels (numba's on-disk cache; the
+    first run on a machine compiles them instead, ~2 s): paid once per process, in
+    IKRetargeter's constructor, never in a tick."""
+    import subprocess
+    import sys
+
+    code = ("import time; t = time.perf_counter(); from g1_control.ik import kernels; kernels.warm_up(); "
+            "print(time.perf_counter() - t)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return float(out.stdout.strip().splitlines()[-1])
+
+
 def _load_average() -> str:
     try:
         return Path("/proc/loadavg").read_text().split()[0]
@@ -169,6 +182,7 @@ def main(args) -> int:
     proxqp = _time_online("proxqp", refs[: max(200, ticks // 4)])
     parts = _time_parts(refs)
     offline = _time_offline(max_frames=int(min(600, max(150, seconds * 15))))
+    offline["kernel_start_s"] = _kernel_start_s()
     floor = parts["pinocchio_jacobians_ms"]
     print(f"IK retargeter benchmark (one core; load average {_load_average()} on {os.cpu_count()} cores: "
           "wall-clock percentiles include other processes' preemption, CPU-time ones do not)")
@@ -188,6 +202,7 @@ def main(args) -> int:
           f"{offline['frames_per_s_whole_pipeline']:.0f} frames/s whole pipeline (load, warm-up, FK), "
           f"{offline['frames_per_cpu_s_whole_pipeline']:.0f} frames per CPU second "
           f"(goal >= 500 per core: {'met' if offline['frames_per_cpu_s_whole_pipeline'] >= 500 else 'NOT met'})")
+    print(f"  once per process: {offline['kernel_start_s']:.2f} s to load the compiled IK kernels (numba cache)")
     print("  anchors: GMR 35-70 frames/s; Unitree's arm IK ~5 ms per solve")
     if getattr(args, "json", None):
         Path(args.json).write_text(json.dumps({"online_daqp": daqp, "online_proxqp": proxqp, "parts": parts,
