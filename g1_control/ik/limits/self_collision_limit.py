@@ -3,7 +3,9 @@ must stay at least `margin_m` apart (surface to surface).
 
 For a pair (a, b) with centres p_a, p_b, radii r_a, r_b and unit normal n = (p_a - p_b) / |p_a - p_b|,
 the step must keep  |p_a - p_b| - r_a - r_b + n^T (J_a - J_b) dq >= margin  (first order).
-Only pairs closer than `activation_m` enter the QP, so far-apart limbs cost nothing.
+Only pairs closer than `activation_m` enter the QP, so far-apart limbs cost nothing; a pair that a
+large step carries from beyond that distance into the margin is caught after the step
+(`missed_pairs`) and the step solved again with it (IKRetargeter).
 
 The default spheres are coarse G1 proxies measured on the model (torso link chest and belly, pelvis,
 elbows, hands, knees, ankles): they stop arms going through the torso and legs crossing, the
@@ -65,6 +67,10 @@ class SelfCollisionLimit(Limit):
         self._pair_a = np.arange(len(pairs))
         self._pair_b = np.arange(len(pairs), 2 * len(pairs))
         self._radii = np.array([a.radius_m + b.radius_m for a, b in pairs], dtype=float)
+        self.include = np.zeros(len(pairs), dtype=bool)
+        """Pairs given rows whatever their distance (see `missed_pairs`); the caller sets and clears it."""
+        self._rows = np.zeros(len(pairs), dtype=bool)
+        """Pairs the last `compute` gave rows."""
 
     def _frame_ids(self, configuration: Configuration) -> list[int]:
         return [configuration.frame_id(f) for f in self._frames]
@@ -84,12 +90,27 @@ class SelfCollisionLimit(Limit):
             return np.zeros(0)
         return self._geometry(configuration)[2] - self._radii
 
+    def missed_pairs(self, configuration: Configuration) -> np.ndarray:
+        """(P,) bool: pairs inside the margin at `configuration` that the last `compute` gave no row.
+
+        A pair enters the QP only within `activation_m` of contact, yet one step may move a sphere
+        much further: the joint velocity limits allow v_max * dt per tick (1.2 rad at the shoulder
+        and elbow at 30 Hz; measured: an elbow sphere 11-12 cm in one step on climbing mocap). A pair
+        just beyond the activation distance when the step is solved can thus end the step inside
+        the torso, with no row in the QP to stop it. The caller solves the step again with these
+        pairs in `include`."""
+        if not self.pairs:
+            return np.zeros(0, dtype=bool)
+        return (self.distances(configuration) < self.margin_m) & ~self._rows
+
     def compute(self, configuration: Configuration, dt_s: float) -> RowConstraint | None:
+        self._rows[:] = False
         if not self.pairs:
             return None
         offsets_w, delta, dist = self._geometry(configuration)
         gap = dist - self._radii
-        active = np.flatnonzero((gap <= self.activation_m) & (dist >= 1e-9))
+        self._rows[:] = ((gap <= self.activation_m) | self.include) & (dist >= 1e-9)
+        active = np.flatnonzero(self._rows)
         if not active.size:
             return None
         # Frame Jacobians (6, nv) of the frames the active pairs use, fetched once each.
