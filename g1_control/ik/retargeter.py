@@ -325,6 +325,48 @@ class IKRetargeter(Retargeter):
                 tasks.append(task)
         return tasks
 
+    def _solve_step(self, tasks: list[Task]) -> np.ndarray:
+        cfg = self.config
+        try:
+            return self.solver.solve(self.configuration, tasks, self._limits(True), cfg.dt_s)
+        except NoSolutionFound:
+            # Holding the feet exactly is impossible this tick (e.g. a far touchdown anchor
+            # and the velocity limits): hold them as heavy tasks instead, never skip the limits.
+            self.last_solve_soft_contacts = True
+            return self.solver.solve(self.configuration, tasks + self._soft_contact_tasks(), self._limits(False),
+                                     cfg.dt_s)
+
+    def _take_step(self, tasks: list[Task]) -> None:
+        """One QP step from the current configuration.
+
+        Self-collision pairs get rows only within the limit's activation distance, but one step
+        may carry a pair from beyond it into contact (SelfCollisionLimit.missed_pairs: the
+        velocity limits allow 1.2 rad per joint per tick at 30 Hz). Such a step is solved again
+        from the same configuration with the missed pairs in the QP, until no pair is missed."""
+        conf = self.configuration
+        limit = self.self_collision_limit
+        q_from = conf.q.copy() if limit is not None else None
+        dq = self._solve_step(tasks)
+        conf.integrate_inplace(dq)
+        if limit is None:
+            return
+        try:
+            missed = limit.missed_pairs(conf)
+            while missed.any():  # each round adds a pair to `include`: at most len(pairs) rounds
+                limit.include |= missed
+                conf.update(q_from, check=False)
+                try:
+                    dq = self._solve_step(tasks)
+                except NoSolutionFound:
+                    # No step keeps these pairs apart within the other limits this tick: take the
+                    # last step that met those (the pairs are active from the next step on).
+                    conf.integrate_inplace(dq)
+                    return
+                conf.integrate_inplace(dq)
+                missed = limit.missed_pairs(conf) & ~limit.include
+        finally:
+            limit.include[:] = False
+
     def _project_onto_contacts(self) -> None:
         """A QP step is a linearisation: a held foot drifts by ~L*theta^2/2 when the leg turns by
         theta in one step (measured: 1-4 cm per frame on fast climbing mocap). When the drift
@@ -352,14 +394,7 @@ class IKRetargeter(Retargeter):
         self.smoothness_task.set_previous_step(self._last_step / cfg.iterations, check=False)
         self.last_solve_soft_contacts = False
         for _ in range(cfg.iterations):
-            try:
-                dq = self.solver.solve(conf, tasks, self._limits(True), cfg.dt_s)
-            except NoSolutionFound:
-                # Holding the feet exactly is impossible this tick (e.g. a far touchdown anchor
-                # and the velocity limits): hold them as heavy tasks instead, never skip the limits.
-                self.last_solve_soft_contacts = True
-                dq = self.solver.solve(conf, tasks + self._soft_contact_tasks(), self._limits(False), cfg.dt_s)
-            conf.integrate_inplace(dq)
+            self._take_step(tasks)
         self._project_onto_contacts()
         self._last_step = pin.difference(conf.model, q_start, conf.q)
         self._initialised = True

@@ -48,3 +48,25 @@ def test_far_pairs_add_no_rows_and_bad_setups_are_refused():
     same = (Sphere("pelvis", (0, 0, 0), 0.1), Sphere("pelvis", (0, 0, 0.1), 0.1))
     with pytest.raises(LimitDefinitionError, match="one frame 'pelvis'"):
         SelfCollisionLimit(pairs=(same,))
+
+
+def test_missed_pairs_are_those_inside_the_margin_the_last_compute_gave_no_row():
+    limit = SelfCollisionLimit()
+    q = Configuration().q.copy()
+    q[7 + g1.JOINT_INDEX["left_shoulder_roll_joint"]] = 0.8  # left arm well out to the side
+    out = Configuration(q)
+    elbow_chest = next(i for i, (a, b) in enumerate(limit.pairs)
+                       if a.frame == "left_elbow_link" and b.frame == "torso_link")
+    assert limit.distances(out)[elbow_chest] > limit.activation_m
+    limit.compute(out, 0.02)  # the QP of a step from `out`: no row for the elbow
+    assert not limit.missed_pairs(out).any()
+    q[7 + g1.JOINT_INDEX["left_shoulder_roll_joint"]] = -0.3  # where a large step took it: in the chest
+    q[7 + g1.JOINT_INDEX["left_shoulder_yaw_joint"]] = 0.4
+    inside = Configuration(q)
+    missed = limit.missed_pairs(inside)
+    assert missed[elbow_chest] and (limit.distances(inside)[missed] < limit.margin_m).all()
+    # `include` gives a pair a row whatever its distance, and a pair with a row is never missed
+    limit.include[elbow_chest] = True
+    rows = limit.compute(out, 0.02)
+    assert np.isclose(rows.lower, limit.margin_m - limit.distances(out)[elbow_chest]).any()
+    assert not limit.missed_pairs(inside)[elbow_chest]
