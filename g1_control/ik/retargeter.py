@@ -271,8 +271,9 @@ class IKRetargeter(Retargeter):
         if not self.config.scene:
             return self.config.ground_height_m
         bottom = np.array([[point_w[0], point_w[1], sole_height]])
+        # a top at most ground_snap_m above the sole still counts: the touchdown snaps up onto it
         return float(support_height(self.config.scene, bottom, self.config.ground_height_m,
-                                    self.ground_limit.reach_m if self.ground_limit else 0.05)[0])
+                                    self.config.ground_snap_m)[0])
 
     def _update_contacts(self, ref: KinematicReference) -> None:
         if not self.config.hold_contacts:
@@ -291,7 +292,7 @@ class IKRetargeter(Retargeter):
             self.root_task.set_target_vector(np.concatenate([ref.root_pos_w_m, ref.root_quat_wxyz]))
             tasks.append(self.root_task)
         for name, pose in ref.frame_targets_w.items():
-            task = self.frame_tasks.get(name) or self._frame_task(name)
+            task = self._frame_task(name)
             task.set_target_vector(pose)  # checked in _check_reference
             tasks.append(task)
         if any(cfg.com_cost):
