@@ -49,6 +49,11 @@ def foot_contact_points() -> dict[str, list[tuple[np.ndarray, float]]]:
     return points
 
 
+def sole_depth_m(foot_link: str) -> float:
+    """Height of a foot link's origin above its sole when the foot is level (URDF spheres)."""
+    return -min(c[2] - r for c, r in foot_contact_points()[foot_link])
+
+
 def _build_model() -> pin.Model:
     """The shared G1 model plus operational frames on the soles (toe, heel, sole centre)."""
     model = pin.Model(description.pinocchio_model())  # a copy: the cached model stays untouched

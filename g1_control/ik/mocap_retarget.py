@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from g1_control.ik.configuration import sole_depth_m
 from g1_control.ik.exceptions import IKError
 from g1_control.ik.retargeter import IKConfig, IKRetargeter
 from g1_control.motion import quaternion as quat
@@ -227,12 +228,11 @@ class MocapRetargeter:
         motion.validate()
         skeleton = skeleton or detect_skeleton(motion.joint_names, motion.source)
         skeleton = skeleton.validate(motion.source)
-        ik = IKRetargeter(self.ik_config(skeleton))
-        sole = {f: ik._sole_depth.get(f, 0.0) for f in g1.FOOT_BODIES}
+        sole = {f: sole_depth_m(f) for f in g1.FOOT_BODIES}
         sole.update({"left_toe": 0.0, "right_toe": 0.0})
         targets = prepare_targets(motion, skeleton, self.config, sole)
-        if targets.scene:  # the boxes' tops are floor too (ground limit, touchdowns)
-            ik = IKRetargeter(dataclasses.replace(self.ik_config(skeleton), scene=targets.scene))
+        # the scene's box tops are floor too (ground limit, touchdowns)
+        ik = IKRetargeter(dataclasses.replace(self.ik_config(skeleton), scene=targets.scene))
         n = targets.root_pos_w_m.shape[0]
         root_quats = quat.from_matrix(targets.pelvis_rot)
         refs = []

@@ -16,7 +16,7 @@ import numpy as np
 import pinocchio as pin
 
 from g1_control.ik import kernels
-from g1_control.ik.configuration import Configuration, foot_contact_points
+from g1_control.ik.configuration import Configuration, foot_contact_points, sole_depth_m
 from g1_control.ik.exceptions import InvalidReferenceError, NoSolutionFound, TaskDefinitionError
 from g1_control.ik.limits import (
     BaseVelocityLimit,
@@ -76,10 +76,10 @@ class IKConfig:
     enforce_ground: bool = True
     ground_height_m: float = 0.0
     ground_snap_m: float = 0.03
+    """A foot touching down with its sole within this of the ground is put on it, level."""
     scene: tuple = ()
     """Static shapes (motion.objects.ObjectShape, world coordinates) the feet stand on besides the
     floor: the ground limit keeps feet on their tops and a touchdown snaps onto them."""
-    """A foot touching down with its sole within this of the ground is put on it, level."""
     self_collision: bool = False
     """Keep arms out of the torso and the legs apart (SelfCollisionLimit); off online by default
     (a generator's references rarely need it and it costs rows), on in offline retargeting."""
@@ -142,7 +142,7 @@ class IKRetargeter(Retargeter):
                 self._sole_depth[frame] = 0.0
                 self._sole_centre[frame] = np.zeros(3)
             else:
-                self._sole_depth[frame] = -min(c[2] - r for c, r in spheres[frame])
+                self._sole_depth[frame] = sole_depth_m(frame)
                 self._sole_centre[frame] = np.mean([c for c, _ in spheres[frame]], axis=0)
         self._initialised = False
         self._last_step = np.zeros(nv)
@@ -230,8 +230,8 @@ class IKRetargeter(Retargeter):
         pose = pin.SE3(self.configuration.frame_placement(self.configuration.frame_id(frame)))
         depth = self._sole_depth[frame]
         centre = self._sole_centre[frame]
-        sole_height = (pose.rotation @ centre + pose.translation)[2] - (depth + centre[2])
         centre_w = pose.rotation @ centre + pose.translation
+        sole_height = centre_w[2] - (depth + centre[2])
         support = self._support_under(centre_w, sole_height)
         self._anchored_on_support[frame] = sole_height >= support - 1e-9
         if self.config.enforce_ground and sole_height - support < self.config.ground_snap_m:
@@ -255,9 +255,8 @@ class IKRetargeter(Retargeter):
             world = centres @ pose.rotation.T + pose.translation
             worst, push = -1e-6, None  # touching (clearance 0 to rounding) is fine
             for shape in self.config.scene:
-                values = world @ shape.planes[:, :3].T + shape.planes[:, 3]
-                face = values.argmax(axis=1)
-                clearance = values[np.arange(len(face)), face] - radii
+                distance, face = shape.nearest_face(world)
+                clearance = distance - radii
                 k = int(clearance.argmin())
                 if clearance[k] < worst:
                     worst, push = float(clearance[k]), shape.planes[face[k], :3]

@@ -58,6 +58,13 @@ class ObjectShape:
         """(..., 3) points in the object frame -> (...) distance to the surface, negative inside."""
         return (points_o @ self.planes[:, :3].T + self.planes[:, 3]).max(axis=-1)
 
+    def nearest_face(self, points_o: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(N, 3) points -> (signed distance (N,), index (N,) of the face giving it): the face to
+        push a point out through, and whose normal linearises the distance."""
+        values = points_o @ self.planes[:, :3].T + self.planes[:, 3]
+        face = values.argmax(axis=1)
+        return values[np.arange(face.shape[0]), face], face
+
     def scaled(self, factor: float) -> ObjectShape:
         """The shape grown by `factor` about the object origin (a human-to-robot scale)."""
         planes = self.planes.copy()

@@ -93,9 +93,8 @@ class GroundLimit(Limit):
             world = arms + placement.translation
             jac = None
             for shape in self.scene:
-                values = world @ shape.planes[:, :3].T + shape.planes[:, 3]  # (spheres, faces)
-                face = values.argmax(axis=1)
-                clearance = values[np.arange(len(face)), face] - radii
+                distance, face = shape.nearest_face(world)
+                clearance = distance - radii
                 near = np.flatnonzero(clearance < self.reach_m)
                 if near.size == 0:
                     continue
