@@ -1,10 +1,13 @@
-"""The small interfaces every stage of the loop implements (see DESIGN.md).
+"""The small interfaces every stage of the loop implements: the loop's whole contract with a stage.
 
-operator -> InputDevice.poll() -> Command
+operator -> InputDevice.poll(now_s) -> Command
          -> Generator.update(Command, RobotState) -> KinematicReference
          -> Retargeter.solve(KinematicReference, q_prev) -> JointReference
-         -> Tracker.act(JointReference, RobotState) -> MotorCommand
+         -> Tracker.observe(EstimatedState); Tracker.act(JointReference, RobotState) -> MotorCommand
          -> safety filter -> Backend.write_command(MotorCommand)
+
+The control loop (g1_control/loop/control_loop.py) reads nothing from a stage that is not
+declared here; defaults are what a stage without that capability should report.
 """
 
 from __future__ import annotations
@@ -13,7 +16,14 @@ from abc import ABC, abstractmethod
 
 import numpy as np
 
-from g1_control.types import Command, JointReference, KinematicReference, MotorCommand, RobotState
+from g1_control.types import (
+    Command,
+    EstimatedState,
+    JointReference,
+    KinematicReference,
+    MotorCommand,
+    RobotState,
+)
 
 
 class Backend(ABC):
@@ -34,8 +44,21 @@ class Backend(ABC):
     def step(self, dt_s: float) -> None:
         """Advance `dt_s` seconds (lockstep only; a no-op on wall-clock backends)."""
 
+    def damp(self) -> None:
+        """Put damping on the motors now, not at the next tick (signal handlers, faults)."""
+        self.write_command(MotorCommand.damping())
+
+    @property
+    def bad_crc(self) -> int:
+        """States dropped so far for a bad checksum (robot links; 0 for simulators)."""
+        return 0
+
     @abstractmethod
     def close(self) -> None: ...
+
+    def describe(self) -> str:
+        """One line naming the backend, for run summaries and the deploy's chain check."""
+        return type(self).__name__
 
     def __enter__(self):
         return self
@@ -45,8 +68,16 @@ class Backend(ABC):
 
 
 class InputDevice(ABC):
+    """Operator intent. `now_s` is the loop's clock (simulated time in lockstep, the monotonic
+    clock on the robot); devices time slew rates and staleness with it."""
+
     @abstractmethod
-    def poll(self) -> Command: ...
+    def poll(self, now_s: float) -> Command: ...
+
+    @property
+    def lost(self) -> bool:
+        """True once the device is gone for good (the loop then stops the robot, then damps it)."""
+        return False
 
     def close(self) -> None:
         """Release the device."""
@@ -71,3 +102,13 @@ class Tracker(ABC):
 
     def reset(self, state: RobotState) -> None:
         """Clear internal memory (action history, phase)."""
+
+    def observe(self, estimate: EstimatedState) -> None:
+        """The state estimator's latest output (at the estimator's rate); trackers that close
+        loops on the base's velocity keep it."""
+
+    @property
+    def policy_command(self) -> np.ndarray | None:
+        """(vx, vy, wz) the tracker actually asks its walking controller for, after its own
+        shaping (e.g. velocity correction); None when it has no such command. Logged."""
+        return None

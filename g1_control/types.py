@@ -2,7 +2,8 @@
 
 Arrays are float64 numpy arrays in the robot's joint order (g1_control.robot.g1.JOINT_NAMES);
 units are in the field names. Quaternions are (w, x, y, z). "_w" is the world frame, "_b" the
-base (pelvis) frame. Nothing here does I/O or math beyond validation.
+base (pelvis) frame, "_h" the heading frame (the world turned by the base's yaw: x forward along
+the ground, y left, z up). Nothing here does I/O or math beyond validation.
 """
 
 from __future__ import annotations
@@ -108,19 +109,24 @@ class RobotState:
 
 @dataclass
 class KinematicReference:
-    """Whole-body target from the generator: root pose, posture, named frame targets, contacts."""
+    """Whole-body target from the generator: root pose and twist, posture, named frame targets, contacts."""
 
     t_s: float = 0.0
     root_pos_w_m: np.ndarray = field(default_factory=lambda: np.zeros(3))
     root_quat_wxyz: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0, 0.0]))
-    root_linvel_b_mps: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    root_angvel_b_radps: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    root_linvel_h_mps: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    """The plan's root velocity in the heading frame (x forward, y left): what a walking tracker follows."""
+    root_angvel_h_radps: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    """The plan's root angular velocity in the heading frame (z: the yaw rate)."""
     q_rad: np.ndarray = field(default_factory=_zeros)
     frame_targets_w: dict[str, np.ndarray] = field(default_factory=dict)
     """Frame name -> 7-vector (x, y, z, qw, qx, qy, qz) in the world frame."""
     contacts: np.ndarray = field(default_factory=lambda: np.ones(2, dtype=bool))
     """(left foot, right foot) in contact."""
     style: str = "default"
+    upper_body_override: bool = False
+    """True when the plan's waist and arm posture is meant to be followed; False leaves them to a
+    balancing tracker's own judgement (a walking policy's own arm swing)."""
 
 
 @dataclass
@@ -132,12 +138,28 @@ class JointReference:
     dq_radps: np.ndarray = field(default_factory=_zeros)
     root_pos_w_m: np.ndarray = field(default_factory=lambda: np.zeros(3))
     root_quat_wxyz: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0, 0.0]))
-    root_linvel_b_mps: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    """Commanded base velocity in the heading frame (x forward, y left); locomotion trackers follow it."""
-    root_angvel_b_radps: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    root_linvel_h_mps: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    """Commanded root velocity in the heading frame (x forward, y left); locomotion trackers follow it."""
+    root_angvel_h_radps: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    """Commanded root angular velocity in the heading frame (z: the yaw rate)."""
     contacts: np.ndarray = field(default_factory=lambda: np.ones(2, dtype=bool))
     upper_body_override: bool = False
     """When True, a balancing tracker takes waist/arm targets from q_rad instead of its own."""
+
+
+@dataclass
+class EstimatedState:
+    """The state estimator's output (g1_control/estimation/estimator.py), for trackers that close
+    loops on the base's motion."""
+
+    t_s: float = 0.0
+    base_quat_wxyz: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0, 0.0]))
+    base_angvel_b_radps: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    base_linvel_w_mps: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    stance_weight: np.ndarray = field(default_factory=lambda: np.full(2, 0.5))
+    yaw_rad: float = 0.0
+    heading_velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    """(vx, vy, wz): base linear velocity in the heading frame and the yaw rate."""
 
 
 @dataclass

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Install Unitree's official Python SDK wheel as a TEST ORACLE only (tests/unitree_reference.py).
+# Install Unitree's official Python SDK wheel as a TEST ORACLE only (tests/hardware/unitree_reference.py).
 # --no-deps: the wheel pulls opencv and friends that nothing here needs, and it is incomplete
 # (its top-level __init__ imports a missing `b2` subpackage; its native CRC library is absent),
 # so the project never imports it at run time. Its message modules need cyclonedds: run

@@ -50,7 +50,7 @@ def _build(args) -> int:
 
 def _show(args) -> int:
     from g1_control.library.builder import default_library_dir
-    from g1_control.library.index import MotionLibrary
+    from g1_control.motion.library import MotionLibrary
 
     lib = MotionLibrary(args.path or default_library_dir())
     print(lib.summary())

@@ -18,7 +18,7 @@ SUBCOMMAND_MODULES = (
     "g1_control.cli.launch_cmd",
     "g1_control.cli.policies_cmd",
     "g1_control.cli.bench_cmd",
-    "g1_control.teleop.cli",
+    "g1_control.cli.input_cmd",
     "g1_control.cli.sim_robot_cmd",
     "g1_control.cli.retarget_cmd",
     "g1_control.cli.deploy_cmd",

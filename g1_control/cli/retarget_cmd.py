@@ -86,10 +86,10 @@ def process_one(path: str, out_path: str, options: dict, show_frames: bool = Fal
     from g1_control.errors import G1ControlError
 
     try:
-        from g1_control.ik.mocap_retarget import MocapRetargetConfig, MocapRetargeter
+        from g1_control.retarget.mocap import MocapRetargetConfig, MocapRetargeter
         from g1_control.motion.clip import MotionClip
         from g1_control.motion.formats.dispatch import load_motion, save_clip
-        from g1_control.motion.metrics import compute_metrics, plot_metrics
+        from g1_control.retarget.metrics import compute_metrics, plot_metrics
         from g1_control.motion.resample import resample
         from g1_control.motion.skeletons import load_joint_map
 
@@ -129,7 +129,7 @@ def run(args) -> int:
     from tqdm import tqdm
 
     from g1_control.ik.exceptions import IKError
-    from g1_control.motion.metrics import ClipMetrics, format_table
+    from g1_control.retarget.metrics import ClipMetrics, format_table
 
     files = _collect(args)
     if not files:

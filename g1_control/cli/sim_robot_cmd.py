@@ -40,24 +40,24 @@ def register(subparsers) -> None:
     parser.add_argument("--seconds", type=float, help="stop after this long (default: until Ctrl-C)")
     parser.add_argument("--control-stdin", action="store_true",
                         help="read fault names and remote commands ('press start', 'press A', 'stick ly 0.5', "
-                        "'press L1+R1') from stdin, answer JSON lines (see hardware/emulator.py)")
+                        "'press L1+R1') from stdin, answer JSON lines (see g1_control/sim/emulator.py)")
     parser.set_defaults(func=_run)
 
 
 def _run(args) -> int:
-    from g1_control.hardware.emulator import RobotEmulator
+    from g1_control.sim.emulator import RobotEmulator
 
     if args.physics == "mujoco":
         from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
 
         physics = MujocoBackend(MujocoConfig(lockstep=True))
         if args.gantry or args.lower_gantry_on_policy:
-            from g1_control.hardware.emulator import Gantry
+            from g1_control.sim.emulator import Gantry
 
             physics = Gantry(physics, physics_dt_s=physics.config.physics_dt_s,
                              lower_on_policy=args.lower_gantry_on_policy)
     else:
-        from g1_control.hardware.mock_robot import MockG1
+        from g1_control.sim.mock_robot import MockG1
 
         physics = MockG1(mode_machine=args.mode_machine)
     emulator = RobotEmulator(physics, args.interface, args.domain, partition=args.partition,

@@ -39,7 +39,7 @@ def register(subparsers) -> None:
 
 def _generator(args) -> int:
     from g1_control.generator.learned import SHIPPED_DIR
-    from g1_control.generator.train import TrainConfig, train
+    from g1_control.training.train import TrainConfig, train
     from g1_control.library.builder import build_library, default_library_dir
 
     library = args.library or default_library_dir()

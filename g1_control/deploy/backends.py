@@ -13,7 +13,7 @@ import os
 from pathlib import Path
 
 from g1_control.errors import NetworkInterfaceError, TransportError
-from g1_control.hardware.network import LOOPBACK, check_interface
+from g1_control.hardware.links.network import LOOPBACK, check_interface
 from g1_control.launch.schema import BackendConfig
 from g1_control.robot import g1
 
@@ -68,12 +68,12 @@ def open_robot_backend(config: BackendConfig, *, damping_kd: float = 2.0, releas
     from g1_control.hardware.link_backend import LinkBackend
 
     if config.type == "can":
-        from g1_control.hardware.can_link import CanLink
+        from g1_control.hardware.links.can_bus import CanLink
 
         return LinkBackend(CanLink("host", interface=config.can_interface, channel=config.channel,
                                    fd=config.can_fd), **common)
     if config.type == "serial":
-        from g1_control.hardware.serial_link import SerialLink
+        from g1_control.hardware.links.serial_port import SerialLink
 
         return LinkBackend(SerialLink("host", config.port, config.baudrate), **common)
     raise TransportError(f"backend.type {config.type} is not a robot link; g1 deploy needs unitree_dds, can or serial")

@@ -22,7 +22,7 @@ import yaml
 from g1_control.errors import G1ControlError, RobotNotConnectedError, VariantMismatchError
 from g1_control.launch.schema import InputConfig, LaunchFile, Segment
 from g1_control.robot import g1
-from g1_control.safety import tilt_rad
+from g1_control.rotations import tilt_rad
 
 log = logging.getLogger("g1_control.deploy")
 
@@ -136,7 +136,7 @@ class Preflight:
 
     def check_robot(self, backend, launch: LaunchFile, policy_variant: str | None):
         """variant, state_stream, imu_upright, joint_limits, temperatures, battery; the state or None."""
-        from g1_control.hardware.conversions import variant_of
+        from g1_control.hardware.unitree.conversions import variant_of
 
         cfg = launch.deploy
         try:
@@ -232,11 +232,11 @@ class Preflight:
         bound = [("+".join(sorted(chord))) for chord, action in mapper.config.buttons.items()
                  if action == "estop"] if mapper is not None else []
         deadline = time.monotonic() + launch.deploy.input_check_s
-        while time.monotonic() < deadline and not getattr(device, "lost", False):
-            device.poll()
+        while time.monotonic() < deadline and not device.lost:
+            device.poll(time.monotonic())
             time.sleep(0.02)
-        device.poll()
-        if getattr(device, "lost", False):
+        device.poll(time.monotonic())
+        if device.lost:
             return self.record("estop_input", FAIL, f"{kind} lost: {getattr(device, 'lost_reason', '?')}; reconnect it "
                                "and start again", overridable=False)
         if not bound:

@@ -23,8 +23,9 @@ from pathlib import Path
 from g1_control.deploy.preflight import CHECKS, FAIL, Preflight
 from g1_control.deploy.state_machine import DeployState, DeployTracker, OperatorButtons, Transition
 from g1_control.errors import G1ControlError, LaunchFileError
-from g1_control.hardware.network import LOOPBACK
+from g1_control.hardware.links.network import LOOPBACK
 from g1_control.launch.schema import LaunchFile
+from g1_control.robot import g1
 
 log = logging.getLogger("g1_control.deploy")
 
@@ -63,6 +64,8 @@ class DeployReport:
     link: dict = field(default_factory=dict)
     control: dict = field(default_factory=dict)
     loop: dict = field(default_factory=dict)
+    chain: dict = field(default_factory=dict)
+    """The loop's stages (g1_control/launch/builder.py), the same the preflight's dry run ran."""
 
     def to_json(self) -> str:
         return json.dumps(dataclasses.asdict(self), indent=2, default=float)
@@ -96,15 +99,14 @@ def _apply_cli(launch: LaunchFile, options: DeployOptions) -> None:
                               f"'{LOOPBACK}' (or a virtual CAN bus). On a robot the operator presses start and run")
 
 
-def _open_input(launch: LaunchFile, backend, command_ranges, scripted_clock: Callable[[], float]):
+def _open_input(launch: LaunchFile, backend, command_ranges):
     """(device, None) or (None, why it cannot be opened)."""
+    from g1_control.launch.builder import timeline_of
     from g1_control.launch.inputs import make_input
-    from g1_control.launch.runner import timeline_of
 
     kind = launch.input.type
-    clock = scripted_clock if kind in ("scripted", "random", "gamepad_script") else time.monotonic
     try:
-        device = make_input(launch, timeline_of(launch), clock=clock, command_ranges=command_ranges,
+        device = make_input(launch, timeline_of(launch), command_ranges=command_ranges,
                             state_source=backend.read_state if backend is not None else None)
     except G1ControlError as exc:
         return None, f"{kind} cannot be opened: {exc}"
@@ -130,7 +132,6 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
 
     spec, policy_variant = pf.check_policy(launch)
     backend = device = None
-    clock_box: list[Callable[[], float]] = [lambda: 0.0]
     try:
         if pf.check_interface(launch):
             from g1_control.deploy.backends import open_robot_backend
@@ -144,8 +145,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             pf.check_robot(backend, launch, policy_variant)
         else:
             pf.not_run(ROBOT_CHECKS, "no link to the robot")
-        device, open_error = _open_input(launch, backend, spec.command_ranges if spec else None,
-                                         lambda: clock_box[0]())
+        device, open_error = _open_input(launch, backend, spec.command_ranges if spec else None)
         if launch.input.type == "unitree_remote" and pf.results["variant"].status == "not run":
             pf.not_run(["estop_input"], "the remote's bytes ride in the robot's LowState_, and none arrived")
         else:
@@ -166,7 +166,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
         if options.preflight_only:
             say("preflight passed (--preflight-only): nothing was sent to the robot")
             return report
-        _control(launch, spec, backend, device, options, clock_box, report, say)
+        _control(launch, pf, backend, device, options, report, say)
         return report
     finally:
         if device is not None:
@@ -184,16 +184,10 @@ def _refuse(pf: Preflight, report: DeployReport, say) -> DeployReport:
     raise refusal
 
 
-def _control(launch: LaunchFile, spec, backend, device, options: DeployOptions, clock_box, report: DeployReport,
+def _control(launch: LaunchFile, pf: Preflight, backend, device, options: DeployOptions, report: DeployReport,
              say) -> None:
-    from g1_control.generator.velocity import CopyRetargeter, VelocityReferenceGenerator
-    from g1_control.launch.runner import safety_config
-    from g1_control.loop.control_loop import ControlLoop
-    from g1_control.safety import SafetyFilter
-    from g1_control.trackers.locomotion import LocomotionPolicyTracker, VelocityCorrectionConfig
+    from g1_control.launch.builder import CHAIN_STAGES, build_loop
 
-    safety = SafetyFilter(safety_config(launch))
-    policy = LocomotionPolicyTracker(spec, VelocityCorrectionConfig(enabled=launch.tracker.velocity_correction))
     buttons = OperatorButtons(device)
     t_start = time.monotonic()
 
@@ -203,14 +197,33 @@ def _control(launch: LaunchFile, spec, backend, device, options: DeployOptions, 
             say(f"holding the default pose: press {_keys_for(device, 'run') or 'run'} to start the policy")
 
     control_s = options.duration_s if options.duration_s is not None else launch.duration_s
-    tracker = DeployTracker(policy, spec.default_q_rad, spec.kp, spec.kd, safety, time.monotonic, launch.deploy,
-                            buttons=buttons, auto=options.yes, control_s=control_s, on_transition=on_transition)
-    clock_box[0] = tracker.control_elapsed_s
-    r, lim = launch.rates, launch.limits
+    wrapped: list[DeployTracker] = []
+
+    def deploy_state_machine(inner, safety):
+        # The pose and gains of the ramp: the walking policy's own when it has them, else the robot's defaults.
+        spec = getattr(inner, "spec", None)
+        pose = spec.default_q_rad if spec is not None else g1.DEFAULT_Q_RAD
+        kp, kd = (spec.kp, spec.kd) if spec is not None else (g1.KP_DEFAULT, g1.KD_DEFAULT)
+        tracker = DeployTracker(inner, pose, kp, kd, safety, time.monotonic, launch.deploy, buttons=buttons,
+                                auto=options.yes, control_s=control_s, on_transition=on_transition)
+        wrapped.append(tracker)
+        return tracker
+
+    r = launch.rates
     expected_s = (control_s or 600.0) + launch.deploy.ramp_s + 60.0
-    loop = ControlLoop(backend, buttons, VelocityReferenceGenerator(lim.max_vx_mps, lim.max_vy_mps, lim.max_wz_radps),
-                       CopyRetargeter(), tracker, r,
-                       wallclock=True, safety=safety, log_capacity=int(expected_s * r.tracker_hz))
+    loop = build_loop(launch, backend=backend, input_device=buttons, wrap_tracker=deploy_state_machine,
+                      wallclock=True, log_capacity=int(expected_s * r.tracker_hz))
+    tracker, safety = wrapped[0], loop.safety
+    # A scripted timeline starts when control starts.
+    buttons.timeline_clock = tracker.control_elapsed_s
+    report.chain = dict(loop.chain)
+    dry = pf.dry_run.chain if pf.dry_run is not None else {}
+    differs = [k for k in CHAIN_STAGES if dry.get(k) != loop.chain.get(k)]
+    if dry and differs:
+        raise G1ControlError("the robot's loop differs from the one the dry run checked: " + "; ".join(
+            f"{k}: dry run {dry.get(k)!r}, robot {loop.chain.get(k)!r}" for k in differs))
+    say("control chain (as checked by the dry run): " + " -> ".join(loop.chain[k] for k in ("generator", "retargeter",
+                                                                                            "tracker")))
 
     def on_signal(signum, frame):
         safety.estop(f"{signal.Signals(signum).name} received", time.monotonic())

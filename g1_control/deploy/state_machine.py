@@ -22,7 +22,9 @@ import numpy as np
 from g1_control.interfaces import InputDevice, Tracker
 from g1_control.launch.schema import DeployConfig
 from g1_control.safety import SafetyFilter
-from g1_control.types import Command, JointReference, MotorCommand, RobotState
+from g1_control.teleop.gamepad_script import ScriptedGamepad
+from g1_control.teleop.scripted import ScriptedInput
+from g1_control.types import Command, EstimatedState, JointReference, MotorCommand, RobotState
 
 log = logging.getLogger("g1_control.deploy")
 
@@ -54,13 +56,19 @@ class OperatorButtons(InputDevice):
     def __init__(self, inner: InputDevice):
         self.inner = inner
         self._pressed: set[str] = set()
+        self.timeline_clock: Callable[[], float] | None = None
+        """For a scripted input (a timeline or a gamepad script): its clock, which starts when control
+        starts (the DeployTracker's control_elapsed_s); live devices keep the loop's clock."""
+        self._scripted = isinstance(inner, (ScriptedInput, ScriptedGamepad))
 
     @property
     def lost(self) -> bool:
-        return bool(getattr(self.inner, "lost", False))
+        return self.inner.lost
 
-    def poll(self) -> Command:
-        command = self.inner.poll()
+    def poll(self, now_s: float) -> Command:
+        if self._scripted and self.timeline_clock is not None:
+            now_s = self.timeline_clock()
+        command = self.inner.poll(now_s)
         if command.buttons:
             self._pressed |= command.buttons
         return command
@@ -103,19 +111,13 @@ class DeployTracker(Tracker):
         self._run_requested = False
         self.ignored: list[str] = []
 
-    # The loop feeds the estimator's velocity to the tracker and logs the policy's command.
-    @property
-    def velocity_estimate(self):
-        return getattr(self.policy, "velocity_estimate", None)
-
-    @velocity_estimate.setter
-    def velocity_estimate(self, value) -> None:
-        if hasattr(self.policy, "velocity_estimate"):
-            self.policy.velocity_estimate = value
+    # The wrapped tracker sees the estimator's output and reports its command, as it would unwrapped.
+    def observe(self, estimate: EstimatedState) -> None:
+        self.policy.observe(estimate)
 
     @property
-    def last_policy_command(self):
-        return getattr(self.policy, "last_policy_command", np.zeros(3))
+    def policy_command(self) -> np.ndarray | None:
+        return self.policy.policy_command
 
     def reset(self, state: RobotState | None = None) -> None:
         """Start over in zero torque (a deploy runs the machine once; reset is for the loop's reset)."""

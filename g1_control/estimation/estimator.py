@@ -13,25 +13,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from g1_control.robot import description, g1
-from g1_control.types import RobotState
+from g1_control.rotations import quat_to_rot, yaw_of
+from g1_control.types import EstimatedState, RobotState
 
 GRAVITY_W = np.array([0.0, 0.0, -9.81])
 SOLE_OFFSET_M = np.array([0.035, 0.0, -0.035])
 """Sole centre in the ankle-roll link frame (middle of the URDF's four foot contact spheres)."""
 
 
-def quat_to_rot(quat_wxyz: np.ndarray) -> np.ndarray:
-    w, x, y, z = quat_wxyz
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-    ])
 
 
-def yaw_of(quat_wxyz: np.ndarray) -> float:
-    w, x, y, z = quat_wxyz
-    return float(np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
 
 
 @dataclass
@@ -40,25 +31,6 @@ class EstimatorConfig:
     """Time constant pulling the integrated velocity to the kinematic one."""
     stance_height_scale_m: float = 0.003
     """Soft stance weighting: the foot lower by this much gets 73 % of the weight; sharp, because blending in the swing foot biases the speed low."""
-
-
-@dataclass
-class EstimatedState:
-    t_s: float = 0.0
-    base_quat_wxyz: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0, 0.0]))
-    base_angvel_b_radps: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    base_linvel_w_mps: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    stance_weight: np.ndarray = field(default_factory=lambda: np.full(2, 0.5))
-    yaw_rad: float = 0.0
-
-    @property
-    def heading_velocity(self) -> np.ndarray:
-        """(vx, vy, wz): base linear velocity in the heading (yaw) frame and yaw rate."""
-        c, s = np.cos(self.yaw_rad), np.sin(self.yaw_rad)
-        vx, vy = self.base_linvel_w_mps[0], self.base_linvel_w_mps[1]
-        rot = quat_to_rot(self.base_quat_wxyz)
-        wz_world = (rot @ self.base_angvel_b_radps)[2]
-        return np.array([c * vx + s * vy, -s * vx + c * vy, wz_world])
 
 
 class StateEstimator:
@@ -121,5 +93,8 @@ class StateEstimator:
         est.base_quat_wxyz = quat.copy()
         est.base_angvel_b_radps = state.imu_gyro_radps.copy()
         est.stance_weight = weights
-        est.yaw_rad = yaw_of(quat)
+        yaw = est.yaw_rad = yaw_of(quat)
+        c, s = np.cos(yaw), np.sin(yaw)
+        v = est.base_linvel_w_mps
+        est.heading_velocity = np.array([c * v[0] + s * v[1], -s * v[0] + c * v[1], (rot @ state.imu_gyro_radps)[2]])
         return est

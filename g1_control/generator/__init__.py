@@ -7,7 +7,7 @@ primitives.py    critically damped springs (root, heading), style poses, height,
 inbetween.py     the Inbetweener interface (canonical frames, partial keyframes)
 baselines.py     interpolation and motion matching
 backbone.py      the learned root + pose modules (torch); train.py / dataset.py train them
-learned.py       the trained backbone through ONNX Runtime (policies/generator/backbone.onnx)
+learned.py       the trained backbone through ONNX Runtime (g1_control/policies/generator/backbone.onnx)
 features.py, fk.py   the 50-D frame representation and batched forward kinematics
 evaluation.py, bench.py   Harvey et al. protocol (L2P, L2Q, NPSS) and `g1 bench generator`
 retarget.py, factory.py   the IK path to the locomotion tracker; generators by name for launch files

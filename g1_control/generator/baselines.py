@@ -18,7 +18,7 @@ import numpy as np
 
 from g1_control.generator import features as F
 from g1_control.generator.inbetween import Inbetweener, fill_target, interpolate
-from g1_control.motion import quaternion as quat
+from g1_control import rotations as quat
 
 
 class InterpolationInbetweener(Inbetweener):

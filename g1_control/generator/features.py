@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from g1_control.robot import g1
+from g1_control.rotations import rot_z, yaw_of_matrix  # noqa: F401  (part of the feature API)
 
 ROOT_POS = slice(0, 3)
 ROOT_ROT = slice(3, 9)
@@ -34,16 +35,8 @@ def effector_indices(body_names: tuple[str, ...]) -> list[int]:
     return [body_names.index(b) for b in EFFECTOR_BODIES]
 
 
-def yaw_of_matrix(rot: np.ndarray) -> np.ndarray:
-    """Heading (rad) of rotation matrices (..., 3, 3): the body x axis projected on the ground."""
-    return np.arctan2(rot[..., 1, 0], rot[..., 0, 0])
 
 
-def rot_z(yaw: np.ndarray) -> np.ndarray:
-    c, s = np.cos(yaw), np.sin(yaw)
-    out = np.zeros(np.shape(yaw) + (3, 3))
-    out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1], out[..., 2, 2] = c, -s, s, c, 1.0
-    return out
 
 
 def rot6d_to_matrix(r6: np.ndarray) -> np.ndarray:
@@ -74,7 +67,7 @@ def world_features(root_pos: np.ndarray, root_rot: np.ndarray, joints: np.ndarra
 
 def clip_features(clip) -> np.ndarray:
     """World-frame features of a MotionClip, (T, D)."""
-    from g1_control.motion import quaternion as quat
+    from g1_control import rotations as quat
 
     eff = clip.body_pos_w_m[:, effector_indices(clip.body_names)]
     return world_features(clip.root_pos_w_m, quat.to_matrix(clip.root_quat_wxyz), clip.joint_pos_rad, eff)

@@ -1,6 +1,6 @@
 """The generator's path to a locomotion tracker: the IK retargeter makes the whole-body
 reference feasible (limits, held stance feet, ground, effector/frame targets), then the plan's
-heading-frame root velocity becomes the tracker's command and the upper body is overridden, so
+heading-frame root velocity (passed through the IK) is the tracker's command and the upper body is overridden, so
 the policy walks the generated root path while waist and arms follow the generated pose."""
 
 from __future__ import annotations
@@ -27,9 +27,5 @@ class GeneratorRetargeter(Retargeter):
 
     def solve(self, reference: KinematicReference, q_prev: np.ndarray) -> JointReference:
         out = self.ik.solve(reference, q_prev)
-        # The IK's own twist is the base motion of one small QP step; the tracker wants the
-        # plan's velocity in the heading frame.
-        out.root_linvel_b_mps = reference.root_linvel_b_mps.copy()
-        out.root_angvel_b_radps = reference.root_angvel_b_radps.copy()
         out.upper_body_override = self.upper_body_override
         return out

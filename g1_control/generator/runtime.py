@@ -35,7 +35,7 @@ from g1_control.generator.primitives import (
 )
 from g1_control.generator.style_stats import StyleStats
 from g1_control.interfaces import Generator
-from g1_control.library.styles import STYLES, style_id
+from g1_control.generator.styles import STYLES, style_id
 from g1_control.robot import g1
 from g1_control.types import Command, KinematicReference, RobotState
 
@@ -292,8 +292,8 @@ class InbetweeningGenerator(Generator):
             v[:2] = 0.0
         if abs(wz) < self.config.yaw_rate_deadband_radps:
             wz = 0.0
-        ref.root_linvel_b_mps = v
-        ref.root_angvel_b_radps = np.array([0.0, 0.0, wz])
+        ref.root_linvel_h_mps = v
+        ref.root_angvel_h_radps = np.array([0.0, 0.0, wz])
         feet = frame[F.EFFECTORS].reshape(4, 3)[2:]
         ref.contacts = feet[:, 2] < 0.034 + 0.025
         ref.frame_targets_w = dict(self._frame_targets)

@@ -53,7 +53,7 @@ def compute_style_stats(clips) -> dict:
 
 
 def write_style_stats(library_root, path: Path) -> dict:
-    from g1_control.library.index import MotionLibrary
+    from g1_control.motion.library import MotionLibrary
 
     lib = MotionLibrary(library_root)
     # Originals only: a style's mirror image (a left-hand wave for a right-hand one) would

@@ -407,15 +407,17 @@ class IKRetargeter(Retargeter):
         q_start = self._start_configuration(reference, q_prev)
         q_new = self.step(reference, q_start)
         dt = self.config.dt_s
-        twist = self._last_step[:6] / dt  # base-frame linear, angular velocity
+        # The commanded root twist (heading frame) passes through: it is what a walking tracker
+        # follows; the IK's own base motion is in the returned root pose.
         return JointReference(
             t_s=reference.t_s,
             q_rad=q_new[7:].copy(),
             dq_radps=self._last_step[6:] / dt,
             root_pos_w_m=q_new[:3].copy(),
             root_quat_wxyz=_quat_xyzw_to_wxyz(q_new[3:7]),
-            root_linvel_b_mps=twist[:3].copy(),
-            root_angvel_b_radps=twist[3:].copy(),
+            root_linvel_h_mps=np.array(reference.root_linvel_h_mps, dtype=float),
+            root_angvel_h_radps=np.array(reference.root_angvel_h_radps, dtype=float),
             contacts=np.array([c.active for c in self.contacts]) if self.config.hold_contacts
             else np.asarray(reference.contacts, dtype=bool).copy(),
+            upper_body_override=reference.upper_body_override,
         )

@@ -2,21 +2,20 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 from g1_control.errors import InputDeviceError
 from g1_control.interfaces import InputDevice
-from g1_control.launch.schema import TELEOP_DEVICES, LaunchFile, Segment
-from g1_control.teleop.scripted import ScriptedInput
+from g1_control.launch.schema import TELEOP_DEVICES, LaunchFile
+from g1_control.teleop.scripted import ScriptedInput, Segment
 
 
-def make_input(launch: LaunchFile, segments: list[Segment], clock: Callable[[], float],
-               command_ranges: dict | None = None, state_source=None) -> InputDevice:
+def make_input(launch: LaunchFile, segments: list[Segment], command_ranges: dict | None = None,
+               state_source=None) -> InputDevice:
     """Open the device `launch.input` names. Teleop devices get the tracker's command ranges as
-    limits and the loop's clock (sim time in lockstep), so slew rates follow simulated time."""
+    limits; every device is timed by the loop's clock (poll(now_s)), so slew rates follow
+    simulated time in lockstep."""
     cfg = launch.input
     if cfg.type in ("scripted", "random"):
-        return ScriptedInput(segments, clock=clock)
+        return ScriptedInput(segments)
     from g1_control.teleop.command_limits import CommandLimits
     from g1_control.teleop.factory import make_input_device
 
@@ -27,17 +26,16 @@ def make_input(launch: LaunchFile, segments: list[Segment], clock: Callable[[], 
         steps = parse_gamepad_script(cfg.gamepad_script, "input.gamepad_script")
 
         def open_pad(path: str):
-            return make_input_device(dict(cfg.device, type="gamepad", path=path), "input.device", limits=limits,
-                                     clock=clock)
+            return make_input_device(dict(cfg.device, type="gamepad", path=path), "input.device", limits=limits)
 
-        return ScriptedGamepad(steps, open_pad, clock)
+        return ScriptedGamepad(steps, open_pad)
     assert cfg.type in TELEOP_DEVICES
     device_cfg = dict(cfg.device, type=cfg.type)
     try:
-        return make_input_device(device_cfg, "input.device", limits=limits, state_source=state_source, clock=clock)
+        return make_input_device(device_cfg, "input.device", limits=limits, state_source=state_source)
     except InputDeviceError:
         if cfg.type == "gamepad" and cfg.fallback == "keyboard":
             keyboard_cfg = {"type": "keyboard"}
             print("input: no gamepad found; using the keyboard (see g1_control/teleop/README.md for keys)")
-            return make_input_device(keyboard_cfg, "input.device", limits=limits, clock=clock)
+            return make_input_device(keyboard_cfg, "input.device", limits=limits)
         raise

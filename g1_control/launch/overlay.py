@@ -11,7 +11,7 @@ def overlay_lines(loop: ControlLoop) -> tuple[str, str]:
     safety = loop.safety
     if safety.tripped:
         state = f"DAMPING ({safety.trip_event.kind.value})"
-    elif getattr(loop.input, "lost", False):
+    elif loop.input.lost:
         state = "INPUT LOST: stopping"
     else:
         state = "ok"

@@ -19,12 +19,10 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from g1_control.errors import LaunchFileError
-from g1_control.launch.inputs import make_input
-from g1_control.launch.schema import LaunchFile, Segment
+from g1_control.launch.builder import build_loop, make_sim_backend, timeline_of
+from g1_control.launch.schema import LaunchFile
 from g1_control.loop.control_loop import ControlLoop
-from g1_control.safety import SafetyConfig, SafetyFilter
-from g1_control.teleop.scripted import random_timeline
+from g1_control.teleop.scripted import Segment
 
 STEADY_STATE_SKIP_S = 2.0
 """Time after a segment starts before its velocity counts as steady state."""
@@ -57,6 +55,8 @@ class RunResult:
     overruns: int
     events: list[dict]
     estimator_rms_mps: float | None
+    chain: dict[str, str] = field(default_factory=dict)
+    """What each stage of the loop was (g1_control/launch/builder.py)."""
     run_dir: Path | None = None
     video: str | None = None
     extra: dict = field(default_factory=dict)
@@ -64,15 +64,6 @@ class RunResult:
     @property
     def real_time_factor(self) -> float:
         return self.duration_s / self.wall_s if self.wall_s > 0 else float("inf")
-
-
-def timeline_of(launch: LaunchFile) -> list[Segment]:
-    """The command timeline when it is known in advance (scripted or random), else []."""
-    if launch.input.type == "random":
-        return random_timeline(launch.input.random, launch.total_duration_s)
-    if launch.input.type == "scripted":
-        return list(launch.input.timeline)
-    return []
 
 
 def segments_from_log(log: dict[str, np.ndarray], min_s: float = 1.0) -> list[tuple[float, Segment]]:
@@ -90,43 +81,6 @@ def segments_from_log(log: dict[str, np.ndarray], min_s: float = 1.0) -> list[tu
             out.append((float(t[a]), Segment(duration_s=float((b - a) * dt), vx_mps=vx, vy_mps=vy, wz_radps=wz,
                                             label="held")))
     return out
-
-
-def safety_config(launch: LaunchFile) -> SafetyConfig:
-    """The launch file's safety section, with limits.max_tilt_rad as a further cap on the tilt."""
-    return dataclasses.replace(launch.safety, max_tilt_rad=min(launch.safety.max_tilt_rad,
-                                                               launch.limits.max_tilt_rad))
-
-
-def build_loop(launch: LaunchFile, segments: list[Segment]) -> ControlLoop:
-    if launch.tracker.type == "wbc":
-        from g1_control.wbc.launch_loop import build_wbc_loop
-
-        return build_wbc_loop(launch, segments)
-    from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
-    from g1_control.trackers.locomotion import LocomotionPolicyTracker, VelocityCorrectionConfig
-    from g1_control.trackers.policy_spec import load_spec
-
-    spec = load_spec(launch.tracker.policy)
-    tracker = LocomotionPolicyTracker(spec, VelocityCorrectionConfig(enabled=launch.tracker.velocity_correction))
-    wallclock = launch.backend.mode == "wallclock"
-    backend = MujocoBackend(MujocoConfig(physics_dt_s=launch.backend.physics_dt_s, lockstep=True))
-    r, lim = launch.rates, launch.limits
-    loop_box: list[ControlLoop] = []
-    device = make_input(launch, segments, clock=lambda: loop_box[0].time_s if loop_box else 0.0,
-                        command_ranges=spec.command_ranges,
-                        state_source=backend.read_state)
-    from g1_control.generator.factory import make_generator
-
-    generator, retargeter = make_generator(launch.generator.type, model=launch.generator.model or None, limits=lim)
-    loop = ControlLoop(
-        backend, device, generator, retargeter, tracker,
-        r,
-        wallclock=wallclock, safety=SafetyFilter(safety_config(launch)),
-        log_capacity=int(launch.total_duration_s * r.tracker_hz) + 2,
-    )
-    loop_box.append(loop)
-    return loop
 
 
 def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentResult]:
@@ -151,11 +105,8 @@ def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentR
 def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None = None,
         progress: bool = True, viewer: bool = False) -> RunResult:
     """Run `launch` to the end (or a fall); write the run folder when `out_root` is given."""
-    if launch.backend.type != "mujoco":
-        raise LaunchFileError(f"launch file '{launch.name}' drives a robot (backend.type {launch.backend.type}); "
-                              "run it with `g1 deploy`, which checks the robot before anything moves")
     segments = timeline_of(launch)
-    loop = build_loop(launch, segments)
+    loop = build_loop(launch, backend=make_sim_backend(launch))
     loop.reset()
     duration = launch.total_duration_s
     bar = None
@@ -195,24 +146,16 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
 
 
 def _open_viewer(loop: ControlLoop):
-    import mujoco.viewer
+    from g1_control.sim.viewer import open_viewer
 
-    view = mujoco.viewer.launch_passive(loop.backend.model, loop.backend.data, show_left_ui=False,
-                                        show_right_ui=False)
-    view.cam.type = mujoco.mjtCamera.mjCAMERA_TRACKING
-    view.cam.trackbodyid = loop.backend.model.body("pelvis").id
-    view.cam.distance, view.cam.elevation = 3.0, -15.0
-    return view
+    return open_viewer(loop.backend.model, loop.backend.data)
 
 
 def _update_viewer(view, loop: ControlLoop) -> None:
-    import mujoco
-
     from g1_control.launch.overlay import overlay_lines
+    from g1_control.sim.viewer import update_viewer
 
-    labels, values = overlay_lines(loop)
-    view.set_texts((mujoco.mjtFont.mjFONT_NORMAL, mujoco.mjtGridPos.mjGRID_TOPLEFT, labels, values))
-    view.sync()
+    update_viewer(view, *overlay_lines(loop))
 
 
 def _result(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], wall: float) -> RunResult:
@@ -226,7 +169,7 @@ def _result(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], wall
         name=launch.name, fell=loop.fell, duration_s=loop.time_s, wall_s=wall,
         segments=segment_results(loop, segments), timings=loop.scheduler.report(),
         deadline_misses=loop.scheduler.deadline_misses, overruns=loop.scheduler.overruns,
-        events=[dataclasses.asdict(e) for e in loop.events], estimator_rms_mps=est_rms,
+        events=[dataclasses.asdict(e) for e in loop.events], estimator_rms_mps=est_rms, chain=dict(loop.chain),
     )
 
 

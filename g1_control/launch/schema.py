@@ -15,11 +15,15 @@ from g1_control.config import from_dict
 from g1_control.errors import LaunchFileError, SafetyConfigError
 from g1_control.loop.rates import LoopRates
 from g1_control.safety.config import SafetyConfig
+from g1_control.teleop.scripted import RandomTimelineConfig, Segment
 
 ROBOT_BACKENDS = ("unitree_dds", "can", "serial")
 """Backends that drive a robot (real, or `g1 sim-robot`) through a robot link; `g1 deploy` runs them."""
 
 VARIANT_NAMES = ("g1_23dof", "g1_29dof", "g1_29dof_locked_waist")
+
+MIN_WBC_TRACKER_HZ = 200.0
+"""The whole-body controller's slowest useful rate."""
 
 
 @dataclass
@@ -124,47 +128,39 @@ class DeployConfig:
 
 @dataclass
 class TrackerConfig:
-    type: Literal["policy", "wbc"] = "policy"
+    """Which tracker turns references into motor commands (g1_control/launch/builder.py).
+
+    policy: a velocity-command walking policy (`policy`: a built-in spec name or a spec YAML) with
+    upper-body override and closed-loop velocity correction; wbc: the model-based whole-body
+    controller (needs rates.tracker_hz >= 200 and a generator with root poses and a contact
+    schedule: generator.type scripted); wbt: holosoma's whole-body-tracking policy (50 Hz), kept as
+    a comparison baseline for the WBC.
+    """
+
+    type: Literal["policy", "wbc", "wbt"] = "policy"
     policy: str = "holosoma_loco_ppo"
     """Built-in spec name (g1 policies list) or a path to a spec YAML."""
     velocity_correction: bool = True
-    wbc_reference: str = "stand"
-    """type wbc: the scripted whole-body reference to track (see g1_control.wbc.launch_loop)."""
 
 
 @dataclass
 class GeneratorConfig:
-    """Which motion generator makes the reference (g1_control/generator/factory.py)."""
+    """Which motion generator makes the reference (g1_control/generator/factory.py).
 
-    type: Literal["velocity", "backbone", "interpolation", "motion_matching"] = "velocity"
+    velocity: the operator's velocity with the style's upper-body pose; backbone: the learned
+    in-betweening generator through the IK; interpolation / motion_matching: the same runtime with
+    a baseline in-betweener; scripted: a scripted whole-body reference (`reference`, from
+    g1_control/generator/scripted.py), for the whole-body controller.
+    """
+
+    type: Literal["velocity", "backbone", "interpolation", "motion_matching", "scripted"] = "velocity"
     model: str = ""
-    """Backbone ONNX file; empty: the shipped policies/generator/backbone.onnx."""
-
-
-@dataclass
-class Segment:
-    """One piece of a scripted command timeline."""
-
-    duration_s: float
-    vx_mps: float = 0.0
-    vy_mps: float = 0.0
-    wz_radps: float = 0.0
-    label: str = ""
-    style: str = "default"
-
-    def validate(self, where: str) -> None:
-        if self.duration_s <= 0:
-            raise LaunchFileError(f"{where}.duration_s: must be > 0, got {self.duration_s}")
-
-
-@dataclass
-class RandomTimelineConfig:
-    seed: int = 0
-    segment_s: tuple[float, float] = (3.0, 8.0)
-    vx_mps: tuple[float, float] = (-0.4, 0.8)
-    vy_mps: tuple[float, float] = (-0.3, 0.3)
-    wz_radps: tuple[float, float] = (-0.6, 0.6)
-    stand_probability: float = 0.2
+    """Backbone ONNX file; empty: the shipped g1_control/policies/generator/backbone.onnx."""
+    reference: str = "stand"
+    """type scripted: which reference (stand, arm_wave, crouch, lean_reach, step_in_place, walk)."""
+    reference_params: dict[str, float] = field(default_factory=dict)
+    """type scripted: the reference's parameters (e.g. {duration_s: 20} for stand, {speed_mps: 0.3}
+    for walk; see the functions in g1_control/generator/scripted.py)."""
 
 
 TELEOP_DEVICES = ("gamepad", "keyboard", "unitree_remote")
@@ -246,6 +242,29 @@ class LaunchFile:
     def validate(self, where: str) -> None:
         if self.duration_s is not None and self.duration_s <= 0:
             raise LaunchFileError(f"duration_s: must be > 0, got {self.duration_s}")
+        if self.generator.type == "scripted":
+            from g1_control.generator.scripted import REFERENCES
+
+            if self.generator.reference not in REFERENCES:
+                raise LaunchFileError(f"generator.reference: unknown reference '{self.generator.reference}'; "
+                                      f"known: {', '.join(REFERENCES)}")
+            import inspect
+
+            accepted = inspect.signature(REFERENCES[self.generator.reference]).parameters
+            unknown = sorted(set(self.generator.reference_params) - set(accepted))
+            if unknown:
+                raise LaunchFileError(f"generator.reference_params: {', '.join(unknown)} not a parameter of reference "
+                                      f"'{self.generator.reference}'; known: {', '.join(accepted)}")
+        if self.tracker.type == "wbc":
+            if self.rates.tracker_hz < MIN_WBC_TRACKER_HZ:
+                raise LaunchFileError(f"rates.tracker_hz: {self.rates.tracker_hz:g} Hz is too slow for tracker.type "
+                                      f"wbc (the whole-body controller needs >= {MIN_WBC_TRACKER_HZ:.0f} Hz, e.g. 250)")
+            if self.generator.type != "scripted":
+                raise LaunchFileError(f"generator.type: tracker.type wbc needs root poses and a contact schedule, "
+                                      f"which only generator.type scripted provides (got {self.generator.type})")
+        if self.tracker.type == "wbt" and self.rates.tracker_hz != 50.0:
+            raise LaunchFileError(f"rates.tracker_hz: tracker.type wbt runs at the policy's 50 Hz, got "
+                                  f"{self.rates.tracker_hz:g}")
         lim = self.limits
         for i, seg in enumerate(self.input.timeline):
             for name, limit in (("vx_mps", lim.max_vx_mps), ("vy_mps", lim.max_vy_mps), ("wz_radps", lim.max_wz_radps)):

@@ -12,7 +12,7 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from g1_control.library.index import INDEX_NAME, LibraryError, MotionLibrary
+from g1_control.motion.library import INDEX_NAME, LibraryError, MotionLibrary
 from g1_control.motion.clip import MotionClip
 
 BUILD_VERSION = 1
@@ -52,7 +52,7 @@ def default_library_dir() -> Path:
 
 def _rollout_job(args) -> tuple[MotionClip | None, dict]:
     from g1_control.library.rollouts import RolloutConfig, record_rollout
-    from g1_control.library.styles import ROLLOUT_STYLES
+    from g1_control.generator.styles import ROLLOUT_STYLES
 
     style, seed, seconds, fps = args
     return record_rollout(ROLLOUT_STYLES[style], RolloutConfig(duration_s=seconds, seed=seed, fps=fps))
@@ -60,7 +60,7 @@ def _rollout_job(args) -> tuple[MotionClip | None, dict]:
 
 def _demo_clips(fps: float) -> list[MotionClip]:
     from g1_control.assets import fetch
-    from g1_control.ik.mocap_retarget import MocapRetargetConfig, MocapRetargeter
+    from g1_control.retarget.mocap import MocapRetargetConfig, MocapRetargeter
     from g1_control.motion.formats.dispatch import load_motion
 
     root = fetch("holosoma-demo-mocap") / "holosoma_retargeting" / "demo_data"
@@ -88,7 +88,7 @@ def build_library(out_dir: str | Path, config: LibraryConfig | None = None, *, f
                   jobs: int = 1, progress: bool = True) -> MotionLibrary:
     from tqdm import tqdm
 
-    from g1_control.library.styles import ROLLOUT_STYLES
+    from g1_control.generator.styles import ROLLOUT_STYLES
     from g1_control.motion.formats.clip_npz import write_clip_npz
     from g1_control.motion.mirror import mirror
 

@@ -1,8 +1,8 @@
 """Physics rollouts of the locomotion tracker under randomized commands, one upper-body style
 per rollout, recorded as MotionClips.
 
-The loop is the project's own ControlLoop in lockstep (MuJoCo, holosoma loco policy, safety
-filter), so the recorded motion is what the robot's physics and policy produce: real gait
+The loop is the project's own, built from a launch file like every other (MuJoCo in lockstep,
+the velocity generator with the style's pose, holosoma's loco policy, the safety filter), so the recorded motion is what the robot's physics and policy produce: real gait
 timing, foot contacts and the ~80 % speed response (FACTS.md), not an idealized gait. Frames
 after a fall are dropped.
 """
@@ -13,13 +13,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from g1_control.generator.velocity import CopyRetargeter
-from g1_control.interfaces import Generator, InputDevice
-from g1_control.library.styles import UpperBodyStyle
+from g1_control.generator.styles import ROLLOUT_STYLES, UpperBodyStyle
+from g1_control.launch.builder import build_loop, timeline_of
+from g1_control.launch.schema import LaunchFile
+from g1_control.teleop.scripted import RandomTimelineConfig
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.resample import interpolate_positions, interpolate_quaternions
-from g1_control.robot import g1
-from g1_control.types import Command, JointReference, KinematicReference, RobotState
 
 
 @dataclass
@@ -34,73 +33,33 @@ class RolloutConfig:
     stand_probability: float = 0.2
 
 
+def rollout_launch(style: UpperBodyStyle, config: RolloutConfig) -> LaunchFile:
+    """The rollout as a launch file: seeded random commands with one upper-body style, the velocity
+    generator (the style's pose, tracked with the upper-body override), holosoma's loco policy."""
+    launch = LaunchFile(name=f"rollout_{style.name}_s{config.seed}", duration_s=config.duration_s)
+    launch.input.type = "random"
+    launch.input.random = RandomTimelineConfig(
+        seed=config.seed, segment_s=config.segment_s, vx_mps=config.vx_mps, vy_mps=config.vy_mps,
+        wz_radps=config.wz_radps, stand_probability=config.stand_probability, style=style.name)
+    launch.tracker.policy = "holosoma_loco_ppo"
+    launch.output.video, launch.output.plot, launch.viewer = False, False, False
+    return launch
+
+
 def random_commands(config: RolloutConfig) -> list[tuple[float, float, float, float]]:
     """(start_s, vx, vy, wz) segments: stands, straight walks, sidesteps, turns and mixes."""
-    from g1_control.launch.schema import RandomTimelineConfig
-    from g1_control.teleop.scripted import random_timeline
-
-    cfg = RandomTimelineConfig(seed=config.seed, segment_s=config.segment_s, vx_mps=config.vx_mps,
-                               vy_mps=config.vy_mps, wz_radps=config.wz_radps,
-                               stand_probability=config.stand_probability)
     out, t = [], 0.0
-    for seg in random_timeline(cfg, config.duration_s):
+    for seg in timeline_of(rollout_launch(ROLLOUT_STYLES["default"], config)):
         out.append((t, seg.vx_mps, seg.vy_mps, seg.wz_radps))
         t += seg.duration_s
     return out
 
 
-class _TimelineInput(InputDevice):
-    def __init__(self, segments, clock):
-        self.starts = np.array([s[0] for s in segments])
-        self.commands = [Command(vx_mps=s[1], vy_mps=s[2], wz_radps=s[3]) for s in segments]
-        self.clock = clock
-
-    def poll(self) -> Command:
-        return self.commands[int(np.searchsorted(self.starts, self.clock(), side="right")) - 1]
-
-
-class StyleVelocityGenerator(Generator):
-    """Velocity command for the legs, the style's upper-body posture for waist and arms."""
-
-    def __init__(self, style: UpperBodyStyle):
-        self.style = style
-        self.ref = KinematicReference(q_rad=g1.DEFAULT_Q_RAD.copy(), style=style.name)
-
-    def update(self, command: Command, state: RobotState) -> KinematicReference:
-        self.ref.t_s = state.t_s
-        self.ref.root_linvel_b_mps[:2] = (command.vx_mps, command.vy_mps)
-        self.ref.root_angvel_b_radps[2] = command.wz_radps
-        self.ref.q_rad[:] = self.style.pose(state.t_s)
-        return self.ref
-
-
-class OverrideRetargeter(CopyRetargeter):
-    """Copies the reference and asks the tracker to take waist/arm targets from it."""
-
-    def __init__(self, override: bool = True):
-        super().__init__()
-        self.override = override
-
-    def solve(self, reference: KinematicReference, q_prev: np.ndarray) -> JointReference:
-        out = super().solve(reference, q_prev)
-        out.upper_body_override = self.override
-        return out
-
-
 def record_rollout(style: UpperBodyStyle, config: RolloutConfig) -> tuple[MotionClip | None, dict]:
     """One rollout; returns (clip at config.fps or None if it fell at once, info)."""
-    from g1_control.loop.control_loop import ControlLoop
-    from g1_control.sim.mujoco_backend import MujocoBackend
-    from g1_control.trackers.locomotion import LocomotionPolicyTracker
-    from g1_control.trackers.policy_spec import load_spec
-
+    launch = rollout_launch(style, config)
     segments = random_commands(config)
-    box: list[ControlLoop] = []
-    loop = ControlLoop(MujocoBackend(), _TimelineInput(segments, lambda: box[0].time_s if box else 0.0),
-                       StyleVelocityGenerator(style), OverrideRetargeter(style.override),
-                       LocomotionPolicyTracker(load_spec("holosoma_loco_ppo")),
-                       log_capacity=int(config.duration_s * 50) + 10)
-    box.append(loop)
+    loop = build_loop(launch, log_capacity=int(config.duration_s * 50) + 10)
     loop.reset()
     # Run in 1 s pieces so that a fall stops the recording early.
     for _ in range(int(np.ceil(config.duration_s))):

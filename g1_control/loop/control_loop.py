@@ -9,12 +9,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from g1_control.errors import InvalidCommandError, InvalidStateError
-from g1_control.estimation.estimator import StateEstimator, quat_to_rot, yaw_of
+from g1_control.estimation.estimator import StateEstimator
 from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, Tracker
 from g1_control.loop.rates import LoopRates
 from g1_control.loop.scheduler import Scheduler, Stage
 from g1_control.robot import g1
-from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter, tilt_rad
+from g1_control.rotations import quat_to_rot, tilt_rad, yaw_of
+from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter
 from g1_control.types import Command, RobotState
 
 
@@ -83,6 +84,8 @@ class ControlLoop:
         self._tracker_command = self.motor_command
         self.invalid_commands = 0
         self.events: list[LoopEvent] = []
+        self.chain: dict[str, str] = {}
+        """What each stage is (set by g1_control/launch/builder.py): the same in a deploy's dry run and on the robot."""
         self.log = RunLog(max(1, log_capacity))
         r = self.rates
         stages = [
@@ -138,9 +141,9 @@ class ControlLoop:
 
     # -- stages --------------------------------------------------------------------------------------
     def _input(self) -> None:
-        command = self.input.poll()
         now = self.now_s()
-        if getattr(self.input, "lost", False):
+        command = self.input.poll(now)
+        if self.input.lost:
             # A lost device is no input at all: the safety layer stops the robot, then damps it.
             self.command = self.safety.vet_input(None, now)
             return
@@ -174,9 +177,7 @@ class ControlLoop:
     def _estimate(self) -> None:
         state = self._read_state()
         if state is not None:
-            est = self.estimator.update(state)
-            if hasattr(self.tracker, "velocity_estimate"):
-                self.tracker.velocity_estimate = est.heading_velocity
+            self.tracker.observe(self.estimator.update(state))
 
     def _generate(self) -> None:
         self._kin_ref = self.generator.update(self.command, self.state)
@@ -194,9 +195,7 @@ class ControlLoop:
 
     def _safety(self) -> None:
         # Robot links count states dropped for a bad CRC; a burst of them trips the filter.
-        bad_crc = getattr(self.backend, "bad_crc", None)
-        if bad_crc is not None:
-            self.safety.report_crc_errors(bad_crc, self.now_s())
+        self.safety.report_crc_errors(self.backend.bad_crc, self.now_s())
         # Missed deadlines endanger a robot that runs on its own; a simulator we step just slows down.
         if self.scheduler.wallclock and not self.backend.lockstep:
             self.safety.report_deadline(self.scheduler.deadline_misses > self._misses_seen, self.now_s())
@@ -220,7 +219,8 @@ class ControlLoop:
         s, est = self.state, self.estimator.estimate
         log.t_s[i] = self.time_s
         log.command[i] = (self.command.vx_mps, self.command.vy_mps, self.command.wz_radps)
-        log.policy_command[i] = getattr(self.tracker, "last_policy_command", log.command[i])
+        policy_command = self.tracker.policy_command
+        log.policy_command[i] = log.command[i] if policy_command is None else policy_command
         log.velocity_est[i] = est.heading_velocity
         yaw = yaw_of(s.imu_quat_wxyz)
         log.yaw_rad[i] = yaw

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from g1_control.motion import quaternion as quat
+from g1_control import rotations as quat
 from g1_control.motion.exceptions import InvalidClipError
 from g1_control.motion.objects import ObjectShape, ObjectTrack
 from g1_control.robot import g1

@@ -6,7 +6,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from g1_control.motion import quaternion as quat
+from g1_control import rotations as quat
+from g1_control.rotations import yaw_of
 from g1_control.motion.clip import ARRAY_FIELDS, MotionClip
 from g1_control.motion.exceptions import IncompatibleClipsError, InvalidClipError
 from g1_control.motion.objects import ObjectTrack
@@ -25,9 +26,6 @@ def slice_clip(clip: MotionClip, start: int = 0, stop: int | None = None) -> Mot
     return out.validate()
 
 
-def _yaw(q_wxyz: np.ndarray) -> float:
-    w, x, y, z = q_wxyz
-    return float(np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
 
 
 def transform_clip(clip: MotionClip, yaw_rad: float, translation_xy_m: np.ndarray) -> MotionClip:
@@ -65,7 +63,7 @@ def concatenate(clips: Sequence[MotionClip], align_root: bool = True) -> MotionC
     for clip in clips[1:]:
         if align_root:
             prev_end = parts[-1]
-            yaw = _yaw(prev_end.root_quat_wxyz[-1]) - _yaw(clip.root_quat_wxyz[0])
+            yaw = yaw_of(prev_end.root_quat_wxyz[-1]) - yaw_of(clip.root_quat_wxyz[0])
             c, s = np.cos(yaw), np.sin(yaw)
             start_xy = np.array([[c, -s], [s, c]]) @ clip.root_pos_w_m[0, :2]
             clip = transform_clip(clip, yaw, prev_end.root_pos_w_m[-1, :2] - start_xy)

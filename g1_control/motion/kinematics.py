@@ -11,7 +11,7 @@ import functools
 
 import numpy as np
 
-from g1_control.motion import quaternion as quat
+from g1_control import rotations as quat
 from g1_control.motion.exceptions import UnknownJointError
 from g1_control.robot import description, g1
 

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from g1_control.motion import quaternion as quat
+from g1_control import rotations as quat
 from g1_control.motion.exceptions import InvalidClipError, MotionFormatError
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from g1_control.motion import quaternion as quat
+from g1_control import rotations as quat
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.exceptions import InvalidClipError
 

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from g1_control.robot import g1
+from g1_control.rotations import tilt_rad
 from g1_control.safety.config import SafetyConfig
 from g1_control.safety.events import SafetyEvent, SafetyEventKind
 from g1_control.types import Command, MotorCommand, RobotState
@@ -52,10 +53,6 @@ class ClampCounts:
         return int(sum(int(v.sum()) for v in self.per_joint.values()))
 
 
-def tilt_rad(quat_wxyz: np.ndarray) -> float:
-    """Angle between the body z axis and world up."""
-    _, x, y, _ = np.asarray(quat_wxyz, dtype=float) / np.linalg.norm(quat_wxyz)
-    return float(np.arccos(np.clip(1.0 - 2.0 * (x * x + y * y), -1.0, 1.0)))
 
 
 class _Burst:

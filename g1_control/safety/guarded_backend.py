@@ -45,9 +45,7 @@ class GuardedBackend(Backend):
     def write_command(self, command: MotorCommand) -> None:
         state = self.inner.read_state()
         now = self.now_s(state)
-        bad_crc = getattr(self.inner, "bad_crc", None)
-        if bad_crc is not None:
-            self.safety.report_crc_errors(bad_crc, now)
+        self.safety.report_crc_errors(self.inner.bad_crc, now)
         out = self.safety.filter(command, state, now)
         self.last_sent = out
         self.inner.write_command(out)

@@ -29,7 +29,8 @@ class DeviceLost(Exception):
 
 
 class TeleopDevice(InputDevice):
-    """Base class: subclasses implement `_read() -> InputSnapshot` (non-blocking)."""
+    """Base class: subclasses implement `_read() -> InputSnapshot` (non-blocking; the poll's time
+    is `self._now_s`)."""
 
     kind: str = "device"
 
@@ -40,6 +41,7 @@ class TeleopDevice(InputDevice):
         self.mapper = CommandMapper(mapping, limits)
         self.name = name or self.kind
         self._clock = clock
+        self._now_s = 0.0
         self._lost_reason: str | None = None
         self._closed = False
 
@@ -55,14 +57,17 @@ class TeleopDevice(InputDevice):
     def stats(self):
         return self.mapper.stats
 
-    def poll(self) -> Command:
+    def poll(self, now_s: float | None = None) -> Command:
+        """The Command for `now_s` (the loop's clock); without it (a device used on its own, as
+        `g1 input` does), the device's own clock."""
+        self._now_s = self._clock() if now_s is None else now_s
         if not self.lost:
             try:
                 snapshot = self._read()
             except DeviceLost as exc:
                 self._mark_lost(str(exc))
             else:
-                return self.mapper.update(snapshot, self._clock())
+                return self.mapper.update(snapshot, self._now_s)
         return self.mapper.lost_command()
 
     def _mark_lost(self, reason: str) -> None:

@@ -14,6 +14,8 @@ lockstep) reaches it; an EvdevGamepad opened on feeder.path reads them as from /
 
 from __future__ import annotations
 
+import time
+
 import math
 import os
 import tempfile
@@ -156,18 +158,19 @@ class ScriptedGamepad:
     """A gamepad script played through the real evdev reader: an InputDevice whose poll() first
     writes the steps due by `clock()` into the FIFO, then reads them back as a pad would."""
 
-    def __init__(self, steps: list[GamepadStep], make_gamepad, clock) -> None:
+    def __init__(self, steps: list[GamepadStep], make_gamepad, clock=None) -> None:
         self.feeder = GamepadScriptFeeder(steps)
         self.gamepad = make_gamepad(self.feeder.path)
-        self.clock = clock
+        self.clock = clock or time.monotonic
 
     @property
     def lost(self) -> bool:
         return self.gamepad.lost
 
-    def poll(self):
-        self.feeder.advance(self.clock())
-        return self.gamepad.poll()
+    def poll(self, now_s: float | None = None):
+        now = self.clock() if now_s is None else now_s
+        self.feeder.advance(now)
+        return self.gamepad.poll(now)
 
     def close(self) -> None:
         self.gamepad.close()

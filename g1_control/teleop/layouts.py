@@ -17,6 +17,8 @@ import string
 from dataclasses import dataclass, field
 from typing import Any
 
+from g1_control.hardware.unitree.remote import REMOTE_BUTTON_BITS
+
 STICK = "stick"
 TRIGGER = "trigger"
 
@@ -62,9 +64,6 @@ GAMEPAD_DEFAULT_MAPPING: dict[str, Any] = {
 }
 
 # --- Unitree handheld remote (bytes in LowState.wireless_remote) -------------------------------
-REMOTE_BUTTON_BITS = ("R1", "L1", "start", "select", "R2", "L2", "F1", "F2",
-                      "A", "B", "X", "Y", "up", "right", "down", "left")
-"""Bit i of the u16 at bytes 2-3 (little-endian) is button REMOTE_BUTTON_BITS[i] (FACTS.md)."""
 REMOTE_BUTTONS = frozenset(REMOTE_BUTTON_BITS)
 REMOTE_AXES = {"lx": STICK, "ly": STICK, "rx": STICK, "ry": STICK, "L2": TRIGGER}
 # The remote reports ly positive forward (unlike evdev), so only vy and wz flip sign.

@@ -3,23 +3,53 @@
 from __future__ import annotations
 
 import bisect
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
+from g1_control.errors import LaunchFileError
 from g1_control.interfaces import InputDevice
-from g1_control.launch.schema import RandomTimelineConfig, Segment
 from g1_control.types import Command
 
 
-class ScriptedInput(InputDevice):
-    """Plays `segments` back to back; after the last one, commands zero velocity."""
+@dataclass
+class Segment:
+    """One piece of a scripted command timeline."""
 
-    def __init__(self, segments: Sequence[Segment], clock: Callable[[], float]):
+    duration_s: float
+    vx_mps: float = 0.0
+    vy_mps: float = 0.0
+    wz_radps: float = 0.0
+    label: str = ""
+    style: str = "default"
+
+    def validate(self, where: str) -> None:
+        if self.duration_s <= 0:
+            raise LaunchFileError(f"{where}.duration_s: must be > 0, got {self.duration_s}")
+
+
+@dataclass
+class RandomTimelineConfig:
+    seed: int = 0
+    segment_s: tuple[float, float] = (3.0, 8.0)
+    vx_mps: tuple[float, float] = (-0.4, 0.8)
+    vy_mps: tuple[float, float] = (-0.3, 0.3)
+    wz_radps: tuple[float, float] = (-0.6, 0.6)
+    stand_probability: float = 0.2
+    style: str = "default"
+    """Upper-body style of every segment."""
+
+
+class ScriptedInput(InputDevice):
+    """Plays `segments` back to back from `start_s` on the poll's clock; after the last one (and
+    before `start_s`), commands zero velocity."""
+
+    def __init__(self, segments: Sequence[Segment], start_s: float = 0.0):
         if not segments:
             raise ValueError("a scripted timeline needs at least one segment")
         self.segments = list(segments)
-        self.clock = clock
+        self.start_s = start_s
         self.starts = np.concatenate([[0.0], np.cumsum([s.duration_s for s in self.segments])])
         self._commands = [
             Command(vx_mps=s.vx_mps, vy_mps=s.vy_mps, wz_radps=s.wz_radps, style=s.style).validate()
@@ -34,19 +64,20 @@ class ScriptedInput(InputDevice):
         """Segment index playing at `t_s` (len(segments) after the end)."""
         return min(bisect.bisect_right(self.starts, t_s) - 1, len(self.segments))
 
-    def poll(self) -> Command:
-        return self._commands[self.index_at(self.clock())]
+    def poll(self, now_s: float) -> Command:
+        t = now_s - self.start_s
+        return self._commands[self.index_at(t)] if t >= 0.0 else self._commands[-1]
 
 
 def random_timeline(config: RandomTimelineConfig, duration_s: float) -> list[Segment]:
     """Seeded random segments: stands, walks, turns, sidesteps and their mixes; starts standing."""
     rng = np.random.default_rng(config.seed)
-    segments = [Segment(duration_s=2.0, label="stand")]
+    segments = [Segment(duration_s=2.0, label="stand", style=config.style)]
     total = 2.0
     while total < duration_s:
         length = min(float(rng.uniform(*config.segment_s)), duration_s - total)
         if rng.random() < config.stand_probability:
-            seg = Segment(duration_s=length, label="stand")
+            seg = Segment(duration_s=length, label="stand", style=config.style)
         else:
             vx, vy, wz = (float(rng.uniform(*r)) for r in (config.vx_mps, config.vy_mps, config.wz_radps))
             # Mostly one dominant motion, as an operator would command.
@@ -54,7 +85,7 @@ def random_timeline(config: RandomTimelineConfig, duration_s: float) -> list[Seg
             mix = rng.random() < 0.3
             vx, vy, wz = [(v if (i == keep or mix) else 0.0) for i, v in enumerate((vx, vy, wz))]
             seg = Segment(duration_s=length, vx_mps=round(vx, 3), vy_mps=round(vy, 3), wz_radps=round(wz, 3),
-                          label="random")
+                          label="random", style=config.style)
         segments.append(seg)
         total += length
     return segments

@@ -1,9 +1,5 @@
-"""The Unitree handheld remote, as the G1 reports it in LowState.wireless_remote (40 bytes).
-
-Layout (Unitree's G1 developer docs, "remote control data"; FACTS.md): bytes 0-1 a header,
-bytes 2-3 a little-endian u16 button bitfield (bit i = REMOTE_BUTTON_BITS[i]), then
-little-endian f32 lx [4:8], rx [8:12], ry [12:16], L2 analog [16:20], ly [20:24], then 16
-idle bytes. Sticks are nominally in [-1, 1], ly positive forward.
+"""The Unitree handheld remote as an operator input device. Its bytes ride in
+LowState_.wireless_remote; their layout is g1_control/hardware/unitree/remote.py.
 
 The remote's bytes ride inside the robot's state stream, so the device has no file of its own:
 it reads from a `state_source` (called each poll; returns the latest RobotState or raw bytes)
@@ -15,58 +11,22 @@ source failing, or malformed bytes, and each of those makes the device lost.
 from __future__ import annotations
 
 import math
-import struct
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 from g1_control.errors import LaunchFileError, RemoteDecodeError
+from g1_control.hardware.unitree.remote import (  # noqa: F401  (the wire format, re-exported)
+    REMOTE_SIZE,
+    RemoteReading,
+    decode_wireless_remote,
+    encode_wireless_remote,
+)
 from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.device import DeviceLost, TeleopDevice
-from g1_control.teleop.layouts import REMOTE_BUTTON_BITS
 from g1_control.teleop.mapping import MappingConfig
 from g1_control.teleop.snapshot import InputSnapshot
 from g1_control.types import RobotState
-
-REMOTE_SIZE = 40
-_STRUCT = struct.Struct("<2sH5f16s")  # head, buttons, lx, rx, ry, L2, ly, idle
-assert _STRUCT.size == REMOTE_SIZE
-
-
-@dataclass(frozen=True)
-class RemoteReading:
-    """One decoded remote sample (values as sent: not clamped, may be NaN)."""
-
-    buttons: frozenset[str]
-    lx: float
-    rx: float
-    ry: float
-    l2: float
-    ly: float
-
-    def axes(self) -> dict[str, float]:
-        return {"lx": self.lx, "ly": self.ly, "rx": self.rx, "ry": self.ry, "L2": self.l2}
-
-
-def decode_wireless_remote(data: bytes) -> RemoteReading:
-    """Decode LowState.wireless_remote; RemoteDecodeError if it is not 40 bytes."""
-    if len(data) != REMOTE_SIZE:
-        raise RemoteDecodeError(f"wireless_remote has {len(data)} bytes; expected {REMOTE_SIZE}")
-    _, bits, lx, rx, ry, l2, ly, _ = _STRUCT.unpack(bytes(data))
-    buttons = frozenset(name for i, name in enumerate(REMOTE_BUTTON_BITS) if bits >> i & 1)
-    return RemoteReading(buttons, lx, rx, ry, l2, ly)
-
-
-def encode_wireless_remote(buttons=(), lx: float = 0.0, rx: float = 0.0, ry: float = 0.0, l2: float = 0.0,
-                           ly: float = 0.0) -> bytes:
-    """The 40 bytes the robot would send (for simulators, emulators and tests)."""
-    unknown = set(buttons) - set(REMOTE_BUTTON_BITS)
-    if unknown:
-        raise RemoteDecodeError(f"unknown remote buttons {sorted(unknown)}; known: {', '.join(REMOTE_BUTTON_BITS)}")
-    bits = sum(1 << REMOTE_BUTTON_BITS.index(b) for b in set(buttons))
-    return _STRUCT.pack(b"\x00\x00", bits, lx, rx, ry, l2, ly, bytes(16))
-
 
 class UnitreeRemote(TeleopDevice):
     kind = "unitree_remote"
@@ -80,7 +40,10 @@ class UnitreeRemote(TeleopDevice):
             raise LaunchFileError(f"stale_after_s is {stale_after_s!r}; expected a positive number of seconds")
         self._source = state_source
         self.stale_after_s = float(stale_after_s)
-        self._last_fresh_s = clock()
+        self._last_fresh_s: float | None = None
+        """Poll time at which the latest fresh sample was seen (None before the first poll)."""
+        self._fresh_samples = 0
+        self._seen_samples = 0
         self._last_tick: int | None = None
         self._last_bytes: bytes | None = None
         self._reading = RemoteReading(frozenset(), 0.0, 0.0, 0.0, 0.0, 0.0)
@@ -101,7 +64,7 @@ class UnitreeRemote(TeleopDevice):
         with self._lock:
             self._presses.extend(sorted(reading.buttons - self._reading.buttons))
             self._reading = reading
-            self._last_fresh_s = self._clock()
+            self._fresh_samples += 1
             self.samples += 1
 
     def _pull(self) -> None:
@@ -127,8 +90,13 @@ class UnitreeRemote(TeleopDevice):
     def _read(self) -> InputSnapshot:
         if self._source is not None:
             self._pull()
+        now = self._now_s
         with self._lock:
-            silent_s = self._clock() - self._last_fresh_s
+            # Freshness is judged on the poll's clock, whichever thread fed the sample.
+            if self._last_fresh_s is None or self._fresh_samples != self._seen_samples:
+                self._seen_samples = self._fresh_samples
+                self._last_fresh_s = now
+            silent_s = now - self._last_fresh_s
             if silent_s > self.stale_after_s:
                 what = f" ({self.decode_errors} malformed samples)" if self.decode_errors else ""
                 raise DeviceLost(f"no remote data for {silent_s:.3f} s (limit {self.stale_after_s} s){what}")

@@ -15,17 +15,13 @@ import numpy as np
 
 from g1_control.interfaces import Tracker
 from g1_control.robot import g1
+from g1_control.rotations import projected_gravity
 from g1_control.trackers.observation import ObservationBuilder
 from g1_control.trackers.onnx_runner import OnnxRunner
 from g1_control.trackers.policy_spec import PolicySpec
-from g1_control.types import JointReference, MotorCommand, RobotState
+from g1_control.types import EstimatedState, JointReference, MotorCommand, RobotState
 
 
-def projected_gravity(quat_wxyz: np.ndarray) -> np.ndarray:
-    """World gravity direction (0, 0, -1) expressed in the body frame of `quat_wxyz`."""
-    w, x, y, z = quat_wxyz
-    # Third row of R (body->world), negated: R^T @ (0, 0, -1).
-    return -np.array([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)])
 
 
 @dataclass
@@ -82,7 +78,7 @@ class LocomotionPolicyTracker(Tracker):
         self.obs = ObservationBuilder(spec.observation)
         self.corrector = VelocityCorrector(correction or VelocityCorrectionConfig(), self.dt_s)
         self.velocity_estimate: np.ndarray | None = None
-        """(vx, vy, wz) in the heading frame, set by the loop from the state estimator."""
+        """(vx, vy, wz) in the heading frame, from the state estimator (observe())."""
         self._ranges = np.array([
             spec.command_ranges.get("lin_vel_x", (-1.0, 1.0)),
             spec.command_ranges.get("lin_vel_y", (-1.0, 1.0)),
@@ -94,6 +90,13 @@ class LocomotionPolicyTracker(Tracker):
         self._standing = True
         self._command = MotorCommand(q_rad=spec.default_q_rad.copy(), kp=spec.kp.copy(), kd=spec.kd.copy())
         self._values: dict[str, np.ndarray] = {}
+
+    def observe(self, estimate: EstimatedState) -> None:
+        self.velocity_estimate = estimate.heading_velocity
+
+    @property
+    def policy_command(self) -> np.ndarray:
+        return self.last_policy_command
 
     def reset(self, state: RobotState | None = None) -> None:
         self.last_action[:] = 0.0
@@ -116,7 +119,7 @@ class LocomotionPolicyTracker(Tracker):
             self._standing = False
 
     def act(self, reference: JointReference, state: RobotState) -> MotorCommand:
-        cmd = np.array([reference.root_linvel_b_mps[0], reference.root_linvel_b_mps[1], reference.root_angvel_b_radps[2]])
+        cmd = np.array([reference.root_linvel_h_mps[0], reference.root_linvel_h_mps[1], reference.root_angvel_h_radps[2]])
         cmd = self.corrector(cmd, self.velocity_estimate)
         cmd = np.clip(cmd, self._ranges[:, 0], self._ranges[:, 1])
         self.last_policy_command = cmd

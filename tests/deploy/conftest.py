@@ -14,8 +14,8 @@ def partition() -> str:
 @pytest.fixture
 def mock_robot(partition):
     """A robot emulator (MockG1 motors, built-in controller active) on lo, domain 1, in this process."""
-    from g1_control.hardware.emulator import RobotEmulator
-    from g1_control.hardware.mock_robot import MockG1
+    from g1_control.sim.emulator import RobotEmulator
+    from g1_control.sim.mock_robot import MockG1
 
     made = []
 

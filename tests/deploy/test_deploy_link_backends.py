@@ -24,10 +24,10 @@ BENCH = {"rates": {"lowlevel_hz": 50}, "backend": {"command_rate_hz": 100, "inte
 @pytest.fixture
 def can_robot():
     """A MockG1 behind the robot side of a virtual CAN FD bus, 200 Hz LowState_."""
-    from g1_control.hardware.can_link import CanLink
-    from g1_control.hardware.emulator import FaultyPhysics
-    from g1_control.hardware.mock_robot import MockG1
-    from g1_control.hardware.robot_endpoint import RobotEndpoint
+    from g1_control.hardware.links.can_bus import CanLink
+    from g1_control.sim.emulator import FaultyPhysics
+    from g1_control.sim.mock_robot import MockG1
+    from g1_control.sim.robot_endpoint import RobotEndpoint
 
     channel = f"deploy-{os.getpid()}-{uuid.uuid4().hex[:6]}"
     link = CanLink("robot", interface="virtual", channel=channel)
@@ -68,7 +68,7 @@ def test_missing_socketcan_interface_and_serial_port_are_refused(tmp_path):
 
 
 def test_serial_backend_opens_on_a_pty(tmp_path):
-    from g1_control.hardware.serial_link import open_pty_pair
+    from g1_control.hardware.links.serial_port import open_pty_pair
 
     tty_end, master_end = open_pty_pair()
     try:

@@ -127,7 +127,7 @@ def test_intermittent_bad_crcs_fail_the_stream_check(tmp_path, partition, mock_r
 
 
 def test_short_samples_are_refused(tmp_path, partition, mock_robot):
-    from g1_control.hardware.unitree_hg import LowState
+    from g1_control.hardware.unitree.messages import LowState
 
     robot = mock_robot()
     robot.endpoint.publish = False

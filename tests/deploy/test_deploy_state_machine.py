@@ -41,7 +41,7 @@ class Buttons(InputDevice):
     def __init__(self):
         self.next: frozenset[str] = frozenset()
 
-    def poll(self) -> Command:
+    def poll(self, now_s: float) -> Command:
         buttons, self.next = self.next, frozenset()
         return Command(buttons=buttons)
 
@@ -61,7 +61,7 @@ def _state(q=None) -> RobotState:
 
 def _press(device, buttons, *names):
     device.next = frozenset(names)
-    buttons.poll()
+    buttons.poll(0.0)
 
 
 def _act(tracker, clock, dt=0.02, state=None):
@@ -140,7 +140,7 @@ def test_run_is_ignored_before_start_and_during_the_ramp():
 def test_a_press_between_tracker_ticks_is_not_lost():
     tracker, clock, _, _, device, buttons = _machine()
     _press(device, buttons, "start")
-    buttons.poll()  # a second input poll in the same tracker tick, with nothing pressed
+    buttons.poll(0.0)  # a second input poll in the same tracker tick, with nothing pressed
     _act(tracker, clock)
     assert tracker.state == DeployState.RAMP
 
@@ -203,7 +203,7 @@ def test_unitree_remote_buttons_drive_the_machine():
     def tick(*held):
         samples.append(encode_wireless_remote(held))
         clock.t += 0.02
-        command = buttons.poll()
+        command = buttons.poll(clock.t)
         safety.vet_input(command, clock.t)
         tracker.act(JointReference(), _state())
 

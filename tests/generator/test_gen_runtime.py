@@ -66,12 +66,12 @@ def test_generator_walks_at_the_commanded_velocity_and_replans_on_change_and_low
     gen, state = _generator()
     assert isinstance(gen, Generator)
     ref = _run(gen, state, Command(vx_mps=0.5), 4.0)
-    assert ref.root_linvel_b_mps[0] == pytest.approx(0.5, abs=0.05)
+    assert ref.root_linvel_h_mps[0] == pytest.approx(0.5, abs=0.05)
     assert gen.stats.replan_reasons["command"] == 1 and gen.stats.replan_reasons["buffer"] >= 5
     x_before = ref.root_pos_w_m[0]
     ref = _run(gen, state, Command(wz_radps=0.6), 3.0, t0=4.0)
     assert gen.stats.replan_reasons["command"] == 2
-    assert ref.root_angvel_b_radps[2] == pytest.approx(0.6, abs=0.06)
+    assert ref.root_angvel_h_radps[2] == pytest.approx(0.6, abs=0.06)
     assert ref.root_pos_w_m[0] > x_before + 0.1  # coasted ~v * half-life / ln 2 = 0.18 m while stopping
 
 
@@ -137,7 +137,7 @@ def test_effector_goal_becomes_a_frame_target():
 
 
 def test_long_rollout_under_random_commands_stays_healthy():
-    from g1_control.generator.bench import long_rollout
+    from g1_control.tools.bench_generator import long_rollout
 
     gen = InbetweeningGenerator(InterpolationInbetweener(), _styles())
     result = long_rollout(gen, seconds=60.0)
@@ -148,7 +148,7 @@ def test_long_rollout_under_random_commands_stays_healthy():
 
 
 def test_effector_goals_are_reached_through_the_ik():
-    from g1_control.generator.bench import effector_goals_through_ik
+    from g1_control.tools.bench_generator import effector_goals_through_ik
 
     result = effector_goals_through_ik(lambda: InbetweeningGenerator(InterpolationInbetweener(), _styles()), goals=4)
     assert result["success"] == 1.0 and result["mean_m"] < 0.05

@@ -1,0 +1,417 @@
+"""Scripted whole-body references for the WBC's tests and figures.
+
+Each builder returns a WholeBodyTrajectory: root pose, joint angles and the contact schedule
+sampled in time, played back through cubic splines (so joint and root velocities are smooth and
+exact). Poses that must keep the feet planted or put a hand somewhere come from a small
+damped-least-squares whole-body IK (WholeBodyIK); stepping references take their CoM from ZMP
+preview control over a footstep plan (zmp_preview.py).
+
+    stand          the default pose, still
+    arm_wave       both arms swinging in antiphase (shoulder pitch +-0.6 rad, elbows, 0.5 Hz)
+    crouch         pelvis down 15 cm and back up, feet planted
+    lean_reach     right hand to a point 0.5 m ahead of the pelvis's start, leaning, and back
+    step_in_place  eight steps on the spot (5 cm foot lift)
+    walk           straight walk at 0.3 m/s
+
+In the loop: ControlLoop(backend, input, TrajectoryGenerator(traj), TrajectoryRetargeter(traj), tracker).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from g1_control.errors import WbcConfigError
+from g1_control.interfaces import Generator, Retargeter
+from g1_control.robot import g1
+from g1_control.types import Command, JointReference, KinematicReference, RobotState
+from g1_control.robot.dynamics import SOLE_FRAMES, build_model
+from g1_control.rotations import quat_to_rot, rotation_error, rot_to_rpy, rpy_to_quat, rpy_to_rot
+from g1_control.generator.zmp_preview import ZmpPreviewController
+
+
+
+
+
+
+
+
+def smoothstep(x: np.ndarray | float) -> np.ndarray:
+    """Quintic 0 -> 1 with zero velocity and acceleration at both ends."""
+    x = np.clip(x, 0.0, 1.0)
+    return x**3 * (10 - 15 * x + 6 * x * x)
+
+
+@dataclass
+class WholeBodyTrajectory:
+    """Samples of a whole-body reference; sample(t) interpolates with cubic splines."""
+
+    name: str
+    t_s: np.ndarray
+    root_pos_w_m: np.ndarray
+    root_rpy_rad: np.ndarray
+    q_rad: np.ndarray
+    contacts: np.ndarray
+    """(n, 2) bool per sample; held constant from one sample to the next."""
+    extras: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        from scipy.interpolate import CubicSpline
+
+        n = len(self.t_s)
+        shapes = {"root_pos_w_m": (n, 3), "root_rpy_rad": (n, 3), "q_rad": (n, g1.NUM_JOINTS), "contacts": (n, 2)}
+        for name, shape in shapes.items():
+            if getattr(self, name).shape != shape:
+                raise WbcConfigError(f"WholeBodyTrajectory.{name} has shape {getattr(self, name).shape}; expected {shape}")
+        if n < 2 or np.any(np.diff(self.t_s) <= 0):
+            raise WbcConfigError("WholeBodyTrajectory needs at least 2 samples at increasing times")
+        if not np.all(self.contacts.any(axis=1)):
+            raise WbcConfigError("WholeBodyTrajectory has samples with no foot in contact")
+        # One spline over all 35 columns (root xyz, root rpy, joints): two evaluations per sample.
+        self._spline = CubicSpline(self.t_s, np.hstack([self.root_pos_w_m, self.root_rpy_rad, self.q_rad]),
+                                   bc_type="clamped")
+        self._last: tuple[float, JointReference] | None = None
+
+    @property
+    def duration_s(self) -> float:
+        return float(self.t_s[-1])
+
+    def sample(self, t_s: float, out: JointReference | None = None) -> JointReference:
+        out = out or JointReference()
+        if self._last is not None and self._last[0] == t_s:  # generator and retargeter ask for the same tick
+            _copy_reference(self._last[1], out)
+            return out
+        t = float(np.clip(t_s, self.t_s[0], self.t_s[-1]))
+        x, dx = self._spline(t), self._spline(t, 1)
+        out.t_s = t_s
+        out.q_rad[:] = x[6:]
+        out.dq_radps[:] = dx[6:]
+        out.root_pos_w_m[:] = x[:3]
+        rpy, drpy = x[3:6], dx[3:6]
+        out.root_quat_wxyz[:] = rpy_to_quat(rpy)
+        vel_w = dx[:3]
+        c, s = np.cos(rpy[2]), np.sin(rpy[2])
+        out.root_linvel_h_mps[:] = (c * vel_w[0] + s * vel_w[1], -s * vel_w[0] + c * vel_w[1], vel_w[2])
+        # ZYX Euler rates -> world angular velocity -> heading frame
+        _, p, y = rpy
+        w_world = np.array([-np.sin(y) * drpy[1] + np.cos(y) * np.cos(p) * drpy[0],
+                            np.cos(y) * drpy[1] + np.sin(y) * np.cos(p) * drpy[0],
+                            drpy[2] - np.sin(p) * drpy[0]])
+        out.root_angvel_h_radps[:] = (c * w_world[0] + s * w_world[1], -s * w_world[0] + c * w_world[1], w_world[2])
+        k = int(np.searchsorted(self.t_s, t, side="right")) - 1
+        out.contacts[:] = self.contacts[min(max(k, 0), len(self.t_s) - 1)]
+        if self._last is None:
+            self._last = (t_s, JointReference())
+        self._last = (t_s, self._last[1])
+        _copy_reference(out, self._last[1])
+        return out
+
+
+def _copy_reference(src: JointReference, dst: JointReference) -> None:
+    dst.t_s = src.t_s
+    for name in ("q_rad", "dq_radps", "root_pos_w_m", "root_quat_wxyz", "root_linvel_h_mps", "root_angvel_h_radps",
+                 "contacts"):
+        getattr(dst, name)[:] = getattr(src, name)
+    dst.upper_body_override = src.upper_body_override
+
+
+class TrajectoryGenerator(Generator):
+    """Plays a trajectory as the generator stage (time from the robot state's clock)."""
+
+    def __init__(self, trajectory: WholeBodyTrajectory):
+        self.trajectory = trajectory
+        self._joint = JointReference()
+        self._ref = KinematicReference()
+        self._t0 = 0.0
+
+    def reset(self, state: RobotState) -> None:
+        self._t0 = state.t_s
+
+    def update(self, command: Command, state: RobotState) -> KinematicReference:
+        j = self.trajectory.sample(state.t_s - self._t0, self._joint)
+        ref = self._ref
+        ref.t_s = state.t_s - self._t0
+        ref.root_pos_w_m[:] = j.root_pos_w_m
+        ref.root_quat_wxyz[:] = j.root_quat_wxyz
+        ref.root_linvel_h_mps[:] = j.root_linvel_h_mps
+        ref.root_angvel_h_radps[:] = j.root_angvel_h_radps
+        ref.q_rad[:] = j.q_rad
+        ref.contacts[:] = j.contacts
+        return ref
+
+
+class TrajectoryRetargeter(Retargeter):
+    """The trajectory is feasible by construction: sample it (with exact joint velocities, which
+    a KinematicReference does not carry) at the generator's time."""
+
+    def __init__(self, trajectory: WholeBodyTrajectory):
+        self.trajectory = trajectory
+        self._out = JointReference()
+
+    def solve(self, reference: KinematicReference, q_prev: np.ndarray) -> JointReference:
+        return self.trajectory.sample(reference.t_s, self._out)
+
+
+LEG_LIGHT_POSTURE_WEIGHT = np.where(np.isin(np.arange(g1.NUM_JOINTS), g1.LEG_JOINTS), 0.002, 0.05)
+"""The legs are fixed by the feet and pelvis targets; a posture pull as strong as the upper body's
+would leave a 15 cm crouch 2 cm short."""
+
+
+# -- whole-body IK for the reference poses -------------------------------------------------------------------
+class WholeBodyIK:
+    """Damped least squares on the floating-base configuration: soles at their targets, CoM xy,
+    pelvis height and orientation, an optional hand point, posture as a weak regulariser."""
+
+    def __init__(self):
+        import pinocchio as pin
+
+        self.pin = pin
+        self.model = build_model()
+        self.data = self.model.createData()
+        self.sole_ids = [self.model.getFrameId(n) for n in SOLE_FRAMES]
+        self.pelvis_id = self.model.getFrameId(g1.BASE_BODY)
+
+    def nominal(self) -> np.ndarray:
+        """Default pose with the soles flat on z = 0 and the pelvis above the origin."""
+        q = np.concatenate([[0, 0, 0, 0, 0, 0, 1.0], g1.DEFAULT_Q_RAD])
+        self.pin.framesForwardKinematics(self.model, self.data, q)
+        q[2] = -self.data.oMf[self.sole_ids[0]].translation[2]
+        return q
+
+    def frame_pose(self, q: np.ndarray, name: str) -> tuple[np.ndarray, np.ndarray]:
+        self.pin.framesForwardKinematics(self.model, self.data, q)
+        placement = self.data.oMf[self.model.getFrameId(name)]
+        return placement.translation.copy(), placement.rotation.copy()
+
+    def com(self, q: np.ndarray) -> np.ndarray:
+        return self.pin.centerOfMass(self.model, self.data, q).copy()
+
+    def solve(self, q0: np.ndarray, soles: list[tuple[np.ndarray, np.ndarray]], com_xy: np.ndarray | None,
+              pelvis_z: float | None, pelvis_rot: np.ndarray, posture: np.ndarray, *,
+              hand: tuple[str, np.ndarray] | None = None, hand_weight: float = 10.0,
+              pelvis_rot_weight=(10.0, 10.0, 10.0),
+              posture_weight: np.ndarray | float | None = None, iterations: int = 30, tol: float = 1e-6) -> np.ndarray:
+        pin, m, d = self.pin, self.model, self.data
+        if posture_weight is None:
+            posture_weight = LEG_LIGHT_POSTURE_WEIGHT
+        q = q0.copy()
+        lwa = pin.LOCAL_WORLD_ALIGNED
+        nv = m.nv
+        for _ in range(iterations):
+            pin.computeJointJacobians(m, d, q)
+            pin.updateFramePlacements(m, d)
+            rows, errs, weights = [], [], []
+            for fid, (pos, rot) in zip(self.sole_ids, soles):
+                J = pin.getFrameJacobian(m, d, fid, lwa)
+                rows.append(J)
+                errs.append(np.concatenate([pos - d.oMf[fid].translation, rotation_error(rot, d.oMf[fid].rotation)]))
+                weights.append(np.full(6, 100.0))
+            Jp = pin.getFrameJacobian(m, d, self.pelvis_id, lwa)
+            rows.append(Jp[3:])
+            errs.append(rotation_error(pelvis_rot, d.oMf[self.pelvis_id].rotation))
+            weights.append(np.asarray(pelvis_rot_weight, dtype=float))
+            if pelvis_z is not None:
+                rows.append(Jp[2:3])
+                errs.append(np.array([pelvis_z - d.oMf[self.pelvis_id].translation[2]]))
+                weights.append(np.array([30.0]))
+            if com_xy is not None:
+                Jc = pin.jacobianCenterOfMass(m, d, q)
+                rows.append(Jc[:2])
+                errs.append(com_xy - d.com[0][:2])
+                weights.append(np.full(2, 30.0))
+            if hand is not None:
+                fid = m.getFrameId(hand[0])
+                rows.append(pin.getFrameJacobian(m, d, fid, lwa)[:3])
+                errs.append(hand[1] - d.oMf[fid].translation)
+                weights.append(np.full(3, hand_weight))
+            Jpost = np.zeros((g1.NUM_JOINTS, nv))
+            Jpost[:, 6:] = np.eye(g1.NUM_JOINTS)
+            rows.append(Jpost)
+            errs.append(posture - q[7:])
+            weights.append(np.broadcast_to(np.asarray(posture_weight, dtype=float), (g1.NUM_JOINTS,)))
+            J, e, w = np.vstack(rows), np.concatenate(errs), np.concatenate(weights)
+            H = J.T @ (J * w[:, None]) + 1e-6 * np.eye(nv)
+            dv = np.linalg.solve(H, J.T @ (w * e))
+            q = pin.integrate(m, q, dv)
+            q[7:] = np.clip(q[7:], g1.Q_MIN_RAD + 0.02, g1.Q_MAX_RAD - 0.02)
+            if np.abs(dv).max() < tol:
+                break
+        return q
+
+
+def _trajectory(name: str, t: np.ndarray, qs: np.ndarray, contacts: np.ndarray, **extras) -> WholeBodyTrajectory:
+    """From pinocchio configurations (n, 36) to a trajectory."""
+    rpy = np.zeros((len(t), 3))
+    for k, qk in enumerate(qs):
+        x, y, z, w = qk[3:7]
+        rpy[k] = rot_to_rpy(quat_to_rot(np.array([w, x, y, z])))
+    rpy[:, 2] = np.unwrap(rpy[:, 2])
+    return WholeBodyTrajectory(name, t, qs[:, :3].copy(), rpy, qs[:, 7:].copy(), contacts, dict(extras))
+
+
+
+
+# -- the references ------------------------------------------------------------------------------------------
+def stand(duration_s: float = 60.0) -> WholeBodyTrajectory:
+    q0 = WholeBodyIK().nominal()
+    t = np.array([0.0, duration_s])
+    return _trajectory("stand", t, np.array([q0, q0]), np.ones((2, 2), dtype=bool))
+
+
+def arm_wave(duration_s: float = 10.0, frequency_hz: float = 0.5, amplitude_rad: float = 0.6) -> WholeBodyTrajectory:
+    q0 = WholeBodyIK().nominal()
+    t = np.arange(0.0, duration_s + 1e-9, 0.01)
+    qs = np.repeat(q0[None], len(t), axis=0)
+    ramp = smoothstep(t / 1.0) * smoothstep((duration_s - t) / 1.0)
+    phase = 2 * np.pi * frequency_hz * t
+    j = g1.JOINT_INDEX
+    for side, sign in (("left", 1.0), ("right", -1.0)):
+        qs[:, 7 + j[f"{side}_shoulder_pitch_joint"]] += ramp * amplitude_rad * sign * np.sin(phase)
+        qs[:, 7 + j[f"{side}_elbow_joint"]] += ramp * 0.4 * sign * np.sin(phase + 0.5)
+        qs[:, 7 + j[f"{side}_shoulder_roll_joint"]] += ramp * 0.3 * (1 if side == "left" else -1) * (1 - np.cos(phase)) / 2
+    return _trajectory("arm_wave", t, qs, np.ones((len(t), 2), dtype=bool))
+
+
+def _planted_feet(ik: WholeBodyIK, q0: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    return [ik.frame_pose(q0, name) for name in SOLE_FRAMES]
+
+
+def crouch(depth_m: float = 0.15, down_s: float = 2.0, hold_s: float = 1.5) -> WholeBodyTrajectory:
+    ik = WholeBodyIK()
+    q0 = ik.nominal()
+    soles = _planted_feet(ik, q0)
+    com_xy = ik.com(q0)[:2]
+    t_events = np.cumsum([1.0, down_s, hold_s, down_s, hold_s])
+    t = np.arange(0.0, t_events[-1] + 1e-9, 0.02)
+    drop = depth_m * (smoothstep((t - t_events[0]) / down_s) - smoothstep((t - t_events[2]) / down_s))
+    qs, q = [], q0
+    for dz in drop:
+        q = ik.solve(q, soles, com_xy, q0[2] - dz, np.eye(3), g1.DEFAULT_Q_RAD, iterations=8)
+        qs.append(q)
+    return _trajectory("crouch", t, np.array(qs), np.ones((len(t), 2), dtype=bool), depth_m=depth_m)
+
+
+def lean_reach(ahead_m: float = 0.5, height_m: float = 0.8, side_m: float = -0.2,
+               reach_s: float = 2.5, hold_s: float = 2.0) -> WholeBodyTrajectory:
+    """Right hand to (ahead_m, side_m, height_m) in the start pelvis's ground frame, CoM kept over
+    the feet (the hips move back as the torso leans), then back to the default pose."""
+    ik = WholeBodyIK()
+    q0 = ik.nominal()
+    soles = _planted_feet(ik, q0)
+    com_xy = ik.com(q0)[:2]
+    hand0, _ = ik.frame_pose(q0, "right_hand")
+    target = np.array([ahead_m, side_m, height_m])
+    t_events = np.cumsum([1.0, reach_s, hold_s, reach_s, 1.0])
+    t = np.arange(0.0, t_events[-1] + 1e-9, 0.02)
+    s = smoothstep((t - t_events[0]) / reach_s) - smoothstep((t - t_events[2]) / reach_s)
+    qs, q = [], q0
+    for sk in s:
+        goal = hand0 + sk * (target - hand0)
+        q = ik.solve(q, soles, com_xy, None, np.eye(3), g1.DEFAULT_Q_RAD, hand=("right_hand", goal), hand_weight=100.0,
+                     pelvis_rot_weight=(10.0, 0.5, 10.0), posture_weight=0.05, iterations=10)
+        qs.append(q)
+    achieved, _ = ik.frame_pose(qs[int(np.argmax(s))], "right_hand")
+    return _trajectory("lean_reach", t, np.array(qs), np.ones((len(t), 2), dtype=bool), hand_target_w_m=target,
+                       hand_reference_w_m=achieved, hold_window_s=(float(t_events[1]), float(t_events[2])))
+
+
+def stepping(footsteps: list[tuple[int, np.ndarray]], *, single_support_s: float = 0.4,
+             double_support_s: float = 0.15, lift_m: float = 0.05, start_s: float = 1.0, end_s: float = 1.5,
+             pelvis_drop_m: float = 0.02, name: str = "stepping", dt_s: float = 0.01) -> WholeBodyTrajectory:
+    """Footsteps (foot index 0 left / 1 right, new sole xy) taken one after another; CoM from
+    ZMP preview control, ZMP on the stance sole during single support and moving linearly
+    between soles during double support."""
+    ik = WholeBodyIK()
+    q0 = ik.nominal()
+    soles0 = _planted_feet(ik, q0)
+    com0 = ik.com(q0)
+    offset_xy = com0[:2] - (soles0[0][0][:2] + soles0[1][0][:2]) / 2  # CoM over the feet, as standing
+    step_period = single_support_s + double_support_s
+    total = start_s + len(footsteps) * step_period + double_support_s + end_s
+    t = np.arange(0.0, total + 1e-9, dt_s)
+    n = len(t)
+    feet = np.zeros((n, 2, 3))
+    feet[:] = [soles0[0][0], soles0[1][0]]
+    contacts = np.ones((n, 2), dtype=bool)
+    zmp = np.zeros((n, 2))
+    current = [soles0[0][0].copy(), soles0[1][0].copy()]
+    zmp[:] = com0[:2]
+    prev_zmp = com0[:2].copy()
+    t0 = start_s
+    for swing, target_xy in footsteps:
+        stance = 1 - swing
+        stance_zmp = current[stance][:2] + offset_xy
+        ds = (t >= t0) & (t < t0 + double_support_s)
+        zmp[ds] = prev_zmp + ((t[ds] - t0) / double_support_s)[:, None] * (stance_zmp - prev_zmp)
+        ss = (t >= t0 + double_support_s) & (t < t0 + step_period)
+        zmp[ss] = stance_zmp
+        tau = (t[ss] - t0 - double_support_s) / single_support_s
+        start, goal = current[swing].copy(), np.array([target_xy[0], target_xy[1], current[swing][2]])
+        feet[ss, swing] = start + smoothstep(tau)[:, None] * (goal - start)
+        feet[ss, swing, 2] += lift_m * (1 - np.cos(2 * np.pi * tau)) / 2
+        contacts[ss, swing] = False
+        after = t >= t0 + step_period
+        feet[after, swing] = goal
+        current[swing] = goal
+        zmp[after] = stance_zmp
+        prev_zmp = stance_zmp
+        t0 += step_period
+    final_zmp = (current[0][:2] + current[1][:2]) / 2 + offset_xy
+    ds = t >= t0
+    zmp[ds] = prev_zmp + np.clip((t[ds] - t0) / double_support_s, 0, 1)[:, None] * (final_zmp - prev_zmp)
+    # The pelvis lowers during the initial stand, so the first sample is the nominal pose.
+    pelvis_z = q0[2] - pelvis_drop_m * smoothstep(t / start_s)
+    preview = ZmpPreviewController(dt_s, com0[2] - pelvis_drop_m)
+    com_xy, _, _ = preview.plan(zmp, com0[:2])
+    rot0 = soles0[0][1]
+    qs, q = [], q0
+    for k in range(n):
+        q = ik.solve(q, [(feet[k, 0], rot0), (feet[k, 1], rot0)], com_xy[k], pelvis_z[k], np.eye(3),
+                     g1.DEFAULT_Q_RAD, iterations=6 if k else 30)
+        qs.append(q)
+    return _trajectory(name, t, np.array(qs), contacts, zmp_ref_xy_m=zmp, com_plan_xy_m=com_xy,
+                       feet_w_m=feet)
+
+
+def step_in_place(n_steps: int = 8, **kw) -> WholeBodyTrajectory:
+    ik = WholeBodyIK()
+    q0 = ik.nominal()
+    soles = _planted_feet(ik, q0)
+    steps = [(k % 2, soles[k % 2][0][:2].copy()) for k in range(n_steps)]
+    return stepping(steps, name="step_in_place", **kw)
+
+
+def walk(speed_mps: float = 0.3, n_steps: int = 12, single_support_s: float = 0.4,
+         double_support_s: float = 0.15, **kw) -> WholeBodyTrajectory:
+    """Walk straight ahead at `speed_mps` (step length = speed x step period), then close the feet."""
+    ik = WholeBodyIK()
+    q0 = ik.nominal()
+    soles = _planted_feet(ik, q0)
+    step = speed_mps * (single_support_s + double_support_s)
+    steps = []
+    for k in range(n_steps):
+        foot = k % 2
+        x = soles[foot][0][0] + step * (k + 1)
+        steps.append((foot, np.array([x, soles[foot][0][1]])))
+    last = n_steps % 2  # bring the trailing foot alongside
+    steps.append((last, np.array([steps[-1][1][0], soles[last][0][1]])))
+    return stepping(steps, single_support_s=single_support_s, double_support_s=double_support_s,
+                    name="walk", **kw)
+
+
+REFERENCES: dict[str, Callable[[], WholeBodyTrajectory]] = {
+    "stand": stand,
+    "arm_wave": arm_wave,
+    "crouch": crouch,
+    "lean_reach": lean_reach,
+    "step_in_place": step_in_place,
+    "walk": walk,
+}
+
+
+def build_reference(name: str, **kw) -> WholeBodyTrajectory:
+    if name not in REFERENCES:
+        raise WbcConfigError(f"unknown WBC reference '{name}'; known: {', '.join(REFERENCES)}")
+    return REFERENCES[name](**kw)

@@ -1,0 +1,222 @@
+"""Backend over any robot link: the host side of the G1 low-level protocol.
+
+A writer thread resends the latest LowCmd_ at a fixed rate (500 Hz, as the robot expects a steady
+stream, whatever rate the controller runs at); a reader thread decodes every LowState_, checks its
+CRC and keeps the newest valid one. Every command carries a fresh CRC and echoes the mode_machine
+the robot reports. close() leaves a damping command streaming for a moment before the stream
+stops, so the last thing the robot heard is "damp".
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from g1_control.errors import (
+    CrcMismatchError,
+    InvalidCommandError,
+    MalformedMessageError,
+    RobotNotConnectedError,
+    VariantMismatchError,
+)
+from g1_control.hardware.unitree.conversions import lowstate_to_robot_state, motor_command_to_lowcmd, variant_of
+from g1_control.hardware.links.base import Link
+from g1_control.interfaces import Backend
+from g1_control.robot import g1
+from g1_control.types import MotorCommand, RobotState
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class LinkStats:
+    commands_sent: int
+    states_received: int
+    bad_crc: int
+    malformed: int
+    bad_frames: int
+    state_rate_hz: float
+    """Valid states per second over the last second."""
+    command_rate_hz: float
+    command_period_p99_s: float
+    last_state_age_s: float
+
+
+class LinkBackend(Backend):
+    """Wall-clock backend speaking LowCmd_/LowState_ over `link` (host side)."""
+
+    lockstep = False
+
+    def __init__(self, link: Link, *, command_rate_hz: float = 500.0, mode_pr: int = 0,
+                 expected_mode_machine: int | None = None, connect_timeout_s: float = 2.0,
+                 close_damping_s: float = 0.2, damping_kd: float = 2.0):
+        if link.side != "host":
+            raise ValueError("LinkBackend needs the host side of a link")
+        if not command_rate_hz > 0:
+            raise ValueError(f"command_rate_hz must be positive; got {command_rate_hz}")
+        if mode_pr not in (0, 1):
+            raise ValueError(f"mode_pr must be 0 or 1; got {mode_pr}")
+        self.link = link
+        self.command_period_s = 1.0 / command_rate_hz
+        self.mode_pr = mode_pr
+        self.expected_mode_machine = expected_mode_machine
+        self.connect_timeout_s = connect_timeout_s
+        self.close_damping_s = close_damping_s
+        self.damping_kd = damping_kd
+        self._lock = threading.Lock()
+        self._state: RobotState | None = None
+        self._state_event = threading.Event()
+        self._payload: bytes | None = None
+        self._bad_crc = 0
+        self._malformed = 0
+        self._received = 0
+        self._state_times: deque[float] = deque(maxlen=2000)
+        self._send_times: deque[float] = deque(maxlen=2000)
+        self._stop = threading.Event()
+        self._threads: list[threading.Thread] = []
+        self._closed = False
+        self._start()
+
+    # -- Backend ---------------------------------------------------------------------------------
+    def reset(self) -> RobotState:
+        """Wait for the first valid state (the robot must be talking before anything is sent)."""
+        state = self.wait_for_state(self.connect_timeout_s)
+        if self.expected_mode_machine is not None and state.mode_machine != self.expected_mode_machine:
+            want, got = variant_of(self.expected_mode_machine), variant_of(state.mode_machine)
+            raise VariantMismatchError(
+                f"the robot reports mode_machine {state.mode_machine} ({got.name}, {got.num_dof} DoF) but this "
+                f"setup expects {self.expected_mode_machine} ({want.name}); use a launch file and policy made "
+                "for this robot"
+            )
+        return state
+
+    def read_state(self) -> RobotState:
+        with self._lock:
+            state = self._state
+        if state is None:
+            raise RobotNotConnectedError(self._no_state_message(None))
+        return state
+
+    def write_command(self, command: MotorCommand) -> None:
+        state = self.read_state()  # mode_machine must be known before anything goes out
+        if not command.is_finite():
+            self.damp()
+            raise InvalidCommandError("MotorCommand contains NaN or inf; the robot was switched to damping")
+        for name in ("q_rad", "dq_radps", "kp", "kd", "tau_nm", "enable"):
+            if np.shape(getattr(command, name)) != (g1.NUM_JOINTS,):
+                raise InvalidCommandError(
+                    f"MotorCommand.{name} has shape {np.shape(getattr(command, name))}; expected ({g1.NUM_JOINTS},)")
+        msg = motor_command_to_lowcmd(command, mode_machine=state.mode_machine, mode_pr=self.mode_pr)
+        payload = self.link.encode(msg)
+        with self._lock:
+            self._payload = payload
+
+    def damp(self) -> None:
+        """Switch the stream to damping (kp 0, kd > 0) at once; needs a known mode_machine."""
+        with self._lock:
+            state = self._state
+        if state is None:
+            return  # nothing was ever sent; the robot is not under our control
+        msg = motor_command_to_lowcmd(MotorCommand.damping(self.damping_kd), state.mode_machine, self.mode_pr)
+        payload = self.link.encode(msg)
+        with self._lock:
+            self._payload = payload
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            if self._payload is not None:
+                self.damp()
+                time.sleep(self.close_damping_s)
+        finally:
+            self._stop.set()
+            for thread in self._threads:
+                thread.join(timeout=2.0)
+            self.link.close()
+
+    # -- extras ----------------------------------------------------------------------------------
+    @property
+    def bad_crc(self) -> int:
+        """Running count of states dropped for a bad CRC (the safety layer watches its bursts)."""
+        with self._lock:
+            return self._bad_crc
+
+    def wait_for_state(self, timeout_s: float) -> RobotState:
+        if not self._state_event.wait(timeout_s):
+            raise RobotNotConnectedError(self._no_state_message(timeout_s))
+        return self.read_state()
+
+    def stats(self) -> LinkStats:
+        now = time.monotonic()
+        with self._lock:
+            state_times = [t for t in self._state_times if now - t <= 1.0]
+            sends = np.array(self._send_times)
+            last = self._state.t_s if self._state is not None else float("nan")
+            bad_crc, malformed, received = self._bad_crc, self._malformed, self._received
+        recent = sends[sends >= now - 1.0] if sends.size else sends
+        periods = np.diff(sends) if sends.size > 1 else np.array([float("nan")])
+        return LinkStats(
+            commands_sent=self.link.counters.sent, states_received=received, bad_crc=bad_crc,
+            malformed=malformed, bad_frames=self.link.counters.bad_frames,
+            state_rate_hz=float(len(state_times)), command_rate_hz=float(recent.size),
+            command_period_p99_s=float(np.percentile(periods, 99)), last_state_age_s=now - last,
+        )
+
+    # -- threads ---------------------------------------------------------------------------------
+    def _start(self) -> None:
+        for target, name in ((self._read_loop, "lowstate-reader"), (self._write_loop, "lowcmd-writer")):
+            thread = threading.Thread(target=target, name=name, daemon=True)
+            thread.start()
+            self._threads.append(thread)
+
+    def _read_loop(self) -> None:
+        while not self._stop.is_set():
+            for payload in self.link.receive(0.05):
+                try:
+                    msg = self.link.decode_state(payload)
+                except CrcMismatchError:
+                    with self._lock:
+                        self._bad_crc += 1
+                    continue
+                except MalformedMessageError:
+                    with self._lock:
+                        self._malformed += 1
+                    continue
+                now = time.monotonic()
+                state = lowstate_to_robot_state(msg, now)
+                with self._lock:
+                    self._state = state
+                    self._received += 1
+                    self._state_times.append(now)
+                self._state_event.set()
+
+    def _write_loop(self) -> None:
+        next_t = time.monotonic()
+        while not self._stop.is_set():
+            with self._lock:
+                payload = self._payload
+            if payload is not None:
+                self.link.send(payload)
+                with self._lock:
+                    self._send_times.append(time.monotonic())
+            next_t += self.command_period_s
+            delay = next_t - time.monotonic()
+            if delay > 0:
+                self._stop.wait(delay)
+            elif delay < -0.1:
+                next_t = time.monotonic()  # fell far behind (host stalled): restart the schedule
+
+    def _no_state_message(self, timeout_s: float | None) -> str:
+        waited = f" within {timeout_s:.1f} s" if timeout_s is not None else " yet"
+        with self._lock:
+            bad = f" ({self._bad_crc} samples had a bad CRC, {self._malformed} were malformed)" \
+                if self._bad_crc or self._malformed else ""
+        return (f"no valid LowState from the robot{waited} on {self.link.describe()}{bad}; check that the robot "
+                "is on and cabled to this interface (or that `g1 sim-robot` runs on the same interface and domain)")

@@ -1,0 +1,147 @@
+"""The G1's DDS link on Cyclone DDS 0.10.2: rt/lowcmd (host -> robot), rt/lowstate (robot -> host).
+
+Samples are encoded by the numpy codecs in unitree_hg.py (~10 us) and handed to Cyclone as bytes
+through the binding's C layer, instead of through IdlStruct.serialize (~170 us per LowCmd, ~370 us
+per LowState to decode in pure Python); the topics are still registered with the IdlStruct types
+of unitree_idl.py so that discovery and type matching with the robot are unchanged.
+
+One process holds one Cyclone domain per domain id, configured here with the named interface
+only. On loopback, which has no multicast, peers are found by unicast to 127.0.0.1 with automatic
+participant indices (ports 7400 + 250 * domain + 10 + 2 * index).
+"""
+
+from __future__ import annotations
+
+import threading
+from xml.sax.saxutils import quoteattr
+
+from g1_control.errors import TransportError
+from g1_control.hardware.links.base import Link, Side
+from g1_control.hardware.links.network import LOOPBACK, check_interface
+from g1_control.hardware.unitree.messages import LOWCMD_TOPIC, LOWSTATE_TOPIC
+
+MAX_LOOPBACK_PARTICIPANTS = 32
+"""Automatic participant indices on loopback (Cyclone's default, 9, allows only ~10 processes)."""
+
+_domains: dict[int, tuple[str, object]] = {}
+_domains_lock = threading.Lock()
+
+
+def import_cyclonedds():
+    try:
+        import cyclonedds  # noqa: F401
+        from cyclonedds import _clayer  # noqa: F401
+        from cyclonedds.domain import Domain  # noqa: F401
+    except ImportError as exc:
+        raise TransportError(
+            f"the DDS transport needs the cyclonedds 0.10.2 Python binding ({exc}); "
+            "install it with scripts/install_cyclonedds.sh"
+        ) from None
+
+
+def cyclone_config(interface: str) -> str:
+    """Cyclone DDS XML confining the domain to `interface` (unicast discovery on loopback)."""
+    if interface == LOOPBACK:
+        discovery = (
+            "<Discovery><ParticipantIndex>auto</ParticipantIndex>"
+            f"<MaxAutoParticipantIndex>{MAX_LOOPBACK_PARTICIPANTS}</MaxAutoParticipantIndex>"
+            '<Peers><Peer address="127.0.0.1"/></Peers></Discovery>'
+        )
+        multicast = "<AllowMulticast>false</AllowMulticast>"
+    else:
+        discovery, multicast = "", ""
+    return (
+        '<CycloneDDS xmlns="https://cdds.io/config"><Domain id="any"><General><Interfaces>'
+        f'<NetworkInterface name={quoteattr(interface)} priority="default" multicast="default"/>'
+        f"</Interfaces>{multicast}</General>{discovery}</Domain></CycloneDDS>"
+    )
+
+
+def domain_participant(interface: str, domain_id: int):
+    """A participant on `domain_id` bound to `interface` (one domain configuration per process)."""
+    import_cyclonedds()
+    from cyclonedds.domain import Domain, DomainParticipant
+
+    check_interface(interface)
+    if not 0 <= int(domain_id) <= 232:
+        raise TransportError(f"DDS domain id must be 0..232; got {domain_id} (the robot uses 0, simulation 1)")
+    with _domains_lock:
+        if domain_id in _domains:
+            bound, _ = _domains[domain_id]
+            if bound != interface:
+                raise TransportError(
+                    f"DDS domain {domain_id} is already bound to interface '{bound}' in this process; "
+                    f"cannot also bind it to '{interface}'"
+                )
+        else:
+            _domains[domain_id] = (interface, Domain(domain_id, cyclone_config(interface)))
+    return DomainParticipant(domain_id)
+
+
+class DdsLink(Link):
+    """One side of the G1 low-level DDS stream."""
+
+    wire = "dds"
+
+    def __init__(self, side: Side, interface: str, domain_id: int = 0, partition: str | None = None,
+                 history_depth: int = 32):
+        super().__init__(side)
+        self.interface, self.domain_id, self.partition = interface, int(domain_id), partition
+        participant = domain_participant(interface, self.domain_id)
+        from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState, WaitSet
+        from cyclonedds.pub import DataWriter, Publisher
+        from cyclonedds.qos import Policy, Qos
+        from cyclonedds.sub import DataReader, Subscriber
+        from cyclonedds.topic import Topic
+
+        from g1_control.hardware.unitree import idl as unitree_idl
+
+        cmd_topic = Topic(participant, LOWCMD_TOPIC, unitree_idl.LowCmd_)
+        state_topic = Topic(participant, LOWSTATE_TOPIC, unitree_idl.LowState_)
+        out_topic, in_topic = (cmd_topic, state_topic) if side == "host" else (state_topic, cmd_topic)
+        # A partition isolates concurrent test runs that share loopback and domain 1 on one host;
+        # the robot itself publishes in the default partition, so real use passes None.
+        group_qos = Qos(Policy.Partition([partition])) if partition else None
+        self._participant = participant
+        self._writer = DataWriter(Publisher(participant, qos=group_qos), out_topic)
+        self._reader = DataReader(
+            Subscriber(participant, qos=group_qos), in_topic,
+            qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(history_depth)),
+        )
+        self._waitset = WaitSet(participant)
+        self._condition = ReadCondition(self._reader, SampleState.Any | ViewState.Any | InstanceState.Any)
+        self._waitset.attach(self._condition)
+        self._depth = history_depth
+        from cyclonedds._clayer import ddspy_take, ddspy_write
+
+        self._write, self._take = ddspy_write, ddspy_take
+        self._closed = False
+
+    def describe(self) -> str:
+        where = f"interface {self.interface}, domain {self.domain_id}"
+        return f"DDS ({where}{', partition ' + self.partition if self.partition else ''})"
+
+    def send(self, payload: bytes) -> None:
+        ret = self._write(self._writer._ref, payload)
+        if ret < 0:
+            raise TransportError(f"DDS write on {self.describe()} failed with code {ret}")
+        self._count("sent")
+
+    def receive(self, timeout_s: float) -> list[bytes]:
+        samples = self._take(self._reader._ref, self._depth)
+        if isinstance(samples, int) or not samples:
+            self._waitset.wait(int(timeout_s * 1e9))
+            samples = self._take(self._reader._ref, self._depth)
+            if isinstance(samples, int):
+                return []
+        payloads = [data for data, info in samples if info.valid_data]
+        self._count("received", len(payloads))
+        return payloads
+
+    def close(self) -> None:
+        # Entities are reclaimed with the participant; dropping our references is enough, and the
+        # domain (with its interface binding) stays for the rest of the process.
+        if not self._closed:
+            self._closed = True
+            self._waitset.detach(self._condition)
+            del self._writer, self._reader, self._condition, self._waitset, self._participant

@@ -1,0 +1,142 @@
+"""The one place a ControlLoop is assembled from a launch file.
+
+    loop = build_loop(launch)                                   # g1 launch: MuJoCo + the launch file's input
+    loop = build_loop(launch, backend=robot, input_device=remote,
+                      wrap_tracker=deploy_state_machine)        # g1 deploy: the robot link
+    loop = build_loop(dry_run_launch(launch))                   # the deploy preflight's dry run
+
+`g1 launch`, `g1 deploy`, the preflight's dry run, the motion library's physics rollouts and the
+WBC evaluation all call `build_loop`: the generator -> retargeter -> tracker chain, the rates, the
+safety filter and the estimator come from the launch file alone. Only the backend (MuJoCo or a
+robot link) and the input device may be handed in, and on the robot the deploy state machine
+wraps the tracker. `loop.chain` names the stages, so a deploy can show that its dry run ran the
+same chain as the robot (g1_control/deploy/session.py).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+
+from g1_control.errors import LaunchFileError
+from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, Tracker
+from g1_control.launch.schema import LaunchFile
+from g1_control.loop.control_loop import ControlLoop
+from g1_control.safety import SafetyConfig, SafetyFilter
+from g1_control.teleop.scripted import Segment, random_timeline
+
+CHAIN_STAGES = ("generator", "retargeter", "tracker", "rates", "safety")
+"""The parts of `loop.chain` that must be the same in a deploy's dry run and on the robot."""
+
+
+def safety_config(launch: LaunchFile) -> SafetyConfig:
+    """The launch file's safety section, with limits.max_tilt_rad as a further cap on the tilt."""
+    return dataclasses.replace(launch.safety, max_tilt_rad=min(launch.safety.max_tilt_rad,
+                                                               launch.limits.max_tilt_rad))
+
+
+def timeline_of(launch: LaunchFile) -> list[Segment]:
+    """The command timeline when it is known in advance (scripted or random), else []."""
+    if launch.input.type == "random":
+        return random_timeline(launch.input.random, launch.total_duration_s)
+    if launch.input.type == "scripted":
+        return list(launch.input.timeline)
+    return []
+
+
+def make_tracker(launch: LaunchFile) -> Tracker:
+    cfg = launch.tracker
+    if cfg.type == "policy":
+        from g1_control.trackers.locomotion import LocomotionPolicyTracker, VelocityCorrectionConfig
+        from g1_control.trackers.policy_spec import load_spec
+
+        return LocomotionPolicyTracker(load_spec(cfg.policy), VelocityCorrectionConfig(enabled=cfg.velocity_correction))
+    if cfg.type == "wbc":
+        from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
+
+        return WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz))
+    if cfg.type == "wbt":
+        from g1_control.trackers.wbt import WbtPolicyTracker
+
+        return WbtPolicyTracker()
+    raise LaunchFileError(f"tracker.type: unknown tracker '{cfg.type}'")
+
+
+def make_generator(launch: LaunchFile) -> tuple[Generator, Retargeter]:
+    cfg = launch.generator
+    if cfg.type == "scripted":
+        from g1_control.generator.scripted import TrajectoryGenerator, TrajectoryRetargeter, build_reference
+
+        trajectory = build_reference(cfg.reference, **cfg.reference_params)
+        return TrajectoryGenerator(trajectory), TrajectoryRetargeter(trajectory)
+    from g1_control.generator.factory import make_generator as make_named
+
+    return make_named(cfg.type, model=cfg.model or None, limits=launch.limits)
+
+
+def command_ranges(tracker: Tracker) -> dict | None:
+    """The walking policy's command ranges (what teleop sticks scale to), when the tracker has them."""
+    spec = getattr(tracker, "spec", None)
+    return spec.command_ranges if spec is not None else None
+
+
+def make_sim_backend(launch: LaunchFile) -> Backend:
+    if launch.backend.type != "mujoco":
+        raise LaunchFileError(f"launch file '{launch.name}' drives a robot (backend.type {launch.backend.type}); "
+                              "run it with `g1 deploy`, which checks the robot before anything moves")
+    from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
+
+    return MujocoBackend(MujocoConfig(physics_dt_s=launch.backend.physics_dt_s, lockstep=True))
+
+
+def describe_chain(launch: LaunchFile, generator: Generator, retargeter: Retargeter, tracker: Tracker) -> dict[str, str]:
+    g, t, r = launch.generator, launch.tracker, launch.rates
+    what_generator = g.type + (f" {g.model}" if g.model else "") + (
+        f" {g.reference} {g.reference_params}" if g.type == "scripted" else "")
+    what_tracker = t.type + (f" {t.policy} (velocity correction {'on' if t.velocity_correction else 'off'})"
+                             if t.type == "policy" else "")
+    s = safety_config(launch)
+    return {
+        "generator": f"{type(generator).__name__} [{what_generator}]",
+        "retargeter": type(retargeter).__name__,
+        "tracker": f"{type(tracker).__name__} [{what_tracker}]",
+        "rates": f"tracker {r.tracker_hz:g} Hz, input {r.input_hz:g} Hz, estimator {r.estimator_hz:g} Hz, "
+                 f"low-level {r.lowlevel_hz:g} Hz",
+        "safety": f"tilt {s.max_tilt_rad:g} rad, stale state {s.stale_state_s:g} s",
+    }
+
+
+def build_loop(launch: LaunchFile, *, backend: Backend | None = None, input_device: InputDevice | None = None,
+               wrap_tracker: Callable[[Tracker, SafetyFilter], Tracker] | None = None, wallclock: bool | None = None,
+               log_capacity: int | None = None) -> ControlLoop:
+    """The loop `launch` describes.
+
+    backend: the robot link (g1 deploy); default: MuJoCo in lockstep. input_device: default: the
+    launch file's input section. wrap_tracker(tracker, safety): g1 deploy's state machine around the
+    tracker (it is given the loop's safety filter, whose trips it follows).
+    wallclock: default: the launch file's backend.mode (a robot link always runs on the wall clock).
+    """
+    from g1_control.launch.inputs import make_input
+
+    tracker = make_tracker(launch)
+    generator, retargeter = make_generator(launch)
+    chain = describe_chain(launch, generator, retargeter, tracker)
+    if backend is None:
+        backend = make_sim_backend(launch)
+    if input_device is None:
+        input_device = make_input(launch, timeline_of(launch), command_ranges=command_ranges(tracker),
+                                  state_source=backend.read_state)
+    safety = SafetyFilter(safety_config(launch))
+    if wrap_tracker is not None:
+        tracker = wrap_tracker(tracker, safety)
+        chain["wrapper"] = type(tracker).__name__
+    if wallclock is None:
+        wallclock = launch.backend.mode == "wallclock" or not backend.lockstep
+    r = launch.rates
+    capacity = log_capacity if log_capacity is not None else int(launch.total_duration_s * r.tracker_hz) + 2
+    loop = ControlLoop(backend, input_device, generator, retargeter, tracker, r, wallclock=wallclock,
+                       safety=safety, log_capacity=capacity)
+    chain["input"] = type(input_device).__name__
+    chain["backend"] = backend.describe()
+    loop.chain = chain
+    return loop

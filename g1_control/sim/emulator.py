@@ -1,0 +1,299 @@
+"""The robot emulator behind `g1 sim-robot`: a physics backend (MuJoCo, or MockG1) speaking the
+G1's DDS protocol, so the unchanged robot path can run against simulation (sim2sim).
+
+It behaves like the robot where the host can tell: LowState_ at 500 Hz with CRC and tick; LowCmd_
+with a bad CRC or a foreign mode_machine dropped; motor enable honoured; a motion service whose
+built-in controller holds the robot standing and ignores rt/lowcmd until it is released, after
+which the motors damp until the host's first command. Faults can be injected by name (for the
+fault-injection suite), from code or, in `--control-stdin` mode, one per input line.
+
+Loopback only: the emulator refuses any interface but `lo` (no robot traffic off this host).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import threading
+import time
+
+import numpy as np
+
+from g1_control.errors import NetworkInterfaceError
+from g1_control.hardware.links.dds import DdsLink
+from g1_control.hardware.unitree.motion_service import MotionServiceEmulator
+from g1_control.hardware.links.network import LOOPBACK
+from g1_control.sim.robot_endpoint import RobotEndpoint
+from g1_control.interfaces import Backend
+from g1_control.robot import g1
+from g1_control.hardware.unitree.remote import encode_wireless_remote
+from g1_control.types import MotorCommand, RobotState
+
+FAULTS = {
+    "state_stops": "LowState_ stops (robot side silent)",
+    "state_frozen": "LowState_ keeps arriving with the same contents and tick",
+    "crc_corrupted": "every LowState_ carries a wrong CRC",
+    "tilt": "pelvis tilted 1.3 rad (fall)",
+    "overspeed": "left knee reports 30 rad/s",
+    "over_temperature": "waist yaw motor reports 110 degC",
+    "clear": "remove every injected fault",
+}
+REMOTE_COMMANDS = {
+    "press B1[+B2...]": "press remote buttons for 0.15 s (e.g. press start, press A, press L1+R1)",
+    "hold B1[+B2...]": "hold remote buttons down ('hold' alone releases them)",
+    "stick NAME VALUE": "set a remote stick: lx, ly (forward +), rx, ry, l2 in [-1, 1]",
+}
+REMOTE_PRESS_S = 0.15
+
+
+class FaultyPhysics(Backend):
+    """Wraps the physics to corrupt what the robot reports (sensor-side faults)."""
+
+    def __init__(self, inner: Backend):
+        self.inner = inner
+        self.lockstep = inner.lockstep
+        self.tilt_rad = 0.0
+        self.overspeed_joint: int | None = None
+        self.hot_joint: int | None = None
+        # The operator's Unitree remote, as the robot reports it inside LowState_ (press/stick).
+        self.remote_held: frozenset[str] = frozenset()
+        self.remote_pressed: frozenset[str] = frozenset()
+        self.remote_pressed_until = 0.0
+        self.remote_sticks = {"lx": 0.0, "rx": 0.0, "ry": 0.0, "l2": 0.0, "ly": 0.0}
+
+    def reset(self) -> RobotState:
+        return self.inner.reset()
+
+    def read_state(self) -> RobotState:
+        state = self.inner.read_state()
+        held = self.remote_held | (self.remote_pressed if time.monotonic() < self.remote_pressed_until else frozenset())
+        state.wireless_remote = encode_wireless_remote(held, **self.remote_sticks)
+        if self.tilt_rad:
+            half = self.tilt_rad / 2
+            state.imu_quat_wxyz = np.array([np.cos(half), np.sin(half), 0.0, 0.0])
+        if self.overspeed_joint is not None:
+            state.dq_radps[self.overspeed_joint] = 30.0
+        if self.hot_joint is not None:
+            state.motor_temperature_c[self.hot_joint] = 110.0
+        return state
+
+    def write_command(self, command: MotorCommand) -> None:
+        self.inner.write_command(command)
+
+    def step(self, dt_s: float) -> None:
+        self.inner.step(dt_s)
+
+    def close(self) -> None:
+        self.inner.close()
+
+
+class Gantry(Backend):
+    """A gantry for the MuJoCo G1, like the frame a real G1 hangs from on its first runs (and
+    unitree_mujoco's elastic band): spring-dampers on the pelvis position (pulling up, never
+    pushing) and on its roll/pitch, anchored at the reset pose, so a robot whose controller is
+    still being tried does not fall. Yaw stays free. Needs MujocoBackend (its push() for the force,
+    its MjData for the torque, which push() leaves alone)."""
+
+    def __init__(self, inner: Backend, stiffness_npm: float = 3000.0, damping_nspm: float = 400.0,
+                 rot_stiffness_nmprad: float = 800.0, rot_damping_nmsprad: float = 80.0,
+                 mass_kg: float = 35.0, physics_dt_s: float = 0.002, lower_on_policy: bool = False,
+                 held_before_policy_s: float = 0.3):
+        """lower_on_policy: take the gantry away when the policy takes over, as the operator lowers
+        the robot onto its feet: when stiff leg targets that were held still for at least
+        `held_before_policy_s` (the deploy's hold) start to move (the policy's first actions). A
+        plain PD hold on the floor falls (FACTS.md), so the gantry must carry the robot until then."""
+        from g1_control.sim.mujoco_backend import MujocoBackend
+
+        if not isinstance(inner, MujocoBackend):
+            raise TypeError(f"{type(inner).__name__} cannot take external forces; the gantry needs MujocoBackend")
+        self.inner, self.lockstep = inner, inner.lockstep
+        self.k, self.c, self.k_rot, self.c_rot = stiffness_npm, damping_nspm, rot_stiffness_nmprad, rot_damping_nmsprad
+        self.weight_n = mass_kg * 9.81
+        self.dt = physics_dt_s
+        self.anchor = np.zeros(3)
+        self._pelvis = inner.model.body(g1.BASE_BODY).id
+        self.lower_on_policy = lower_on_policy
+        self.held_before_policy_s = held_before_policy_s
+        self.lowered = False
+        self.lowered_at_s = float("nan")
+        """time.monotonic() when the gantry was lowered."""
+        self.lowered_base_pos_m: np.ndarray | None = None
+        self._held_q: np.ndarray | None = None
+        self._held_since_s = 0.0
+
+    def reset(self) -> RobotState:
+        state = self.inner.reset()
+        self.anchor = state.base_pos_w_m.copy()
+        return state
+
+    def read_state(self) -> RobotState:
+        return self.inner.read_state()
+
+    def write_command(self, command: MotorCommand) -> None:
+        if self.lower_on_policy and not self.lowered:
+            self._watch_for_policy(command)
+        self.inner.write_command(command)
+
+    def _watch_for_policy(self, command: MotorCommand) -> None:
+        legs = list(g1.LEG_JOINTS)
+        now = time.monotonic()
+        stiff = bool(np.all(command.enable[legs]) and np.all(command.kp[legs] > 0))
+        q = command.q_rad[legs]
+        if not stiff:
+            self._held_q = None
+            return
+        if self._held_q is None or np.max(np.abs(q - self._held_q)) > 1e-4:
+            if self._held_q is not None and now - self._held_since_s >= self.held_before_policy_s:
+                self.lowered, self.lowered_at_s = True, now
+                self.lowered_base_pos_m = self.inner.data.qpos[0:3].copy()
+                self.inner.data.xfrc_applied[self._pelvis, 3:] = 0.0
+            self._held_q, self._held_since_s = q.copy(), now
+
+    def step(self, dt_s: float) -> None:
+        if self.lowered:
+            self.inner.step(dt_s)
+            return
+        d = self.inner.data
+        for _ in range(max(1, round(dt_s / self.dt))):
+            force = self.k * (self.anchor - d.qpos[0:3]) - self.c * d.qvel[0:3]
+            force[2] = max(0.0, force[2] + self.weight_n * 0.9)  # a band pulls, never pushes
+            self.inner.push(force, self.dt)
+            # Roll/pitch spring: the body z axis is pulled back to world up (torque ~ z_body x up).
+            rot = d.xmat[self._pelvis].reshape(3, 3)
+            z_body = rot[:, 2]
+            omega_w = rot @ d.qvel[3:6]  # free-joint angular velocity is in the body frame
+            torque = self.k_rot * np.cross(z_body, [0.0, 0.0, 1.0])
+            torque[:2] -= self.c_rot * omega_w[:2]
+            d.xfrc_applied[self._pelvis, 3:] = torque
+            self.inner.step(self.dt)
+
+    def close(self) -> None:
+        self.inner.data.xfrc_applied[self._pelvis, 3:] = 0.0
+        self.inner.close()
+
+
+class RobotEmulator:
+    def __init__(self, physics: Backend, interface: str = LOOPBACK, domain_id: int = 1,
+                 partition: str | None = None, rate_hz: float = 500.0, builtin_mode: str = "ai"):
+        if interface != LOOPBACK:
+            raise NetworkInterfaceError(
+                f"the robot emulator runs on loopback only (interface '{LOOPBACK}'); got '{interface}'. "
+                "Point the host at the emulator with the same interface and domain")
+        self.physics = FaultyPhysics(physics)
+        self.state0 = self.physics.reset()
+        self.link = DdsLink("robot", interface, domain_id, partition=partition)
+        self.endpoint = RobotEndpoint(self.link, self.physics, rate_hz=rate_hz)
+        # Until released, the built-in controller "holds" the robot: physics paused at the standing
+        # pose, host commands ignored. Released with no host command yet, the motors damp, as in
+        # the remote's debug mode.
+        self.endpoint.builtin_active = bool(builtin_mode)
+        if not builtin_mode:
+            self.physics.write_command(MotorCommand.damping(g1.KD_DEFAULT))
+        self.service = MotionServiceEmulator(self.link._participant, partition, active_mode=builtin_mode,
+                                             on_change=self._on_mode_change)
+        self._lock = threading.Lock()
+
+    def _on_mode_change(self, mode: str) -> None:
+        self.endpoint.builtin_active = bool(mode)
+        if not mode and self.endpoint.last_command is None:
+            self.physics.write_command(MotorCommand.damping(g1.KD_DEFAULT))
+
+    def remote(self, line: str) -> float:
+        """Operate the emulated Unitree remote (see REMOTE_COMMANDS); return the time.monotonic()."""
+        from g1_control.hardware.unitree.remote import REMOTE_BUTTON_BITS
+
+        words = line.split()
+        p = self.physics
+        if words[0] in ("press", "hold"):
+            buttons = frozenset(b for w in words[1:] for b in w.split("+"))
+            unknown = buttons - set(REMOTE_BUTTON_BITS)
+            if unknown:
+                raise ValueError(f"unknown remote buttons {sorted(unknown)}; known: {', '.join(REMOTE_BUTTON_BITS)}")
+            if words[0] == "hold":
+                p.remote_held = buttons
+            else:
+                p.remote_pressed, p.remote_pressed_until = buttons, time.monotonic() + REMOTE_PRESS_S
+        elif words[0] == "stick" and len(words) == 3 and words[1] in p.remote_sticks:
+            value = float(words[2])
+            if not -1.0 <= value <= 1.0:
+                raise ValueError(f"stick value {value} is outside [-1, 1]")
+            p.remote_sticks[words[1]] = value
+        else:
+            raise ValueError(f"cannot read remote command '{line}'; known: {'; '.join(REMOTE_COMMANDS)}")
+        return time.monotonic()
+
+    def inject(self, fault: str) -> float:
+        """Apply fault `fault` (see FAULTS); return the time.monotonic() it took effect."""
+        if fault not in FAULTS:
+            raise ValueError(f"unknown fault '{fault}'; known: {', '.join(FAULTS)}")
+        e, p = self.endpoint, self.physics
+        if fault == "clear":
+            e.mark_faults_clear()
+            p.tilt_rad, p.overspeed_joint, p.hot_joint = 0.0, None, None
+        elif fault == "state_stops":
+            e.publish = False
+        elif fault == "state_frozen":
+            e.freeze_state = True
+        elif fault == "crc_corrupted":
+            e.corrupt_state_crc = True
+        elif fault == "tilt":
+            p.tilt_rad = 1.3
+        elif fault == "overspeed":
+            p.overspeed_joint = g1.JOINT_INDEX["left_knee_joint"]
+        elif fault == "over_temperature":
+            p.hot_joint = g1.JOINT_INDEX["waist_yaw_joint"]
+        return time.monotonic()
+
+    def start(self) -> RobotEmulator:
+        self.endpoint.start()
+        return self
+
+    def close(self) -> None:
+        self.endpoint.stop()
+        self.service.close()
+        self.link.close()
+        self.physics.close()
+
+    def report(self) -> dict:
+        from dataclasses import asdict
+
+        out = asdict(self.endpoint.counters)
+        out["first_damping_time_s"] = self.endpoint.first_damping_time_s
+        out["builtin_mode"] = self.service.active_mode
+        out.update(self.endpoint.command_wire_stats())
+        state = self.physics.read_state()
+        out["base_pos_w_m"] = None if state.base_pos_w_m is None else [float(v) for v in state.base_pos_w_m]
+        out["first_damping_base_pos_w_m"] = self.endpoint.first_damping_base_pos_w_m
+        last = self.endpoint.last_command
+        out["last_command_is_damping"] = None if last is None else bool(
+            float(np.max(last.motor_kp_nm_per_rad)) == 0.0 and float(np.min(last.motor_kd_nms_per_rad[:g1.NUM_JOINTS])) > 0)
+        gantry = self.physics.inner
+        if isinstance(gantry, Gantry):
+            out["gantry_lowered_at_s"] = gantry.lowered_at_s
+            out["gantry_lowered_base_pos_w_m"] = (None if gantry.lowered_base_pos_m is None
+                                                  else [float(v) for v in gantry.lowered_base_pos_m])
+        return out
+
+    def serve_stdin(self) -> None:
+        """Line protocol for test harnesses: '<fault>' -> {'fault', 't_s'}; a remote command (see
+        REMOTE_COMMANDS) -> {'remote', 't_s'}; 'report' -> counters, lowcmd wire statistics and (MuJoCo)
+        the base position; 'quit' or end of input stops. One JSON object per reply line."""
+        for line in sys.stdin:
+            word = line.strip()
+            if not word:
+                continue
+            if word == "quit":
+                break
+            if word == "report":
+                reply = self.report()
+            elif word.split()[0] in ("press", "hold", "stick"):
+                try:
+                    reply = {"remote": word, "t_s": self.remote(word)}
+                except ValueError as exc:
+                    reply = {"error": str(exc)}
+            else:
+                try:
+                    reply = {"fault": word, "t_s": self.inject(word)}
+                except ValueError as exc:
+                    reply = {"error": str(exc)}
+            print(json.dumps(reply), flush=True)

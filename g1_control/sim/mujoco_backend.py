@@ -1,0 +1,121 @@
+"""MuJoCo backend: the G1 scene under the robot's own motor law.
+
+The latest MotorCommand is applied through the driver law (g1_control.sim.motor_law) at every
+physics step, as the robot's drivers do between host commands. State comes out as the robot
+reports it (IMU quaternion/gyro/accelerometer at the pelvis, joint q/dq/tau), plus ground truth
+that only a simulator has (base position and velocity), for tests and logs.
+
+Lockstep mode: physics advances only in step(dt) - deterministic and faster than real time.
+Wall-clock mode is the same object with `lockstep=False`: the loop paces step() to the wall clock.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from g1_control.interfaces import Backend
+from g1_control.robot import description, g1
+from g1_control.sim.motor_law import motor_torque
+from g1_control.types import MotorCommand, RobotState
+
+
+@dataclass
+class MujocoConfig:
+    physics_dt_s: float = 0.002
+    """Physics step; the motor law is evaluated at this rate (500 Hz by default)."""
+    lockstep: bool = True
+    motor_temperature_c: float = 40.0
+    init_height_clearance_m: float = 0.002
+    seed: int = 0
+
+
+class MujocoBackend(Backend):
+    def __init__(self, config: MujocoConfig | None = None):
+        self.config = config or MujocoConfig()
+        self.lockstep = self.config.lockstep
+        self.model = description.mujoco_spec(timestep_s=self.config.physics_dt_s).compile()
+        self.data = mujoco.MjData(self.model)
+        self._command = MotorCommand.damping(g1.KD_DEFAULT)
+        self._tau = np.zeros(g1.NUM_JOINTS)
+        self._tick = 0
+        adr = self.model.sensor_adr
+        self._gyro = slice(adr[self.model.sensor("imu_gyro").id], adr[self.model.sensor("imu_gyro").id] + 3)
+        self._acc = slice(adr[self.model.sensor("imu_acc").id], adr[self.model.sensor("imu_acc").id] + 3)
+        self._quat = slice(adr[self.model.sensor("imu_quat").id], adr[self.model.sensor("imu_quat").id] + 4)
+        self._push_force_w = np.zeros(3)
+        self._push_until_s = -1.0
+        self._push_body = self.model.body(g1.BASE_BODY).id
+        self.closed = False
+
+    # -- Backend ---------------------------------------------------------------------------------
+    def reset(self, q_rad: np.ndarray | None = None, base_pos_xy_m=(0.0, 0.0), yaw_rad: float = 0.0) -> RobotState:
+        """Stand the robot at `q_rad` (default pose) with its lowest foot point on the floor."""
+        mujoco.mj_resetData(self.model, self.data)
+        q = g1.DEFAULT_Q_RAD if q_rad is None else np.asarray(q_rad, dtype=float)
+        self.data.qpos[7:] = q
+        self.data.qpos[3:7] = [np.cos(yaw_rad / 2), 0.0, 0.0, np.sin(yaw_rad / 2)]
+        self.data.qpos[0:2] = base_pos_xy_m
+        self.data.qpos[2] = 1.0
+        mujoco.mj_kinematics(self.model, self.data)
+        lowest = min(
+            self.data.geom_xpos[i][2] - (self.model.geom_size[i][0] if self.model.geom_type[i] == mujoco.mjtGeom.mjGEOM_SPHERE else 0.0)
+            for i in range(self.model.ngeom)
+            if self.model.geom_conaffinity[i] and self.model.geom_bodyid[i] != 0
+        )
+        self.data.qpos[2] += -lowest + self.config.init_height_clearance_m
+        self._command = MotorCommand(q_rad=q.copy(), kp=g1.KP_DEFAULT.copy(), kd=g1.KD_DEFAULT.copy())
+        self._tick = 0
+        self._push_until_s = -1.0
+        mujoco.mj_forward(self.model, self.data)
+        return self.read_state()
+
+    def read_state(self) -> RobotState:
+        d = self.data
+        return RobotState(
+            t_s=float(d.time),
+            q_rad=d.qpos[7:].copy(),
+            dq_radps=d.qvel[6:].copy(),
+            tau_nm=self._tau.copy(),
+            imu_quat_wxyz=d.sensordata[self._quat].copy(),
+            imu_gyro_radps=d.sensordata[self._gyro].copy(),
+            imu_acc_mps2=d.sensordata[self._acc].copy(),
+            motor_temperature_c=np.full(g1.NUM_JOINTS, self.config.motor_temperature_c),
+            mode_machine=g1.G1_29DOF.mode_machine,
+            tick=self._tick,
+            base_pos_w_m=d.qpos[0:3].copy(),
+            base_linvel_w_mps=d.qvel[0:3].copy(),
+        )
+
+    def write_command(self, command: MotorCommand) -> None:
+        self._command = command
+
+    def step(self, dt_s: float) -> None:
+        n = max(1, int(round(dt_s / self.model.opt.timestep)))
+        d = self.data
+        for _ in range(n):
+            motor_torque(self._command, d.qpos[7:], d.qvel[6:], out=self._tau)
+            d.ctrl[:] = self._tau
+            if d.time < self._push_until_s:
+                d.xfrc_applied[self._push_body, :3] = self._push_force_w
+            else:
+                d.xfrc_applied[self._push_body, :3] = 0.0
+            mujoco.mj_step(self.model, d)
+        self._tick += n
+
+    def close(self) -> None:
+        # A simulated robot left alone is damped, like the real one after close().
+        self._command = MotorCommand.damping(g1.KD_DEFAULT)
+        self.closed = True
+
+    # -- simulation only ----------------------------------------------------------------------------
+    def push(self, force_w_n, duration_s: float) -> None:
+        """Apply a force (N, world frame) to the pelvis for `duration_s` from now."""
+        self._push_force_w = np.asarray(force_w_n, dtype=float)
+        self._push_until_s = self.data.time + duration_s
+
+    @property
+    def time_s(self) -> float:
+        return float(self.data.time)

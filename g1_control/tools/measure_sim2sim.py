@@ -1,0 +1,82 @@
+"""Measure sim2sim: `g1 sim-robot --lower-gantry-on-policy` and `g1 deploy launch/sim2sim.yaml --yes`
+as two processes on lo/domain 1 (a private partition), the emulator sampled for ground truth.
+
+    python -m g1_control.tools.measure_sim2sim        # prints one JSON object
+
+Reports the LowCmd_ stream as the robot took it off the wire (rate, period p50/p99/max), the
+walking velocity from the simulator's base position over the steady part of the forward segment
+(from 3 s after control began to its end), the host's own estimate, and the state sequence.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+import uuid
+from pathlib import Path
+
+_ROOT = Path(__file__).resolve().parents[2]
+
+
+def _g1(*args: str, **kwargs) -> subprocess.Popen:
+    env = {**os.environ, "PYTHONPATH": str(_ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    return subprocess.Popen([sys.executable, "-m", "g1_control.cli.main", *args], cwd=_ROOT, env=env, text=True,
+                            bufsize=1, **kwargs)
+
+
+def measure(launch: str = "launch/sim2sim.yaml") -> dict:
+    partition = f"g1measure-{os.getpid()}-{uuid.uuid4().hex[:6]}"
+    robot = _g1("sim-robot", "--lower-gantry-on-policy", "--partition", partition, "--control-stdin",
+                stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+    host = None
+
+    def ask(word: str) -> dict:
+        robot.stdin.write(word + "\n")
+        robot.stdin.flush()
+        return json.loads(robot.stdout.readline())
+
+    try:
+        if robot.stdout.readline().strip() != "ready":
+            raise RuntimeError("the emulator did not start")
+        with tempfile.TemporaryDirectory() as tmp:
+            report_path = Path(tmp) / "deploy.json"
+            host = _g1("deploy", launch, "--yes", "--partition", partition, "--json", str(report_path),
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            samples = []
+            while host.poll() is None:
+                r = ask("report")
+                if r.get("gantry_lowered_at_s") == r.get("gantry_lowered_at_s"):  # not NaN: control began
+                    samples.append((time.monotonic(), r["base_pos_w_m"], r["gantry_lowered_at_s"]))
+                time.sleep(0.25)
+            report = json.loads(report_path.read_text())
+        wire = ask("report")
+        end = wire["first_damping_time_s"]
+        steady = [(t, p) for t, p, t0 in samples if t0 + 3.0 <= t <= end]
+        (t1, p1), (t2, p2) = steady[0], steady[-1]
+        return {
+            "sequence": report["sequence"], "end_reason": report["end_reason"], "host_exit": host.returncode,
+            "lowcmd_wire": {k: wire[k] for k in wire if k.startswith("lowcmd_")},
+            "lowcmd_sender": {"rate_hz": report["link"]["command_rate_hz"],
+                              "period_p99_ms": report["link"]["command_period_p99_s"] * 1e3},
+            "walk_vx_true_mps": (p2[0] - p1[0]) / (t2 - t1), "walk_vy_true_mps": (p2[1] - p1[1]) / (t2 - t1),
+            "walk_window_s": t2 - t1, "walk_vx_host_estimate_mps": report["control"]["velocity_est_mean"][0],
+            "pelvis_height_at_damping_m": wire["first_damping_base_pos_w_m"][2],
+            "deadline_misses": report["loop"]["deadline_misses"],
+        }
+    finally:
+        if host is not None and host.poll() is None:
+            host.kill()
+        try:
+            robot.stdin.write("quit\n")
+            robot.stdin.flush()
+            robot.wait(timeout=10)
+        except (OSError, subprocess.TimeoutExpired):
+            robot.kill()
+
+
+if __name__ == "__main__":
+    print(json.dumps(measure(*sys.argv[1:]), indent=2))

@@ -1,0 +1,169 @@
+"""The inverse-dynamics QP: joint accelerations, contact wrenches and torques for one tick.
+
+Decision variables x = (ddq [nv], wrench_left [6], wrench_right [6]). The torques are the third
+set of unknowns, but the actuated rows of the equation of motion fix them as an affine function of
+the other two, tau = M_a ddq + h_a - J_a^T f, so they are substituted rather than carried as
+variables: the QP stays at nv + 12 = 47 unknowns (a 29-variable, 29-equality larger problem
+would give the same optimum at roughly twice the solve time). Constraints:
+
+  floating-base dynamics   M_u ddq + h_u = J_u^T f                    (6 equalities)
+  stance foot              J_i ddq + J_dot_i v = -k_v v_i              (6 equalities per foot)
+  swing foot               f_i = 0                                     (same 6 rows, swapped)
+  torque limits            -tau_max <= M_a ddq + h_a - J_a^T f <= tau_max   (29 inequalities)
+  per stance foot          friction pyramid, CoP in the sole, yaw torque, normal-force bounds
+                           (contacts.py; 11 inequalities per foot, relaxed for a swing foot)
+
+The problem keeps one shape whatever the contact state, so proxsuite's dense solver is
+warm-started from the previous tick's primal/dual solution every time.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from g1_control.errors import WbcSolveError
+from g1_control.robot import g1
+from g1_control.trackers.wbc.contacts import ROWS_PER_FOOT, FootGeometry, normal_force_bounds, wrench_constraint_rows
+from g1_control.robot.dynamics import WbcModel
+from g1_control.trackers.wbc.tasks import AccelerationTask
+
+_FREE = 1e20  # proxsuite treats bounds at or beyond this as absent
+
+
+@dataclass(frozen=True)
+class QpConfig:
+    foot: FootGeometry = field(default_factory=FootGeometry)
+    contact_damping_per_s: float = 20.0
+    """A stance foot's acceleration is asked to cancel its residual velocity at this rate."""
+    accel_regularisation: float = 1e-4
+    force_regularisation: float = 1e-5
+    moment_regularisation: float = 1e-2
+    """Moments are regularised harder than forces: it keeps each foot's CoP near its centre."""
+    effort_limit_nm: tuple[float, ...] = tuple(g1.EFFORT_LIMIT_NM)
+    eps_abs: float = 1e-5
+    max_iter: int = 200
+
+
+@dataclass
+class IdSolution:
+    ddq: np.ndarray
+    wrenches: np.ndarray
+    """(2, 6) per foot (left, right): force N and moment N m at the sole, sole axes."""
+    tau_nm: np.ndarray
+    iterations: int
+    solve_time_s: float
+    status: str
+
+
+class InverseDynamicsQP:
+    def __init__(self, nv: int, config: QpConfig | None = None):
+        import proxsuite
+
+        self._proxsuite = proxsuite
+        self.config = config or QpConfig()
+        self.nv = nv
+        self.n = nv + 12
+        self.n_eq = 6 + 12
+        self.n_in = (nv - 6) + 2 * ROWS_PER_FOOT
+        self.effort_limit = np.asarray(self.config.effort_limit_nm, dtype=float)
+        self._foot_rows = wrench_constraint_rows(self.config.foot)
+        self.H = np.zeros((self.n, self.n))
+        self.g = np.zeros(self.n)
+        self.A = np.zeros((self.n_eq, self.n))
+        self.b = np.zeros(self.n_eq)
+        self.C = np.zeros((self.n_in, self.n))
+        self.l = np.zeros(self.n_in)
+        self.u = np.zeros(self.n_in)
+        c = self.config
+        self._reg = np.concatenate([np.full(nv, c.accel_regularisation),
+                                    np.tile([c.force_regularisation] * 3 + [c.moment_regularisation] * 3, 2)])
+        self._qp = None
+        self.solves = 0
+
+    def reset(self) -> None:
+        """Forget the warm start (the next solve starts cold)."""
+        self._qp = None
+
+    def _new_solver(self):
+        dense = self._proxsuite.proxqp.dense
+        qp = dense.QP(self.n, self.n_eq, self.n_in)
+        qp.settings.eps_abs = self.config.eps_abs
+        qp.settings.eps_rel = 0.0
+        qp.settings.max_iter = self.config.max_iter
+        qp.settings.verbose = False
+        qp.init(self.H, self.g, self.A, self.b, self.C, self.l, self.u)
+        return qp
+
+    def solve(self, model: WbcModel, tasks: list[AccelerationTask], stance: np.ndarray,
+              load_fraction: np.ndarray, contact_damping_per_s: float | None = None) -> IdSolution:
+        """Solve for the state last passed to model.update(). stance: (2,) bool; load_fraction:
+        (2,) 0..1, each stance foot's share of the full normal-force allowance (contact ramps);
+        contact_damping_per_s overrides the configured value for this solve."""
+        nv, n = self.nv, self.n
+        M, h, Jc = model.mass_matrix, model.bias, model.contact_jac_local
+        H, g, A, b, C, l, u = self.H, self.g, self.A, self.b, self.C, self.l, self.u
+
+        # cost
+        H[:] = 0.0
+        g[:] = 0.0
+        Hq = H[:nv, :nv]
+        for task in tasks:
+            wj = task.jac * task.weight[:, None]
+            Hq += task.jac.T @ wj
+            g[:nv] -= wj.T @ task.target
+        H[np.diag_indices(n)] += self._reg
+
+        # floating-base dynamics
+        A[:] = 0.0
+        A[:6, :nv] = M[:6]
+        A[:6, nv:] = -Jc[:, :6].T
+        b[:6] = -h[:6]
+        # torque limits
+        C[:nv - 6, :nv] = M[6:]
+        C[:nv - 6, nv:] = -Jc[:, 6:].T
+        l[:nv - 6] = -self.effort_limit - h[6:]
+        u[:nv - 6] = self.effort_limit - h[6:]
+        fC, fl, fu = self._foot_rows
+        kv = self.config.contact_damping_per_s if contact_damping_per_s is None else contact_damping_per_s
+        for i in range(2):
+            eq = slice(6 + 6 * i, 12 + 6 * i)
+            cols = slice(nv + 6 * i, nv + 6 * i + 6)
+            rows = slice(nv - 6 + ROWS_PER_FOOT * i, nv - 6 + ROWS_PER_FOOT * (i + 1))
+            C[rows] = 0.0
+            C[rows, cols] = fC
+            if stance[i]:
+                A[eq, :nv] = Jc[6 * i:6 * i + 6]
+                b[eq] = -model.contact_drift_local[6 * i:6 * i + 6] - kv * model.contact_vel_local[6 * i:6 * i + 6]
+                l[rows], u[rows] = fl, fu
+                fz_min, fz_max = normal_force_bounds(self.config.foot, load_fraction[i])
+                l[rows.stop - 1], u[rows.stop - 1] = fz_min, fz_max
+            else:
+                A[eq, cols] = np.eye(6)
+                b[eq] = 0.0
+                l[rows], u[rows] = -_FREE, _FREE
+
+        t0 = time.perf_counter()
+        if self._qp is None:
+            self._qp = self._new_solver()
+            self._qp.solve()
+            # Only now: proxsuite 0.8 segfaults when asked to warm-start before any result exists.
+            self._qp.settings.initial_guess = self._proxsuite.proxqp.InitialGuess.WARM_START_WITH_PREVIOUS_RESULT
+        else:
+            self._qp.update(H, g, A, b, C, l, u)
+            self._qp.solve()
+        elapsed = time.perf_counter() - t0
+        self.solves += 1
+        info = self._qp.results.info
+        status = str(info.status).rsplit(".", 1)[-1]
+        x = self._qp.results.x
+        if not np.all(np.isfinite(x)) or "SOLVED" not in status:
+            self._qp = None  # do not warm-start from a failed solve
+            raise WbcSolveError(f"inverse-dynamics QP not solved: status {status} after {info.iter} iterations "
+                                f"(stance {stance.tolist()})")
+        ddq = x[:nv].copy()
+        wrenches = x[nv:].reshape(2, 6).copy()
+        tau = M[6:] @ ddq + h[6:] - Jc[:, 6:].T @ x[nv:]
+        return IdSolution(ddq, wrenches, tau, int(info.iter), elapsed, status)

@@ -1,0 +1,47 @@
+"""Launch files select the WBC: tracker.type wbc, a scripted reference by name, a rate it can work at."""
+
+import pytest
+
+from g1_control.errors import LaunchFileError
+from g1_control.launch.builder import build_loop
+from g1_control.launch.schema import load_launch, parse_launch
+from g1_control.trackers.wbc.tracker import WholeBodyTracker
+from tests.paths import LAUNCH_DIR
+
+
+def launch_dict(tracker_hz=250, **generator):
+    return {"name": "wbc_test", "rates": {"tracker_hz": tracker_hz}, "tracker": {"type": "wbc"},
+            "generator": {"type": "scripted", **generator},
+            "input": {"type": "scripted", "timeline": [{"duration_s": 1.0}]}, "output": {"video": False}}
+
+
+def test_shipped_wbc_launch_file_builds_a_wbc_loop_that_stands():
+    launch = load_launch(LAUNCH_DIR / "sim_wbc_walk.yaml")
+    launch.generator.reference = "stand"
+    loop = build_loop(launch)
+    assert isinstance(loop.tracker, WholeBodyTracker) and loop.rates.tracker_hz == 250
+    loop.reset()
+    loop.run(1.0)
+    assert not loop.fell
+
+
+def test_too_slow_a_tracker_rate_is_refused():
+    with pytest.raises(LaunchFileError, match="tracker_hz: 50 Hz is too slow for tracker.type wbc"):
+        parse_launch(launch_dict(tracker_hz=50))
+
+
+def test_unknown_reference_is_refused():
+    with pytest.raises(LaunchFileError, match="generator.reference: unknown reference 'moonwalk'"):
+        parse_launch(launch_dict(reference="moonwalk"))
+
+
+def test_unknown_reference_parameter_is_refused():
+    with pytest.raises(LaunchFileError, match="reference_params: pace not a parameter of reference 'walk'"):
+        parse_launch(launch_dict(reference="walk", reference_params={"pace": 2.0}))
+
+
+def test_wbc_without_a_scripted_reference_is_refused():
+    data = launch_dict()
+    data["generator"] = {"type": "velocity"}
+    with pytest.raises(LaunchFileError, match="tracker.type wbc needs root poses and a contact schedule"):
+        parse_launch(data)

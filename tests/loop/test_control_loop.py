@@ -1,0 +1,116 @@
+"""The loop itself: bad commands never reach the tracker, upper-body override, wall-clock pacing."""
+
+import time
+
+import numpy as np
+import pytest
+
+from g1_control.generator.velocity import CopyRetargeter, VelocityReferenceGenerator
+from g1_control.interfaces import Generator, InputDevice
+from g1_control.loop.control_loop import ControlLoop
+from g1_control.robot import g1
+from g1_control.sim.mujoco_backend import MujocoBackend
+from g1_control.trackers.locomotion import LocomotionPolicyTracker
+from g1_control.trackers.policy_spec import load_spec
+from g1_control.types import Command, KinematicReference
+
+
+class SequenceInput(InputDevice):
+    def __init__(self, commands):
+        self.commands = iter(commands)
+        self.last = Command()
+
+    def poll(self, now_s):
+        self.last = next(self.commands, self.last)
+        return self.last
+
+
+def make_loop(device, generator=None, **kw):
+    tracker = LocomotionPolicyTracker(load_spec("holosoma_loco_ppo"))
+    loop = ControlLoop(MujocoBackend(), device, generator or VelocityReferenceGenerator(), CopyRetargeter(),
+                       tracker, log_capacity=1000, **kw)
+    loop.reset()
+    return loop
+
+
+def test_nan_command_is_dropped_then_stops_then_damps():
+    good = Command(vx_mps=0.3)
+    device = SequenceInput([Command()] * 50 + [good] * 50 + [Command(vx_mps=float("nan"))] * 500)
+    loop = make_loop(device)
+    loop.run(1.1)  # NaN since 1.0 s: the last good command stays in force for a moment
+    assert loop.invalid_commands > 0 and loop.command.vx_mps == 0.3
+    assert loop.events[0].kind == "invalid_command" and "vx_mps is nan" in loop.events[0].detail
+    loop.run(0.4)  # late input: velocity zeroed, robot still controlled
+    assert loop.command.vx_mps == 0.0 and not loop.faulted
+    assert np.all(np.isfinite(loop.log.arrays()["q_target_rad"]))
+    loop.run(0.7)  # over a second without valid input: damping for good
+    assert loop.faulted and loop.safety.trip_event.kind.value == "input_lost"
+    assert np.all(loop.motor_command.kp == 0) and np.all(loop.motor_command.kd > 0)
+
+
+def test_estop_button_damps_at_once():
+    device = SequenceInput([Command(vx_mps=0.2)] * 20 + [Command(buttons=frozenset({"estop"}))])
+    loop = make_loop(device)
+    loop.run(0.3)
+    assert loop.faulted and loop.safety.trip_event.kind.value == "estop"
+    assert abs(loop.safety.trip_event.t_s - 0.2) < 0.011
+    assert np.all(loop.motor_command.kp == 0)
+
+
+class WavingArms(Generator):
+    """Stand still while both shoulders swing +-0.4 rad at 0.5 Hz."""
+
+    def __init__(self):
+        self.ref = KinematicReference(q_rad=g1.DEFAULT_Q_RAD.copy())
+
+    def update(self, command, state):
+        wave = 0.4 * np.sin(2 * np.pi * 0.5 * state.t_s)
+        for name in ("left_shoulder_pitch_joint", "right_shoulder_pitch_joint"):
+            self.ref.q_rad[g1.JOINT_INDEX[name]] = g1.DEFAULT_Q_RAD[g1.JOINT_INDEX[name]] + wave
+        return self.ref
+
+
+class OverridingRetargeter(CopyRetargeter):
+    def solve(self, reference, q_prev):
+        out = super().solve(reference, q_prev)
+        out.upper_body_override = True
+        return out
+
+
+def test_upper_body_override_moves_the_arms_while_the_policy_balances():
+    tracker = LocomotionPolicyTracker(load_spec("holosoma_loco_ppo"))
+    loop = ControlLoop(MujocoBackend(), SequenceInput([]), WavingArms(), OverridingRetargeter(), tracker,
+                       log_capacity=400)
+    loop.reset()
+    loop.run(6.0)
+    log = loop.log.arrays()
+    j = g1.JOINT_INDEX["left_shoulder_pitch_joint"]
+    swing = log["q_rad"][100:, j]
+    assert not loop.fell
+    assert swing.max() - swing.min() > 0.6  # the arm really swings (target amplitude 0.8 peak to peak)
+    expected = g1.DEFAULT_Q_RAD[j] + 0.4 * np.sin(2 * np.pi * 0.5 * log["t_s"][100:])
+    target_rms = np.sqrt(np.mean((log["q_target_rad"][100:, j] - expected) ** 2))
+    tracking_rms = np.sqrt(np.mean((swing - expected) ** 2))
+    assert target_rms < 0.05 and tracking_rms < 0.2
+
+
+def test_wallclock_mode_runs_in_real_time():
+    loop = make_loop(SequenceInput([]), wallclock=True)
+    t0 = time.perf_counter()
+    loop.run(0.5)
+    elapsed = time.perf_counter() - t0
+    assert elapsed >= 0.49  # paced: never faster than real time
+    assert loop.scheduler.tick_index == 250
+
+
+@pytest.mark.parametrize("policy", ["holosoma_loco_fastsac"])
+def test_other_builtin_policy_walks(policy):
+    device = SequenceInput([Command()] * 100 + [Command(vx_mps=0.4)] * 500)
+    tracker = LocomotionPolicyTracker(load_spec(policy))
+    loop = ControlLoop(MujocoBackend(), device, VelocityReferenceGenerator(), CopyRetargeter(), tracker,
+                       log_capacity=400)
+    loop.reset()
+    loop.run(6.0)
+    log = loop.log.arrays()
+    assert not loop.fell
+    assert log["velocity_true"][-100:, 0].mean() > 0.3

@@ -1,0 +1,74 @@
+"""Property: whatever the references, policy outputs and states, no command that leaves the safety
+filter, and no LowCmd_ the DDS encoder makes of it, breaks a joint limit, carries NaN, or has a
+bad CRC; and once tripped the filter only ever emits damping."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from g1_control.hardware.unitree.conversions import motor_command_to_lowcmd
+from g1_control.hardware.unitree.messages import LowCmd, verify_crc
+from g1_control.robot import g1
+from g1_control.safety import SafetyFilter
+from g1_control.types import MotorCommand, RobotState
+
+N = g1.NUM_JOINTS
+any_float = st.floats(allow_nan=True, allow_infinity=True, width=64)
+mostly_sane = st.one_of(st.floats(-50, 50), any_float)
+vec = arrays(np.float64, N, elements=mostly_sane)
+
+
+@st.composite
+def commands(draw):
+    return MotorCommand(q_rad=draw(vec), dq_radps=draw(vec), kp=draw(vec), kd=draw(vec), tau_nm=draw(vec),
+                        enable=draw(arrays(np.bool_, N)))
+
+
+@st.composite
+def states(draw):
+    quat = draw(arrays(np.float64, 4, elements=st.floats(-1, 1)))
+    if np.linalg.norm(quat) < 1e-3:
+        quat = np.array([1.0, 0.0, 0.0, 0.0])
+    return RobotState(
+        t_s=draw(st.floats(-0.1, 0.0)),  # now_s is 0: states up to 100 ms old
+        q_rad=draw(arrays(np.float64, N, elements=st.floats(-3, 3))),
+        dq_radps=draw(arrays(np.float64, N, elements=st.one_of(st.floats(-40, 40), any_float))),
+        imu_quat_wxyz=quat / np.linalg.norm(quat),
+        motor_temperature_c=draw(arrays(np.float64, N, elements=st.floats(20, 100))),
+        mode_machine=draw(st.sampled_from([4, 5, 6])),
+    )
+
+
+def assert_safe(cmd: MotorCommand, mode_machine: int) -> None:
+    assert cmd.is_finite()
+    assert np.all(cmd.q_rad >= g1.Q_MIN_RAD) and np.all(cmd.q_rad <= g1.Q_MAX_RAD)
+    assert np.all(np.abs(cmd.tau_nm) <= g1.EFFORT_LIMIT_NM)
+    assert np.all(np.abs(cmd.dq_radps) <= g1.VELOCITY_LIMIT_RADPS)
+    assert np.all(cmd.kp >= 0) and np.all(cmd.kd >= 0)
+    wire = LowCmd.from_dds(motor_command_to_lowcmd(cmd, mode_machine).to_dds())
+    verify_crc(wire)
+    q = wire.motor_q_rad[:N].astype(np.float64)
+    tau = wire.motor_tau_nm[:N].astype(np.float64)
+    on = wire.motor_mode[:N] == 1
+    assert np.all(np.isfinite(q)) and np.all(np.isfinite(tau))
+    assert np.all(q[on] >= g1.Q_MIN_RAD[on]) and np.all(q[on] <= g1.Q_MAX_RAD[on])
+    assert np.all(np.abs(tau) <= g1.EFFORT_LIMIT_NM)
+
+
+@settings(max_examples=80, deadline=None)
+@given(steps=st.lists(st.tuples(commands(), states()), min_size=1, max_size=6))
+def test_no_unsafe_command_ever_leaves_the_filter(steps):
+    f = SafetyFilter()
+    tripped_before = False
+    for i, (cmd, state) in enumerate(steps):
+        now = float(i) * 0.02
+        state.t_s += now
+        state.tick = i
+        out = f.filter(cmd, state, now)
+        assert_safe(out, state.mode_machine)
+        if tripped_before:
+            assert np.all(out.kp == 0) and np.all(out.kd > 0) and np.all(out.tau_nm == 0)
+        tripped_before = f.tripped

@@ -1,0 +1,95 @@
+"""The inverse-dynamics QP at a standing state: its solution obeys the physics it encodes."""
+
+import numpy as np
+import pytest
+
+from g1_control.errors import WbcSolveError
+from g1_control.robot import description, g1
+from g1_control.trackers.wbc.contacts import FootGeometry, cop_of
+from g1_control.robot.dynamics import WbcModel
+from g1_control.trackers.wbc.qp import InverseDynamicsQP, QpConfig
+from g1_control.trackers.wbc.tasks import AccelerationTask, TaskGains, posture_task
+
+
+@pytest.fixture(scope="module")
+def model():
+    m = WbcModel()
+    q = description.pinocchio_q(np.array([0.0, 0.0, 0.756]), np.array([1.0, 0, 0, 0]), g1.DEFAULT_Q_RAD)
+    m.update(q, np.zeros(m.nv))
+    return m
+
+
+def posture(model, q_ref=None):
+    return posture_task(model.nv, g1.DEFAULT_Q_RAD, np.zeros(29),
+                        g1.DEFAULT_Q_RAD if q_ref is None else q_ref, np.zeros(29), TaskGains(100, 20, 1))
+
+
+def com_task(model, a_des):
+    return AccelerationTask("com", model.com_jac, np.asarray(a_des) - model.com_drift, np.full(3, 100.0))
+
+
+def check_dynamics(model, sol):
+    """M ddq + h = S^T tau + J_c^T f, all 35 rows."""
+    lhs = model.mass_matrix @ sol.ddq + model.bias
+    rhs = np.concatenate([np.zeros(6), sol.tau_nm]) + model.contact_jac_local.T @ sol.wrenches.ravel()
+    np.testing.assert_allclose(lhs, rhs, atol=1e-3)
+
+
+def test_double_support_carries_the_weight_within_every_limit(model):
+    qp = InverseDynamicsQP(model.nv)
+    sol = qp.solve(model, [posture(model)], np.array([True, True]), np.ones(2))
+    check_dynamics(model, sol)
+    assert sol.wrenches[:, 2].sum() == pytest.approx(model.mass_kg * 9.81, rel=1e-3)
+    assert np.all(np.abs(sol.tau_nm) <= g1.EFFORT_LIMIT_NM + 1e-6)
+    # stance feet do not accelerate
+    acc = model.contact_jac_local @ sol.ddq + model.contact_drift_local
+    np.testing.assert_allclose(acc, 0.0, atol=1e-4)
+
+
+def test_single_support_puts_no_force_on_the_swing_foot_and_keeps_the_cop_in_the_sole(model):
+    qp = InverseDynamicsQP(model.nv)
+    # ask the CoM to move toward the right foot as single support would
+    sol = qp.solve(model, [posture(model), com_task(model, [0.0, -1.0, 0.0])], np.array([False, True]), np.ones(2))
+    check_dynamics(model, sol)
+    np.testing.assert_allclose(sol.wrenches[0], 0.0, atol=1e-6)
+    foot = FootGeometry()
+    px, py = cop_of(sol.wrenches[1])
+    assert 0.8 * foot.x_min_m - 1e-4 <= px <= 0.8 * foot.x_max_m + 1e-4
+    assert 0.8 * foot.y_min_m - 1e-4 <= py <= 0.8 * foot.y_max_m + 1e-4
+    fx, fy, fz = sol.wrenches[1, :3]
+    assert abs(fx) <= foot.friction * fz + 1e-6 and abs(fy) <= foot.friction * fz + 1e-6
+
+
+def test_torque_limits_bind(model):
+    # a knee limit below what standing needs: the QP must respect it, not the task
+    limits = g1.EFFORT_LIMIT_NM.copy()
+    limits[[3, 9]] = 5.0
+    qp = InverseDynamicsQP(model.nv, QpConfig(effort_limit_nm=tuple(limits)))
+    sol = qp.solve(model, [posture(model)], np.array([True, True]), np.ones(2))
+    assert np.all(np.abs(sol.tau_nm[[3, 9]]) <= 5.0 + 1e-4)
+    check_dynamics(model, sol)
+
+
+def test_warm_started_solve_gives_the_cold_solution(model):
+    shifted = g1.DEFAULT_Q_RAD + 0.05
+    warm = InverseDynamicsQP(model.nv)
+    warm.solve(model, [posture(model)], np.array([True, True]), np.ones(2))
+    warm_sol = warm.solve(model, [posture(model, shifted), com_task(model, [0.2, 0, 0])], np.array([True, True]), np.ones(2))
+    cold_sol = InverseDynamicsQP(model.nv).solve(model, [posture(model, shifted), com_task(model, [0.2, 0, 0])],
+                                                 np.array([True, True]), np.ones(2))
+    np.testing.assert_allclose(warm_sol.tau_nm, cold_sol.tau_nm, atol=1e-2)
+
+
+def test_load_ramp_limits_a_new_contact(model):
+    qp = InverseDynamicsQP(model.nv)
+    sol = qp.solve(model, [posture(model)], np.array([True, True]), np.array([1.0, 0.1]))
+    assert sol.wrenches[1, 2] <= 0.1 * FootGeometry().fz_max_n + 1e-3
+    assert sol.wrenches[0, 2] > 0.5 * model.mass_kg * 9.81
+
+
+def test_infeasible_problem_raises_a_named_error(model):
+    # no torque and a foot just touching down (its normal force capped near zero): nothing can
+    # hold the robot while the stance foot must not accelerate
+    qp = InverseDynamicsQP(model.nv, QpConfig(effort_limit_nm=(0.0,) * 29, max_iter=100))
+    with pytest.raises(WbcSolveError, match="QP not solved"):
+        qp.solve(model, [posture(model)], np.array([True, False]), np.zeros(2))
