@@ -131,7 +131,7 @@ def fetch(name: str, *, force: bool = False, quiet: bool = False, wheel: Path | 
                "--disable-pip-version-check", "-d", tmp, f"{asset.package}=={asset.version}"]
         if quiet:
             cmd.insert(4, "-q")
-        proc = subprocess.run(cmd, capture_output=quiet, text=True)
+        proc = subprocess.run(cmd, capture_output=quiet, text=True, check=False)
         found = list(Path(tmp).glob("*.whl"))
         if proc.returncode != 0 or not found:
             detail = (proc.stderr or "").strip().splitlines()[-1:] if quiet else []

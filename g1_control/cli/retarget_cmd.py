@@ -86,12 +86,12 @@ def process_one(path: str, out_path: str, options: dict, show_frames: bool = Fal
     from g1_control.errors import G1ControlError
 
     try:
-        from g1_control.retarget.mocap import MocapRetargetConfig, MocapRetargeter
         from g1_control.motion.clip import MotionClip
         from g1_control.motion.formats.dispatch import load_motion, save_clip
-        from g1_control.retarget.metrics import compute_metrics, plot_metrics
         from g1_control.motion.resample import resample
         from g1_control.motion.skeletons import load_joint_map
+        from g1_control.retarget.metrics import compute_metrics, plot_metrics
+        from g1_control.retarget.mocap import MocapRetargetConfig, MocapRetargeter
 
         skeleton = load_joint_map(options["joint_map"]) if options.get("joint_map") else None
         motion = load_motion(path, joint_names=skeleton.joints if skeleton else None,
@@ -121,7 +121,7 @@ def process_one(path: str, out_path: str, options: dict, show_frames: bool = Fal
                 "object_contact_preserved_fraction": metrics.object_contact_preserved_fraction}
     except G1ControlError as exc:
         return {"input": path, "error": str(exc)}
-    except Exception as exc:  # noqa: BLE001 - a batch reports every failure and goes on
+    except Exception as exc:
         return {"input": path, "error": f"unexpected {type(exc).__name__}: {exc}"}
 
 

@@ -39,8 +39,8 @@ def register(subparsers) -> None:
 
 def _generator(args) -> int:
     from g1_control.generator.learned import SHIPPED_DIR
-    from g1_control.training.train import TrainConfig, train
     from g1_control.library.builder import build_library, default_library_dir
+    from g1_control.training.train import TrainConfig, train
 
     library = args.library or default_library_dir()
     if args.library is None:

@@ -8,7 +8,7 @@ between kinematic corrections (a complementary filter), which smooths the switch
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 

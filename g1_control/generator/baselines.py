@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from g1_control import rotations as quat
 from g1_control.generator import features as F
 from g1_control.generator.inbetween import Inbetweener, fill_target, interpolate
-from g1_control import rotations as quat
 
 
 class InterpolationInbetweener(Inbetweener):

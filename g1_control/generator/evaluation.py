@@ -20,9 +20,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from g1_control import rotations as quat
 from g1_control.generator import features as F
 from g1_control.generator.inbetween import CONTEXT_FRAMES, Inbetweener
-from g1_control import rotations as quat
 
 WINDOW_STRIDE = 20
 STANCE_ANKLE_Z_M = 0.034

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from g1_control.robot import g1
-from g1_control.rotations import rot_z, yaw_of_matrix  # noqa: F401  (part of the feature API)
+from g1_control.rotations import rot_z, yaw_of_matrix
 
 ROOT_POS = slice(0, 3)
 ROOT_ROT = slice(3, 9)

@@ -53,7 +53,7 @@ def spring_root_trajectory(start: RootState, v_cmd_heading: np.ndarray, wz_cmd: 
     Velocity: dv/dt = -lam (v - v_cmd), lam = ln2 / half-life (exact exponential per step).
     Heading with an absolute target: critically damped x(t) = x_d + (j0 + j1 t) e^{-y t}, y = 2 ln2 / half-life.
     """
-    n = max(1, int(round(horizon_s / dt_s)))
+    n = max(1, round(horizon_s / dt_s))
     k = np.arange(1, n + 1)
     t = k * dt_s
     decay = math.exp(-LN2 / cfg.velocity_halflife_s * dt_s)

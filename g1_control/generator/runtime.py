@@ -34,8 +34,8 @@ from g1_control.generator.primitives import (
     spring_root_trajectory,
 )
 from g1_control.generator.style_stats import StyleStats
-from g1_control.interfaces import Generator
 from g1_control.generator.styles import STYLES, style_id
+from g1_control.interfaces import Generator
 from g1_control.robot import g1
 from g1_control.types import Command, KinematicReference, RobotState
 
@@ -242,7 +242,7 @@ class InbetweeningGenerator(Generator):
     # ------------------------------------------------------------------ per tick
     def _advance(self, t: float) -> None:
         """Plan frames whose time has come become history (the executed motion)."""
-        k = int(math.floor((t - self.plan_t0) * self.config.fps + 1e-9))
+        k = math.floor((t - self.plan_t0) * self.config.fps + 1e-9)
         k = min(k, len(self.plan))
         if k > 0:
             self.history = np.concatenate([self.history, self.plan[:k]])[-CONTEXT_FRAMES:]

@@ -13,7 +13,7 @@ preview control over a footstep plan (zmp_preview.py).
     step_in_place  eight steps on the spot (5 cm foot lift)
     walk           straight walk at 0.3 m/s
 
-In the loop: ControlLoop(backend, input, TrajectoryGenerator(traj), TrajectoryRetargeter(traj), tracker).
+In the loop: a launch file with `generator: {type: scripted, reference: NAME}` (g1_control/launch/builder.py).
 """
 
 from __future__ import annotations
@@ -24,18 +24,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from g1_control.errors import WbcConfigError
+from g1_control.generator.zmp_preview import ZmpPreviewController
 from g1_control.interfaces import Generator, Retargeter
 from g1_control.robot import g1
-from g1_control.types import Command, JointReference, KinematicReference, RobotState
 from g1_control.robot.dynamics import SOLE_FRAMES, build_model
-from g1_control.rotations import quat_to_rot, rotation_error, rot_to_rpy, rpy_to_quat, rpy_to_rot
-from g1_control.generator.zmp_preview import ZmpPreviewController
-
-
-
-
-
-
+from g1_control.rotations import quat_to_rot, rot_to_rpy, rotation_error, rpy_to_quat
+from g1_control.types import Command, JointReference, KinematicReference, RobotState
 
 
 def smoothstep(x: np.ndarray | float) -> np.ndarray:

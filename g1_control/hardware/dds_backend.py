@@ -9,8 +9,8 @@ The real robot: domain 0, the NIC on 192.168.123.0/24, robot hanging on a gantry
 
 from __future__ import annotations
 
-from g1_control.hardware.links.dds import DdsLink
 from g1_control.hardware.link_backend import LinkBackend
+from g1_control.hardware.links.dds import DdsLink
 from g1_control.hardware.unitree.motion_service import release_motion_service
 from g1_control.types import RobotState
 

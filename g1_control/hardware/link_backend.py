@@ -24,8 +24,12 @@ from g1_control.errors import (
     RobotNotConnectedError,
     VariantMismatchError,
 )
-from g1_control.hardware.unitree.conversions import lowstate_to_robot_state, motor_command_to_lowcmd, variant_of
 from g1_control.hardware.links.base import Link
+from g1_control.hardware.unitree.conversions import (
+    lowstate_to_robot_state,
+    motor_command_to_lowcmd,
+    variant_of,
+)
 from g1_control.interfaces import Backend
 from g1_control.robot import g1
 from g1_control.types import MotorCommand, RobotState

@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import json
 import time
 from dataclasses import dataclass, field
@@ -75,7 +76,7 @@ def segments_from_log(log: dict[str, np.ndarray], min_s: float = 1.0) -> list[tu
     bounds = np.concatenate([[0], change, [len(t)]])
     dt = t[1] - t[0] if len(t) > 1 else 0.02
     out = []
-    for a, b in zip(bounds[:-1], bounds[1:]):
+    for a, b in itertools.pairwise(bounds):
         if (b - a) * dt >= min_s:
             vx, vy, wz = (float(v) for v in cmd[a])
             out.append((float(t[a]), Segment(duration_s=float((b - a) * dt), vx_mps=vx, vy_mps=vy, wz_radps=wz,
@@ -130,7 +131,7 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
     t0 = time.perf_counter()
     stop = (lambda: not view.is_running()) if view is not None else None
     try:
-        loop.scheduler.run(int(round(duration * loop.rates.lowlevel_hz)), stop=stop, progress=on_tick)
+        loop.scheduler.run(round(duration * loop.rates.lowlevel_hz), stop=stop, progress=on_tick)
     finally:
         wall = time.perf_counter() - t0
         if bar is not None:
@@ -210,8 +211,8 @@ def summary_dict(result: RunResult) -> dict:
 
 def format_summary(result: RunResult) -> str:
     lines = [
-        f"run '{result.name}': {'FELL' if result.fell else 'no fall'}; {result.duration_s:.1f} s simulated in "
-        f"{result.wall_s:.1f} s wall (real-time factor {result.real_time_factor:.1f}x)",
+        (f"run '{result.name}': {'FELL' if result.fell else 'no fall'}; {result.duration_s:.1f} s simulated in "
+        f"{result.wall_s:.1f} s wall (real-time factor {result.real_time_factor:.1f}x)"),
         "",
         f"{'segment':<12} {'time (s)':>11}   {'commanded vx vy wz':>22}   {'achieved vx vy wz':>22}   error %",
     ]

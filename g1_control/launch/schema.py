@@ -307,6 +307,6 @@ def load_launch(path: str | Path) -> LaunchFile:
 
     try:
         resolve_spec_path(launch.tracker.policy)
-    except Exception as exc:  # noqa: BLE001 - re-raised with the key path
+    except Exception as exc:
         raise LaunchFileError(f"{path}: tracker.policy: {exc}") from None
     return launch

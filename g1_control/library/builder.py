@@ -5,6 +5,7 @@ index on disk is skipped unless forced."""
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
 import sys
 import time
@@ -12,8 +13,8 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from g1_control.motion.library import INDEX_NAME, LibraryError, MotionLibrary
 from g1_control.motion.clip import MotionClip
+from g1_control.motion.library import INDEX_NAME, LibraryError, MotionLibrary
 
 BUILD_VERSION = 1
 """Bumped when the builder's output changes for the same configuration (invalidates caches)."""
@@ -51,8 +52,8 @@ def default_library_dir() -> Path:
 
 
 def _rollout_job(args) -> tuple[MotionClip | None, dict]:
-    from g1_control.library.rollouts import RolloutConfig, record_rollout
     from g1_control.generator.styles import ROLLOUT_STYLES
+    from g1_control.library.rollouts import RolloutConfig, record_rollout
 
     style, seed, seconds, fps = args
     return record_rollout(ROLLOUT_STYLES[style], RolloutConfig(duration_s=seconds, seed=seed, fps=fps))
@@ -60,8 +61,8 @@ def _rollout_job(args) -> tuple[MotionClip | None, dict]:
 
 def _demo_clips(fps: float) -> list[MotionClip]:
     from g1_control.assets import fetch
-    from g1_control.retarget.mocap import MocapRetargetConfig, MocapRetargeter
     from g1_control.motion.formats.dispatch import load_motion
+    from g1_control.retarget.mocap import MocapRetargetConfig, MocapRetargeter
 
     root = fetch("holosoma-demo-mocap") / "holosoma_retargeting" / "demo_data"
     out = []
@@ -78,10 +79,10 @@ def cut(clip: MotionClip, seconds: float) -> list[MotionClip]:
     """Consecutive pieces of about `seconds`; a short tail joins the last piece."""
     from g1_control.motion.edit import slice_clip
 
-    n = max(1, int(round(seconds * clip.fps)))
+    n = max(1, round(seconds * clip.fps))
     count = max(1, clip.num_frames // n)
     bounds = [i * n for i in range(count)] + [clip.num_frames]
-    return [slice_clip(clip, a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+    return [slice_clip(clip, a, b) for a, b in itertools.pairwise(bounds)]
 
 
 def build_library(out_dir: str | Path, config: LibraryConfig | None = None, *, force: bool = False,

@@ -114,7 +114,7 @@ class ControlLoop:
         return self.state
 
     def run(self, duration_s: float, progress=None) -> int:
-        n = int(round(duration_s * self.rates.lowlevel_hz))
+        n = round(duration_s * self.rates.lowlevel_hz)
         return self.scheduler.run(n, progress=progress)
 
     @property

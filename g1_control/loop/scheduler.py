@@ -61,7 +61,7 @@ class Scheduler:
             if stage.rate_hz <= 0 or abs(ratio - round(ratio)) > 1e-9:
                 raise ValueError(f"stage '{stage.name}' rate {stage.rate_hz} Hz does not divide the base rate "
                                  f"{base_rate_hz} Hz into whole ticks")
-            stage.period_ticks = int(round(ratio))
+            stage.period_ticks = round(ratio)
         self.wallclock = wallclock
         self.clock = clock
         self.sleep = sleep

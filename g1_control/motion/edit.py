@@ -7,10 +7,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from g1_control import rotations as quat
-from g1_control.rotations import yaw_of
 from g1_control.motion.clip import ARRAY_FIELDS, MotionClip
 from g1_control.motion.exceptions import IncompatibleClipsError, InvalidClipError
 from g1_control.motion.objects import ObjectTrack
+from g1_control.rotations import yaw_of
 
 
 def slice_clip(clip: MotionClip, start: int = 0, stop: int | None = None) -> MotionClip:

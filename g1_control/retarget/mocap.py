@@ -18,10 +18,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from g1_control import rotations as quat
 from g1_control.ik.configuration import sole_depth_m
 from g1_control.ik.exceptions import IKError
 from g1_control.ik.retargeter import IKConfig, IKRetargeter
-from g1_control import rotations as quat
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.contacts import stance_from_trajectory
 from g1_control.motion.human import HumanMotion

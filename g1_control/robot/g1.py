@@ -52,7 +52,7 @@ JOINT_NAMES: tuple[str, ...] = (
 NUM_JOINTS = len(JOINT_NAMES)
 JOINT_INDEX = {name: i for i, name in enumerate(JOINT_NAMES)}
 
-LEG_JOINTS = tuple(range(0, 12))
+LEG_JOINTS = tuple(range(12))
 WAIST_JOINTS = (12, 13, 14)
 ARM_JOINTS = tuple(range(15, 29))
 UPPER_BODY_JOINTS = WAIST_JOINTS + ARM_JOINTS

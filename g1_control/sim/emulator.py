@@ -21,12 +21,12 @@ import numpy as np
 
 from g1_control.errors import NetworkInterfaceError
 from g1_control.hardware.links.dds import DdsLink
-from g1_control.hardware.unitree.motion_service import MotionServiceEmulator
 from g1_control.hardware.links.network import LOOPBACK
-from g1_control.sim.robot_endpoint import RobotEndpoint
+from g1_control.hardware.unitree.motion_service import MotionServiceEmulator
+from g1_control.hardware.unitree.remote import encode_wireless_remote
 from g1_control.interfaces import Backend
 from g1_control.robot import g1
-from g1_control.hardware.unitree.remote import encode_wireless_remote
+from g1_control.sim.robot_endpoint import RobotEndpoint
 from g1_control.types import MotorCommand, RobotState
 
 FAULTS = {

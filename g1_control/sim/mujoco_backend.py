@@ -93,7 +93,7 @@ class MujocoBackend(Backend):
         self._command = command
 
     def step(self, dt_s: float) -> None:
-        n = max(1, int(round(dt_s / self.model.opt.timestep)))
+        n = max(1, round(dt_s / self.model.opt.timestep))
         d = self.data
         for _ in range(n):
             motor_torque(self._command, d.qpos[7:], d.qvel[6:], out=self._tau)

@@ -24,13 +24,13 @@ def render_video(log_path: Path, out_path: Path, fps: float = 10.0, size=(480, 3
     for backend in GL_BACKENDS:
         env = dict(os.environ, MUJOCO_GL=backend, PYOPENGL_PLATFORM=backend)
         # Probe quietly (a missing GL stack fails with a long traceback), then render with progress.
-        probe = subprocess.run(cmd + ["--probe"], env=env, stderr=subprocess.PIPE, text=True)
+        probe = subprocess.run(cmd + ["--probe"], env=env, stderr=subprocess.PIPE, text=True, check=False)
         if probe.returncode != 0:
             if not quiet:
                 last = (probe.stderr or "").strip().splitlines()[-1:] or ["no output"]
                 print(f"render: {backend} unavailable ({last[0]})", file=sys.stderr)
             continue
-        proc = subprocess.run(cmd + (["--quiet"] if quiet else []), env=env)
+        proc = subprocess.run(cmd + (["--quiet"] if quiet else []), env=env, check=False)
         if proc.returncode == 0 and out_path.is_file():
             return backend
     return None

@@ -22,8 +22,8 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from g1_control.errors import CrcMismatchError, MalformedMessageError
-from g1_control.hardware.unitree.conversions import lowcmd_to_motor_command, robot_state_to_lowstate
 from g1_control.hardware.links.base import Link
+from g1_control.hardware.unitree.conversions import lowcmd_to_motor_command, robot_state_to_lowstate
 from g1_control.hardware.unitree.messages import LowCmd
 from g1_control.interfaces import Backend
 from g1_control.robot import g1
@@ -184,8 +184,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     from g1_control.hardware.links.dds import DdsLink
-    from g1_control.sim.mock_robot import MockG1
     from g1_control.hardware.unitree.motion_service import MotionServiceEmulator
+    from g1_control.sim.mock_robot import MockG1
 
     link = DdsLink("robot", args.interface, args.domain, partition=args.partition)
     service = MotionServiceEmulator(link._participant, args.partition, active_mode=args.motion_service)

@@ -14,11 +14,10 @@ lockstep) reaches it; an EvdevGamepad opened on feeder.path reads them as from /
 
 from __future__ import annotations
 
-import time
-
 import math
 import os
 import tempfile
+import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any

@@ -28,6 +28,7 @@ from g1_control.teleop.mapping import MappingConfig
 from g1_control.teleop.snapshot import InputSnapshot
 from g1_control.types import RobotState
 
+
 class UnitreeRemote(TeleopDevice):
     kind = "unitree_remote"
 
@@ -70,7 +71,7 @@ class UnitreeRemote(TeleopDevice):
     def _pull(self) -> None:
         try:
             sample = self._source()
-        except Exception as exc:  # noqa: BLE001 - whatever broke, the operator's link is gone
+        except Exception as exc:
             raise DeviceLost(f"state source failed: {type(exc).__name__}: {exc}") from None
         if sample is None:
             return

@@ -49,9 +49,9 @@ def effector_goals_through_ik(generator_factory, goals: int = 12, seconds: float
     """Right-hand goals in front of a standing robot, given as Command effector goals: the
     generator passes them as a partial keyframe and a frame target, the IK retargeter solves
     (as in the loop, 50 Hz). Returns success within 10 cm and the mean final hand distance."""
+    from g1_control import rotations as quat
     from g1_control.generator.fk import fk_numpy
     from g1_control.generator.retarget import GeneratorRetargeter
-    from g1_control import rotations as quat
     from g1_control.motion.kinematics import default_body_names
     from g1_control.robot import g1
     from g1_control.types import Command, EffectorGoal, RobotState
@@ -103,7 +103,7 @@ def _latency(gen_factory, n: int = 300) -> np.ndarray:
     gen = gen_factory()
     rng = np.random.default_rng(1)
     times, cpu = [], []
-    for i in range(n):
+    for _ in range(n):
         cmd = Command(vx_mps=float(rng.uniform(-0.3, 0.8)), wz_radps=float(rng.uniform(-0.5, 0.5)),
                       style=str(rng.choice(["default", "carry", "wave", "guard"])))
         gen._t += 1.0 / 30
@@ -151,7 +151,7 @@ def long_rollout(generator, seconds: float = 600.0, fps: float = 30.0, seed: int
             next_change = state.t_s + float(rng.uniform(2.0, 6.0))
         ref = generator.update(cmd, state)
         z[i] = ref.root_pos_w_m[2]
-        w, x, y, _ = ref.root_quat_wxyz
+        _w, x, y, _ = ref.root_quat_wxyz
         tilt[i] = np.arccos(np.clip(1 - 2 * (x * x + y * y), -1, 1))
         q[i] = ref.q_rad
     finite = bool(np.isfinite(z).all() and np.isfinite(q).all())
@@ -224,7 +224,7 @@ def main(args) -> int:
           f"of {eff['goals']}, distance to goal mean {eff['mean_m']:.3f} m, max {eff['max_m']:.3f} m")
     print("\nspeed (this CPU, 1 inference thread)")
     for m in (interp, backbone):
-        lat, cpu = _latency(lambda: _fresh(InbetweeningGenerator(m, styles)))
+        lat, cpu = _latency(lambda m=m: _fresh(InbetweeningGenerator(m, styles)))
         figures[f"replan_ms_{m.name}"] = {"wall_p50": float(np.percentile(lat, 50)), "wall_p99": float(np.percentile(lat, 99)),
                                           "cpu_p50": float(np.percentile(cpu, 50)), "cpu_p99": float(np.percentile(cpu, 99))}
         print(f"  replan latency {m.name:<14} wall p50 {np.percentile(lat, 50):6.2f} ms  p99 {np.percentile(lat, 99):6.2f} ms"

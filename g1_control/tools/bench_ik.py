@@ -124,9 +124,9 @@ def _time_parts(refs) -> dict:
 
 def _time_offline(max_frames: int) -> dict:
     from g1_control.assets import fetch
-    from g1_control.retarget.mocap import MocapRetargeter
     from g1_control.motion.formats.dispatch import load_motion
     from g1_control.motion.human import HumanMotion
+    from g1_control.retarget.mocap import MocapRetargeter
 
     root = fetch("holosoma-demo-mocap") / "holosoma_retargeting" / "demo_data"
     files = [root / "OMOMO_new/sub3_largebox_003.pt", next(iter(sorted(root.glob("climb/*_0/*.npy"))))]

@@ -31,7 +31,7 @@ def physics_only_seconds(seconds: float, physics_dt_s: float) -> float:
     backend = MujocoBackend(MujocoConfig(physics_dt_s=physics_dt_s))
     backend.reset()
     model, data = backend.model, backend.data
-    n = int(round(seconds / physics_dt_s))
+    n = round(seconds / physics_dt_s)
     t0 = time.perf_counter()
     for _ in range(n):
         mujoco.mj_step(model, data)

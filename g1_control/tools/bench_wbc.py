@@ -33,10 +33,10 @@ def _pct(samples_s) -> tuple[float, float]:
 def main(args) -> int:
     import pinocchio as pin
 
-    from g1_control.tools.bench_loop import physics_only_seconds
     from g1_control.generator import scripted as R
-    from g1_control.trackers.wbc import tracker as tracker_module
+    from g1_control.tools.bench_loop import physics_only_seconds
     from g1_control.tools.wbc_evaluate import DEFAULT_TRACKER_HZ, run_wbc
+    from g1_control.trackers.wbc import tracker as tracker_module
 
     seconds = float(args.seconds)
     params = {"speed_mps": 0.3, "n_steps": max(2, int((seconds - 2.6) / 0.55))}

@@ -21,7 +21,6 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-
 DEFAULT_TRACKER_HZ = 250.0
 
 

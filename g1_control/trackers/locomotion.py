@@ -22,8 +22,6 @@ from g1_control.trackers.policy_spec import PolicySpec
 from g1_control.types import EstimatedState, JointReference, MotorCommand, RobotState
 
 
-
-
 @dataclass
 class VelocityCorrectionConfig:
     """Command shaping so that the achieved velocity follows the operator's command.

@@ -32,8 +32,8 @@ class WbtPolicyTracker(Tracker):
         import pinocchio as pin
 
         from g1_control.assets import fetch
-        from g1_control.trackers.onnx_runner import OnnxRunner
         from g1_control.robot.dynamics import build_model
+        from g1_control.trackers.onnx_runner import OnnxRunner
 
         path = fetch("holosoma-policies") / POLICY_FILE
         self._time_step = np.zeros((1, 1), dtype=np.float32)

@@ -87,7 +87,7 @@ class _TokenModule(nn.Module):
         nn.init.normal_(self.role, std=0.02)
 
     def forward(self, values, given, style, gap: int):
-        b, length, _ = values.shape
+        _b, length, _ = values.shape
         x = self.inp(torch.cat([values, given], dim=-1))
         # positions: context 0..C-1, gap C..C+G-1, target at C+G (its true distance in frames)
         x = x + self.pos[:length]

@@ -100,9 +100,9 @@ def _to_torch(batch: dict):
 
 
 def load_split(library_root: str | Path | None, split: str):
+    from g1_control.generator.styles import style_id
     from g1_control.library.builder import default_library_dir
     from g1_control.motion.library import MotionLibrary
-    from g1_control.generator.styles import style_id
 
     lib = MotionLibrary(library_root or default_library_dir())
     clips = lib.clips(split)
@@ -114,9 +114,9 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | N
     import torch
     import torch.distributed as dist
 
+    from g1_control.generator.styles import STYLES
     from g1_control.training.backbone import Backbone, BackboneConfig
     from g1_control.training.dataset import WindowSampler
-    from g1_control.generator.styles import STYLES
 
     world = int(os.environ.get("WORLD_SIZE", "1"))
     rank = int(os.environ.get("RANK", "0"))

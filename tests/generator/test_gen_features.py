@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
+from g1_control import rotations as quat
 from g1_control.generator import features as F
 from g1_control.generator.fk import fk_numpy, fk_torch
-from g1_control import rotations as quat
 from g1_control.motion.kinematics import default_body_names, forward_kinematics
 from g1_control.robot import g1
 

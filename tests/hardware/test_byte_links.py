@@ -12,14 +12,14 @@ import pytest
 import serial
 
 from g1_control.errors import TransportError
-from g1_control.hardware.links.can_bus import CanLink
-from g1_control.hardware.unitree.conversions import motor_command_to_lowcmd
 from g1_control.hardware.link_backend import LinkBackend
-from g1_control.sim.mock_robot import MockG1
-from g1_control.sim.robot_endpoint import RobotEndpoint
+from g1_control.hardware.links.can_bus import CanLink
 from g1_control.hardware.links.serial_port import SerialLink, open_pty_pair
+from g1_control.hardware.unitree.conversions import motor_command_to_lowcmd
 from g1_control.hardware.unitree.messages import LowState, verify_crc
 from g1_control.robot import g1
+from g1_control.sim.mock_robot import MockG1
+from g1_control.sim.robot_endpoint import RobotEndpoint
 from g1_control.types import MotorCommand
 
 RATE_HZ = 200.0  # byte links run at bench rates; the stream logic is the DDS one

@@ -25,10 +25,10 @@ from g1_control.errors import (
 )
 from g1_control.hardware.dds_backend import UnitreeDDSBackend
 from g1_control.hardware.links.dds import DdsLink, cyclone_config
-from g1_control.sim.mock_robot import MockG1
 from g1_control.hardware.unitree.motion_service import MotionServiceEmulator
-from g1_control.sim.robot_endpoint import RobotEndpoint
 from g1_control.robot import g1
+from g1_control.sim.mock_robot import MockG1
+from g1_control.sim.robot_endpoint import RobotEndpoint
 from g1_control.types import MotorCommand
 
 INTERFACE, DOMAIN = "lo", 1

@@ -25,8 +25,8 @@ if "unitree_sdk2py" not in sys.modules:
     _pkg.__path__ = list(_spec.submodule_search_locations)
     sys.modules["unitree_sdk2py"] = _pkg
 
-from unitree_sdk2py.idl.unitree_api.msg import dds_ as api
-from unitree_sdk2py.idl.unitree_hg.msg import dds_ as hg
+from unitree_sdk2py.idl.unitree_api.msg import dds_ as api  # noqa: E402  (after the package stub above)
+from unitree_sdk2py.idl.unitree_hg.msg import dds_ as hg  # noqa: E402
 
 __all__ = ["api", "crc32_bitwise", "hg", "official_crc"]
 

@@ -4,6 +4,7 @@ from test_ik_frame_task import random_configuration
 
 from g1_control.ik.configuration import Configuration, foot_contact_points
 from g1_control.ik.limits import GroundLimit
+from g1_control.motion.objects import ObjectShape
 from g1_control.robot import g1
 
 
@@ -40,9 +41,8 @@ def test_rows_are_the_jacobian_of_the_point_heights():
     np.testing.assert_allclose(rows, fd, atol=2e-6)
 
 
-def _box_near_left_foot(conf: Configuration, gap_m: float) -> "ObjectShape":
+def _box_near_left_foot(conf: Configuration, gap_m: float) -> ObjectShape:
     """A 20 cm box on the floor whose -x face is gap_m in front of the left foot's toe spheres."""
-    from g1_control.motion.objects import ObjectShape
 
     placement = conf.frame_placement(conf.frame_id("left_ankle_roll_link"))
     toes = max(c[0] for c, _ in foot_contact_points()["left_ankle_roll_link"])

@@ -5,9 +5,9 @@ import json
 import numpy as np
 import pytest
 
+from g1_control.generator.styles import ROLLOUT_STYLES, STYLES, style_id
 from g1_control.library.builder import LibraryConfig, build_library, cut
 from g1_control.motion.library import LibraryError, MotionLibrary
-from g1_control.generator.styles import ROLLOUT_STYLES, STYLES, style_id
 from g1_control.robot import g1
 
 

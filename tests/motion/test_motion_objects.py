@@ -7,10 +7,10 @@ from g1_control.motion.clip import MotionClip
 from g1_control.motion.edit import concatenate, slice_clip
 from g1_control.motion.exceptions import InvalidClipError, MotionFormatError
 from g1_control.motion.formats.clip_npz import read_clip_npz, write_clip_npz
-from g1_control.retarget.metrics import compute_metrics, format_table, object_hand_distances, plot_metrics
 from g1_control.motion.mirror import mirror
 from g1_control.motion.objects import ObjectShape, ObjectTrack, read_obj_vertices
 from g1_control.motion.resample import resample
+from g1_control.retarget.metrics import compute_metrics, format_table, object_hand_distances, plot_metrics
 from g1_control.robot import g1
 
 BOX = ObjectShape.box("box", (0.2, 0.15, 0.1))

@@ -4,16 +4,16 @@ import numpy as np
 import pytest
 
 from g1_control.ik.exceptions import IKError
+from g1_control.motion.exceptions import InvalidClipError, UnknownJointError
+from g1_control.motion.human import HumanMotion
+from g1_control.motion.skeletons import LAFAN1, SMPLH
+from g1_control.retarget.metrics import compute_metrics
 from g1_control.retarget.mocap import (
     MocapRetargetConfig,
     MocapRetargeter,
     frame_from_left_up,
     prepare_targets,
 )
-from g1_control.motion.exceptions import InvalidClipError, UnknownJointError
-from g1_control.motion.human import HumanMotion
-from g1_control.retarget.metrics import compute_metrics
-from g1_control.motion.skeletons import LAFAN1, SMPLH
 
 
 def demo_root(monkeypatch) -> Path:

@@ -2,9 +2,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from g1_control.sim.mock_robot import MockG1
 from g1_control.robot import g1
 from g1_control.safety import GuardedBackend, SafetyEventKind
+from g1_control.sim.mock_robot import MockG1
 from g1_control.types import MotorCommand
 
 

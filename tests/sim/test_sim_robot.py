@@ -14,11 +14,11 @@ import pytest
 
 from g1_control.errors import NetworkInterfaceError
 from g1_control.hardware.dds_backend import UnitreeDDSBackend
-from g1_control.sim.emulator import RobotEmulator
-from g1_control.sim.mock_robot import MockG1
 from g1_control.hardware.unitree.motion_service import release_motion_service
 from g1_control.robot import g1
 from g1_control.rotations import tilt_rad
+from g1_control.sim.emulator import RobotEmulator
+from g1_control.sim.mock_robot import MockG1
 from g1_control.types import MotorCommand
 
 ROOT = Path(__file__).resolve().parents[2]

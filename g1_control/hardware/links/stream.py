@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from abc import abstractmethod
 
-from g1_control.hardware.links.framing import KIND_LOWCMD, KIND_LOWSTATE, Deframer, encode_frame
 from g1_control.hardware.links.base import Link, Side
+from g1_control.hardware.links.framing import KIND_LOWCMD, KIND_LOWSTATE, Deframer, encode_frame
 
 
 class StreamLink(Link):

@@ -50,7 +50,7 @@ def read_clip_npz(path: str | Path) -> MotionClip:
     path = Path(path)
     try:
         data = np.load(path, allow_pickle=False)
-    except Exception as exc:  # noqa: BLE001 - any unreadable file becomes one named error
+    except Exception as exc:
         raise MotionFormatError(f"{path}: not a readable npz file ({exc})") from None
     with data:
         missing = [k for k in REQUIRED if k not in data.files]

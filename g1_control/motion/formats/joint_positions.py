@@ -11,10 +11,9 @@ Facts about the layouts are from holosoma_retargeting's loaders.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import pickle
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -38,7 +37,7 @@ def read_npy(path: str | Path, joint_names: tuple[str, ...] | None = None, fps: 
     path = Path(path)
     try:
         pos = np.load(path, allow_pickle=False)
-    except Exception as exc:  # noqa: BLE001
+    except Exception as exc:
         raise MotionFormatError(f"{path}: not a readable .npy array ({exc})") from None
     if pos.ndim != 3 or pos.shape[2] != 3:
         raise MotionFormatError(f"{path}: array has shape {pos.shape}; expected (T, J, 3) world joint positions")
@@ -64,7 +63,7 @@ def read_omomo_pt(path: str | Path, height_m: float | None = None) -> HumanMotio
     path = Path(path)
     try:
         raw = torch.load(path, map_location="cpu", weights_only=True)
-    except Exception as exc:  # noqa: BLE001
+    except Exception as exc:
         raise MotionFormatError(f"{path}: not a readable torch tensor file ({exc})") from None
     arr = raw.detach().cpu().numpy() if hasattr(raw, "detach") else np.asarray(raw)
     if arr.ndim != 2 or arr.shape[1] < OMOMO_JOINT_COLUMNS.stop:

@@ -26,8 +26,13 @@ import numpy as np
 
 from g1_control.errors import WbcSolveError
 from g1_control.robot import g1
-from g1_control.trackers.wbc.contacts import ROWS_PER_FOOT, FootGeometry, normal_force_bounds, wrench_constraint_rows
 from g1_control.robot.dynamics import WbcModel
+from g1_control.trackers.wbc.contacts import (
+    ROWS_PER_FOOT,
+    FootGeometry,
+    normal_force_bounds,
+    wrench_constraint_rows,
+)
 from g1_control.trackers.wbc.tasks import AccelerationTask
 
 _FREE = 1e20  # proxsuite treats bounds at or beyond this as absent

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from g1_control.errors import WbcConfigError
-from g1_control.rotations import rotation_error  # noqa: F401  (re-exported for the QP's tasks)
+from g1_control.rotations import rotation_error
 
 
 @dataclass(frozen=True)

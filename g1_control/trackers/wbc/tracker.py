@@ -24,15 +24,21 @@ import numpy as np
 
 from g1_control.errors import WbcConfigError, WbcSolveError
 from g1_control.estimation.estimator import StateEstimator
-from g1_control.rotations import quat_to_rot, yaw_of
 from g1_control.interfaces import Tracker
 from g1_control.robot import g1
-from g1_control.types import JointReference, MotorCommand, RobotState
-from g1_control.trackers.wbc import capture_point as cp
 from g1_control.robot.dynamics import WbcModel
+from g1_control.rotations import quat_to_rot, yaw_of
+from g1_control.trackers.wbc import capture_point as cp
 from g1_control.trackers.wbc.odometry import BaseOdometry
 from g1_control.trackers.wbc.qp import IdSolution, InverseDynamicsQP, QpConfig
-from g1_control.trackers.wbc.tasks import AccelerationTask, TaskGains, orientation_task, position_task, posture_task
+from g1_control.trackers.wbc.tasks import (
+    AccelerationTask,
+    TaskGains,
+    orientation_task,
+    position_task,
+    posture_task,
+)
+from g1_control.types import JointReference, MotorCommand, RobotState
 
 
 @dataclass(frozen=True)

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from g1_control.errors import WbcConfigError
-from g1_control.trackers.wbc import capture_point as cp
 from g1_control.generator.zmp_preview import ZmpPreviewController
+from g1_control.trackers.wbc import capture_point as cp
 
 
 def test_lipm_frequency_and_bad_height():

@@ -5,8 +5,8 @@ import pytest
 
 from g1_control.errors import WbcSolveError
 from g1_control.robot import description, g1
-from g1_control.trackers.wbc.contacts import FootGeometry, cop_of
 from g1_control.robot.dynamics import WbcModel
+from g1_control.trackers.wbc.contacts import FootGeometry, cop_of
 from g1_control.trackers.wbc.qp import InverseDynamicsQP, QpConfig
 from g1_control.trackers.wbc.tasks import AccelerationTask, TaskGains, posture_task
 

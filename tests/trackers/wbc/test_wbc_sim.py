@@ -4,7 +4,6 @@ and walking without a fall, with tracking figures held to bounds measured when t
 
 import numpy as np
 
-from g1_control.generator import scripted as R
 from g1_control.tools.wbc_evaluate import run_wbc
 from g1_control.trackers.wbc.tracker import WholeBodyTracker
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from g1_control.errors import WbcConfigError
-from g1_control.sim.mujoco_backend import MujocoBackend
 from g1_control.generator import scripted as R
+from g1_control.sim.mujoco_backend import MujocoBackend
 from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
 
 

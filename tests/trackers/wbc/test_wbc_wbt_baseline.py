@@ -2,9 +2,9 @@
 
 import numpy as np
 
+from g1_control.generator import scripted as R
 from g1_control.robot import g1
 from g1_control.sim.mujoco_backend import MujocoBackend
-from g1_control.generator import scripted as R
 from g1_control.trackers.wbt import WbtPolicyTracker
 
 
