@@ -12,7 +12,7 @@ every step also has a timeout (`timeout_s`, or a default from ProgramRunner's Ru
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import MISSING, dataclass, fields
 from typing import Any, ClassVar
 
 from g1_control.library.styles import STYLES
@@ -65,7 +65,7 @@ class Step:
         out: dict[str, Any] = {"kind": self.kind}
         for f in fields(self):  # type: ignore[arg-type]
             value = getattr(self, f.name)
-            if value == f.default or value is None:
+            if value is None or (f.default is not MISSING and value == f.default):
                 continue
             if isinstance(value, Step):
                 value = value.to_dict()
@@ -104,8 +104,6 @@ class Step:
 
 
 def _required(f) -> bool:
-    from dataclasses import MISSING
-
     return f.default is MISSING and f.default_factory is MISSING  # type: ignore[misc]
 
 
@@ -281,7 +279,7 @@ class Stand(Step):
     """Stand still (wait) for a time."""
 
     kind: ClassVar[str] = "stand"
-    duration_s: float = 0.0
+    duration_s: float
 
     def _check(self, where: str) -> None:
         _positive(where, "duration_s", self.duration_s)
@@ -300,7 +298,7 @@ class Style(Step):
     (completes at once). Inside a Parallel: held while the main step runs (no duration)."""
 
     kind: ClassVar[str] = "style"
-    name: str = "default"
+    name: str
     duration_s: float | None = None
 
     def _check(self, where: str) -> None:
@@ -391,7 +389,7 @@ class Pick(Step):
     """Pick up a named object (the execution layer walks to it, grasps and lifts)."""
 
     kind: ClassVar[str] = "pick"
-    object: str = ""
+    object: str
     hands: str = "both"
     timeout_s: float | None = None
 
@@ -414,7 +412,7 @@ class Place(Step):
     without a target: put it down in front of the robot."""
 
     kind: ClassVar[str] = "place"
-    object: str = ""
+    object: str
     target: str | None = None
     timeout_s: float | None = None
 
@@ -436,7 +434,7 @@ class StepUp(Step):
     """Step up onto a named platform."""
 
     kind: ClassVar[str] = "step_up"
-    platform: str = ""
+    platform: str
     timeout_s: float | None = None
 
     def _check(self, where: str) -> None:
@@ -479,8 +477,8 @@ class Parallel(Step):
     table"). The main step decides completion; the others last as long as it does."""
 
     kind: ClassVar[str] = "parallel"
-    main: Step = field(default_factory=Stand)
-    alongside: list[Step] = field(default_factory=list)
+    main: Step
+    alongside: list[Step]
 
     def _check(self, where: str) -> None:
         if not isinstance(self.main, LOCOMOTION):
@@ -510,8 +508,8 @@ class Repeat(Step):
     """Run `steps` `count` times in all."""
 
     kind: ClassVar[str] = "repeat"
-    count: int = 2
-    steps: list[Step] = field(default_factory=list)
+    count: int
+    steps: list[Step]
 
     def _check(self, where: str) -> None:
         if isinstance(self.count, bool) or not isinstance(self.count, int) or not 1 <= self.count <= MAX_REPEAT:
