@@ -311,7 +311,7 @@ class Style(Step):
 
     def describe(self) -> str:
         if self.duration_s is None:
-            return f"style {self.name}"
+            return f"style {self.name} from now on"
         return f"{self.name} for {_fmt(self.duration_s)} s"
 
 
@@ -500,7 +500,8 @@ class Parallel(Step):
         return "main"
 
     def describe(self) -> str:
-        return self.main.describe() + ", while: " + "; ".join(s.describe() for s in self.alongside)
+        side = (s.name if isinstance(s, Style) else s.describe().replace(" from now on", "") for s in self.alongside)
+        return self.main.describe() + ", while: " + ", ".join(side)
 
 
 @dataclass

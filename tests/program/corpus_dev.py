@@ -288,7 +288,7 @@ DEV = [
     # --- step up / down ---------------------------------------------------------------------------------
     ("step up onto the platform", [up("platform")]),
     ("step onto the platform", [up("platform")]),
-    ("climb onto the platform", [up("platform")]),
+    ("climb up onto the platform", [up("platform")]),
     ("get on the platform", [up("platform")]),
     ("climb the platform", [up("platform")]),
     ("step down", [down()]),

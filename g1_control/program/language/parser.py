@@ -21,7 +21,7 @@ import math
 import re
 from dataclasses import dataclass, field
 
-from g1_control.program.exceptions import InstructionError, UnknownWordError
+from g1_control.program.exceptions import InstructionError, ProgramError, UnknownWordError
 from g1_control.program.language import lexicon as L
 from g1_control.program.program import Program
 from g1_control.program.steps import (
@@ -145,7 +145,10 @@ class InstructionParser:
         if not steps:
             raise InstructionError(f'no action in "{text.strip()}": say what to do, e.g. "walk forward two meters"')
         program = Program(steps, text.strip())
-        return program.validate()
+        try:
+            return program.validate()
+        except ProgramError as exc:  # words that parse into a value the program refuses
+            raise InstructionError(f"\"{text.strip()}\": {exc}") from None
 
     # --- stage 1: words ---------------------------------------------------------------------------
     def _check_words(self, words: list[str]) -> None:
@@ -154,10 +157,10 @@ class InstructionParser:
                 continue
             from rapidfuzz import fuzz, process
 
-            found = process.extract(w, self._suggest_from, scorer=fuzz.ratio, limit=3, score_cutoff=55)
+            found = process.extract(w, self._suggest_from, scorer=fuzz.ratio, limit=3, score_cutoff=60)
             sugg = tuple(s for s, _, _ in found)
             lo, hi = max(0, i - 4), min(len(words), i + 5)
-            context = ("... " if lo else "") + " ".join(words[lo:hi]) + (" ..." if hi < len(words) else "")
+            context = ("... " if lo else "") + _join(words[lo:hi]) + (" ..." if hi < len(words) else "")
             hint = f"closest known words: {', '.join(sugg)}" if sugg else "no known word is close"
             raise UnknownWordError(f"unknown word '{w}' in \"{context}\"; {hint}", w, sugg)
 
@@ -191,7 +194,7 @@ class InstructionParser:
                 out.append(Tok("qty", (value * f, dim), i, j))
             elif j < n and words[j] in ("times", "time"):
                 if value != int(value) or value < 1:
-                    raise InstructionError(f"\"{' '.join(words[i:j + 1])}\": a count must be a whole number >= 1")
+                    raise InstructionError(f"\"{_join(words[i:j + 1])}\": a count must be a whole number >= 1")
                 out.append(Tok("count", int(value), i, j + 1))
                 j += 1
             else:
@@ -676,10 +679,10 @@ class _State:
         self.last_sentence = (0, 0)
 
     def text(self, t: Tok) -> str:
-        return " ".join(self.words[t.i0:t.i1])
+        return _join(self.words[t.i0:t.i1])
 
     def span(self, toks: list[Tok]) -> str:
-        return " ".join(self.words[toks[0].i0:toks[-1].i1]) if toks else ""
+        return _join(self.words[toks[0].i0:toks[-1].i1]) if toks else ""
 
     def resolve(self, name: str, t: Tok) -> str:
         if name == "IT":
@@ -688,6 +691,14 @@ class _State:
             return self.last_place
         self.last_place = name
         return name
+
+
+def _join(words: list[str]) -> str:
+    """Words back into text, punctuation attached to the word before it."""
+    out = ""
+    for w in words:
+        out += w if (w in SENTENCE_ENDS or w == ",") or not out else " " + w
+    return out
 
 
 def _is_verb(t: Tok) -> bool:
