@@ -438,5 +438,14 @@ class ProgramRunner:
         return Command(style=self.style, pelvis_height_m=self.pelvis_height_m)
 
 
-__all__ = ["GoalRequest", "ProgramProgress", "ProgramRunner", "RunnerConfig", "StepOutcome", "wrap_angle",
-           "COMPLETED", "TIMED_OUT", "FAILED"]
+__all__ = [
+    "COMPLETED",
+    "FAILED",
+    "TIMED_OUT",
+    "GoalRequest",
+    "ProgramProgress",
+    "ProgramRunner",
+    "RunnerConfig",
+    "StepOutcome",
+    "wrap_angle",
+]

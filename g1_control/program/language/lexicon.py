@@ -11,10 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-FILLERS = frozenset("""
-please kindly the your you yourself robot now just ok okay hey also again carefully still can could would
-my its
-""".split())
+FILLERS = frozenset(["please", "kindly", "the", "your", "you", "yourself", "robot", "now", "just", "ok", "okay", "hey", "also", "again", "carefully", "still", "can", "could", "would", "my", "its"])
 """Dropped before anything else ("please", "the", "robot", ...)."""
 
 ARTICLES = frozenset({"a", "an"})

@@ -55,7 +55,7 @@ LOCOMOTION_VERBS = frozenset({"WALK", "TURN", "FACE", "WAIT"})
 
 
 class Tok:
-    __slots__ = ("kind", "value", "i0", "i1")
+    __slots__ = ("i0", "i1", "kind", "value")
 
     def __init__(self, kind: str, value, i0: int, i1: int) -> None:
         self.kind, self.value, self.i0, self.i1 = kind, value, i0, i1
@@ -705,7 +705,7 @@ def _is_verb(t: Tok) -> bool:
     if t.kind != "w":
         return False
     v = t.value
-    return v in MAIN_VERBS or v == "REPEAT" or v.startswith("STYLE:") or v.startswith("HEIGHT:")
+    return v in MAIN_VERBS or v == "REPEAT" or v.startswith(("STYLE:", "HEIGHT:"))
 
 
 def _main_verb(s: _Slots) -> str | None:
