@@ -121,11 +121,11 @@ class RunnerConfig:
     min_speed_mps: float = 0.08
     """Walks slow down as they near the end (speed = gain x remaining) but not below this."""
     slowdown_gain_per_s: float = 1.2
-    distance_tolerance_m: float = 0.03
-    place_tolerance_m: float = 0.08
+    distance_tolerance_m: float = 0.02
+    place_tolerance_m: float = 0.05
     min_yaw_rate_radps: float = 0.12
     turn_gain_per_s: float = 2.0
-    heading_tolerance_rad: float = math.radians(2.0)
+    heading_tolerance_rad: float = math.radians(1.5)
     heading_hold_gain_per_s: float = 1.5
     """Walks steer the heading back to their start (or target) heading with this gain."""
     timeout_factor: float = 2.0
