@@ -1,0 +1,1 @@
+"""English instruction -> behaviour Program (rule-based): lexicon tables, parser, latency bench."""
