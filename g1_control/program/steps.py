@@ -15,7 +15,7 @@ import math
 from dataclasses import MISSING, dataclass, fields
 from typing import Any, ClassVar
 
-from g1_control.library.styles import STYLES
+from g1_control.generator.styles import STYLES
 from g1_control.program.exceptions import ProgramError
 
 DIRECTIONS = ("forward", "backward", "left", "right")
@@ -293,7 +293,7 @@ class Stand(Step):
 
 @dataclass
 class Style(Step):
-    """An upper-body style (g1_control.library.styles.STYLES). With a duration: stand and hold it
+    """An upper-body style (g1_control.generator.styles.STYLES). With a duration: stand and hold it
     that long, then return to the style before. Without: switch to it for the steps that follow
     (completes at once). Inside a Parallel: held while the main step runs (no duration)."""
 

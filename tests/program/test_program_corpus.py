@@ -50,7 +50,7 @@ def test_corpus_size_and_split():
 
 
 def test_expected_programs_are_valid_programs():
-    for text, expected in DEV + HELD_OUT:
+    for _text, expected in DEV + HELD_OUT:
         if expected is not None:
             Program.from_dict(expected)  # raises ProgramError on a bad expectation
 
