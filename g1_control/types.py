@@ -9,6 +9,7 @@ the ground, y left, z up). Nothing here does I/O or math beyond validation.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import Enum
 
 import numpy as np
 
@@ -20,10 +21,27 @@ def _zeros() -> np.ndarray:
     return np.zeros(NUM_JOINTS)
 
 
-BUTTONS = frozenset(
-    {"start", "stop", "estop", "run", "style_next", "style_prev", "policy_switch", "damp"}
-)
-"""Operator buttons a Command may carry (edges: present on the tick they were pressed)."""
+class Button(str, Enum):
+    """Operator buttons a Command may carry (edges: present on the tick they were pressed). A str
+    enum: `"stop" in command.buttons` and `Button.STOP in command.buttons` are the same test."""
+
+    START = "start"
+    """Ramp to the default pose (g1 deploy)."""
+    STOP = "stop"
+    """Stop: damping, for good (g1 deploy)."""
+    ESTOP = "estop"
+    """Emergency stop: damping at once, from any state."""
+    RUN = "run"
+    """Hand the robot to the tracker (g1 deploy)."""
+    STYLE_NEXT = "style_next"
+    STYLE_PREV = "style_prev"
+    POLICY_SWITCH = "policy_switch"
+    DAMP = "damp"
+    """Damping now (the remote's select)."""
+
+
+BUTTONS = frozenset(b.value for b in Button)
+"""Every button name a Command may carry."""
 
 
 @dataclass

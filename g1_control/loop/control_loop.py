@@ -16,7 +16,7 @@ from g1_control.loop.scheduler import Scheduler, Stage
 from g1_control.robot import g1
 from g1_control.rotations import quat_to_rot, tilt_rad, yaw_of
 from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter
-from g1_control.types import Command, RobotState
+from g1_control.types import Button, Command, RobotState
 
 
 @dataclass
@@ -168,7 +168,7 @@ class ControlLoop:
                 self._event("invalid_command", str(exc))
             self.command = self.safety.vet_input(None, now)
             return
-        if "damp" in command.buttons:
+        if Button.DAMP in command.buttons:
             self.safety.estop("damp pressed on the operator input", now)
         self.command = self.safety.vet_input(command, now)
 
