@@ -100,14 +100,15 @@ def _apply_cli(launch: LaunchFile, options: DeployOptions) -> None:
                               f"'{LOOPBACK}' (or a virtual CAN bus). On a robot the operator presses start and run")
 
 
-def _open_input(launch: LaunchFile, backend, command_ranges):
+def _open_input(launch: LaunchFile, backend, spec):
     """(device, None) or (None, why it cannot be opened)."""
-    from g1_control.launch.builder import timeline_of
+    from g1_control.launch.builder import command_limits, timeline_of
     from g1_control.launch.inputs import make_input
 
     kind = launch.input.type
+    limits = command_limits(launch, spec.command_limits if spec is not None else None)
     try:
-        device = make_input(launch, timeline_of(launch), command_ranges=command_ranges,
+        device = make_input(launch, timeline_of(launch), limits=limits,
                             state_source=backend.read_state if backend is not None else None)
     except G1ControlError as exc:
         return None, f"{kind} cannot be opened: {exc}"
@@ -146,7 +147,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             pf.check_robot(backend, launch, policy_variant)
         else:
             pf.not_run(ROBOT_CHECKS, "no link to the robot")
-        device, open_error = _open_input(launch, backend, spec.command_ranges if spec else None)
+        device, open_error = _open_input(launch, backend, spec)
         if launch.input.type == "unitree_remote" and pf.results["variant"].status == "not run":
             pf.not_run(["estop_input"], "the remote's bytes ride in the robot's LowState_, and none arrived")
         else:

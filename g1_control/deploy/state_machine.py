@@ -24,7 +24,7 @@ from g1_control.launch.schema import DeployConfig
 from g1_control.safety import SafetyFilter
 from g1_control.teleop.gamepad_script import ScriptedGamepad
 from g1_control.teleop.scripted import ScriptedInput
-from g1_control.types import Button, Command, EstimatedState, JointReference, MotorCommand, RobotState
+from g1_control.types import Button, Command, CommandLimits, EstimatedState, JointReference, MotorCommand, RobotState
 
 log = logging.getLogger("g1_control.deploy")
 
@@ -118,6 +118,10 @@ class DeployTracker(Tracker):
     @property
     def policy_command(self) -> np.ndarray | None:
         return self.policy.policy_command
+
+    @property
+    def command_limits(self) -> CommandLimits | None:
+        return self.policy.command_limits
 
     def reset(self, state: RobotState | None = None) -> None:
         """Start over in zero torque (a deploy runs the machine once; reset is for the loop's reset)."""

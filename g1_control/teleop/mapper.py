@@ -10,11 +10,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.layouts import STICK
 from g1_control.teleop.mapping import MappingConfig
 from g1_control.teleop.snapshot import InputSnapshot
-from g1_control.types import BUTTONS, Button, Command
+from g1_control.types import BUTTONS, Button, Command, CommandLimits
 
 _STOPPING_ACTIONS = frozenset({Button.ESTOP, Button.DAMP, Button.STOP, "zero_velocity"})
 

@@ -23,6 +23,7 @@ from g1_control.config import from_dict
 from g1_control.errors import PolicyMismatchError
 from g1_control.robot import g1
 from g1_control.trackers.observation import ObservationSpec
+from g1_control.types import CommandLimits
 
 GAIN_RTOL = 0.02
 """Gains in a policy's metadata may differ from the robot's by this fraction (rounding)."""
@@ -126,6 +127,13 @@ class PolicySpec:
     phase: PhaseSpec | None
     command_ranges: dict[str, tuple[float, float]]
     metadata: dict[str, str]
+
+    @property
+    def command_limits(self) -> CommandLimits:
+        """The command range the policy was trained on (holosoma: lin_vel_x, lin_vel_y, ang_vel_yaw)."""
+        r = self.command_ranges
+        return CommandLimits(r.get("lin_vel_x", (-1.0, 1.0)), r.get("lin_vel_y", (-1.0, 1.0)),
+                             r.get("ang_vel_yaw", (-1.0, 1.0)))
 
     @property
     def joint_index(self) -> np.ndarray:
