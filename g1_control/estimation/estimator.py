@@ -93,6 +93,7 @@ class StateEstimator:
         est.base_quat_wxyz = quat.copy()
         est.base_angvel_b_radps = state.imu_gyro_radps.copy()
         est.stance_weight = weights
+        est.pelvis_height_m = -float(min(heights[0], heights[1]))
         yaw = est.yaw_rad = yaw_of(quat)
         c, s = np.cos(yaw), np.sin(yaw)
         v = est.base_linvel_w_mps

@@ -31,7 +31,7 @@ def plot_run(log: dict[str, np.ndarray], result, out: Path) -> None:
     for seg in result.segments:
         for ax in axes:
             ax.axvline(seg.start_s, color="0.85", lw=0.8, zorder=0)
-    status = "FELL" if result.fell else "no fall"
+    status = "no fall" if result.fall is None else f"FELL at {result.fall['t_s']:.1f} s"
     fig.suptitle(f"{result.name}: {status}, real-time factor {result.real_time_factor:.1f}x")
     fig.tight_layout()
     fig.savefig(out, dpi=90)

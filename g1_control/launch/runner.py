@@ -61,6 +61,8 @@ class RunResult:
     run_dir: Path | None = None
     video: str | None = None
     extra: dict = field(default_factory=dict)
+    fall: dict | None = None
+    """The first fall (g1_control/safety/fall.py): {t_s, kind, detail}; None when the robot stayed up."""
 
     @property
     def real_time_factor(self) -> float:
@@ -194,8 +196,10 @@ def _result(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], wall
     if valid.sum() > 10:
         err = log["velocity_est"][valid, :2] - log["velocity_true"][valid, :2]
         est_rms = float(np.sqrt((err**2).sum(axis=1).mean()))
+    fall = loop.fall
     return RunResult(
-        name=launch.name, fell=loop.fell, duration_s=loop.time_s, wall_s=wall,
+        name=launch.name, fell=fall is not None, fall=dataclasses.asdict(fall) if fall else None,
+        duration_s=loop.time_s, wall_s=wall,
         segments=segment_results(loop, segments), timings=loop.scheduler.report(),
         deadline_misses=loop.scheduler.deadline_misses, overruns=loop.scheduler.overruns,
         events=[dataclasses.asdict(e) for e in loop.events], estimator_rms_mps=est_rms, chain=dict(loop.chain),
@@ -237,9 +241,14 @@ def summary_dict(result: RunResult) -> dict:
     return d
 
 
+def fall_text(fall: dict | None) -> str:
+    """'no fall', or 'FELL at 12.34 s: left_knee_link on the ground'."""
+    return "no fall" if fall is None else f"FELL at {fall['t_s']:.2f} s: {fall['detail']}"
+
+
 def format_summary(result: RunResult) -> str:
     lines = [
-        (f"run '{result.name}': {'FELL' if result.fell else 'no fall'}; {result.duration_s:.1f} s simulated in "
+        (f"run '{result.name}': {fall_text(result.fall)}; {result.duration_s:.1f} s simulated in "
         f"{result.wall_s:.1f} s wall (real-time factor {result.real_time_factor:.1f}x)"),
         "",
         f"{'segment':<12} {'time (s)':>11}   {'commanded vx vy wz':>22}   {'achieved vx vy wz':>22}   error %",

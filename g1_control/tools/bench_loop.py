@@ -39,7 +39,7 @@ def physics_only_seconds(seconds: float, physics_dt_s: float) -> float:
 
 
 def main(args) -> int:
-    from g1_control.launch.runner import run
+    from g1_control.launch.runner import fall_text, run
 
     seconds = float(args.seconds)
     launch = bench_launch(seconds)
@@ -48,8 +48,9 @@ def main(args) -> int:
     rtf = result.real_time_factor
     print(f"g1 bench loop: {seconds:.0f} s simulated, physics {1 / launch.backend.physics_dt_s:.0f} Hz, "
           f"low-level {launch.rates.lowlevel_hz:.0f} Hz, tracker {launch.rates.tracker_hz:.0f} Hz")
-    print(f"  full loop:     {result.wall_s:7.2f} s wall  -> real-time factor {rtf:6.1f}x  (goal >= 20x)"
-          f"{'  FELL' if result.fell else ''}")
+    print(f"  full loop:     {result.wall_s:7.2f} s wall  -> real-time factor {rtf:6.1f}x  (goal >= 20x)")
+    if result.fell:
+        print(f"  {fall_text(result.fall)}")
     print(f"  physics only:  {baseline:7.2f} s wall  -> real-time factor {seconds / baseline:6.1f}x  (baseline)")
     print(f"  loop / physics-only wall time: {result.wall_s / baseline:.2f}x")
     print(f"\n  {'stage':<12} {'calls':>7} {'p50 us':>8} {'p99 us':>8} {'mean us':>8}")
@@ -59,5 +60,5 @@ def main(args) -> int:
         Path(args.json).write_text(json.dumps({
             "seconds": seconds, "loop_wall_s": result.wall_s, "real_time_factor": rtf,
             "physics_only_wall_s": baseline, "ratio_loop_to_physics": result.wall_s / baseline,
-            "stages": result.timings, "fell": result.fell}, indent=2))
-    return 0
+            "stages": result.timings, "fell": result.fell, "fall": result.fall}, indent=2))
+    return 1 if result.fell else 0
