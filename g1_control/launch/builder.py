@@ -52,7 +52,8 @@ def make_tracker(launch: LaunchFile) -> Tracker:
         from g1_control.trackers.locomotion import LocomotionPolicyTracker, VelocityCorrectionConfig
         from g1_control.trackers.policy_spec import load_spec
 
-        return LocomotionPolicyTracker(load_spec(cfg.policy), VelocityCorrectionConfig(enabled=cfg.velocity_correction))
+        return LocomotionPolicyTracker(load_spec(cfg.policy), VelocityCorrectionConfig(enabled=cfg.velocity_correction),
+                                       envelope_limits=cfg.envelope_limits)
     if cfg.type == "wbc":
         from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
 

@@ -1,10 +1,12 @@
-"""Velocity-command locomotion policy as a Tracker, with an upper-body override and closed-loop
-velocity correction.
+"""Velocity-command locomotion policy as a Tracker: styled walking, a planned pelvis height and
+closed-loop velocity correction.
 
 The reference's root velocity (heading frame) is the command. When the reference sets
-`upper_body_override`, waist and arm targets come from the reference while the policy keeps
-balancing with the legs. The correction closes the loop on the estimated base velocity, because
-the bare holosoma policies reach only ~80 % of the commanded speed (FACTS.md).
+`upper_body_override`, the plan drives arms and waist yaw while the policy, observing the upper
+body it was trained with, keeps balancing (g1_control/trackers/styled.py). A reference
+`pelvis_height_m` crouches the legs under the policy. The correction closes the loop on the
+estimated base velocity, because the bare holosoma policies reach only ~80 % of the commanded
+speed (FACTS.md).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from g1_control.rotations import projected_gravity
 from g1_control.trackers.observation import ObservationBuilder
 from g1_control.trackers.onnx_runner import OnnxRunner
 from g1_control.trackers.policy_spec import PolicySpec
+from g1_control.trackers.styled import LEGS, Crouch, PlannedUpperBody
 from g1_control.types import CommandLimits, EstimatedState, JointReference, MotorCommand, RobotState
 
 
@@ -28,7 +31,11 @@ class VelocityCorrectionConfig:
 
     policy_cmd = ff * cmd + ki * integral(cmd - v_est), on vx, vy and wz, clamped to the
     policy's command ranges. The feedforward comes from the policy's measured speed ratio; the
-    integral removes what is left. The integral resets while the command is near zero.
+    integral removes what is left, on every axis while the robot walks: an axis commanded zero is
+    held at zero (a styled pose that shifts the centre of mass drifted 0.26 m/s forward on a
+    sideways command, measured). The integrals reset while the whole command is near zero (the
+    policy then stands); each starts `settle_s` after the robot starts walking or its axis'
+    command starts or stops.
     """
 
     enabled: bool = True
@@ -36,6 +43,9 @@ class VelocityCorrectionConfig:
     ki: tuple[float, float, float] = (2.0, 2.0, 1.0)
     integral_limit: tuple[float, float, float] = (0.5, 0.7, 0.4)
     velocity_filter_tau_s: float = 0.1
+    settle_s: float = 1.0
+    """The gait's first step goes the wrong way (-0.06 m/s sideways on a vy command); integrating
+    it wound the integral up (vy 0.2 overshot by 17 %, measured), so each axis waits this long."""
 
 
 class VelocityCorrector:
@@ -47,10 +57,15 @@ class VelocityCorrector:
         self._limit = np.array(config.integral_limit)
         self.integral = np.zeros(3)
         self.v_filtered = np.zeros(3)
+        self.moving_s = np.zeros(3)
+        """How long each axis has been corrected in its current state (commanded or held at zero)."""
+        self._was_moving = np.zeros(3, dtype=bool)
 
     def reset(self) -> None:
         self.integral[:] = 0.0
         self.v_filtered[:] = 0.0
+        self.moving_s[:] = 0.0
+        self._was_moving[:] = False
 
     def __call__(self, cmd: np.ndarray, v_est: np.ndarray | None) -> np.ndarray:
         """cmd and v_est are (vx, vy, wz) in the heading frame."""
@@ -59,24 +74,42 @@ class VelocityCorrector:
         alpha = self.dt_s / (self.config.velocity_filter_tau_s + self.dt_s)
         self.v_filtered += alpha * (v_est - self.v_filtered)
         moving = np.abs(cmd) > 0.05
-        self.integral = np.where(moving, self.integral + (cmd - self.v_filtered) * self.dt_s * self._ki, 0.0)
+        if not moving.any():
+            self.integral[:] = 0.0
+            self.moving_s[:] = 0.0
+            self._was_moving[:] = False
+            return cmd
+        # An axis whose command starts or stops starts over.
+        restart = moving != self._was_moving
+        self._was_moving[:] = moving
+        self.integral[restart] = 0.0
+        self.moving_s[restart] = 0.0
+        self.moving_s += self.dt_s
+        settled = self.moving_s > self.config.settle_s
+        self.integral += settled * (cmd - self.v_filtered) * (self.dt_s * self._ki)
         np.clip(self.integral, -self._limit, self._limit, out=self.integral)
-        return np.where(moving, self._ff * cmd + self.integral, cmd)
+        return self._ff * cmd + self.integral
 
 
 class LocomotionPolicyTracker(Tracker):
     """Runs a velocity-command locomotion policy (e.g. holosoma's) at spec.rate_hz."""
 
-    def __init__(self, spec: PolicySpec, correction: VelocityCorrectionConfig | None = None):
+    def __init__(self, spec: PolicySpec, correction: VelocityCorrectionConfig | None = None, *,
+                 envelope_limits: bool = True):
         if spec.kind != "locomotion":
             raise ValueError(f"policy '{spec.name}' is a {spec.kind} policy, not a locomotion policy")
         self.spec = spec
+        self.envelope_limits = envelope_limits
         self.dt_s = 1.0 / spec.rate_hz
         self.runner = OnnxRunner(spec.onnx_path, spec.input_name)
         self.obs = ObservationBuilder(spec.observation)
         self.corrector = VelocityCorrector(correction or VelocityCorrectionConfig(), self.dt_s)
         self.velocity_estimate: np.ndarray | None = None
         """(vx, vy, wz) in the heading frame, from the state estimator (observe())."""
+        self.height_estimate: float | None = None
+        """Pelvis height above the ground from the state estimator (observe())."""
+        self.upper_body = PlannedUpperBody(spec.default_q_rad, self.dt_s)
+        self.crouch = Crouch(spec.default_q_rad, self.dt_s)
         self._ranges = np.array([
             spec.command_ranges.get("lin_vel_x", (-1.0, 1.0)),
             spec.command_ranges.get("lin_vel_y", (-1.0, 1.0)),
@@ -87,10 +120,13 @@ class LocomotionPolicyTracker(Tracker):
         self._phase = np.zeros(2)
         self._standing = True
         self._command = MotorCommand(q_rad=spec.default_q_rad.copy(), kp=spec.kp.copy(), kd=spec.kd.copy())
-        self._values: dict[str, np.ndarray] = {}
+        self._dof_pos = np.zeros(g1.NUM_JOINTS)
+        self._dof_vel = np.zeros(g1.NUM_JOINTS)
+        self._values: dict[str, np.ndarray] = {"dof_pos": self._dof_pos, "dof_vel": self._dof_vel}
 
     def observe(self, estimate: EstimatedState) -> None:
         self.velocity_estimate = estimate.heading_velocity
+        self.height_estimate = estimate.pelvis_height_m
 
     @property
     def policy_command(self) -> np.ndarray:
@@ -98,12 +134,18 @@ class LocomotionPolicyTracker(Tracker):
 
     @property
     def command_limits(self) -> CommandLimits:
+        """What this tracker was measured to deliver (the spec's envelope, `g1 bench envelope`), or
+        the policy's trained range when asked (envelope_limits False) or when none was measured."""
+        if self.envelope_limits and self.spec.envelope is not None:
+            return self.spec.envelope.command_limits
         return self.spec.command_limits
 
     def reset(self, state: RobotState | None = None) -> None:
         self.last_action[:] = 0.0
         self.corrector.reset()
         self.obs.reset()
+        self.upper_body.reset()
+        self.crouch.reset()
         self._standing = True
         if self.spec.phase is not None:
             self._phase = np.full(2, np.pi)
@@ -126,6 +168,20 @@ class LocomotionPolicyTracker(Tracker):
         cmd = np.clip(cmd, self._ranges[:, 0], self._ranges[:, 1])
         self.last_policy_command = cmd
         self._advance_phase(cmd)
+        styled = reference.upper_body_override
+        crouch = self.crouch
+        crouch.update(reference.pelvis_height_m, self.height_estimate)
+        # What the policy observes: its joints, legs shifted back by the crouch, the upper body
+        # as it was trained to see it when the plan drives it.
+        dof_pos, dof_vel = self._dof_pos, self._dof_vel
+        np.subtract(state.q_rad, self.spec.default_q_rad, out=dof_pos)
+        dof_pos -= crouch.offset
+        dof_vel[:] = state.dq_radps
+        if styled:
+            self.upper_body.begin(reference.q_rad)
+            self.upper_body.observation(dof_pos, dof_vel)
+        else:
+            self.upper_body.reset()
         v = self._values
         v["actions"] = self.last_action
         v["base_ang_vel"] = state.imu_gyro_radps
@@ -133,15 +189,16 @@ class LocomotionPolicyTracker(Tracker):
         v["command_lin_vel"] = cmd[0:2]
         v["cos_phase"] = np.cos(self._phase)
         v["sin_phase"] = np.sin(self._phase)
-        v["dof_pos"] = state.q_rad - self.spec.default_q_rad
-        v["dof_vel"] = state.dq_radps
         v["projected_gravity"] = projected_gravity(state.imu_quat_wxyz)
         action = self.runner(self.obs.build(v))
         np.clip(action, -self.spec.action_clip, self.spec.action_clip, out=action)
         self.last_action = action.astype(float)
         out = self._command
-        out.q_rad[:] = self.spec.default_q_rad + self.spec.action_scale * self.last_action
-        if reference.upper_body_override:
-            ub = list(g1.UPPER_BODY_JOINTS)
-            out.q_rad[ub] = reference.q_rad[ub]
+        np.multiply(self.spec.action_scale, self.last_action, out=out.q_rad)
+        out.q_rad += self.spec.default_q_rad
+        out.q_rad[LEGS] += crouch.offset[LEGS]
+        out.dq_radps[:] = 0.0
+        out.tau_nm[:] = 0.0
+        if styled:
+            self.upper_body.command(out, state.imu_quat_wxyz, state.q_rad)
         return out
