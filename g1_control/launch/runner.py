@@ -23,10 +23,12 @@ import yaml
 from g1_control.launch.builder import build_loop, make_sim_backend, timeline_of
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.control_loop import ControlLoop
+from g1_control.robot import g1
 from g1_control.teleop.scripted import Segment
 
 STEADY_STATE_SKIP_S = 2.0
 """Time after a segment starts before its velocity counts as steady state."""
+UPPER_BODY = list(g1.UPPER_BODY_JOINTS)
 
 
 @dataclass
@@ -36,6 +38,9 @@ class SegmentResult:
     end_s: float
     commanded: tuple[float, float, float]
     achieved: tuple[float, float, float]
+    upper_body_rms_rad: float | None = None
+    """Waist and arm joints, measured vs the tracker's reference posture (the plan after the IK),
+    RMS over the same steady-state window; None without a reference."""
 
     def error_pct(self) -> tuple[float | None, float | None, float | None]:
         """Relative error per axis where the command is meaningfully non-zero."""
@@ -91,8 +96,6 @@ def upper_body_rms_by_style(log: dict[str, np.ndarray], window: np.ndarray | Non
     """Waist and arm joints as measured vs the tracker's reference posture (the plan after the IK),
     per operator style: RMS (rad) over the ticks in `window`, skipping the first `settle_s` after each
     style change (the arms are still moving to the new pose)."""
-    from g1_control.robot import g1
-
     ids, t = log["style_id"], log["t_s"]
     if window is None:
         window = np.ones(len(t), dtype=bool)
@@ -128,8 +131,13 @@ def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentR
         end = start + seg.duration_s
         window = (t >= start + min(STEADY_STATE_SKIP_S, seg.duration_s / 2)) & (t < end)
         mean = achieved[window].mean(axis=0) if window.any() else np.full(3, np.nan)
+        ub = None
+        rows = window & ~np.isnan(log["q_ref_rad"][:, 0])
+        if rows.any():
+            err = log["q_rad"][rows][:, UPPER_BODY] - log["q_ref_rad"][rows][:, UPPER_BODY]
+            ub = float(np.sqrt(np.mean(err**2)))
         out.append(SegmentResult(seg.label or "segment", start, end, (seg.vx_mps, seg.vy_mps, seg.wz_radps),
-                                 tuple(float(x) for x in mean)))
+                                 tuple(float(x) for x in mean), ub))
     return out
 
 
@@ -251,13 +259,15 @@ def format_summary(result: RunResult) -> str:
         (f"run '{result.name}': {fall_text(result.fall)}; {result.duration_s:.1f} s simulated in "
         f"{result.wall_s:.1f} s wall (real-time factor {result.real_time_factor:.1f}x)"),
         "",
-        f"{'segment':<12} {'time (s)':>11}   {'commanded vx vy wz':>22}   {'achieved vx vy wz':>22}   error %",
+        f"{'segment':<12} {'time (s)':>11}   {'commanded vx vy wz':>22}   {'achieved vx vy wz':>22}   "
+        f"{'error %':<20} ub rms",
     ]
     for s in result.segments:
         err = " ".join("   -  " if e is None else f"{e:+5.1f}" for e in s.error_pct())
         cmd = " ".join(f"{v:+6.2f}" for v in s.commanded)
         ach = " ".join(f"{v:+6.2f}" for v in s.achieved)
-        lines.append(f"{s.label[:12]:<12} {s.start_s:5.1f}-{s.end_s:5.1f}   {cmd:>22}   {ach:>22}   {err}")
+        ub = "-" if s.upper_body_rms_rad is None else f"{s.upper_body_rms_rad:.3f}"
+        lines.append(f"{s.label[:12]:<12} {s.start_s:5.1f}-{s.end_s:5.1f}   {cmd:>22}   {ach:>22}   {err:<20} {ub}")
     lines += ["", f"{'stage':<12} {'calls':>7} {'p50 us':>8} {'p99 us':>8} {'max us':>8}"]
     for name, t in result.timings.items():
         lines.append(f"{name:<12} {t['calls']:>7} {t['p50_us']:>8.1f} {t['p99_us']:>8.1f} {t['max_us']:>8.1f}")

@@ -3,8 +3,10 @@ per rollout, recorded as MotionClips.
 
 The loop is the project's own, built from a launch file like every other (MuJoCo in lockstep,
 the velocity generator with the style's pose, holosoma's loco policy, the safety filter), so the recorded motion is what the robot's physics and policy produce: real gait
-timing, foot contacts and the ~80 % speed response (FACTS.md), not an idealized gait. Frames
-after a fall are dropped.
+timing, foot contacts and speed response, not an idealized gait. The styled-walking tracker
+(g1_control/trackers/styled.py) holds the style's arms and keeps the torso up (waist pitch within
+a few 0.1 rad: the lean that balances arms held forward) instead of the 0.5 rad sag the earlier
+upper-body override recorded. Frames after a fall are dropped.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from g1_control.launch.builder import build_loop, timeline_of
 from g1_control.launch.schema import LaunchFile
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.resample import interpolate_positions, interpolate_quaternions
+from g1_control.robot import g1
 from g1_control.teleop.scripted import RandomTimelineConfig
 
 
@@ -55,6 +58,18 @@ def random_commands(config: RolloutConfig) -> list[tuple[float, float, float, fl
     return out
 
 
+def pose_figures(log: dict[str, np.ndarray], n: int) -> dict[str, float]:
+    """How well the recording holds the style's pose over its first n ticks: RMS of the waist and
+    arm joints against the pose the tracker was given (the style's plan), and the mean waist pitch
+    (the plan's is 0; the earlier override let it sag to the 0.52 rad joint limit)."""
+    if n == 0:
+        return {}
+    ub = list(g1.UPPER_BODY_JOINTS)
+    err = log["q_rad"][:n, ub] - log["q_ref_rad"][:n, ub]
+    return {"upper_body_rms_rad": float(np.sqrt(np.mean(err**2))),
+            "waist_pitch_mean_rad": float(log["q_rad"][:n, g1.JOINT_INDEX["waist_pitch_joint"]].mean())}
+
+
 def record_rollout(style: UpperBodyStyle, config: RolloutConfig) -> tuple[MotionClip | None, dict]:
     """One rollout; returns (clip at config.fps or None if it fell at once, info)."""
     launch = rollout_launch(style, config)
@@ -76,7 +91,7 @@ def record_rollout(style: UpperBodyStyle, config: RolloutConfig) -> tuple[Motion
     n = int(np.argmin(valid)) if not valid.all() else len(valid)
     info = {"style": style.name, "seed": config.seed, "fell": bool(loop.fell),
             "fault": loop.safety.trip_event.kind.value if loop.faulted else None, "recorded_s": float(n / 50.0),
-            "commands": segments}
+            "commands": segments, **pose_figures(log, n)}
     if n < 60:
         return None, info
     src_fps = 50.0

@@ -103,7 +103,8 @@ def velocity_figures(result: TrialResult, index: int, command: tuple[float, floa
     return max(errors, default=0.0), max(drift, default=0.0)
 
 
-def judge_walk(command: tuple[float, float, float], height_m: float | None = None) -> Callable[[TrialResult], Verdict]:
+def judge_walk(command: tuple[float, float, float], height_m: float | None = None,
+               height_tolerance_m: float = HEIGHT_TOLERANCE_M) -> Callable[[TrialResult], Verdict]:
     def judge(result: TrialResult) -> Verdict:
         if result.fell:
             return Verdict(False, note=f"fell: {result.fall}")
@@ -114,9 +115,9 @@ def judge_walk(command: tuple[float, float, float], height_m: float | None = Non
         note = f"v ({v[0]:+.2f}, {v[1]:+.2f}, {v[2]:+.2f})"
         if height_m is not None:
             z = result.pelvis_height(1)
-            ok = ok and abs(z - height_m) <= HEIGHT_TOLERANCE_M
+            ok = ok and abs(z - height_m) <= height_tolerance_m
             note += f", pelvis {z:.3f} m (asked {height_m:.2f})"
-        return Verdict(ok, err, drift, ub, note=note)
+        return Verdict(bool(ok), float(err), float(drift), ub, note=note)
     return judge
 
 
@@ -223,6 +224,53 @@ def cost_summary(samples: list[np.ndarray], period_s: float = TICK_S) -> dict:
             "max_us": float(data.max() * 1e6), "margin_p99": float(period_s / p99) if p99 > 0 else math.inf}
 
 
+def layer_cost(repeats: int = 3) -> dict:
+    """The styled tracker's act() per 50 Hz tick against the same policy tracker without the
+    upper-body override (the baseline: what the bare policy costs), on the states and plans of a
+    styled walk (carry, vx 0.4 + wz 0.3), calls interleaved so that machine load hits both alike.
+    Wall time per call, and the thread's CPU time per call (what the code itself costs, without
+    the time other processes on a loaded machine take from it)."""
+    import time
+
+    from g1_control.trackers.locomotion import LocomotionPolicyTracker
+    from g1_control.trackers.policy_spec import load_spec
+    from g1_control.types import JointReference, RobotState
+
+    log = run_trial(Trial("cost", walk_timeline("carry", WALK_COMMANDS["vx0.4+wz0.3"]))).log
+    spec = load_spec("holosoma_loco_ppo")
+    trackers = {True: LocomotionPolicyTracker(spec), False: LocomotionPolicyTracker(spec)}
+    dq = np.gradient(log["q_rad"], TICK_S, axis=0)
+    ticks = []
+    for k in range(len(log["t_s"])):
+        state = RobotState(t_s=float(log["t_s"][k]), q_rad=log["q_rad"][k].copy(), dq_radps=dq[k],
+                           imu_quat_wxyz=log["base_quat_wxyz"][k].copy())
+        refs = {styled: JointReference(q_rad=log["q_ref_rad"][k].copy(), upper_body_override=styled,
+                                       root_linvel_h_mps=np.array([*log["command"][k][:2], 0.0]),
+                                       root_angvel_h_radps=np.array([0.0, 0.0, log["command"][k][2]]))
+                for styled in (True, False)}
+        ticks.append((state, refs))
+    wall: dict[bool, list[float]] = {True: [], False: []}
+    cpu: dict[bool, list[float]] = {True: [], False: []}
+    for _ in range(repeats):
+        for tracker in trackers.values():
+            tracker.reset(ticks[0][0])
+        for state, refs in ticks:
+            for styled in (True, False):
+                t0, c0 = time.perf_counter(), time.thread_time()
+                trackers[styled].act(refs[styled], state)
+                cpu[styled].append(time.thread_time() - c0)
+                wall[styled].append(time.perf_counter() - t0)
+    out: dict = {}
+    for styled, name in ((True, "styled"), (False, "bare")):
+        p50, p99 = np.percentile(np.array(wall[styled]) * 1e6, [50, 99])
+        c50, c99 = np.percentile(np.array(cpu[styled]) * 1e6, [50, 99])
+        out[name] = {"p50_us": float(p50), "p99_us": float(p99), "cpu_p50_us": float(c50), "cpu_p99_us": float(c99)}
+    out["margin_p99"] = TICK_S * 1e6 / out["styled"]["p99_us"]
+    out["margin_cpu_p99"] = TICK_S * 1e6 / out["styled"]["cpu_p99_us"]
+    out["ticks"] = len(wall[True])
+    return out
+
+
 def main(args) -> int:
     only = getattr(args, "only", None)
     seed = int(getattr(args, "seed", 0) or 0)
@@ -245,6 +293,13 @@ def main(args) -> int:
           f"p99 {cost['p99_us']:.0f} us, max {cost['max_us']:.0f} us -> margin {cost['margin_p99']:.1f}x at p99 "
           f"(goal >= 2x); full loop real-time factor {min(rtf):.1f}-{max(rtf):.1f}x over {sim} trials; "
           f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    layer = layer_cost()
+    st, bare = layer["styled"], layer["bare"]
+    print(f"tracking layer act() replayed ({layer['ticks']} ticks, interleaved), wall p50/p99: styled "
+          f"{st['p50_us']:.0f}/{st['p99_us']:.0f} us, bare policy {bare['p50_us']:.0f}/{bare['p99_us']:.0f} us; "
+          f"thread CPU p50/p99: styled {st['cpu_p50_us']:.0f}/{st['cpu_p99_us']:.0f} us, bare "
+          f"{bare['cpu_p50_us']:.0f}/{bare['cpu_p99_us']:.0f} us; margin to the 20 ms tick at p99: "
+          f"{layer['margin_p99']:.1f}x wall, {layer['margin_cpu_p99']:.0f}x CPU")
     for row in rows:
         for note in row.notes if not row.met else []:
             print(f"  {row.behaviour}: {note}")
@@ -252,7 +307,8 @@ def main(args) -> int:
     missed = [r.behaviour for r in rows if not r.met]
     if args.json:
         Path(args.json).write_text(json.dumps({"seed": seed, "rows": [dataclasses.asdict(r) for r in rows],
-                                               "tracking_cost": cost, "load_average_1min": os.getloadavg()[0]}, indent=1))
+                                               "tracking_cost": cost, "layer_cost": layer,
+                                               "load_average_1min": os.getloadavg()[0]}, indent=1))
     if fell or missed:
         print(f"FAILED: {sum(r.falls for r in rows)} trial(s) fell; goals missed: {', '.join(missed) or 'none'}")
         return 1

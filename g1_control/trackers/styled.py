@@ -238,7 +238,7 @@ class Crouch:
         else:
             a_ff = float(np.interp(self.straight_m - target_m, self._table_drop, self._table_a))
             settled = abs(a_ff + self._integral - a) <= self._step
-            if settled and self._height is not None:
+            if settled and measured_m is not None:
                 self._integral += self.ki * (self._height - target_m) * self.dt_s
             goal = min(max(a_ff + self._integral, 0.0), self.max_rad)
             self._integral = goal - a_ff  # no wind-up beyond the reachable range
