@@ -22,6 +22,7 @@ def make_generator(kind: str, *, model: str | Path | None = None, limits=None):
         return VelocityReferenceGenerator(*args), CopyRetargeter()
     if kind not in GENERATORS:
         raise G1ControlError(f"unknown generator '{kind}'; known: {', '.join(GENERATORS)}")
+    from g1_control.generator.inbetween import Inbetweener
     from g1_control.generator.learned import SHIPPED_DIR, OnnxInbetweener
     from g1_control.generator.retarget import GeneratorRetargeter
     from g1_control.generator.runtime import InbetweeningGenerator, RuntimeConfig
@@ -29,6 +30,7 @@ def make_generator(kind: str, *, model: str | Path | None = None, limits=None):
 
     model_path = Path(model) if model else SHIPPED_DIR / "backbone.onnx"
     styles = load_style_stats(model_path.parent / "style_stats.json")
+    inbetweener: Inbetweener
     if kind == "backbone":
         inbetweener = OnnxInbetweener(model_path)
     elif kind == "interpolation":

@@ -16,6 +16,7 @@ import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import yaml
@@ -24,6 +25,9 @@ from g1_control.launch.builder import build_loop, make_sim_backend, timeline_of
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.teleop.scripted import Segment
+
+if TYPE_CHECKING:
+    from g1_control.sim.mujoco_backend import MujocoBackend
 
 STEADY_STATE_SKIP_S = 2.0
 """Time after a segment starts before its velocity counts as steady state."""
@@ -99,7 +103,7 @@ def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentR
         window = (t >= start + min(STEADY_STATE_SKIP_S, seg.duration_s / 2)) & (t < end)
         mean = achieved[window].mean(axis=0) if window.any() else np.full(3, np.nan)
         out.append(SegmentResult(seg.label or "segment", start, end, (seg.vx_mps, seg.vy_mps, seg.wz_radps),
-                                 tuple(float(x) for x in mean)))
+                                 (float(mean[0]), float(mean[1]), float(mean[2]))))
     return out
 
 
@@ -107,7 +111,8 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
         progress: bool = True, viewer: bool = False) -> RunResult:
     """Run `launch` to the end (or a fall); write the run folder when `out_root` is given."""
     segments = timeline_of(launch)
-    loop = build_loop(launch, backend=make_sim_backend(launch))
+    sim = make_sim_backend(launch)
+    loop = build_loop(launch, backend=sim)
     loop.reset()
     duration = launch.total_duration_s
     bar = None
@@ -116,7 +121,7 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
 
         bar = tqdm(total=round(duration, 1), unit="sim s", desc=launch.name, bar_format="{l_bar}{bar}| {n:.1f}/{total} sim s [{elapsed}<{remaining}]")
     ticks_per_update = int(loop.rates.lowlevel_hz)
-    view = _open_viewer(loop) if viewer else None
+    view = _open_viewer(sim) if viewer else None
 
     def on_tick(i: int) -> None:
         if bar is not None and (i + 1) % ticks_per_update == 0:
@@ -146,10 +151,10 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
     return result
 
 
-def _open_viewer(loop: ControlLoop):
+def _open_viewer(sim: MujocoBackend):
     from g1_control.sim.viewer import open_viewer
 
-    return open_viewer(loop.backend.model, loop.backend.data)
+    return open_viewer(sim.model, sim.data)
 
 
 def _update_viewer(view, loop: ControlLoop) -> None:
@@ -184,7 +189,8 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, o
     run_dir.mkdir(parents=True)
     result.run_dir = run_dir
     (run_dir / "launch.yaml").write_text(yaml.safe_dump(dataclasses.asdict(launch), sort_keys=False))
-    np.savez_compressed(run_dir / "log.npz", **loop.log.arrays())
+    # numpy's stub has a keyword `allow_pickle: bool` that mypy matches against **dict[str, ndarray].
+    np.savez_compressed(run_dir / "log.npz", **loop.log.arrays())  # type: ignore[arg-type]
     if launch.output.plot:
         from g1_control.launch.plots import plot_run
 

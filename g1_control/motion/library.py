@@ -68,7 +68,7 @@ class MotionLibrary:
         return sorted({e.style for e in self.entries})
 
     def summary(self) -> str:
-        rows = {}
+        rows: dict[str, dict[str, list[int]]] = {}
         for e in self.entries:
             r = rows.setdefault(e.style, {"train": [0, 0], "test": [0, 0]})
             r[e.split][0] += 1

@@ -383,7 +383,7 @@ class ProgramRunner:
         speed = step.speed_mps or cfg.walk_speed_mps[step.direction]
         pos = np.array([p.x_m, p.y_m])
         if step.target is not None:
-            d = a.target_xy - pos  # type: ignore[operator]
+            d = a.target_xy - pos
             dist = float(np.hypot(*d))
             remaining = dist - a.stop_m
             if remaining <= cfg.place_tolerance_m:

@@ -178,8 +178,9 @@ def prepare_targets(motion: HumanMotion, skeleton: Skeleton, config: MocapRetarg
     if motion.object is not None:
         track = motion.object.resampled(motion.fps, times).scaled(scale)
         hands = [next((h for h, f in skeleton.frame_map.items() if f == frame), None) for frame in HAND_FRAMES]
-        if None not in hands:
-            track.hand_contacts = track.distance(np.stack([p(h) for h in hands], axis=1)) < config.object_contact_m
+        found = [h for h in hands if h is not None]
+        if len(found) == len(hands):
+            track.hand_contacts = track.distance(np.stack([p(h) for h in found], axis=1)) < config.object_contact_m
     scene = tuple(shape.scaled(scale) for shape in motion.scene)
     return PreparedTargets(config.fps, keypoints, root, pelvis_rot, torso_rot, foot_rot, contacts, scale, track,
                            scene)
@@ -224,7 +225,7 @@ class MocapRetargeter:
         )
 
     def retarget(self, motion: HumanMotion, skeleton: Skeleton | None = None,
-                 progress: Callable[[int], None] | None = None) -> MotionClip:
+                 progress: Callable[[int], object] | None = None) -> MotionClip:
         motion.validate()
         skeleton = skeleton or detect_skeleton(motion.joint_names, motion.source)
         skeleton = skeleton.validate(motion.source)

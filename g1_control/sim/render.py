@@ -90,7 +90,9 @@ def _render(log_path: Path, out_path: Path, fps: float, size: tuple[int, int], q
     frame_times = np.arange(t[0], t[-1], 1.0 / fps)
     idx = np.searchsorted(t, frame_times).clip(0, len(t) - 1)
     try:
-        with imageio.get_writer(out_path, fps=fps, codec="libx264", quality=7, macro_block_size=8) as writer:
+        # Not `with ... as writer`: imageio's stub types __enter__ as its base class, which has no append_data.
+        writer = imageio.get_writer(out_path, fps=fps, codec="libx264", quality=7, macro_block_size=8)
+        with writer:
             for i in tqdm(idx, desc="render", unit="frame", disable=quiet):
                 data.qpos[:3], data.qpos[3:7], data.qpos[7:] = pos[i], quat[i], q[i]
                 mujoco.mj_forward(model, data)  # also the subtree CoM the tracking camera follows

@@ -32,15 +32,17 @@ def measure(launch: str = "launch/sim2sim.yaml") -> dict:
     partition = f"g1measure-{os.getpid()}-{uuid.uuid4().hex[:6]}"
     robot = _g1("sim-robot", "--lower-gantry-on-policy", "--partition", partition, "--control-stdin",
                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+    to_robot, from_robot = robot.stdin, robot.stdout
+    assert to_robot is not None and from_robot is not None  # both opened as pipes just above
     host = None
 
     def ask(word: str) -> dict:
-        robot.stdin.write(word + "\n")
-        robot.stdin.flush()
-        return json.loads(robot.stdout.readline())
+        to_robot.write(word + "\n")
+        to_robot.flush()
+        return json.loads(from_robot.readline())
 
     try:
-        if robot.stdout.readline().strip() != "ready":
+        if from_robot.readline().strip() != "ready":
             raise RuntimeError("the emulator did not start")
         with tempfile.TemporaryDirectory() as tmp:
             report_path = Path(tmp) / "deploy.json"
@@ -71,8 +73,8 @@ def measure(launch: str = "launch/sim2sim.yaml") -> dict:
         if host is not None and host.poll() is None:
             host.kill()
         try:
-            robot.stdin.write("quit\n")
-            robot.stdin.flush()
+            to_robot.write("quit\n")
+            to_robot.flush()
             robot.wait(timeout=10)
         except (OSError, subprocess.TimeoutExpired):
             robot.kill()

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from g1_control.errors import G1ControlError
 from g1_control.generator import features as F
 
 
@@ -145,7 +146,7 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | N
     vfeats, vstyles = load_split(library_root, "test")
     vsampler = WindowSampler(vfeats, vstyles, len(STYLES), seed=12345, style_dropout=0.0)
     history: list[dict] = []
-    best = (float("inf"), None)
+    best: tuple[float, dict[str, torch.Tensor] | None] = (float("inf"), None)
 
     val_batches = [_to_torch(vsampler.sample(128, gap=g)) for g in (15, 30)]
 
@@ -192,6 +193,8 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | N
     result = {"steps": step + 1, "wall_s": wall, "initial_val_loss": initial_val, "best_val_loss": best[0],
               "world_size": world}
     if rank == 0:
+        if best[1] is None:  # every validation loss was NaN
+            raise G1ControlError(f"training gave no finite validation loss in {step + 1} steps; nothing saved")
         model.load_state_dict(best[1])
         save_checkpoint(model, out / "backbone.pt", config)
         (out / "train_config.json").write_text(json.dumps({"train": asdict(config), "model": model_cfg.to_dict(),
