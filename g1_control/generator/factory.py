@@ -39,7 +39,7 @@ def make_generator(kind: str, *, model: str | Path | None = None, limits=None):
         inbetweener = InterpolationInbetweener()
     else:
         from g1_control.generator.baselines import MotionMatchingInbetweener
-        from g1_control.training.train import load_split
+        from g1_control.generator.features import load_split
 
         inbetweener = MotionMatchingInbetweener(load_split(None, "train")[0])
     config = RuntimeConfig()

@@ -45,12 +45,6 @@ class LibraryConfig:
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
-def default_library_dir() -> Path:
-    from g1_control.assets import cache_dir
-
-    return cache_dir() / "library"
-
-
 def _rollout_job(args) -> tuple[MotionClip | None, dict]:
     from g1_control.generator.styles import ROLLOUT_STYLES
     from g1_control.library.rollouts import RolloutConfig, record_rollout

@@ -14,7 +14,7 @@ import numpy as np
 
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.exceptions import MotionFormatError
-from g1_control.motion.resample import interpolate_positions, interpolate_quaternions
+from g1_control.motion.interpolation import interpolate_positions, interpolate_quaternions
 from g1_control.robot import g1
 
 POLICY_RATE_HZ = 50.0

@@ -18,6 +18,13 @@ INDEX_NAME = "index.json"
 SPLITS = ("train", "test")
 
 
+def default_library_dir() -> Path:
+    """Where `g1 library build` writes the library and its readers look by default."""
+    from g1_control.assets import cache_dir
+
+    return cache_dir() / "library"
+
+
 class LibraryError(G1ControlError):
     """A motion library that is missing, stale or malformed."""
 

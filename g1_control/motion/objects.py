@@ -166,7 +166,7 @@ class ObjectTrack:
                            self.hand_contacts.copy())
 
     def resampled(self, fps: float, times_s: np.ndarray) -> ObjectTrack:
-        from g1_control.motion.resample import interpolate_positions, interpolate_quaternions
+        from g1_control.motion.interpolation import interpolate_positions, interpolate_quaternions
 
         nearest = np.clip(np.rint(times_s * fps).astype(int), 0, self.num_frames - 1)
         return ObjectTrack(self.shape, interpolate_positions(self.pos_w_m, fps, times_s),

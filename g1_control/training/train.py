@@ -20,6 +20,7 @@ import numpy as np
 
 from g1_control.errors import G1ControlError
 from g1_control.generator import features as F
+from g1_control.generator.features import load_split
 
 
 @dataclass
@@ -98,16 +99,6 @@ def _to_torch(batch: dict):
         elif k != "gap":
             out[k] = torch.as_tensor(v, dtype=torch.float32)
     return out
-
-
-def load_split(library_root: str | Path | None, split: str):
-    from g1_control.generator.styles import style_id
-    from g1_control.library.builder import default_library_dir
-    from g1_control.motion.library import MotionLibrary
-
-    lib = MotionLibrary(library_root or default_library_dir())
-    clips = lib.clips(split)
-    return [F.clip_features(c) for c in clips], [style_id(c.style) for c in clips]
 
 
 def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | None = None,
@@ -203,7 +194,7 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | N
         plot_losses(history, out / "loss.png")
         export_onnx(model, out / "backbone.onnx")
         from g1_control.generator.style_stats import write_style_stats
-        from g1_control.library.builder import default_library_dir
+        from g1_control.motion.library import default_library_dir
 
         write_style_stats(library_root or default_library_dir(), out / "style_stats.json")
     if world > 1:
