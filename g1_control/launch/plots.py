@@ -58,8 +58,8 @@ def plot_run(log: dict[str, np.ndarray], result, out: Path) -> None:
     for k, ax in enumerate(axes[:3]):
         ax.plot(t, log["velocity_true"][:, k], color="tab:blue", lw=0.6, alpha=0.25, zorder=2)
         ax.plot(t, log["policy_command"][:, k], color="0.55", lw=0.9, ls=":", zorder=3)
-        ax.plot(t, est[:, k], color="tab:orange", lw=1.2, alpha=0.9, zorder=4)
-        ax.plot(t, truth[:, k], color="tab:blue", lw=2.0, zorder=5)
+        ax.plot(t, truth[:, k], color="tab:blue", lw=2.2, zorder=4)
+        ax.plot(t, est[:, k], color="tab:orange", lw=1.0, zorder=5)  # thin, on top: the truth shows around it
         ax.plot(t, log["command"][:, k], color="k", lw=1.3, ls="--", zorder=6)
         ax.set_ylabel(labels[k])
         ax.grid(alpha=0.3)
@@ -89,15 +89,15 @@ def plot_run(log: dict[str, np.ndarray], result, out: Path) -> None:
 
     handles = [
         Line2D([], [], color="k", lw=1.3, ls="--", label="commanded"),
-        Line2D([], [], color="tab:blue", lw=2.0, label=f"achieved, ground truth ({GAIT_WINDOW_S:g} s gait-cycle mean)"),
+        Line2D([], [], color="tab:blue", lw=2.2, label=f"achieved, ground truth ({GAIT_WINDOW_S:g} s gait-cycle mean)"),
         Line2D([], [], color="tab:blue", lw=0.8, alpha=0.35, label="achieved, ground truth (raw 50 Hz)"),
-        Line2D([], [], color="tab:orange", lw=1.2, label=f"state estimate ({GAIT_WINDOW_S:g} s mean)"),
+        Line2D([], [], color="tab:orange", lw=1.0, label=f"state estimate ({GAIT_WINDOW_S:g} s mean)"),
         Line2D([], [], color="0.55", lw=0.9, ls=":", label="sent to the policy (after velocity correction)"),
         Patch(facecolor="0.93", edgecolor="0.75", label="command segments"),
     ]
     status = "FELL" if result.fell else "no fall"
     fig.suptitle(f"{result.name}: {status}, real-time factor {result.real_time_factor:.1f}x", y=0.995)
     fig.legend(handles=handles, loc="upper center", ncol=3, fontsize=8, frameon=False, bbox_to_anchor=(0.5, 0.97))
-    fig.tight_layout(rect=(0, 0, 1, 0.915))
+    fig.tight_layout(rect=(0, 0, 1, 0.925))
     fig.savefig(out, dpi=90)
     plt.close(fig)
