@@ -55,7 +55,6 @@ class WebView:
                 f"/robot/b{body}/g{g}", vertices=np.asarray(model.mesh_vert[va:va + vn], dtype=np.float32),
                 faces=np.asarray(model.mesh_face[fa:fa + fn], dtype=np.uint32), color=ROBOT_RGB,
                 position=tuple(model.geom_pos[g]), wxyz=tuple(model.geom_quat[g]))
-        self._camera_set = False
 
     @property
     def url(self) -> str:
@@ -73,12 +72,13 @@ class WebView:
                 frame.wxyz = tuple(self.data.xquat[body])
             if text:
                 self.text.content = "```\n" + text + "\n```"
-        base = self.data.qpos[:3]
+        # The camera follows the pelvis: new pages start looking at it from the front left, open
+        # pages keep the user's viewing angle and distance and only turn towards the robot.
+        base = tuple(float(x) for x in self.data.qpos[:3])
+        self.server.initial_camera.look_at = base
+        self.server.initial_camera.position = (base[0] + 2.0, base[1] + 1.6, base[2] + 0.5)
         for client in self.server.get_clients().values():
-            client.camera.look_at = tuple(base)
-            if not self._camera_set:
-                client.camera.position = (base[0] + 2.2, base[1] - 2.2, base[2] + 0.6)
-        self._camera_set = bool(self.server.get_clients())
+            client.camera.look_at = base
 
     def close(self) -> None:
         self.server.stop()
