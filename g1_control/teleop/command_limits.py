@@ -17,7 +17,7 @@ from typing import Any
 from g1_control.errors import LaunchFileError
 from g1_control.robot.g1 import DEFAULT_PELVIS_HEIGHT_M
 
-# A 15 cm crouch is what the whole-body tracker was measured to follow (11 of 15 cm, FACTS.md);
+# A 15 cm crouch is what the whole-body tracker was measured to follow (11 of 15 cm, docs/robot_facts.md);
 # deeper crouches are untested, so the default range stops there.
 DEFAULT_CROUCH_M = 0.15
 

@@ -85,3 +85,15 @@ def test_readme_links_resolve():
             if "://" in target:
                 continue
             assert (doc.parent / target).exists(), f"{doc.name} links to missing {target}"
+
+
+def test_code_cites_only_files_in_this_repository():
+    """Comments point at docs/ in this repository, not at team documents outside it."""
+    outside = ("FACTS.md", "DESIGN.md", "STYLE.md")
+    offenders = []
+    for folder in ("g1_control", "tests", "launch", "scripts", "examples", "docs"):
+        for path in (REPO / folder).rglob("*"):
+            if path.suffix in (".py", ".yaml", ".sh", ".md") and path.name != "test_cli_usability.py":
+                text = path.read_text(errors="replace")
+                offenders += [f"{path.relative_to(REPO)}: {name}" for name in outside if name in text]
+    assert not offenders, offenders
