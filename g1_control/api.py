@@ -146,7 +146,7 @@ class RunRecord:
         try:
             import pandas as pd
         except ImportError:
-            raise G1ControlError("RunRecord.dataframe needs pandas (pip install pandas); rec.log has numpy arrays")
+            raise G1ControlError("RunRecord.dataframe needs pandas (pip install pandas); rec.log has numpy arrays") from None
         axes = {3: ("vx", "vy", "wz"), 4: ("w", "x", "y", "z")}
         columns: dict[str, np.ndarray] = {}
         for name, arr in self.log.items():
