@@ -140,9 +140,6 @@ def fetch(name: str, *, force: bool = False, quiet: bool = False, wheel: Path | 
         extract(asset, Path(wheel), dest)
         return dest
     with tempfile.TemporaryDirectory(prefix="g1-fetch-") as tmp:
-        if not quiet:
-            print(f"Fetching {asset.package}=={asset.version} ({asset.description}) from the package registry ...",
-                  file=sys.stderr)
         pip = pip_command()
         if pip is None:
             raise PolicyFetchError(
@@ -152,6 +149,9 @@ def fetch(name: str, *, force: bool = False, quiet: bool = False, wheel: Path | 
                 f"{asset.package}=={asset.version} -d DIR`, or `uvx pip download ...`) and run "
                 f"`g1 policies fetch --asset {asset.name} --wheel DIR/{asset.wheel_name}`"
             )
+        if not quiet:
+            print(f"Fetching {asset.package}=={asset.version} ({asset.description}) from the package registry ...",
+                  file=sys.stderr)
         cmd = [*pip, "download", "--no-deps", "--only-binary=:all:", "--disable-pip-version-check", "-d", tmp,
                f"{asset.package}=={asset.version}"] + (["-q"] if quiet else [])
         proc = subprocess.run(cmd, capture_output=quiet, text=True, check=False)
