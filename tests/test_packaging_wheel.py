@@ -2,16 +2,19 @@
 quick start's --check from an unrelated directory, finds its launch files and docs, and carries
 only runtime files plus the license texts.
 
-Fast on purpose: the venv sees this interpreter's packages (--system-site-packages) and the
-wheel goes in with --no-deps, so nothing is downloaded; the test checks that g1_control is
-imported from the wheel, not from this checkout.
+Fast on purpose: the venv also sees this environment's packages (a .pth file adds its
+site-packages after the venv's own; --system-site-packages would not do inside another venv)
+and the wheel goes in with --no-deps, so nothing is downloaded; the test checks that g1_control
+is imported from the wheel, not from this checkout.
 """
 
 import os
 import shutil
 import subprocess
 import sys
+import sysconfig
 import zipfile
+from pathlib import Path
 
 import pytest
 
@@ -22,11 +25,14 @@ SKIP = shutil.ignore_patterns(".git", ".venv", "runs", "build", "dist", "*.egg-i
 
 
 def _setuptools_new_enough() -> bool:
+    # Read the version without importing setuptools: its distutils shim refuses to load after
+    # another package imported the stdlib's distutils (seen in a Debian venv).
+    from importlib.metadata import PackageNotFoundError, version
+
     try:
-        import setuptools
-    except ImportError:
+        return int(version("setuptools").split(".")[0]) >= 77
+    except PackageNotFoundError:
         return False
-    return int(setuptools.__version__.split(".")[0]) >= 77
 
 
 @pytest.fixture(scope="module")
@@ -59,9 +65,13 @@ def test_wheel_carries_runtime_files_launch_files_docs_and_licenses(wheel):
 @pytest.mark.slow
 def test_installed_wheel_runs_the_quick_start_check_anywhere(wheel, tmp_path):
     venv = tmp_path / "venv"
-    subprocess.run([sys.executable, "-m", "venv", "--system-site-packages", "--without-pip", str(venv)], check=True,
-                   timeout=120)
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True, timeout=120)
     py, g1 = venv / "bin" / "python", venv / "bin" / "g1"
+    venv_site = subprocess.run([str(py), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+                               check=True, capture_output=True, text=True).stdout.strip()
+    ours = {sysconfig.get_paths()["purelib"], sysconfig.get_paths()["platlib"]}
+    (Path(venv_site) / "_this_environment.pth").write_text(
+        "".join(f"import site; site.addsitedir({d!r})\n" for d in sorted(ours)))
     subprocess.run([str(py), "-m", "pip", "install", "-q", "--no-deps", "--no-index", "--ignore-installed",
                     "--disable-pip-version-check", str(wheel)], check=True, capture_output=True, timeout=300)
     elsewhere = tmp_path / "elsewhere"
