@@ -22,7 +22,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 ROOT_UNIT = "(root)"
-"""The package's own __init__.py: importable from every layer; it may import nothing of the package."""
+"""The package's own __init__.py: importable from every layer; it imports only the units named as
+`root_imports` (a public API it re-exports)."""
 
 
 @dataclass(frozen=True)
@@ -144,23 +145,27 @@ def unknown_layer_units(package_dir: Path, layers: Sequence[Sequence[str]], data
 
 
 def layer_violations(package_dir: Path, layers: Sequence[Sequence[str]], data_units: Iterable[str] = (),
-                     imports: list[Import] | None = None) -> list[str]:
-    """One message per import that goes up a layer, across siblings, into an unassigned unit, or out
-    of a data unit or the package root."""
+                     imports: list[Import] | None = None, root_imports: Iterable[str] = ()) -> list[str]:
+    """One message per import that goes up a layer, across siblings, into an unassigned unit, out of
+    a data unit, or out of the package root to other than `root_imports`."""
     package_dir = Path(package_dir)
     package = package_dir.name
     rank = layer_of(layers)
     data = set(data_units)
+    from_root = set(root_imports)
     names = [" | ".join(layer) for layer in layers]
     out = []
     for imp in imports if imports is not None else collect_imports(package_dir):
         src, dst = unit_of(imp.source, package), unit_of(imp.target, package)
-        if src == dst or dst in data or dst == ROOT_UNIT:
+        if src == dst or dst in data or dst == ROOT_UNIT or (src == ROOT_UNIT and dst in from_root):
             continue
         what = f"{imp.where(package_dir.parent)}: {imp.source} imports {imp.target}" + (
             " (type-only)" if imp.type_only else "")
-        if src in data or src == ROOT_UNIT:
+        if src in data:
             out.append(f"{what}: {src} may import nothing of {package}")
+        elif src == ROOT_UNIT:
+            allowed = ", ".join(sorted(from_root)) or "nothing"
+            out.append(f"{what}: the package root may import {allowed} of {package}")
         elif src not in rank or dst not in rank:
             missing = " and ".join(u for u in (src, dst) if u not in rank)
             out.append(f"{what}: {missing} is in no layer")

@@ -30,7 +30,7 @@ from tests.paths import REPO
 PACKAGE = REPO / "g1_control"
 
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("cli",),
+    ("cli", "api"),
     ("tools",),
     ("deploy", "training"),
     ("library",),
@@ -44,13 +44,16 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("interfaces",),
     ("types",),
     ("robot",),
-    ("config", "assets", "rotations"),
+    ("config", "assets", "rotations", "resources"),
     ("errors",),
 )
 """Top to bottom. A unit may import from its own package or from lower layers only."""
 
 DATA_UNITS = ("policies",)
 """Shipped data (policy specs, the generator's weights): read as resources, importable by any layer."""
+
+ROOT_IMPORTS = ("api",)
+"""What g1_control/__init__.py may import: the public API it re-exports (lazily)."""
 
 
 def _report(messages: list[str]) -> str:
@@ -73,7 +76,7 @@ def test_every_package_has_exactly_one_layer():
 
 def test_imports_go_down_the_layers_only(imports):
     assert len(imports) > 500  # the checker sees the package's imports (about a thousand)
-    violations = layer_violations(PACKAGE, LAYERS, DATA_UNITS, imports)
+    violations = layer_violations(PACKAGE, LAYERS, DATA_UNITS, imports, ROOT_IMPORTS)
     assert not violations, _report(violations)
 
 
@@ -164,6 +167,11 @@ def test_checker_refuses_unplaced_packages_and_data_imports(tmp_path):
     assert any("toy/top/uses.py:1" in v and "extra is in no layer" in v for v in violations), violations
     assert any("toy/data/__init__.py:1" in v and "data may import nothing of toy" in v for v in violations), violations
     assert not any("toy/top/uses.py:2" in v for v in violations)  # data is importable from any layer
+    # the package root re-exports a public unit only
+    pkg = _tree(tmp_path / "r", {**CLEAN, "__init__.py": "def __getattr__(name):\n    from toy import top\n"
+                                                          "    from toy.low import util\n"})
+    assert layer_violations(pkg, TOY_LAYERS, root_imports=["top"]) == [
+        "toy/__init__.py:3: toy imports toy.low.util: the package root may import top of toy"]
 
 
 def test_checker_reports_cycles(tmp_path):
@@ -194,13 +202,13 @@ def test_a_deliberate_violation_in_a_copy_of_g1_control_fails(tmp_path):
     copy = tmp_path / "g1_control"
     shutil.copytree(PACKAGE, copy, ignore=lambda _, names: [n for n in names if n == "__pycache__"
                                                            or (n.endswith((".onnx", ".pt", ".png", ".json")))])
-    assert layer_violations(copy, LAYERS, DATA_UNITS) == []
+    assert layer_violations(copy, LAYERS, DATA_UNITS, root_imports=ROOT_IMPORTS) == []
     target = copy / "rotations.py"
     lines = target.read_text().splitlines()
     target.write_text("\n".join([*lines, "", "", "def _bad():", "    from g1_control.launch import builder", ""]))
-    violations = layer_violations(copy, LAYERS, DATA_UNITS)
+    violations = layer_violations(copy, LAYERS, DATA_UNITS, root_imports=ROOT_IMPORTS)
     rank = layer_of(LAYERS)
     assert violations == [
         f"g1_control/rotations.py:{len(lines) + 4}: g1_control.rotations imports g1_control.launch.builder: upward, "
-        f"from rotations (layer {rank['rotations'] + 1}: config | assets | rotations) to launch "
+        f"from rotations (layer {rank['rotations'] + 1}: config | assets | rotations | resources) to launch "
         f"(layer {rank['launch'] + 1}: launch, above it)"]

@@ -1,7 +1,8 @@
 """The tests mirror the package: tests/<package>/... for g1_control/<package>/..., unique basenames.
 
 - Every folder under tests/ is a package of g1_control at the same path (tests/trackers/wbc/ for
-  g1_control/trackers/wbc/), so a package's tests are found where the package is.
+  g1_control/trackers/wbc/), so a package's tests are found where the package is; the one other
+  kind is a test folder for a folder of the repository (OTHER_FOLDERS: tests/examples/ for examples/).
 - Test files at the root of tests/ test a top-level module (test_rotations.py for
   g1_control/rotations.py) or the package as a whole (WHOLE_PACKAGE_TESTS).
 - Python file basenames are unique across tests/ (conftest.py aside): pytest imports test files,
@@ -18,8 +19,10 @@ from tests.paths import REPO
 TESTS = REPO / "tests"
 PACKAGE = REPO / "g1_control"
 
-WHOLE_PACKAGE_TESTS = {"test_layers.py", "test_tests_mirror_packages.py"}
+WHOLE_PACKAGE_TESTS = {"test_layers.py", "test_tests_mirror_packages.py", "test_packaging_wheel.py"}
 """Root test files about g1_control as a whole rather than one module."""
+OTHER_FOLDERS = {"examples": REPO / "examples"}
+"""Test folders for folders of the repository that are not packages of g1_control."""
 
 
 def _python_files() -> list[Path]:
@@ -31,7 +34,8 @@ def test_every_test_folder_mirrors_a_package():
     assert folders, "expected tests/<package>/ folders"
     # A package: a folder of g1_control with Python modules (an __init__.py or a namespace package).
     stray = [f.relative_to(REPO).as_posix() for f in folders
-             if not any((PACKAGE / f.relative_to(TESTS)).glob("*.py"))]
+             if not any((PACKAGE / f.relative_to(TESTS)).glob("*.py"))
+             and not OTHER_FOLDERS.get(f.relative_to(TESTS).parts[0], REPO / "-").is_dir()]
     assert not stray, f"test folders with no g1_control package at the same path: {stray}"
 
 

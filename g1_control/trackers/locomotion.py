@@ -4,7 +4,7 @@ velocity correction.
 The reference's root velocity (heading frame) is the command. When the reference sets
 `upper_body_override`, waist and arm targets come from the reference while the policy keeps
 balancing with the legs. The correction closes the loop on the estimated base velocity, because
-the bare holosoma policies reach only ~80 % of the commanded speed (FACTS.md).
+the bare holosoma policies reach only ~80 % of the commanded speed (docs/robot_facts.md).
 """
 
 from __future__ import annotations
