@@ -44,9 +44,12 @@ class SegmentResult:
 
     def error_pct(self) -> tuple[float | None, float | None, float | None]:
         """Relative error per axis where the command is meaningfully non-zero."""
-        return tuple(
-            (100.0 * (a - c) / c) if abs(c) >= 0.1 else None for c, a in zip(self.commanded, self.achieved)
-        )  # type: ignore[return-value]
+
+        def pct(c: float, a: float) -> float | None:
+            return (100.0 * (a - c) / c) if abs(c) >= 0.1 else None
+
+        (c0, c1, c2), (a0, a1, a2) = self.commanded, self.achieved
+        return pct(c0, a0), pct(c1, a1), pct(c2, a2)
 
 
 @dataclass
