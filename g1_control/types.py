@@ -49,7 +49,7 @@ BUTTONS = frozenset(b.value for b in Button)
 
 
 # -- command limits -------------------------------------------------------------------------------------
-# A 15 cm crouch is what the whole-body tracker was measured to follow (11 of 15 cm, FACTS.md);
+# A 15 cm crouch is what the whole-body tracker was measured to follow (11 of 15 cm, docs/robot_facts.md);
 # deeper crouches are untested, so the default range stops there.
 DEFAULT_CROUCH_M = 0.15
 

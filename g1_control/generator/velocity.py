@@ -46,14 +46,16 @@ class VelocityReferenceGenerator(Generator):
         ref.pelvis_height_m = command.pelvis_height_m
         ref.style = command.style
         style = ROLLOUT_STYLES.get(command.style)
-        override = style is not None and style.override
+        if style is not None and not style.override:
+            style = None  # the tracker's own upper body
         if command.style != self._style:
             if self._style is not None:
                 self._switch_t = t
                 self._from_q[:] = ref.q_rad if ref.upper_body_override else state.q_rad
                 self._from_override = ref.upper_body_override
             self._style = command.style
-        target = style.pose(t) if override else g1.DEFAULT_Q_RAD
+        override = style is not None
+        target = style.pose(t) if style is not None else g1.DEFAULT_Q_RAD
         w = (t - self._switch_t) / self.blend_s if self.blend_s > 0 else 1.0
         if w < 1.0:
             ref.q_rad[:] = self._from_q

@@ -116,7 +116,9 @@ def main(args) -> int:
           f"{envelope.pelvis_height_m} m; trained range {load_spec(POLICY).command_ranges}; "
           f"{time.perf_counter() - t0:.0f} s wall")
     if args.write:
-        path = envelope_path(load_spec(POLICY).spec_file)
+        spec_file = load_spec(POLICY).spec_file
+        assert spec_file is not None  # load_spec always records it
+        path = envelope_path(spec_file)
         envelope.write(path)
         print(f"wrote {path}")
     if args.json:

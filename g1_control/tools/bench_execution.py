@@ -145,15 +145,17 @@ def push_trials(walking: bool, seed: int) -> list[Trial]:
 CROUCH_HEIGHT_M = 0.65
 
 
+def _walk_trials(style: str, label: str, command: tuple[float, float, float]) -> Callable[[int], list[Trial]]:
+    return lambda seed: [Trial(f"walk {style} {label}", walk_timeline(style, command))]
+
+
 def behaviours() -> list[Behaviour]:
     rows = []
     for style in ROLLOUT_STYLES:
         for label, command in WALK_COMMANDS.items():
             rows.append(Behaviour(
                 f"walk.{style}.{label}", f"within {SPEED_TOLERANCE_PCT:.0f} %, drift <= {DRIFT_TOLERANCE}, "
-                f"ub <= {UPPER_BODY_TOLERANCE_RAD} rad, no fall",
-                lambda seed, s=style, c=command, n=label: [Trial(f"walk {s} {n}", walk_timeline(s, c))],
-                judge_walk(command)))
+                f"ub <= {UPPER_BODY_TOLERANCE_RAD} rad, no fall", _walk_trials(style, label, command), judge_walk(command)))
     crouch = (0.3, 0.0, 0.0)
     rows.append(Behaviour(
         "crouch_walk.0.65m.vx0.3", f"pelvis within {HEIGHT_TOLERANCE_M * 100:.0f} cm of {CROUCH_HEIGHT_M} m, "
@@ -281,7 +283,8 @@ def main(args) -> int:
         return 2
     print(f"g1 bench execution: {len(chosen)} behaviours, seed {seed}; figures from the simulator's ground truth")
     print(HEADER)
-    rows, samples = [], []
+    rows: list[Row] = []
+    samples: list[np.ndarray] = []
     for behaviour in chosen:
         row = run_behaviour(behaviour, seed, video_dir, samples)
         rows.append(row)

@@ -15,12 +15,16 @@ import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from g1_control.robot import g1
 from g1_control.safety.fall import Fall
 from g1_control.teleop.scripted import Segment
+
+if TYPE_CHECKING:
+    from g1_control.sim.mujoco_backend import MujocoBackend
 
 GAIT_PERIOD_S = 1.0
 """The holosoma walking policies' gait period: averages over whole periods cancel the sway."""
@@ -143,8 +147,8 @@ def run_trial(trial: Trial, *, log_path: Path | None = None, stop_on_fall: bool 
                 loop.run(mark - loop.time_s)
             push = pushes.get(mark)
             if push is not None:
-                force_w = heading_to_world(push.force_h_n, loop.backend.data.qpos[3:7])
-                loop.backend.push(force_w, push.duration_s)
+                sim = cast("MujocoBackend", loop.backend)
+                sim.push(heading_to_world(push.force_h_n, sim.data.qpos[3:7]), push.duration_s)
             if stop_on_fall and loop.fell:
                 break
     finally:
@@ -153,7 +157,7 @@ def run_trial(trial: Trial, *, log_path: Path | None = None, stop_on_fall: bool 
     log = loop.log.arrays()
     if log_path is not None:
         log_path.parent.mkdir(parents=True, exist_ok=True)
-        np.savez_compressed(log_path, **log)
+        np.savez_compressed(log_path, **log)  # type: ignore[arg-type]
     timing = loop.scheduler.report()["tracker"]
     if samples is not None:
         times = loop.scheduler.times["tracker"]

@@ -6,7 +6,7 @@ The reference's root velocity (heading frame) is the command. When the reference
 body it was trained with, keeps balancing (g1_control/trackers/styled.py). A reference
 `pelvis_height_m` crouches the legs under the policy. The correction closes the loop on the
 estimated base velocity, because the bare holosoma policies reach only ~80 % of the commanded
-speed (FACTS.md).
+speed (docs/robot_facts.md).
 """
 
 from __future__ import annotations

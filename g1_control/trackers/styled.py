@@ -229,17 +229,17 @@ class Crouch:
     def update(self, target_m: float | None, measured_m: float | None) -> None:
         """target_m: the planned pelvis height (None: the policy's own height, no crouch);
         measured_m: the estimator's pelvis height (None: unknown, kinematics only)."""
+        height = self._height
         if measured_m is not None:
-            h = self._height
-            self._height = measured_m if h is None else h + self._alpha * (measured_m - h)
+            height = self._height = measured_m if height is None else height + self._alpha * (measured_m - height)
         a = self.angle_rad
         if target_m is None:
             goal = self._integral = 0.0
         else:
             a_ff = float(np.interp(self.straight_m - target_m, self._table_drop, self._table_a))
             settled = abs(a_ff + self._integral - a) <= self._step
-            if settled and measured_m is not None:
-                self._integral += self.ki * (self._height - target_m) * self.dt_s
+            if settled and measured_m is not None and height is not None:
+                self._integral += self.ki * (height - target_m) * self.dt_s
             goal = min(max(a_ff + self._integral, 0.0), self.max_rad)
             self._integral = goal - a_ff  # no wind-up beyond the reachable range
         if goal == a:
