@@ -18,6 +18,7 @@ import numpy as np
 
 from g1_control.interfaces import Backend
 from g1_control.robot import description, g1
+from g1_control.scene import SceneConfig
 from g1_control.sim.motor_law import motor_torque
 from g1_control.types import MotorCommand, RobotState
 
@@ -33,11 +34,27 @@ class MujocoConfig:
 
 
 class MujocoBackend(Backend):
-    def __init__(self, config: MujocoConfig | None = None):
+    def __init__(self, config: MujocoConfig | None = None, scene: SceneConfig | None = None):
+        """scene: tables, platforms and boxes around the robot (g1_control/sim/scene.py). The
+        robot's state is read through its own joint addresses, so free boxes in the model do not
+        shift it."""
         self.config = config or MujocoConfig()
         self.lockstep = self.config.lockstep
-        self.model = description.mujoco_spec(timestep_s=self.config.physics_dt_s).compile()
+        self.scene = scene or SceneConfig()
+        spec = description.mujoco_spec(timestep_s=self.config.physics_dt_s)
+        if not self.scene.empty:
+            from g1_control.sim.scene import build_scene
+
+            build_scene(spec, self.scene)
+        self.model = spec.compile()
         self.data = mujoco.MjData(self.model)
+        m = self.model
+        base = m.joint(0)  # the robot's floating base is the model's first joint
+        qa, va = int(m.jnt_qposadr[base.id]), int(m.jnt_dofadr[base.id])
+        self._base_q, self._base_v = slice(qa, qa + 7), slice(va, va + 6)
+        # The robot's joints follow its base in the model (objects are added after the robot).
+        self._q = slice(qa + 7, qa + 7 + g1.NUM_JOINTS)
+        self._v = slice(va + 6, va + 6 + g1.NUM_JOINTS)
         self._command = MotorCommand.damping(g1.KD_DEFAULT)
         self._tau = np.zeros(g1.NUM_JOINTS)
         self._tick = 0
@@ -62,17 +79,19 @@ class MujocoBackend(Backend):
         """Stand the robot at `q_rad` (default pose) with its lowest foot point on the floor."""
         mujoco.mj_resetData(self.model, self.data)
         q = g1.DEFAULT_Q_RAD if q_rad is None else np.asarray(q_rad, dtype=float)
-        self.data.qpos[7:] = q
-        self.data.qpos[3:7] = [np.cos(yaw_rad / 2), 0.0, 0.0, np.sin(yaw_rad / 2)]
-        self.data.qpos[0:2] = base_pos_xy_m
-        self.data.qpos[2] = 1.0
+        base = self.data.qpos[self._base_q]
+        self.data.qpos[self._q] = q
+        base[3:7] = [np.cos(yaw_rad / 2), 0.0, 0.0, np.sin(yaw_rad / 2)]
+        base[0:2] = base_pos_xy_m
+        base[2] = 1.0
         mujoco.mj_kinematics(self.model, self.data)
+        m, robot = self.model, self.model.body(g1.BASE_BODY).id
         lowest = min(
-            self.data.geom_xpos[i][2] - (self.model.geom_size[i][0] if self.model.geom_type[i] == mujoco.mjtGeom.mjGEOM_SPHERE else 0.0)
-            for i in range(self.model.ngeom)
-            if self.model.geom_conaffinity[i] and self.model.geom_bodyid[i] != 0
+            self.data.geom_xpos[i][2] - (m.geom_size[i][0] if m.geom_type[i] == mujoco.mjtGeom.mjGEOM_SPHERE else 0.0)
+            for i in range(m.ngeom)
+            if m.geom_conaffinity[i] and m.geom_bodyid[i] != 0 and m.body_rootid[m.geom_bodyid[i]] == robot
         )
-        self.data.qpos[2] += -lowest + self.config.init_height_clearance_m
+        base[2] += -lowest + self.config.init_height_clearance_m
         self._command = MotorCommand(q_rad=q.copy(), kp=g1.KP_DEFAULT.copy(), kd=g1.KD_DEFAULT.copy())
         self._tick = 0
         self._push_until_s = -1.0
@@ -83,8 +102,8 @@ class MujocoBackend(Backend):
         d = self.data
         return RobotState(
             t_s=float(d.time),
-            q_rad=d.qpos[7:].copy(),
-            dq_radps=d.qvel[6:].copy(),
+            q_rad=d.qpos[self._q].copy(),
+            dq_radps=d.qvel[self._v].copy(),
             tau_nm=self._tau.copy(),
             imu_quat_wxyz=d.sensordata[self._quat].copy(),
             imu_gyro_radps=d.sensordata[self._gyro].copy(),
@@ -92,8 +111,8 @@ class MujocoBackend(Backend):
             motor_temperature_c=np.full(g1.NUM_JOINTS, self.config.motor_temperature_c),
             mode_machine=g1.G1_29DOF.mode_machine,
             tick=self._tick,
-            base_pos_w_m=d.qpos[0:3].copy(),
-            base_linvel_w_mps=d.qvel[0:3].copy(),
+            base_pos_w_m=d.qpos[self._base_q][0:3].copy(),
+            base_linvel_w_mps=d.qvel[self._base_v][0:3].copy(),
         )
 
     def write_command(self, command: MotorCommand) -> None:
@@ -103,7 +122,7 @@ class MujocoBackend(Backend):
         n = max(1, round(dt_s / self.model.opt.timestep))
         d = self.data
         for _ in range(n):
-            motor_torque(self._command, d.qpos[7:], d.qvel[6:], out=self._tau)
+            motor_torque(self._command, d.qpos[self._q], d.qvel[self._v], out=self._tau)
             d.ctrl[:] = self._tau
             if d.time < self._push_until_s:
                 d.xfrc_applied[self._push_body, :3] = self._push_force_w
@@ -135,6 +154,12 @@ class MujocoBackend(Backend):
         """Apply a force (N, world frame) to the pelvis for `duration_s` from now."""
         self._push_force_w = np.asarray(force_w_n, dtype=float)
         self._push_until_s = self.data.time + duration_s
+
+    def object_pose(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """(position, quaternion wxyz) of a scene box, from the simulator's state."""
+        from g1_control.sim.scene import free_body_pose
+
+        return free_body_pose(self.model, self.data, name)
 
     @property
     def time_s(self) -> float:

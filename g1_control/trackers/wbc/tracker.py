@@ -182,6 +182,7 @@ class WholeBodyTracker(Tracker):
         v[:3] = rot.T @ est.base_linvel_w_mps
         v[3:6] = state.imu_gyro_radps
         v[6:] = state.dq_radps
+        dyn.hand_forces_w_n[:] = reference.hand_forces_w_n
         dyn.update(q, v)
         sole_pos_before = np.array([dyn.data.oMf[f].translation for f in dyn.sole_ids])
         offsets = sole_pos_before - q[:3]
