@@ -58,7 +58,10 @@ class StateEstimator:
         self.estimate = EstimatedState()
         self._last_t = None
 
-    def update(self, state: RobotState) -> EstimatedState:
+    def update(self, state: RobotState, contacts: np.ndarray | None = None) -> EstimatedState:
+        """contacts: (left, right) feet known to be in stance (a controller's contact schedule);
+        None: the lower foot is taken as the stance foot. Known contacts matter on uneven ground:
+        a foot swinging up from the floor next to one standing on a step is the lower one."""
         pin = self._pin
         est = self.estimate
         quat = state.imu_quat_wxyz
@@ -74,10 +77,13 @@ class StateEstimator:
         for i, fid in enumerate(self._soles):
             heights[i] = pin.updateFramePlacement(self.model, self.data, fid).translation[2]
             velocities[i] = pin.getFrameVelocity(self.model, self.data, fid, pin.LOCAL_WORLD_ALIGNED).linear
-        # Soft stance: the lower foot carries the weight.
-        d = (heights[1] - heights[0]) / self.config.stance_height_scale_m
-        w_left = 1.0 / (1.0 + np.exp(-np.clip(d, -50, 50)))
-        weights = np.array([w_left, 1.0 - w_left])
+        if contacts is not None and np.any(contacts):
+            weights = np.asarray(contacts, dtype=float) / float(np.sum(contacts))
+        else:
+            # Soft stance: the lower foot carries the weight.
+            d = (heights[1] - heights[0]) / self.config.stance_height_scale_m
+            w_left = 1.0 / (1.0 + np.exp(-np.clip(d, -50, 50)))
+            weights = np.array([w_left, 1.0 - w_left])
         v_kin = -(weights @ velocities)
 
         dt = 0.0 if self._last_t is None else max(0.0, state.t_s - self._last_t)

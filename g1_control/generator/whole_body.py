@@ -177,14 +177,16 @@ class WholeBodyIK:
               hands: tuple[tuple[str, np.ndarray], ...] | list = (), hand_weight: float = 10.0,
               hand_rot: tuple[tuple[str, np.ndarray], ...] | list = (), hand_rot_weight: float = 10.0,
               pelvis_rot_weight=(10.0, 10.0, 10.0), posture_weight: np.ndarray | float | None = None,
-              sole_weight: float = 100.0, com_weight: float = 30.0, pelvis_z_weight: float = 30.0,
+              sole_weight: float | np.ndarray = 100.0, com_weight: float = 30.0, pelvis_z_weight: float = 30.0,
               pelvis_z_max: float | None = None, iterations: int = 30, tol: float = 1e-6,
-              damping: float = 1e-6, margin_rad: float = LIMIT_MARGIN_RAD) -> np.ndarray:
+              damping: float = 1e-6, margin_rad: float | np.ndarray = LIMIT_MARGIN_RAD) -> np.ndarray:
         """The configuration (pinocchio q) nearest `q0` that meets the targets in the weighted
         least-squares sense, every joint within its limits (less margin_rad).
 
         soles: (position, rotation) per sole frame; com_xy / pelvis_z: None to leave free;
         pelvis_z_max: a one-sided cap on the pelvis height; hands / hand_rot: (frame name, target).
+        sole_weight: one number, or (2, 6) per sole (position, rotation) - e.g. a swing foot whose
+        pitch may give; margin_rad: one number or per joint (29,).
         """
         pin, m, d = self.pin, self.model, self.data
         if posture_weight is None:
@@ -198,14 +200,15 @@ class WholeBodyIK:
         hand_ids = [(m.getFrameId(name), target) for name, target in hands]
         hand_rot_ids = [(m.getFrameId(name), rot) for name, rot in hand_rot]
         eye = damping * np.eye(nv)
+        w_soles = np.broadcast_to(np.asarray(sole_weight, dtype=float), (2, 6))
         for _ in range(iterations):
             pin.computeJointJacobians(m, d, q)
             pin.updateFramePlacements(m, d)
             rows, errs, weights = [], [], []
-            for fid, (pos, rot) in zip(self.sole_ids, soles):
+            for i, (fid, (pos, rot)) in enumerate(zip(self.sole_ids, soles)):
                 rows.append(pin.getFrameJacobian(m, d, fid, lwa))
                 errs.append(np.concatenate([pos - d.oMf[fid].translation, rotation_error(rot, d.oMf[fid].rotation)]))
-                weights.append(np.full(6, sole_weight))
+                weights.append(w_soles[i])
             jp = pin.getFrameJacobian(m, d, self.pelvis_id, lwa)
             pelvis_now = d.oMf[self.pelvis_id]
             rows.append(jp[3:])

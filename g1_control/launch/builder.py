@@ -95,7 +95,7 @@ def make_sim_backend(launch: LaunchFile) -> MujocoBackend:
                               "run it with `g1 deploy`, which checks the robot before anything moves")
     from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
 
-    return MujocoBackend(MujocoConfig(physics_dt_s=launch.backend.physics_dt_s, lockstep=True))
+    return MujocoBackend(MujocoConfig(physics_dt_s=launch.backend.physics_dt_s, lockstep=True), scene=launch.scene)
 
 
 def describe_chain(launch: LaunchFile, generator: Generator, retargeter: Retargeter, tracker: Tracker) -> dict[str, str]:

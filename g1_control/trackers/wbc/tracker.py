@@ -172,7 +172,9 @@ class WholeBodyTracker(Tracker):
         stance = scheduled | unloading
 
         # 1. floating-base state
-        est = self.estimator.update(state)
+        # Leg-kinematics velocity from the scheduled stance feet (the lower foot is not the stance
+        # foot on a step: with it, a trailing foot swinging up read as the body falling, measured).
+        est = self.estimator.update(state, scheduled if scheduled.all() or not stance.all() else stance)
         quat = state.imu_quat_wxyz
         rot = quat_to_rot(quat)
         q, v = self._q, self._v
