@@ -343,6 +343,17 @@ class JointReference:
     reaction to the squeeze and the object's weight. A whole-body controller puts them in its
     dynamics, so its torques hold the object and its balance accounts for it."""
 
+    def copy_from(self, src: JointReference) -> JointReference:
+        """Copy every field of `src` into this reference's own arrays (no allocation); returns self."""
+        self.t_s = src.t_s
+        for name in ("q_rad", "dq_radps", "root_pos_w_m", "root_quat_wxyz", "root_linvel_h_mps",
+                     "root_angvel_h_radps", "contacts", "hand_forces_w_n"):
+            getattr(self, name)[:] = getattr(src, name)
+        self.upper_body_override = src.upper_body_override
+        self.pelvis_height_m = src.pelvis_height_m
+        self.phase = src.phase
+        return self
+
 
 @dataclass
 class EstimatedState:

@@ -114,13 +114,7 @@ class WholeBodyTrajectory:
 
 
 def copy_reference(src: JointReference, dst: JointReference) -> None:
-    dst.t_s = src.t_s
-    for name in ("q_rad", "dq_radps", "root_pos_w_m", "root_quat_wxyz", "root_linvel_h_mps", "root_angvel_h_radps",
-                 "contacts", "hand_forces_w_n"):
-        getattr(dst, name)[:] = getattr(src, name)
-    dst.upper_body_override = src.upper_body_override
-    dst.pelvis_height_m = src.pelvis_height_m
-    dst.phase = src.phase
+    dst.copy_from(src)
 
 
 def trajectory_from_configurations(name: str, t: np.ndarray, qs: np.ndarray, contacts: np.ndarray,
