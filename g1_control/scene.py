@@ -8,7 +8,7 @@ the rest of the schema, errors naming the key). The robot starts at the origin f
     scene:
       tables:    [{name: table_a, center_xy_m: [2.0, 0.0], size_xy_m: [0.5, 0.8], height_m: 0.7}]
       platforms: [{name: step, center_xy_m: [1.2, 0.0], size_xy_m: [0.6, 1.0], height_m: 0.15}]
-      boxes:     [{name: box, on: table_a, xy_m: [1.9, 0.0], size_m: [0.3, 0.3, 0.3], mass_kg: 2.0}]
+      boxes:     [{name: box, stands_on: table_a, xy_m: [1.9, 0.0], size_m: [0.3, 0.3, 0.3], mass_kg: 2.0}]
 
 Nothing here imports MuJoCo; numbers are SI (m, kg, rad).
 """
@@ -114,8 +114,8 @@ class Box:
     name: str
     xy_m: tuple[float, float]
     """Centre of its footprint, world frame."""
-    on: str = FLOOR
-    """'floor' or the name of the table/platform it stands on."""
+    stands_on: str = FLOOR
+    """'floor' or the name of the table/platform it stands on. (Not `on`: YAML reads that key as true.)"""
     size_m: tuple[float, float, float] = (0.3, 0.3, 0.3)
     """Extent along its own x, y, z (its x, y turned by yaw_rad)."""
     mass_kg: float = 2.0
@@ -172,13 +172,13 @@ class SceneConfig:
                                           "the robot's start at the origin")
         for i, box in enumerate(self.boxes):
             w = f"{where}.boxes[{i}]"
-            if box.on != FLOOR:
-                support = self.block(box.on)
+            if box.stands_on != FLOOR:
+                support = self.block(box.stands_on)
                 if support is None:
-                    raise LaunchFileError(f"{w}.on: '{box.on}' is not a table or platform of the scene; "
+                    raise LaunchFileError(f"{w}.stands_on: '{box.stands_on}' is not a table or platform of the scene; "
                                           f"known: {', '.join([FLOOR] + self.block_names())}")
                 if not support.contains_xy(np.asarray(box.xy_m), margin_m=0.0):
-                    raise LaunchFileError(f"{w}.xy_m: {list(box.xy_m)} is not over the top of '{box.on}'")
+                    raise LaunchFileError(f"{w}.xy_m: {list(box.xy_m)} is not over the top of '{box.stands_on}'")
             elif np.hypot(*box.xy_m) < ROBOT_CLEARANCE_M:
                 raise LaunchFileError(f"{w}.xy_m: closer than {ROBOT_CLEARANCE_M} m to the robot's start")
 
@@ -213,7 +213,7 @@ class SceneConfig:
 
     def box_center(self, box: Box) -> np.ndarray:
         """Where the box's centre is at the start (world, m)."""
-        return np.array([box.xy_m[0], box.xy_m[1], self.surface_height(box.on) + box.size[2] / 2])
+        return np.array([box.xy_m[0], box.xy_m[1], self.surface_height(box.stands_on) + box.size[2] / 2])
 
     def ground_height(self, xy_w: np.ndarray) -> float:
         """Height of what a foot stands on at xy: a platform's top, else the floor."""

@@ -60,11 +60,11 @@ def approach_for(center_xy: np.ndarray, normal_xy: np.ndarray) -> Approach:
 
 def pick_approach(scene: SceneConfig, box: Box, box_xy: np.ndarray, robot_xy: np.ndarray) -> Approach:
     """Where to stand to pick `box` (now at box_xy) up; raises ReachRefused when no side works."""
-    if box.on == FLOOR:
+    if box.stands_on == FLOOR:
         d = robot_xy - box_xy
         n = d / max(float(np.linalg.norm(d)), 1e-6)
         return approach_for(box_xy, n)
-    block = scene.block(box.on)
+    block = scene.block(box.stands_on)
     assert block is not None  # SceneConfig.validate checked it
     normal, inside = _edge_normal(block, box_xy)
     if GRASP_DISTANCE_M - inside < MIN_EDGE_CLEARANCE_M:

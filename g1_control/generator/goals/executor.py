@@ -102,7 +102,8 @@ class GoalConfig:
     force_ramp_s: float = 0.4
     backup_m: float = 0.3
     """Steps back from a table before turning with a box."""
-    carry: SteppingConfig = field(default_factory=lambda: SteppingConfig(max_advance_m=0.12, max_turn_rad=0.18))
+    carry: SteppingConfig = field(default_factory=lambda: SteppingConfig(
+        max_advance_m=0.10, max_turn_rad=0.18, single_support_s=0.6, double_support_s=0.25))
     steps: SteppingConfig = field(default_factory=SteppingConfig)
     toe_gap_m: float = 0.055
     """Stepping up: the toes stop this short of the platform's edge."""
@@ -401,17 +402,33 @@ class GoalGenerator(Generator):
             steps += walk_steps(stance, back, stance.heading, cfg, lambda xy: ground(xy), backward_max_m=1.0)
             for st in steps:
                 stance = stance.apply(st)
-        steps += walk_steps(stance, mid_xy, heading, cfg, lambda xy: ground(xy))
+        steps += walk_steps(stance, mid_xy, heading, cfg, lambda xy: ground(xy), then=steps)
         if not steps:
             return
         t_cpu = time.process_time()
         plan = stepping_trajectory(self.ik, q0, steps, cfg, posture=posture, hand_forces=forces,
                                    com_offset_h_m=com_shift, name=name)
         self._cpu(name, t_cpu)
+        self.last_steps = plan
         if plan.sole_error_m > 0.03:
             raise GoalFailed(f"{name}: the footsteps are out of the legs' reach (plan off by "
                              f"{plan.sole_error_m * 100:.0f} cm)")
         yield from self._run(plan.trajectory)
+
+    def _correct_stance(self, mid_w: np.ndarray, heading: float, cfg: SteppingConfig, *, posture=None,
+                        forces=None, com_shift=None, tolerance_m: float = 0.03, rounds: int = 2) -> Iterator[None]:
+        """Small steps until the stance is where it should be in the world (the tracker's odometry
+        drifts a few cm per metre walked; the world pose says where the robot really is)."""
+        for _ in range(rounds):
+            q0 = self._hold_q()
+            stance = Stance.of(self.ik, q0)
+            mid_plan = mid_w + self._offset()
+            err = float(np.hypot(*(mid_plan - stance.mid_xy)))
+            if err <= tolerance_m and abs(wrap_angle(heading - stance.heading)) <= 0.05:
+                return
+            self._note(f"stance {err * 100:.0f} cm off: correcting steps")
+            yield from self._step_to(mid_plan, heading, cfg, posture=posture, forces=forces, com_shift=com_shift,
+                                     name="correction")
 
     def _cpu(self, what: str, t0: float) -> None:
         key = f"{self._goal.goal_id if self._goal else ''} {what}".strip()
@@ -490,6 +507,7 @@ class GoalGenerator(Generator):
             yield from self._enter_whole_body()
         off = self._offset()
         yield from self._step_to(approach.mid_xy + off, approach.heading, cfg.steps, name="approach")
+        yield from self._correct_stance(approach.mid_xy, approach.heading, cfg.steps)
         # the grasp, from the stance the steps ended in
         q0 = self._hold_q()
         soles = flat_soles(self.ik, q0)
@@ -553,6 +571,9 @@ class GoalGenerator(Generator):
             # carry: the hand forces turn with the robot, so plan them per heading: held constant in
             # the robot's frame (the squeeze across it, the weight down)
             yield from self._carry(approach.mid_xy + off, approach.heading, posture, weight, shift)
+            yield from self._correct_stance(approach.mid_xy, approach.heading, cfg.carry, posture=posture,
+                                            forces=hand_forces(approach.heading, cfg.squeeze_n, weight),
+                                            com_shift=self.poses.com_offset_m + shift)
         q0 = self._hold_q()
         soles = flat_soles(self.ik, q0)
         heading = stance_heading(soles)
@@ -600,12 +621,13 @@ class GoalGenerator(Generator):
         steps = walk_steps(stance, back, stance.heading, cfg.carry, lambda xy: ground(xy), backward_max_m=1.0)
         for st in steps:
             stance = stance.apply(st)
-        steps += walk_steps(stance, mid_xy, heading, cfg.carry, lambda xy: ground(xy))
+        steps += walk_steps(stance, mid_xy, heading, cfg.carry, lambda xy: ground(xy), then=steps)
         t_cpu = time.process_time()
         plan = stepping_trajectory(self.ik, q0, steps, cfg.carry, posture=posture,
                                    hand_forces=hand_forces(stance_heading(flat_soles(self.ik, q0)), cfg.squeeze_n,
                                                            weight),
                                    com_offset_h_m=self.poses.com_offset_m + com_shift, name="carry")
+        self.last_steps = plan
         traj = plan.trajectory
         # hand forces per sample, turned with the pelvis's heading
         yaws = traj.root_rpy_rad[:, 2]
@@ -660,6 +682,7 @@ class GoalGenerator(Generator):
             yield from self._walk_to(approach, out_m=cfg.approach_offset_m)
             yield from self._enter_whole_body()
         yield from self._step_to(mid + self._offset(), heading, cfg.steps, name="approach")
+        yield from self._correct_stance(mid, heading, cfg.steps, tolerance_m=0.02)
         q0 = self._hold_q()
         stance = Stance.of(self.ik, q0)
         forward = SOLE_HALF_LENGTH_M + cfg.toe_gap_m + cfg.past_edge_m

@@ -142,48 +142,65 @@ def _foot_at(mid_xy: np.ndarray, yaw: float, foot: int, width: float, z: float) 
 
 def _segment(stance: Stance, mid_to: np.ndarray, yaw_to: float, cfg: SteppingConfig,
              ground: Callable[[np.ndarray], float], steps: list[Footstep]) -> Stance:
-    """Steps that take the mid-point to mid_to with heading yaw_to (straight, interpolated)."""
+    """Steps that take the mid-point to mid_to with heading yaw_to (straight, interpolated). The
+    feet keep alternating from the last step of `steps` (a foot stepping twice in a row leaves the
+    other in single support twice as long: a carry with a box tipped over it, measured); the first
+    foot of all leads on the side of the motion."""
     mid0, yaw0 = stance.mid_xy, stance.heading
     d = mid_to - mid0
     c, s = math.cos(yaw0), math.sin(yaw0)
     along, side = c * d[0] + s * d[1], -s * d[0] + c * d[1]
     dyaw = float(wrap_angle(yaw_to - yaw0))
-    n = max(1, math.ceil(max(abs(along) / cfg.max_advance_m, abs(side) / cfg.max_side_m,
-                             abs(dyaw) / cfg.max_turn_rad) - 1e-9))
     if np.hypot(*d) < 1e-3 and abs(dyaw) < 1e-3:
         return stance
-    # Lead with the foot on the side of the motion (sideways, or turning), so the feet never cross.
-    lead = LEFT if (side > 0.02 or (abs(side) <= 0.02 and dyaw > 0)) else RIGHT
+    n = max(1, math.ceil(max(abs(along) / cfg.max_advance_m, abs(side) / cfg.max_side_m,
+                             abs(dyaw) / cfg.max_turn_rad) - 1e-9))
+    if steps:
+        first = 1 - steps[-1].foot
+    else:
+        first = LEFT if (side > 0.02 or (abs(side) <= 0.02 and dyaw > 0)) else RIGHT
     for k in range(1, n + 1):
         a = k / n
         mid, yaw = mid0 + a * d, yaw0 + a * dyaw
-        foot = lead if k % 2 else 1 - lead
+        foot = first if k % 2 else 1 - first
         pos = _foot_at(mid, yaw, foot, cfg.stance_width_m, 0.0)
         pos[2] = ground(pos[:2])
         step = Footstep(foot, pos, float(yaw))
         steps.append(step)
         stance = stance.apply(step)
-    # The trailing foot closes alongside.
-    trailing = 1 - steps[-1].foot
-    pos = _foot_at(mid0 + d, yaw0 + dyaw, trailing, cfg.stance_width_m, 0.0)
+    return stance
+
+
+def _close(stance: Stance, cfg: SteppingConfig, ground: Callable[[np.ndarray], float],
+           steps: list[Footstep]) -> Stance:
+    """The trailing foot alongside the last one."""
+    if not steps:
+        return stance
+    last = steps[-1]
+    trailing = 1 - last.foot
+    side = 1.0 if last.foot == LEFT else -1.0
+    mid = last.pos_w_m[:2] - side * cfg.stance_width_m / 2 * np.array([-math.sin(last.yaw_rad), math.cos(last.yaw_rad)])
+    pos = _foot_at(mid, last.yaw_rad, trailing, cfg.stance_width_m, 0.0)
     pos[2] = ground(pos[:2])
-    step = Footstep(trailing, pos, float(yaw0 + dyaw))
+    step = Footstep(trailing, pos, last.yaw_rad)
     steps.append(step)
     return stance.apply(step)
 
 
 def walk_steps(stance: Stance, goal_mid_xy: np.ndarray, goal_yaw: float, cfg: SteppingConfig,
                ground: Callable[[np.ndarray], float] = lambda xy: 0.0, *, backward_max_m: float = 0.6,
-               turn_first_m: float = 0.4) -> list[Footstep]:
-    """Footsteps from `stance` to a stance centred at goal_mid_xy facing goal_yaw."""
-    steps: list[Footstep] = []
+               turn_first_m: float = 0.4, then: list[Footstep] | None = None) -> list[Footstep]:
+    """Footsteps from `stance` to a stance centred at goal_mid_xy facing goal_yaw: turn to face the
+    way, walk straight, turn to the goal's heading (short moves backwards without turning), the
+    trailing foot closing alongside at the end. The feet alternate on from `then` (steps planned
+    before these; not repeated in the result)."""
+    steps: list[Footstep] = list(then or [])
+    before = len(steps)
     goal_mid_xy = np.asarray(goal_mid_xy, dtype=float)
     d = goal_mid_xy - stance.mid_xy
     dist = float(np.hypot(*d))
     if dist > turn_first_m:
-        bearing = math.atan2(d[1], d[0])
-        facing = float(wrap_angle(bearing - stance.heading))
-        # Short moves backwards without turning; otherwise face the way, walk, then turn.
+        facing = float(wrap_angle(math.atan2(d[1], d[0]) - stance.heading))
         if dist <= backward_max_m and abs(wrap_angle(facing - math.pi)) < math.radians(30):
             way = stance.heading
         else:
@@ -191,7 +208,9 @@ def walk_steps(stance: Stance, goal_mid_xy: np.ndarray, goal_yaw: float, cfg: St
         stance = _segment(stance, stance.mid_xy, way, cfg, ground, steps)
         stance = _segment(stance, goal_mid_xy, way, cfg, ground, steps)
     stance = _segment(stance, goal_mid_xy, goal_yaw, cfg, ground, steps)
-    return steps
+    if len(steps) > before:
+        _close(stance, cfg, ground, steps)
+    return steps[before:]
 
 
 def approach_stance_for_edge(block: Block, edge_point_xy: np.ndarray, normal_xy: np.ndarray, toe_gap_m: float,
