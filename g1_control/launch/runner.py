@@ -166,10 +166,17 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
 
         bar = tqdm(total=round(duration, 1), unit="sim s", desc=launch.name, bar_format="{l_bar}{bar}| {n:.1f}/{total} sim s [{elapsed}<{remaining}]")
     ticks_per_update = int(loop.rates.lowlevel_hz)
+    watcher = None
+    if launch.tracker.type == "layer":  # goals: judged from ground truth (g1_control/launch/outcomes.py)
+        from g1_control.launch.outcomes import GoalWatcher
+
+        watcher = GoalWatcher(loop)
     view = _open_viewer(sim) if viewer else None
     web = _open_web(sim, web_port, launch.name) if web_port is not None else None
 
     def on_tick(i: int) -> None:
+        if watcher is not None:
+            watcher.tick(i)
         if bar is not None and (i + 1) % ticks_per_update == 0:
             bar.update(1.0)
             if loop.faulted:
@@ -199,6 +206,8 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
         loop.input.close()
         loop.backend.close()
     result = _result(launch, loop, segments, wall)
+    if watcher is not None:
+        result.extra["goals"] = watcher.outcomes()
     if out_root is not None:
         write_run_folder(result, launch, loop, Path(out_root), video)
     return result
@@ -306,6 +315,10 @@ def format_summary(result: RunResult) -> str:
         lines.append(f"state estimator velocity RMS error vs ground truth: {result.estimator_rms_mps:.3f} m/s")
     for e in result.events:
         lines.append(f"event at {e['t_s']:.2f} s: {e['kind']}: {e['detail']}")
+    if result.extra.get("goals"):
+        from g1_control.launch.outcomes import outcome_line
+
+        lines += ["", "goals (ground truth):"] + ["  " + outcome_line(o) for o in result.extra["goals"]]
     if result.run_dir:
         lines.append(f"run folder: {result.run_dir}" + (f" (video: {Path(result.video).name})" if result.video else ""))
     return "\n".join(lines)

@@ -133,6 +133,9 @@ class GoalGenerator(Generator):
         self.goal_status: dict[str, str] = {}
         self.goal_messages: dict[str, str] = {}
         self.plan_cpu_s: dict[str, float] = {}
+        self.goal_info: dict[str, dict] = {}
+        """Per goal, for judging it from outside: kind, start/end time, the hold window of a reach,
+        its target in the world (reach point, box, where the box goes, platform)."""
         self.log: list[tuple[float, str]] = []
         self._ref = KinematicReference()
         self._joint = JointReference()
@@ -231,6 +234,7 @@ class GoalGenerator(Generator):
     def _run_goal(self, goal: TaskGoal) -> Iterator[None]:
         gid = goal.goal_id
         self._note(f"goal {gid}: {goal.describe()}")
+        self._info = self.goal_info.setdefault(gid, {"kind": goal.kind, "describe": goal.describe(), "start_s": self._t})
         try:
             if self._state is None or self._state.base_pos_w_m is None:
                 raise GoalFailed("no world pose for the robot (goals in world coordinates need localisation; "
@@ -248,6 +252,8 @@ class GoalGenerator(Generator):
                 self.phase = PHASE_LOCOMOTION
         self._walk[:] = 0.0
         self._goal = None
+        self._info["end_s"] = self._t
+        self._info["status"] = self.goal_status.get(gid)
 
     def _note(self, text: str) -> None:
         self.log.append((self._t, text))
@@ -462,6 +468,8 @@ class GoalGenerator(Generator):
         self._cpu("reach", t_cpu)
         self._note(f"reach: {res.mode}, hand {res.residual_m * 100:.1f} cm from the point in the plan")
         move = cfg.move_s * max(1.0, float(np.abs(res.q[7:] - q0[7:]).max()) / 1.5)
+        self._info.update(hand=goal.hand, target_w_m=(target - off).tolist(), mode=res.mode,
+                          plan_residual_m=res.residual_m, hold_s=(self._t + move, self._t + move + cfg.reach_hold_s))
         yield from self._run(keyframe_trajectory("reach", [(0.0, q0), (move, res.q), (move + cfg.reach_hold_s, res.q)]),
                              keep=True)
 
@@ -545,6 +553,8 @@ class GoalGenerator(Generator):
 
         keys = [(0.0, q0), (t["via"], q_via), (t["pre"], q_pre), (t["con"], q_con), (t["squeeze"], q_con),
                 (t["lift"], q_lift), (t["end"], q_lift)]
+        self._info.update(box=box.name, box_start_w_m=center.tolist(), lift_m=cfg.lift_m,
+                          held_from_s=self._t + t["lift"])
         yield from self._run(keyframe_trajectory("pick", keys, hand_forces=forces))
         self._held = Held(box, full)
         self.box_positions[box.name] = None
@@ -559,6 +569,7 @@ class GoalGenerator(Generator):
         s = self._state
         assert s is not None and s.base_pos_w_m is not None
         center_w, approach = place_target(self.scene, box, goal.target, goal.pos_w_m, s.base_pos_w_m[:2])
+        self._info.update(box=box.name, target_w_m=center_w.tolist())
         q0 = self._hold_q()
         posture = q0[7:].copy()
         weight = box.mass_kg * GRAVITY
@@ -604,6 +615,7 @@ class GoalGenerator(Generator):
         keys = [(0.0, q0), (t["down"], q_down.q), (t["release"], q_down.q), (t["open"], q_open), (t["out"], q_out),
                 (t["stand"], q_stand), (t["end"], q_stand)]
         yield from self._run(keyframe_trajectory("place", keys, hand_forces=forces))
+        self._info["released_s"] = self._t - t["end"] + t["release"]
         self._held = None
         self.box_positions[box.name] = center_w
         if self.on_platform is None:
@@ -677,6 +689,7 @@ class GoalGenerator(Generator):
             raise GoalFailed(f"platform '{block.name}' is too shallow to stand on")
         mid = edge + normal * (SOLE_HALF_LENGTH_M + cfg.toe_gap_m)
         heading = math.atan2(-normal[1], -normal[0])
+        self._info.update(platform=block.name, height_m=block.height_m)
         approach = Approach(mid, heading)
         if self.phase != PHASE_WHOLE_BODY:
             yield from self._walk_to(approach, out_m=cfg.approach_offset_m)
@@ -698,6 +711,7 @@ class GoalGenerator(Generator):
         cfg = self.config
         if self.on_platform is None:
             raise GoalFailed("not standing on a platform")
+        self._info.update(platform=self.on_platform)
         forward, _ = self._step_back
         q0 = self._hold_q()
         stance = Stance.of(self.ik, q0)

@@ -26,8 +26,11 @@ from g1_control.rotations import rot_z
 REACH_TOLERANCE_M = 0.01
 REFUSE_RESIDUAL_M = 0.03
 MAX_REACH_M = 0.58
-"""From the shoulder joint to the hand point: beyond this no standing pose reaches (0.52-0.55 m
-is the edge in some directions, issue 17 investigation)."""
+"""From the shoulder joint (allowed to drop by CROUCH_DROP_M for a low point) to the hand point:
+beyond this no standing pose reaches (0.52-0.55 m is the edge in some directions, issue 17
+investigation)."""
+CROUCH_DROP_M = 0.30
+"""Crouching and leaning can lower a shoulder by about this much (pelvis 0.76 -> 0.45 m)."""
 PELVIS_CAP_ABOVE_NOMINAL_M = 0.01
 """Poses keep the pelvis at most this above its nominal height: straight knees are singular."""
 HAND_FACE_OFFSET_M = 0.045
@@ -115,9 +118,14 @@ class PosePlanner:
         """The pose with hand `hand` (0 left, 1 right) at target_w (arm first; module docstring).
         Raises ReachRefused when no standing pose gets within REFUSE_RESIDUAL_M."""
         target_w = np.asarray(target_w, dtype=float)
-        dist = float(np.linalg.norm(target_w - self.shoulder(q0, hand)))
+        shoulder = self.shoulder(q0, hand)
+        dist = float(np.linalg.norm(target_w - shoulder))
+        # crouching and leaning lower the shoulder by up to CROUCH_DROP_M
+        below = max(0.0, shoulder[2] - CROUCH_DROP_M - target_w[2]) if target_w[2] < shoulder[2] else \
+            target_w[2] - shoulder[2]
+        reach_dist = float(np.hypot(np.linalg.norm(target_w[:2] - shoulder[:2]), below))
         side = ("left", "right")[hand]
-        if dist > MAX_REACH_M:
+        if reach_dist > MAX_REACH_M:
             raise ReachRefused(f"{side} hand: the point is {dist:.2f} m from the shoulder; standing, the hand "
                                f"reaches {MAX_REACH_M:.2f} m at most (step closer first)")
         posture = g1.DEFAULT_Q_RAD.copy() if posture is None else posture
@@ -127,6 +135,12 @@ class PosePlanner:
         hands = [(HAND_FRAMES[hand], target_w)]
         com = self.com_over(soles)
         best: PoseResult | None = None
+        # warm start, then the reaching arm (and then both) from the default pose: a warm start
+        # from an arm stretched elsewhere lands in a wrong local solution (measured: 5 cm short)
+        seeds = [q0, q0.copy(), q0.copy()]
+        arm = np.array(g1.ARM_JOINTS[:7] if hand == 0 else g1.ARM_JOINTS[7:])
+        seeds[1][7 + arm] = g1.DEFAULT_Q_RAD[arm]
+        seeds[2][7 + ARMS] = g1.DEFAULT_Q_RAD[ARMS]
         modes = (
             # arm only: pelvis height and trunk held
             ("arm_only", dict(pelvis_z=q0[2], posture_weight=_weights(legs=0.002, waist=5.0, arms=0.02),
@@ -137,14 +151,18 @@ class PosePlanner:
             ("whole_body", dict(pelvis_z=None, posture_weight=_weights(legs=0.002, waist=0.05, arms=0.02),
                                 pelvis_rot_weight=(5.0, 0.3, 2.0), pelvis_z_weight=1.0)),
         )
-        for mode, kw in modes:
-            pz = kw.pop("pelvis_z")
-            q = self._solve(q0, soles, com, pz, heading, posture, hands=hands, hand_weight=100.0, com_weight=300.0,
-                            pelvis_z_max=z_nominal + PELVIS_CAP_ABOVE_NOMINAL_M, rounds=8, **kw)
-            res = float(np.linalg.norm(self.hand_point(q, hand) - target_w))
-            if best is None or res < best.residual_m - 1e-4:
-                best = PoseResult(q, res, mode)
-            if res <= REACH_TOLERANCE_M:
+        for seed in seeds:
+            for mode, kw in modes:
+                kw = dict(kw)
+                pz = kw.pop("pelvis_z")
+                q = self._solve(seed, soles, com, pz, heading, posture, hands=hands, hand_weight=100.0, com_weight=300.0,
+                                pelvis_z_max=z_nominal + PELVIS_CAP_ABOVE_NOMINAL_M, rounds=8, **kw)
+                res = float(np.linalg.norm(self.hand_point(q, hand) - target_w))
+                if best is None or res < best.residual_m - 1e-4:
+                    best = PoseResult(q, res, mode)
+                if res <= REACH_TOLERANCE_M:
+                    break
+            if best is not None and best.residual_m <= REACH_TOLERANCE_M:
                 break
         assert best is not None
         if best.residual_m > REFUSE_RESIDUAL_M:
