@@ -107,10 +107,11 @@ def judge_goal(goal_id: str, info: dict, a: dict[str, np.ndarray]) -> dict:
     elif kind == "place" and info.get("box") and f"box_{info['box']}" in a:
         rows = a[f"box_{info['box']}"]
         final, target = rows[-1], np.asarray(info["target_w_m"])
-        w = abs(float(final[3]))
+        qx, qy = final[4], final[5]
+        up = 1.0 - 2.0 * (qx * qx + qy * qy)  # the box's z axis against the world's
         out.update(place_error_xy_m=float(np.linalg.norm(final[:2] - target[:2])),
                    place_error_z_m=float(final[2] - target[2]),
-                   box_tilt_deg=float(2 * math.degrees(math.acos(min(1.0, w)))),
+                   box_tilt_deg=float(math.degrees(math.acos(max(-1.0, min(1.0, up))))),
                    box_final_w_m=final[:3].tolist())
         if "start_s" in info:
             carried = (t >= info["start_s"]) & (t <= info.get("released_s", t[-1]))

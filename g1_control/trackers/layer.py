@@ -20,6 +20,8 @@ Measured in the issue 17 investigation (standing, policy <-> WBC): largest per-t
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from g1_control.interfaces import Tracker
@@ -35,6 +37,7 @@ from g1_control.types import (
 )
 
 POLICY, WBC = "policy", "wbc"
+PROFILE_TICKS = 1 << 17
 WBC_MIN_PELVIS_HEIGHT_M = 0.45
 """The lowest standing pelvis height the WBC path is measured to hold (issue 17)."""
 
@@ -74,6 +77,11 @@ class TrackingLayer(Tracker):
         """What the policy is given while the plan is whole-body (during a blend out of it): stand."""
         self._last_wbc_ref = JointReference()
         self.switches: list[tuple[float, str]] = []
+        self.cpu_s = np.zeros(PROFILE_TICKS)
+        """Thread CPU time of each act() (the cost without other processes' preemption), ring buffer."""
+        self.cpu_kind = np.zeros(PROFILE_TICKS, dtype=np.int8)
+        """What ran in that act(): 0 the policy, 1 the WBC, 2 both (a hand-over blend)."""
+        self.profiled = 0
         self.reset()
 
     # -- Tracker ------------------------------------------------------------------------------------
@@ -102,6 +110,20 @@ class TrackingLayer(Tracker):
         return self.policy.policy_command if self.active == POLICY or self.previous == POLICY else None
 
     def act(self, reference: JointReference, state: RobotState) -> MotorCommand:
+        c0 = time.thread_time()
+        out = self._act(reference, state)
+        k = self.profiled % PROFILE_TICKS
+        self.cpu_s[k] = time.thread_time() - c0
+        self.cpu_kind[k] = 2 if self.previous is not None else (1 if self.active == WBC else 0)
+        self.profiled += 1
+        return out
+
+    def cpu_samples(self) -> tuple[np.ndarray, np.ndarray]:
+        """(seconds, kind) of the profiled act() calls (the last PROFILE_TICKS)."""
+        n = min(self.profiled, PROFILE_TICKS)
+        return self.cpu_s[:n].copy(), self.cpu_kind[:n].copy()
+
+    def _act(self, reference: JointReference, state: RobotState) -> MotorCommand:
         want = WBC if reference.phase == PHASE_WHOLE_BODY else POLICY
         if want != self.active:
             self._switch(want, state)

@@ -454,7 +454,9 @@ class GoalGenerator(Generator):
             target = np.asarray(goal.pos_w_m, dtype=float) + off
         else:
             assert goal.offset_h_m is not None
-            base = self.poses.hand_point(q0, 0 if goal.hand == "left" else 1)
+            standing = q0.copy()  # the hand's standing position: arms at the default pose
+            standing[7 + ARMS] = g1.DEFAULT_Q_RAD[ARMS]
+            base = self.poses.hand_point(standing, 0 if goal.hand == "left" else 1)
             c, s = math.cos(heading), math.sin(heading)
             o = goal.offset_h_m
             target = base + np.array([c * o[0] - s * o[1], s * o[0] + c * o[1], o[2]])
