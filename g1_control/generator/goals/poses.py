@@ -110,8 +110,16 @@ class PosePlanner:
         trunk (the ankles reach their dorsiflexion limit below ~0.55 m)."""
         weights = LEG_LIGHT_POSTURE_WEIGHT.copy()
         weights[ARMS] = 5.0
-        return self._solve(q0, soles, self.com_over(soles, com_shift_h), pelvis_z, stance_heading(soles), posture,
-                           posture_weight=weights, com_weight=300.0, pelvis_rot_weight=(10.0, 0.3, 10.0), rounds=8)
+        com, heading = self.com_over(soles, com_shift_h), stance_heading(soles)
+        # continuation: a far height in steps, each from the last (one jump from 0.76 to 0.45 m lands
+        # in a wrong local solution, straight knees or stuck at the start)
+        q = q0
+        steps = max(1, math.ceil(abs(pelvis_z - q0[2]) / 0.04))
+        for k in range(1, steps + 1):
+            z = q0[2] + (pelvis_z - q0[2]) * k / steps
+            q = self._solve(q, soles, com, z, heading, posture, posture_weight=weights, com_weight=300.0,
+                            pelvis_rot_weight=(10.0, 0.3, 10.0), rounds=8 if k == steps else 2)
+        return q
 
     def reach(self, q0: np.ndarray, soles: list[Sole], hand: int, target_w: np.ndarray,
               posture: np.ndarray | None = None) -> PoseResult:

@@ -246,7 +246,7 @@ class SteppingPlan:
     pelvis_z_m: np.ndarray
     end_stance: Stance
     sole_error_m: float
-    """Largest distance between a sole in the IK's poses and its plan (feasibility of the plan)."""
+    """Largest distance between a planted sole in the IK's poses and its plan (feasibility)."""
     extras: dict = field(default_factory=dict)
 
 
@@ -355,9 +355,9 @@ def stepping_trajectory(ik: WholeBodyIK, q0: np.ndarray, footsteps: list[Footste
     lim = np.concatenate([np.full(6, cfg.max_root_speed), np.full(g1.NUM_JOINTS, cfg.max_joint_speed_radps)])
     sole_error = 0.0
     margin = np.full(g1.NUM_JOINTS, 0.02)
-    for name in ("left_knee_joint", "right_knee_joint"):
-        margin[g1.JOINT_INDEX[name]] = cfg.knee_margin_rad
-    ankles = [g1.JOINT_INDEX[name] for name in ("left_ankle_pitch_joint", "right_ankle_pitch_joint")]
+    for joint in ("left_knee_joint", "right_knee_joint"):
+        margin[g1.JOINT_INDEX[joint]] = cfg.knee_margin_rad
+    ankles = [g1.JOINT_INDEX[joint] for joint in ("left_ankle_pitch_joint", "right_ankle_pitch_joint")]
     lean = np.zeros(n)
     for t_ds, t_sw, t_td, _lo0, _lo1, m0, m1, _z in levels:
         if m1 < m0 - 1e-6:
@@ -388,7 +388,8 @@ def stepping_trajectory(ik: WholeBodyIK, q0: np.ndarray, footsteps: list[Footste
         qs[k] = q
         if k % 5 == 0 or k == n - 1:
             for i, fname in enumerate(SOLE_FRAMES):
-                sole_error = max(sole_error, float(np.linalg.norm(ik.frame_pose(q, fname)[0] - feet[k, i])))
+                if contacts[k, i]:  # a planted sole off its place is a plan the legs cannot take
+                    sole_error = max(sole_error, float(np.linalg.norm(ik.frame_pose(q, fname)[0] - feet[k, i])))
     forces = None if hand_forces is None else np.repeat(np.asarray(hand_forces, dtype=float)[None], n, axis=0)
     traj = trajectory_from_configurations(name, t, qs, contacts, forces)
     return SteppingPlan(traj, feet, zmp, com_xy, pelvis_z, current, sole_error)
