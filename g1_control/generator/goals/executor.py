@@ -570,7 +570,16 @@ class GoalGenerator(Generator):
             raise GoalFailed(f"holding '{box.name}', not '{goal.object}'")
         s = self._state
         assert s is not None and s.base_pos_w_m is not None
-        center_w, approach = place_target(self.scene, box, goal.target, goal.pos_w_m, s.base_pos_w_m[:2])
+        target, point = goal.target, goal.pos_w_m
+        if target is None and point is None:  # "put it down in front": a table there, else the floor
+            yaw = yaw_of(s.imu_quat_wxyz)
+            ahead = s.base_pos_w_m[:2] + GRASP_DISTANCE_M * np.array([math.cos(yaw), math.sin(yaw)])
+            near = [b for b in (*self.scene.tables, *self.scene.platforms) if b.distance_xy(ahead) < 0.35]
+            if near:
+                target = min(near, key=lambda b: b.distance_xy(ahead)).name
+            else:
+                point = np.array([ahead[0], ahead[1], box.size[2] / 2])
+        center_w, approach = place_target(self.scene, box, target, point, s.base_pos_w_m[:2])
         self._info.update(box=box.name, target_w_m=center_w.tolist())
         q0 = self._hold_q()
         posture = q0[7:].copy()
