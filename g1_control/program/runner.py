@@ -4,8 +4,9 @@ Each tick the loop fills a ProgramProgress (base x/y/yaw from ground truth or th
 the status of the goals the execution layer is working on) and calls `update(now_s, progress)`.
 The runner turns the current step into a Command (velocity in the heading frame, heading, style,
 pelvis height) and, for reach/pick/place/step steps, a GoalRequest for the execution layer
-(`active_goals`; `Command.goals` carries what the current generator can already express, see
-GoalRequest.to_effector_goals). When a step's condition is met it records a StepOutcome with the
+(`active_goals`; `Command.tasks` carries it as a types.TaskGoal for the goal generator of
+tracker.type layer, GoalRequest.to_task_goal; `Command.goals` what the kinematic generator can
+express, GoalRequest.to_effector_goals). When a step's condition is met it records a StepOutcome with the
 measured value (distance covered, heading error, distance to the place, ...) and moves on.
 
 Walk distances are measured from odometry as the displacement along the direction the walk
@@ -39,7 +40,7 @@ from g1_control.program.steps import (
 )
 from g1_control.program.world import START, World
 from g1_control.robot import g1
-from g1_control.types import Command, EffectorGoal
+from g1_control.types import Command, EffectorGoal, TaskGoal
 
 COMPLETED, TIMED_OUT, FAILED = "completed", "timed_out", "failed"
 REACHED, GOAL_FAILED = "reached", "failed"
@@ -67,6 +68,23 @@ class GoalRequest:
     target: str | None = None
     target_w_m: np.ndarray | None = None
     offset_b_m: np.ndarray | None = None
+
+    def to_task_goal(self) -> TaskGoal:
+        """The goal for the execution layer (types.TaskGoal, g1_control/generator/goals/): same id,
+        so GoalGenerator.goal_status[goal_id] answers ProgramProgress.goal_status. Places are
+        passed by name (a table or platform of the launch file's scene is found by it) and by
+        point (for anything else)."""
+        hand = self.hand if self.hand in ("left", "right", "both") else "right"
+        if self.kind == "reach":
+            return TaskGoal("reach", self.goal_id, hand, pos_w_m=None if self.target_w_m is None else self.target_w_m.copy(),
+                            offset_h_m=None if self.target_w_m is not None or self.offset_b_m is None
+                            else self.offset_b_m.copy())
+        if self.kind == "pick":
+            return TaskGoal("pick", self.goal_id, hand, object=self.object)
+        if self.kind == "place":
+            return TaskGoal("place", self.goal_id, hand, object=self.object, target=self.target,
+                            pos_w_m=None if self.target_w_m is None else self.target_w_m.copy())
+        return TaskGoal(self.kind, self.goal_id, hand, target=self.target)
 
     def to_effector_goals(self) -> list[EffectorGoal]:
         """What today's generator can express (generator.runtime OBJECT_GOALS and hand frames);
@@ -343,6 +361,7 @@ class ProgramRunner:
                     cmd.pelvis_height_m = self._height(s)
             for g in a.goals:
                 cmd.goals.extend(g.to_effector_goals())
+                cmd.tasks.append(g.to_task_goal())
             return self._tick_main(a, step.main, cmd, elapsed, p)
         if isinstance(step, (Walk, Turn, Stand)):
             return self._tick_main(a, step, cmd, elapsed, p)
@@ -362,6 +381,7 @@ class ProgramRunner:
         # goal steps: the execution layer moves; the runner waits for its verdict
         g = a.goals[0]
         cmd.goals.extend(g.to_effector_goals())
+        cmd.tasks.append(g.to_task_goal())
         status = p.goal_status.get(g.goal_id)
         if status == REACHED:
             return cmd, (COMPLETED, {"duration_s": elapsed})

@@ -571,6 +571,8 @@ class GoalGenerator(Generator):
         s = self._state
         assert s is not None and s.base_pos_w_m is not None
         target, point = goal.target, goal.pos_w_m
+        if target is not None and self.scene.block(target) is None and point is not None:
+            target = None  # a place the scene does not have as a table or platform: its point
         if target is None and point is None:  # "put it down in front": a table there, else the floor
             yaw = yaw_of(s.imu_quat_wxyz)
             ahead = s.base_pos_w_m[:2] + GRASP_DISTANCE_M * np.array([math.cos(yaw), math.sin(yaw)])
