@@ -52,43 +52,53 @@ class VelocityCorrector:
     def __init__(self, config: VelocityCorrectionConfig, dt_s: float):
         self.config = config
         self.dt_s = dt_s
-        self._ff = np.array(config.feedforward)
-        self._ki = np.array(config.ki)
-        self._limit = np.array(config.integral_limit)
+        self._ff = tuple(float(v) for v in config.feedforward)
+        self._ki = tuple(float(v) for v in config.ki)
+        self._limit = tuple(float(v) for v in config.integral_limit)
+        self._alpha = dt_s / (config.velocity_filter_tau_s + dt_s)
         self.integral = np.zeros(3)
         self.v_filtered = np.zeros(3)
         self.moving_s = np.zeros(3)
         """How long each axis has been corrected in its current state (commanded or held at zero)."""
-        self._was_moving = np.zeros(3, dtype=bool)
+        self._was_moving = [False, False, False]
 
     def reset(self) -> None:
         self.integral[:] = 0.0
         self.v_filtered[:] = 0.0
         self.moving_s[:] = 0.0
-        self._was_moving[:] = False
+        self._was_moving[:] = [False, False, False]
 
     def __call__(self, cmd: np.ndarray, v_est: np.ndarray | None) -> np.ndarray:
         """cmd and v_est are (vx, vy, wz) in the heading frame."""
         if not self.config.enabled or v_est is None:
             return cmd
-        alpha = self.dt_s / (self.config.velocity_filter_tau_s + self.dt_s)
-        self.v_filtered += alpha * (v_est - self.v_filtered)
-        moving = np.abs(cmd) > 0.05
-        if not moving.any():
+        # Per axis on Python floats (three values; numpy's per-call cost would dominate).
+        alpha, dt, settle = self._alpha, self.dt_s, self.config.settle_s
+        c, v = cmd.tolist(), v_est.tolist()
+        vf = self.v_filtered.tolist()
+        for i in range(3):
+            vf[i] += alpha * (v[i] - vf[i])
+        self.v_filtered[:] = vf
+        moving = [abs(x) > 0.05 for x in c]
+        if not any(moving):  # standing: the policy stands; nothing to correct
             self.integral[:] = 0.0
             self.moving_s[:] = 0.0
-            self._was_moving[:] = False
+            self._was_moving[:] = [False, False, False]
             return cmd
-        # An axis whose command starts or stops starts over.
-        restart = moving != self._was_moving
-        self._was_moving[:] = moving
-        self.integral[restart] = 0.0
-        self.moving_s[restart] = 0.0
-        self.moving_s += self.dt_s
-        settled = self.moving_s > self.config.settle_s
-        self.integral += settled * (cmd - self.v_filtered) * (self.dt_s * self._ki)
-        np.clip(self.integral, -self._limit, self._limit, out=self.integral)
-        return self._ff * cmd + self.integral
+        integral, moving_s = self.integral.tolist(), self.moving_s.tolist()
+        out = [0.0, 0.0, 0.0]
+        for i in range(3):
+            if moving[i] != self._was_moving[i]:  # this axis' command started or stopped: start over
+                integral[i] = moving_s[i] = 0.0
+                self._was_moving[i] = moving[i]
+            moving_s[i] += dt
+            if moving_s[i] > settle:
+                limit = self._limit[i]
+                integral[i] = min(max(integral[i] + (c[i] - vf[i]) * dt * self._ki[i], -limit), limit)
+            out[i] = self._ff[i] * c[i] + integral[i]
+        self.integral[:] = integral
+        self.moving_s[:] = moving_s
+        return np.array(out)
 
 
 class LocomotionPolicyTracker(Tracker):
