@@ -95,7 +95,7 @@ class ControlLoop:
             Stage("retargeter", r.tracker_hz, self._retarget),
             Stage("tracker", r.tracker_hz, self._track),
             Stage("safety", r.tracker_hz, self._safety),
-            Stage("lowlevel", r.lowlevel_hz, self._lowlevel),
+            Stage("lowlevel", r.lowlevel_hz, self._lowlevel, batch=self._lowlevel_ticks if backend.lockstep else None),
             Stage("log", r.tracker_hz, self._log),
         ]
         self.scheduler = Scheduler(r.lowlevel_hz, stages, wallclock=wallclock)
@@ -210,6 +210,10 @@ class ControlLoop:
         self.backend.write_command(self.motor_command)
         if self.backend.lockstep:
             self.backend.step(self.scheduler.dt_s)
+
+    def _lowlevel_ticks(self, n: int) -> None:
+        """n low-level ticks in a row with nothing else due (lockstep; see loop/scheduler.py)."""
+        self.backend.step_ticks(self.motor_command, self.scheduler.dt_s, n)
 
     def _log(self) -> None:
         log = self.log

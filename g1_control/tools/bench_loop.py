@@ -27,9 +27,11 @@ def physics_only_seconds(seconds: float, physics_dt_s: float) -> float:
     import mujoco
 
     from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
+    from g1_control.types import MotorCommand
 
     backend = MujocoBackend(MujocoConfig(physics_dt_s=physics_dt_s))
     backend.reset()
+    backend.write_command(MotorCommand())  # no motor law at all: bare physics (the unpowered robot falls)
     model, data = backend.model, backend.data
     n = round(seconds / physics_dt_s)
     t0 = time.perf_counter()
