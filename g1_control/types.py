@@ -8,6 +8,7 @@ the ground, y left, z up). Nothing here does I/O or math beyond validation.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -96,7 +97,7 @@ class RobotState:
                 raise InvalidStateError(f"RobotState.{name} has shape {arr.shape}; expected ({NUM_JOINTS},)")
         quat = self.imu_quat_wxyz
         # One finite check over everything the controllers read (this runs every tick).
-        if not np.isfinite(self.q_rad.sum() + self.dq_radps.sum() + quat.sum() + self.imu_gyro_radps.sum()
+        if not math.isfinite(self.q_rad.sum() + self.dq_radps.sum() + quat.sum() + self.imu_gyro_radps.sum()
                            + self.imu_acc_mps2.sum()):
             bad = [n for n in ("q_rad", "dq_radps", "imu_quat_wxyz", "imu_gyro_radps", "imu_acc_mps2")
                    if not np.all(np.isfinite(getattr(self, n)))]

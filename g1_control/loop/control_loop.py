@@ -3,6 +3,7 @@ guard -> low-level stream, as scheduler stages at their own rates (see scheduler
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -221,20 +222,22 @@ class ControlLoop:
         if i >= log.capacity:
             return
         s, est = self.state, self.estimator.estimate
+        quat = s.imu_quat_wxyz
         log.t_s[i] = self.time_s
-        log.command[i] = (self.command.vx_mps, self.command.vy_mps, self.command.wz_radps)
+        command = log.command[i]
+        command[:] = (self.command.vx_mps, self.command.vy_mps, self.command.wz_radps)
         policy_command = self.tracker.policy_command
-        log.policy_command[i] = log.command[i] if policy_command is None else policy_command
+        log.policy_command[i] = command if policy_command is None else policy_command
         log.velocity_est[i] = est.heading_velocity
-        yaw = yaw_of(s.imu_quat_wxyz)
+        yaw = yaw_of(quat)
         log.yaw_rad[i] = yaw
-        log.base_quat_wxyz[i] = s.imu_quat_wxyz
-        log.tilt_rad[i] = tilt_rad(s.imu_quat_wxyz)
+        log.base_quat_wxyz[i] = quat
+        log.tilt_rad[i] = tilt_rad(quat)
         if s.base_linvel_w_mps is not None:
-            c, sn = np.cos(yaw), np.sin(yaw)
-            v = s.base_linvel_w_mps
-            wz = (quat_to_rot(s.imu_quat_wxyz) @ s.imu_gyro_radps)[2]
-            log.velocity_true[i] = (c * v[0] + sn * v[1], -sn * v[0] + c * v[1], wz)
+            c, sn = math.cos(yaw), math.sin(yaw)
+            vx, vy, _ = s.base_linvel_w_mps.tolist()
+            wz = float(quat_to_rot(quat)[2] @ s.imu_gyro_radps)
+            log.velocity_true[i] = (c * vx + sn * vy, -sn * vx + c * vy, wz)
             log.base_pos_m[i] = s.base_pos_w_m
         log.q_rad[i] = s.q_rad
         log.q_target_rad[i] = self.motor_command.q_rad

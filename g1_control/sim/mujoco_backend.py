@@ -73,6 +73,7 @@ class MujocoBackend(Backend):
         self._gyro = slice(adr[self.model.sensor("imu_gyro").id], adr[self.model.sensor("imu_gyro").id] + 3)
         self._acc = slice(adr[self.model.sensor("imu_acc").id], adr[self.model.sensor("imu_acc").id] + 3)
         self._quat = slice(adr[self.model.sensor("imu_quat").id], adr[self.model.sensor("imu_quat").id] + 4)
+        self._temperature = np.full(g1.NUM_JOINTS, float(self.config.motor_temperature_c))
         self._push_force_w = np.zeros(3)
         self._push_until_s = -1.0
         self._pushing = False
@@ -112,7 +113,7 @@ class MujocoBackend(Backend):
             imu_quat_wxyz=d.sensordata[self._quat].copy(),
             imu_gyro_radps=d.sensordata[self._gyro].copy(),
             imu_acc_mps2=d.sensordata[self._acc].copy(),
-            motor_temperature_c=np.full(g1.NUM_JOINTS, self.config.motor_temperature_c),
+            motor_temperature_c=self._temperature.copy(),
             mode_machine=g1.G1_29DOF.mode_machine,
             tick=self._tick,
             base_pos_w_m=d.qpos[0:3].copy(),
