@@ -17,6 +17,10 @@ from g1_control.errors import InvalidCommandError, InvalidStateError
 from g1_control.robot.g1 import NUM_JOINTS
 
 
+_sum = np.add.reduce
+"""ndarray.sum without its Python wrapper (the per-tick finite checks sum small arrays)."""
+
+
 def _zeros() -> np.ndarray:
     return np.zeros(NUM_JOINTS)
 
@@ -53,7 +57,7 @@ class Command:
         """Raise InvalidCommandError naming the first bad field; return self when fine."""
         for name in ("vx_mps", "vy_mps", "wz_radps", "heading_rad", "pelvis_height_m"):
             value = getattr(self, name)
-            if value is not None and not np.isfinite(value):
+            if value is not None and not math.isfinite(value):
                 raise InvalidCommandError(f"Command.{name} is {value}; it must be a finite number")
         for goal in self.goals:
             pos = np.asarray(goal.pos_w_m, dtype=float)
@@ -97,8 +101,8 @@ class RobotState:
                 raise InvalidStateError(f"RobotState.{name} has shape {arr.shape}; expected ({NUM_JOINTS},)")
         quat = self.imu_quat_wxyz
         # One finite check over everything the controllers read (this runs every tick).
-        if not math.isfinite(self.q_rad.sum() + self.dq_radps.sum() + quat.sum() + self.imu_gyro_radps.sum()
-                           + self.imu_acc_mps2.sum()):
+        if not math.isfinite(_sum(self.q_rad) + _sum(self.dq_radps) + _sum(quat) + _sum(self.imu_gyro_radps)
+                             + _sum(self.imu_acc_mps2)):
             bad = [n for n in ("q_rad", "dq_radps", "imu_quat_wxyz", "imu_gyro_radps", "imu_acc_mps2")
                    if not np.all(np.isfinite(getattr(self, n)))]
             raise InvalidStateError(f"RobotState.{', '.join(bad) or 'values'} contains NaN or inf")

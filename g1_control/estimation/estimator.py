@@ -36,7 +36,21 @@ class StateEstimator:
 
         self._pin = pin
         self.config = config or EstimatorConfig()
-        self.model = pin.Model(description.pinocchio_model())
+        # Only the legs matter (base -> sole chains): the other joints are locked out of the model,
+        # which leaves the legs' kinematics as they are and halves the forward kinematics.
+        full = description.pinocchio_model()
+        keep: set[int] = set()
+        for body in g1.FOOT_BODIES:
+            joint = full.frames[full.getFrameId(body)].parentJoint
+            while joint > 0:
+                keep.add(joint)
+                joint = full.parents[joint]
+        locked = [j for j in range(1, full.njoints) if j not in keep]
+        self.model = pin.buildReducedModel(full, locked, pin.neutral(full))
+        self._n_legs = self.model.nq - 7
+        names = tuple(self.model.names[2:])  # after "universe" and the floating base
+        if names != g1.JOINT_NAMES[: self._n_legs]:
+            raise ValueError(f"estimator: leg joints {names} are not the robot's first joints in order")
         self._soles = []
         for body in g1.FOOT_BODIES:
             parent = self.model.getFrameId(body)
@@ -66,9 +80,10 @@ class StateEstimator:
         # are then relative to the base, expressed in world axes.
         q, v = self._q, self._v
         q[3:7] = (x, y, z, w)
-        q[7:] = state.q_rad
+        n = self._n_legs
+        q[7:] = state.q_rad[:n]
         v[3:6] = state.imu_gyro_radps
-        v[6:] = state.dq_radps
+        v[6:] = state.dq_radps[:n]
         pin.forwardKinematics(model, data, q, v)
         left, right = self._soles
         height_left = pin.updateFramePlacement(model, data, left).translation[2]

@@ -116,8 +116,9 @@ class SafetyFilter:
             return False
         c = self.config
         # One finite test over everything first (this runs every tick); name the culprit only on failure.
-        total = (state.q_rad.sum() + state.dq_radps.sum() + state.imu_quat_wxyz.sum()
-                 + state.imu_gyro_radps.sum() + state.motor_temperature_c.sum())
+        add = np.add.reduce  # ndarray.sum without its Python wrapper
+        total = (add(state.q_rad) + add(state.dq_radps) + add(state.imu_quat_wxyz)
+                 + add(state.imu_gyro_radps) + add(state.motor_temperature_c))
         if not math.isfinite(total):
             arrays = {"q_rad": state.q_rad, "dq_radps": state.dq_radps, "imu_quat_wxyz": state.imu_quat_wxyz,
                       "imu_gyro_radps": state.imu_gyro_radps, "motor_temperature_c": state.motor_temperature_c}
@@ -214,7 +215,7 @@ class SafetyFilter:
         raw[0], raw[1], raw[2], raw[3], raw[4] = (command.q_rad, command.dq_radps, command.tau_nm, command.kp,
                                                   command.kd)
         # One finite test over all fields (MotorCommand.is_finite's test, on the stacked copy).
-        if not math.isfinite(raw.sum()):
+        if not math.isfinite(np.add.reduce(raw, axis=None)):
             bad = [n for n in CLAMPED_FIELDS if not np.all(np.isfinite(getattr(command, n)))] or ["values"]
             self._trip(now_s, SafetyEventKind.NONFINITE_COMMAND, f"MotorCommand.{', '.join(bad)} {'contains' if len(bad) == 1 else 'contain'} NaN or inf")
             return self._damping.copy()

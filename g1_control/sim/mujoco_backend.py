@@ -138,7 +138,10 @@ class MujocoBackend(Backend):
 
     def step_ticks(self, command: MotorCommand, dt_s: float, n: int) -> None:
         # Writing the same command again changes nothing here: n ticks are one run of physics steps.
-        self.write_command(command)
+        # The command last written is not written again: the loop hands on the command it wrote
+        # on the tick before, unchanged (see Backend.step_ticks).
+        if command is not self._command:
+            self.write_command(command)
         self._physics_steps(n * max(1, round(dt_s / self.model.opt.timestep)))
 
     def _physics_steps(self, n: int) -> None:
