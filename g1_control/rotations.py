@@ -102,14 +102,19 @@ def _floats(quat_wxyz) -> list[float]:
     return np.asarray(quat_wxyz, dtype=float).tolist()
 
 
-def quat_to_rot(quat_wxyz: np.ndarray) -> np.ndarray:
-    """(3, 3) rotation matrix (body -> world) of one unit quaternion."""
+def quat_to_rot_rows(quat_wxyz) -> list[list[float]]:
+    """quat_to_rot as three rows of Python floats (for per-tick arithmetic on 3-vectors)."""
     w, x, y, z = _floats(quat_wxyz)
-    return np.array([
+    return [
         [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
         [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-    ])
+    ]
+
+
+def quat_to_rot(quat_wxyz: np.ndarray) -> np.ndarray:
+    """(3, 3) rotation matrix (body -> world) of one unit quaternion."""
+    return np.array(quat_to_rot_rows(quat_wxyz))
 
 
 def yaw_of(quat_wxyz: np.ndarray) -> float:

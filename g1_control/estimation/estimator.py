@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from g1_control.robot import description, g1
-from g1_control.rotations import quat_to_rot, yaw_of
+from g1_control.rotations import quat_to_rot_rows, yaw_of
 from g1_control.types import EstimatedState, RobotState
 
 GRAVITY_W = np.array([0.0, 0.0, -9.81])
@@ -96,7 +96,7 @@ class StateEstimator:
         w_right = 1.0 - w_left
         v_kin = [-(w_left * a + w_right * b) for a, b in zip(vel_left, vel_right)]
 
-        rot = quat_to_rot(quat).tolist()
+        rot = quat_to_rot_rows(quat)
         dt = 0.0 if self._last_t is None else max(0.0, state.t_s - self._last_t)
         self._last_t = state.t_s
         if dt == 0.0:

@@ -15,7 +15,7 @@ from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, T
 from g1_control.loop.rates import LoopRates
 from g1_control.loop.scheduler import Scheduler, Stage
 from g1_control.robot import g1
-from g1_control.rotations import quat_to_rot, tilt_rad, yaw_of
+from g1_control.rotations import quat_to_rot_rows, tilt_rad, yaw_of
 from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter
 from g1_control.types import Command, RobotState
 
@@ -208,9 +208,10 @@ class ControlLoop:
         self.motor_command = self.safety.damping()
 
     def _lowlevel(self) -> None:
-        self.backend.write_command(self.motor_command)
         if self.backend.lockstep:
-            self.backend.step(self.scheduler.dt_s)
+            self.backend.step_ticks(self.motor_command, self.scheduler.dt_s, 1)  # write_command, then step
+        else:
+            self.backend.write_command(self.motor_command)
 
     def _lowlevel_ticks(self, n: int) -> None:
         """n low-level ticks in a row with nothing else due (lockstep; see loop/scheduler.py)."""
@@ -236,7 +237,8 @@ class ControlLoop:
         if s.base_linvel_w_mps is not None:
             c, sn = math.cos(yaw), math.sin(yaw)
             vx, vy, _ = s.base_linvel_w_mps.tolist()
-            wz = float(quat_to_rot(quat)[2] @ s.imu_gyro_radps)
+            r2, (gx, gy, gz) = quat_to_rot_rows(quat)[2], s.imu_gyro_radps.tolist()
+            wz = r2[0] * gx + r2[1] * gy + r2[2] * gz  # world yaw rate
             log.velocity_true[i] = (c * vx + sn * vy, -sn * vx + c * vy, wz)
             log.base_pos_m[i] = s.base_pos_w_m
         log.q_rad[i] = s.q_rad

@@ -13,6 +13,7 @@ with nothing in between, so the result is the same (a simulator steps its physic
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -91,6 +92,16 @@ class Scheduler:
         every_tick = [s for s in stages if s.period_ticks == 1]
         self._batched = every_tick[0] if len(every_tick) == 1 and every_tick[0].batch is not None else None
         self._others = [s.period_ticks for s in stages if s.period_ticks > 1]
+        # Per phase of the stages' common cycle: how many ticks from it on only the batched stage is due.
+        self._cycle = math.lcm(*self._others) if self._others else 1
+        self._runs: list[int] | None = None
+        if self._others and self._cycle <= 1 << 16:
+            self._runs = [0] * self._cycle
+            due_next = self._cycle  # phase 0 of the next cycle: every stage is due
+            for k in reversed(range(self._cycle)):
+                if any(k % period == 0 for period in self._others):
+                    due_next = k
+                self._runs[k] = due_next - k
 
     @property
     def time_s(self) -> float:
@@ -125,6 +136,8 @@ class Scheduler:
         if self._batched is None or self.wallclock:
             return 0
         k = self.tick_index
+        if self._runs is not None:
+            return min(self._runs[k % self._cycle], limit)
         n = limit
         for period in self._others:
             n = min(n, -k % period)

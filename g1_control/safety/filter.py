@@ -116,9 +116,11 @@ class SafetyFilter:
             return False
         c = self.config
         # One finite test over everything first (this runs every tick); name the culprit only on failure.
-        add = np.add.reduce  # ndarray.sum without its Python wrapper
-        total = (add(state.q_rad) + add(state.dq_radps) + add(state.imu_quat_wxyz)
-                 + add(state.imu_gyro_radps) + add(state.motor_temperature_c))
+        # (np.add.reduce: ndarray.sum without its Python wrapper; the small vectors as Python floats.)
+        add = np.add.reduce
+        quat = state.imu_quat_wxyz.tolist()
+        total = (add(state.q_rad) + add(state.dq_radps) + sum(quat) + sum(state.imu_gyro_radps.tolist())
+                 + add(state.motor_temperature_c))
         if not math.isfinite(total):
             arrays = {"q_rad": state.q_rad, "dq_radps": state.dq_radps, "imu_quat_wxyz": state.imu_quat_wxyz,
                       "imu_gyro_radps": state.imu_gyro_radps, "motor_temperature_c": state.motor_temperature_c}
@@ -138,8 +140,7 @@ class SafetyFilter:
             return self._trip(now_s, SafetyEventKind.STALE_STATE,
                               f"state tick frozen at {state.tick} for {(now_s - self._tick_since_s) * 1000:.1f} ms "
                               f"(limit {c.stale_state_s * 1000:.0f} ms)")
-        w, x, y, z = state.imu_quat_wxyz.tolist()
-        if math.sqrt(w * w + x * x + y * y + z * z) < 1e-6:
+        if math.sqrt(sum(c * c for c in quat)) < 1e-6:
             return self._trip(now_s, SafetyEventKind.NONFINITE_STATE, "IMU quaternion is zero")
         tilt = tilt_rad(state.imu_quat_wxyz)
         if tilt > c.max_tilt_rad:

@@ -61,7 +61,7 @@ class MujocoBackend(Backend):
     def __init__(self, config: MujocoConfig | None = None):
         self.config = config or MujocoConfig()
         self.lockstep = self.config.lockstep
-        self.model = motor_law_scene(self.config.physics_dt_s).compile()
+        self.model = self._compile()
         self.data = mujoco.MjData(self.model)
         self._bias = self.model.actuator_biasprm[:, :3]
         """(b0, b1, b2) per joint: a view into the model, rewritten by write_command."""
@@ -73,12 +73,19 @@ class MujocoBackend(Backend):
         self._gyro = slice(adr[self.model.sensor("imu_gyro").id], adr[self.model.sensor("imu_gyro").id] + 3)
         self._acc = slice(adr[self.model.sensor("imu_acc").id], adr[self.model.sensor("imu_acc").id] + 3)
         self._quat = slice(adr[self.model.sensor("imu_quat").id], adr[self.model.sensor("imu_quat").id] + 4)
+        # What read_state reports, as views into MjData's arrays (MuJoCo keeps them in place).
+        d = self.data
+        self._views = (d.qpos[7:], d.qvel[6:], d.actuator_force, d.sensordata[self._quat], d.sensordata[self._gyro],
+                       d.sensordata[self._acc], d.qpos[0:3], d.qvel[0:3])
         self._temperature = np.full(g1.NUM_JOINTS, float(self.config.motor_temperature_c))
         self._push_force_w = np.zeros(3)
         self._push_until_s = -1.0
         self._pushing = False
         self._push_body = self.model.body(g1.BASE_BODY).id
         self.closed = False
+
+    def _compile(self) -> mujoco.MjModel:
+        return motor_law_scene(self.config.physics_dt_s).compile()
 
     # -- Backend ---------------------------------------------------------------------------------
     def reset(self, q_rad: np.ndarray | None = None, base_pos_xy_m=(0.0, 0.0), yaw_rad: float = 0.0) -> RobotState:
@@ -104,20 +111,20 @@ class MujocoBackend(Backend):
         return self.read_state()
 
     def read_state(self) -> RobotState:
-        d = self.data
+        q, dq, tau, quat, gyro, acc, pos, vel = self._views
         return RobotState(
-            t_s=float(d.time),
-            q_rad=d.qpos[7:].copy(),
-            dq_radps=d.qvel[6:].copy(),
-            tau_nm=d.actuator_force.copy(),
-            imu_quat_wxyz=d.sensordata[self._quat].copy(),
-            imu_gyro_radps=d.sensordata[self._gyro].copy(),
-            imu_acc_mps2=d.sensordata[self._acc].copy(),
+            t_s=float(self.data.time),
+            q_rad=q.copy(),
+            dq_radps=dq.copy(),
+            tau_nm=tau.copy(),
+            imu_quat_wxyz=quat.copy(),
+            imu_gyro_radps=gyro.copy(),
+            imu_acc_mps2=acc.copy(),
             motor_temperature_c=self._temperature.copy(),
             mode_machine=g1.G1_29DOF.mode_machine,
             tick=self._tick,
-            base_pos_w_m=d.qpos[0:3].copy(),
-            base_linvel_w_mps=d.qvel[0:3].copy(),
+            base_pos_w_m=pos.copy(),
+            base_linvel_w_mps=vel.copy(),
         )
 
     def write_command(self, command: MotorCommand) -> None:

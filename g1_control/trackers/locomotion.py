@@ -128,8 +128,7 @@ class LocomotionPolicyTracker(Tracker):
             return
         step = 2 * np.pi * self.dt_s / phase.period_s
         p = self._phase
-        p[0] = math.fmod(p[0] + step + np.pi, 2 * np.pi) - np.pi
-        p[1] = math.fmod(p[1] + step + np.pi, 2 * np.pi) - np.pi
+        p[:] = [math.fmod(a + step + np.pi, 2 * np.pi) - np.pi for a in p.tolist()]
         vx, vy, wz = cmd.tolist()
         if math.sqrt(vx * vx + vy * vy) < phase.stand_threshold and abs(wz) < phase.stand_threshold:
             p[:] = np.pi  # both feet in the same phase: stand

@@ -151,3 +151,28 @@ def test_time_ring_buffer_wraps_for_batches():
     times.add_repeated(2.0, 5)
     assert times.count == 11
     np.testing.assert_array_equal(times.samples, [2.0, 2.0, 2.0, 1.0, 1.0, 1.0, 2.0, 2.0])
+
+
+def test_batch_lengths_follow_every_stage_s_period():
+    calls = []
+    stages = [Stage("a", 100, lambda: calls.append("a")), Stage("b", 125, lambda: calls.append("b")),
+              Stage("low", 500, lambda: calls.append("low"), batch=lambda n: calls.append(n))]
+    Scheduler(500, stages).run(40)  # a every 5 ticks, b every 4: batches between their ticks
+    due = [k for k in range(40) if k % 5 == 0 or k % 4 == 0]
+    expected_batches = [b - a - 1 for a, b in zip(due, due[1:] + [40]) if b - a - 1 > 1]
+    assert [c for c in calls if isinstance(c, int)] == expected_batches
+    assert calls.count("low") + sum(expected_batches) == 40
+
+
+def test_batches_without_the_phase_table_are_the_same():
+    def run(table):
+        calls = []
+        stages = [Stage("a", 100, lambda: calls.append("a")), Stage("b", 125, lambda: calls.append("b")),
+                  Stage("low", 500, lambda: calls.append("low"), batch=lambda n: calls.append(n))]
+        sched = Scheduler(500, stages)
+        if not table:
+            sched._runs = None  # as for stage periods whose common cycle is too long to tabulate
+        sched.run(97)
+        return calls
+
+    assert run(True) == run(False)

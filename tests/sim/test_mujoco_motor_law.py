@@ -19,10 +19,11 @@ class PythonLawBackend(MujocoBackend):
     builds it (implicitfast integrator), the torque computed by motor_law.py before every step."""
 
     def __init__(self):
-        super().__init__()
-        self.model = description.mujoco_spec(timestep_s=self.config.physics_dt_s).compile()
-        self.data = mujoco.MjData(self.model)
         self._tau = np.zeros(g1.NUM_JOINTS)
+        super().__init__()
+
+    def _compile(self):
+        return description.mujoco_spec(timestep_s=self.config.physics_dt_s).compile()
 
     def write_command(self, command):
         self._command = command
