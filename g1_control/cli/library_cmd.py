@@ -31,7 +31,9 @@ def register(subparsers) -> None:
     build.add_argument("--no-demo", action="store_true", help="leave out the retargeted demo mocap")
     build.add_argument("--jobs", type=int, default=2, help="rollout worker processes (default 2)")
     build.set_defaults(func=_build)
-    show = sub.add_parser("show", help="print styles, clips and frames per split")
+    show = sub.add_parser("show", help="print styles, clips and frames per split",
+                          description="Print the built library's styles, clips and frame counts per split "
+                          "(train / held-out). Look at a clip with g1 view CLIP.npz.")
     show.add_argument("path", nargs="?", help="library folder (default: the user cache)")
     show.set_defaults(func=_show)
 

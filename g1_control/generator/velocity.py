@@ -14,22 +14,20 @@ import numpy as np
 from g1_control.generator.styles import ROLLOUT_STYLES
 from g1_control.interfaces import Generator, Retargeter
 from g1_control.robot import g1
-from g1_control.types import Command, JointReference, KinematicReference, RobotState
+from g1_control.types import Command, CommandLimits, JointReference, KinematicReference, RobotState
 
 
 class VelocityReferenceGenerator(Generator):
-    def __init__(self, max_vx_mps: float = 1.0, max_vy_mps: float = 0.6, max_wz_radps: float = 1.0):
-        self._limits = np.array([max_vx_mps, max_vy_mps, max_wz_radps])
-        self._limits_f = tuple(float(v) for v in self._limits)
+    def __init__(self, limits: CommandLimits | None = None):
+        self.limits = limits or CommandLimits()
         self._ref = KinematicReference(q_rad=g1.DEFAULT_Q_RAD.copy())
 
     def update(self, command: Command, state: RobotState) -> KinematicReference:
-        # np.clip's result on Python floats (this runs every tracker tick).
-        lx, ly, lz = self._limits_f
+        v = self.limits.clamp_velocity(command.vx_mps, command.vy_mps, command.wz_radps)
         ref = self._ref
         ref.t_s = state.t_s
-        ref.root_linvel_h_mps[:2] = (min(max(float(command.vx_mps), -lx), lx), min(max(float(command.vy_mps), -ly), ly))
-        ref.root_angvel_h_radps[2] = min(max(float(command.wz_radps), -lz), lz)
+        ref.root_linvel_h_mps[:2] = v[:2]
+        ref.root_angvel_h_radps[2] = v[2]
         ref.style = command.style
         style = ROLLOUT_STYLES.get(command.style)
         if style is not None and style.override:

@@ -21,6 +21,7 @@ import numpy as np
 import yaml
 
 from g1_control.launch.builder import build_loop, make_sim_backend, timeline_of
+from g1_control.launch.overlay import overlay_lines
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.teleop.scripted import Segment
@@ -84,6 +85,34 @@ def segments_from_log(log: dict[str, np.ndarray], min_s: float = 1.0) -> list[tu
     return out
 
 
+def upper_body_rms_by_style(log: dict[str, np.ndarray], window: np.ndarray | None = None,
+                            settle_s: float = 1.0) -> dict[str, dict[str, float]]:
+    """Waist and arm joints as measured vs the tracker's reference posture (the plan after the IK),
+    per operator style: RMS (rad) over the ticks in `window`, skipping the first `settle_s` after each
+    style change (the arms are still moving to the new pose)."""
+    from g1_control.robot import g1
+
+    ids, t = log["style_id"], log["t_s"]
+    if window is None:
+        window = np.ones(len(t), dtype=bool)
+    change_t = np.full(len(t), -np.inf)
+    last = -np.inf
+    for k in range(len(t)):
+        if k == 0 or ids[k] != ids[k - 1]:
+            last = t[k]
+        change_t[k] = last
+    settled = window & (t - change_t >= settle_s) & ~np.isnan(log["q_ref_rad"][:, 0])
+    ub = list(g1.UPPER_BODY_JOINTS)
+    out = {}
+    for i, name in enumerate(log["style_names"]):
+        rows = settled & (ids == i)
+        if rows.sum() < 5:
+            continue
+        err = log["q_rad"][rows][:, ub] - log["q_ref_rad"][rows][:, ub]
+        out[str(name)] = {"rms_rad": float(np.sqrt(np.mean(err**2))), "seconds": float(rows.sum() * np.median(np.diff(t)))}
+    return out
+
+
 def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentResult]:
     log = loop.log.arrays()
     t = log["t_s"]
@@ -104,8 +133,11 @@ def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentR
 
 
 def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None = None,
-        progress: bool = True, viewer: bool = False) -> RunResult:
-    """Run `launch` to the end (or a fall); write the run folder when `out_root` is given."""
+        progress: bool = True, viewer: bool = False, web_port: int | None = None) -> RunResult:
+    """Run `launch` to the end (or a fall); write the run folder when `out_root` is given.
+
+    viewer: the MuJoCo viewer; web_port: the browser view (g1_control/sim/web.py) on that port.
+    """
     segments = timeline_of(launch)
     loop = build_loop(launch, backend=make_sim_backend(launch))
     loop.reset()
@@ -117,6 +149,7 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
         bar = tqdm(total=round(duration, 1), unit="sim s", desc=launch.name, bar_format="{l_bar}{bar}| {n:.1f}/{total} sim s [{elapsed}<{remaining}]")
     ticks_per_update = int(loop.rates.lowlevel_hz)
     view = _open_viewer(loop) if viewer else None
+    web = _open_web(loop, web_port, launch.name) if web_port is not None else None
 
     def on_tick(i: int) -> None:
         if bar is not None and (i + 1) % ticks_per_update == 0:
@@ -126,8 +159,13 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
         if view is not None and (i + 1) % 10 == 0 and time.perf_counter() - last_sync[0] > 1 / 30:
             _update_viewer(view, loop)  # at most 30 Hz: sync() waits for the viewer's render
             last_sync[0] = time.perf_counter()
+        if web is not None and (i + 1) % 10 == 0 and time.perf_counter() - last_web[0] > 1 / 25:
+            web.show(loop.backend.data.qpos, "\n".join(": ".join(kv) for kv in zip(*map(str.splitlines,
+                                                                                    overlay_lines(loop)))))
+            last_web[0] = time.perf_counter()
 
     last_sync = [0.0]
+    last_web = [0.0]
     t0 = time.perf_counter()
     stop = (lambda: not view.is_running()) if view is not None else None
     try:
@@ -138,6 +176,8 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
             bar.close()
         if view is not None:
             view.close()
+        if web is not None:
+            web.close()
         loop.input.close()
         loop.backend.close()
     result = _result(launch, loop, segments, wall)
@@ -152,8 +192,15 @@ def _open_viewer(loop: ControlLoop):
     return open_viewer(loop.backend.model, loop.backend.data)
 
 
+def _open_web(loop: ControlLoop, port: int, title: str):
+    from g1_control.sim.web import WebView
+
+    web = WebView(loop.backend.model, port=port, title=title)
+    print(f"browser view: {web.url}", flush=True)
+    return web
+
+
 def _update_viewer(view, loop: ControlLoop) -> None:
-    from g1_control.launch.overlay import overlay_lines
     from g1_control.sim.viewer import update_viewer
 
     update_viewer(view, *overlay_lines(loop))
@@ -191,10 +238,12 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, o
         plot_run(loop.log.arrays(), result, run_dir / "velocity.png")
     want_video = video if video is not None else launch.output.video in (True, "auto")
     if want_video:
+        from g1_control.launch.overlay import run_overlay_rows
         from g1_control.sim.render import render_video
 
+        overlay = run_overlay_rows(loop.log.arrays(), result.events, [dataclasses.asdict(s) for s in result.segments])
         backend = render_video(run_dir / "log.npz", run_dir / "video.mp4", launch.output.video_fps,
-                               launch.output.video_size)
+                               launch.output.video_size, overlay=overlay)
         result.video = str(run_dir / "video.mp4") if backend else None
         result.extra["render_backend"] = backend
     (run_dir / "summary.json").write_text(json.dumps(summary_dict(result), indent=2))

@@ -1,4 +1,4 @@
-"""The 131 s dance clip stored inside holosoma's WBT policy (FACTS.md), as a MotionClip.
+"""The 131 s dance clip stored inside holosoma's WBT policy (docs/robot_facts.md), as a MotionClip.
 
 The ONNX graph holds the reference motion as constants indexed by its `time_step` input
 (policy steps at 50 Hz); its outputs joint_pos, ref_pos_xyz and ref_quat_xyzw are the

@@ -3,7 +3,7 @@ per rollout, recorded as MotionClips.
 
 The loop is the project's own, built from a launch file like every other (MuJoCo in lockstep,
 the velocity generator with the style's pose, holosoma's loco policy, the safety filter), so the recorded motion is what the robot's physics and policy produce: real gait
-timing, foot contacts and the ~80 % speed response (FACTS.md), not an idealized gait. Frames
+timing, foot contacts and the ~80 % speed response (docs/robot_facts.md), not an idealized gait. Frames
 after a fall are dropped.
 """
 

@@ -4,7 +4,7 @@ velocity correction.
 The reference's root velocity (heading frame) is the command. When the reference sets
 `upper_body_override`, waist and arm targets come from the reference while the policy keeps
 balancing with the legs. The correction closes the loop on the estimated base velocity, because
-the bare holosoma policies reach only ~80 % of the commanded speed (FACTS.md).
+the bare holosoma policies reach only ~80 % of the commanded speed (docs/robot_facts.md).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from g1_control.rotations import projected_gravity
 from g1_control.trackers.observation import ObservationBuilder
 from g1_control.trackers.onnx_runner import OnnxRunner
 from g1_control.trackers.policy_spec import PolicySpec
-from g1_control.types import EstimatedState, JointReference, MotorCommand, RobotState
+from g1_control.types import CommandLimits, EstimatedState, JointReference, MotorCommand, RobotState
 
 
 @dataclass
@@ -113,6 +113,10 @@ class LocomotionPolicyTracker(Tracker):
     @property
     def policy_command(self) -> np.ndarray:
         return self.last_policy_command
+
+    @property
+    def command_limits(self) -> CommandLimits:
+        return self.spec.command_limits
 
     def reset(self, state: RobotState | None = None) -> None:
         self.last_action[:] = 0.0

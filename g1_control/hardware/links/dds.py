@@ -1,4 +1,4 @@
-"""The G1's DDS link on Cyclone DDS 0.10.2: rt/lowcmd (host -> robot), rt/lowstate (robot -> host).
+"""The G1's DDS link on Cyclone DDS 0.10.x: rt/lowcmd (host -> robot), rt/lowstate (robot -> host).
 
 Samples are encoded by the numpy codecs in unitree_hg.py (~10 us) and handed to Cyclone as bytes
 through the binding's C layer, instead of through IdlStruct.serialize (~170 us per LowCmd, ~370 us
@@ -34,7 +34,7 @@ def import_cyclonedds():
         from cyclonedds.domain import Domain  # noqa: F401
     except ImportError as exc:
         raise TransportError(
-            f"the DDS transport needs the cyclonedds 0.10.2 Python binding ({exc}); "
+            f"the DDS transport needs the cyclonedds 0.10.x Python binding ({exc}); "
             "install it with scripts/install_cyclonedds.sh"
         ) from None
 

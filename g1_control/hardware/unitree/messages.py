@@ -1,5 +1,5 @@
 """The G1's low-level messages (`unitree_hg.msg.dds_.LowCmd_` / `LowState_`), defined by this
-project from the protocol (see shared FACTS.md), with fast numpy codecs for both byte forms:
+project from the protocol (see docs/robot_facts.md), with fast numpy codecs for both byte forms:
 
 - `to_dds` / `from_dds`: the XCDR1 little-endian sample DDS carries (4-byte encapsulation header
   + payload), byte-identical to what Unitree's own type definitions serialise to;
