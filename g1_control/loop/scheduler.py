@@ -144,14 +144,16 @@ class Scheduler:
         return n
 
     def _run_batch(self, n: int) -> None:
+        stage = self._batched
+        assert stage is not None and stage.batch is not None  # _batchable() said so
         clock = self.clock
         if self._t0 is None:
             self._t0 = clock()
         start = clock()
-        self._batched.batch(n)
+        stage.batch(n)
         end = clock()
         each = (end - start) / n
-        self.times[self._batched.name].add_repeated(each, n)
+        self.times[stage.name].add_repeated(each, n)
         self.tick_times.add_repeated(each, n)
         if each > self.dt_s:
             self.overruns += n
