@@ -13,11 +13,14 @@ import itertools
 import math
 import types
 import typing
-from typing import Any, Literal, TypeVar
+from typing import TYPE_CHECKING, Any, Literal, TypeVar
 
 from g1_control.errors import LaunchFileError
 
-T = TypeVar("T")
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
+T = TypeVar("T", bound="DataclassInstance")
 
 
 def _type_name(tp) -> str:
@@ -28,7 +31,7 @@ def _type_name(tp) -> str:
         return "a list"
     if origin is dict:
         return "a mapping"
-    if dataclasses.is_dataclass(tp):
+    if isinstance(tp, type) and dataclasses.is_dataclass(tp):
         return f"a mapping of {tp.__name__} fields"
     return {bool: "true or false", int: "an integer", float: "a number", str: "a string"}.get(tp, getattr(tp, "__name__", str(tp)))
 
@@ -88,7 +91,7 @@ def _convert(tp, value: Any, path: str, error: type[Exception]):
         if not isinstance(value, dict):
             raise error(f"{path}: expected a mapping, got {type(value).__name__}")
         return {str(k): _convert(args[1], v, f"{path}.{k}", error) for k, v in value.items()}
-    if dataclasses.is_dataclass(tp):
+    if isinstance(tp, type) and dataclasses.is_dataclass(tp):
         return from_dict(tp, value, path, error)
     if tp is Any:
         return value

@@ -39,7 +39,8 @@ def register(subparsers) -> None:
 
 
 def _build(args) -> int:
-    from g1_control.library.builder import LibraryConfig, build_library, default_library_dir
+    from g1_control.library.builder import LibraryConfig, build_library
+    from g1_control.motion.library import default_library_dir
 
     config = LibraryConfig(rollout_seconds=args.rollout_seconds, rollouts_per_style=args.rollouts_per_style,
                            dance=not args.no_dance, demo=not args.no_demo)
@@ -51,8 +52,7 @@ def _build(args) -> int:
 
 
 def _show(args) -> int:
-    from g1_control.library.builder import default_library_dir
-    from g1_control.motion.library import MotionLibrary
+    from g1_control.motion.library import MotionLibrary, default_library_dir
 
     lib = MotionLibrary(args.path or default_library_dir())
     print(lib.summary())

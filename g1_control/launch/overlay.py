@@ -8,9 +8,9 @@ from g1_control.loop.control_loop import ControlLoop
 def overlay_lines(loop: ControlLoop) -> tuple[str, str]:
     """(labels, values) columns for the viewer's top-left text block."""
     c = loop.command
-    safety = loop.safety
-    if safety.tripped:
-        state = f"DAMPING ({safety.trip_event.kind.value})"
+    trip = loop.safety.trip_event
+    if trip is not None:  # i.e. loop.safety.tripped
+        state = f"DAMPING ({trip.kind.value})"
     elif loop.input.lost:
         state = "INPUT LOST: stopping"
     else:

@@ -16,6 +16,7 @@ import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import yaml
@@ -25,6 +26,9 @@ from g1_control.launch.overlay import overlay_lines
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.teleop.scripted import Segment
+
+if TYPE_CHECKING:
+    from g1_control.sim.mujoco_backend import MujocoBackend
 
 STEADY_STATE_SKIP_S = 2.0
 """Time after a segment starts before its velocity counts as steady state."""
@@ -40,9 +44,12 @@ class SegmentResult:
 
     def error_pct(self) -> tuple[float | None, float | None, float | None]:
         """Relative error per axis where the command is meaningfully non-zero."""
-        return tuple(
-            (100.0 * (a - c) / c) if abs(c) >= 0.1 else None for c, a in zip(self.commanded, self.achieved)
-        )  # type: ignore[return-value]
+
+        def pct(c: float, a: float) -> float | None:
+            return (100.0 * (a - c) / c) if abs(c) >= 0.1 else None
+
+        (c0, c1, c2), (a0, a1, a2) = self.commanded, self.achieved
+        return pct(c0, a0), pct(c1, a1), pct(c2, a2)
 
 
 @dataclass
@@ -128,7 +135,7 @@ def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentR
         window = (t >= start + min(STEADY_STATE_SKIP_S, seg.duration_s / 2)) & (t < end)
         mean = achieved[window].mean(axis=0) if window.any() else np.full(3, np.nan)
         out.append(SegmentResult(seg.label or "segment", start, end, (seg.vx_mps, seg.vy_mps, seg.wz_radps),
-                                 tuple(float(x) for x in mean)))
+                                 (float(mean[0]), float(mean[1]), float(mean[2]))))
     return out
 
 
@@ -139,7 +146,8 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
     viewer: the MuJoCo viewer; web_port: the browser view (g1_control/sim/web.py) on that port.
     """
     segments = timeline_of(launch)
-    loop = build_loop(launch, backend=make_sim_backend(launch))
+    sim = make_sim_backend(launch)
+    loop = build_loop(launch, backend=sim)
     loop.reset()
     duration = launch.total_duration_s
     bar = None
@@ -148,8 +156,8 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
 
         bar = tqdm(total=round(duration, 1), unit="sim s", desc=launch.name, bar_format="{l_bar}{bar}| {n:.1f}/{total} sim s [{elapsed}<{remaining}]")
     ticks_per_update = int(loop.rates.lowlevel_hz)
-    view = _open_viewer(loop) if viewer else None
-    web = _open_web(loop, web_port, launch.name) if web_port is not None else None
+    view = _open_viewer(sim) if viewer else None
+    web = _open_web(sim, web_port, launch.name) if web_port is not None else None
 
     def on_tick(i: int) -> None:
         if bar is not None and (i + 1) % ticks_per_update == 0:
@@ -160,7 +168,7 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
             _update_viewer(view, loop)  # at most 30 Hz: sync() waits for the viewer's render
             last_sync[0] = time.perf_counter()
         if web is not None and (i + 1) % 10 == 0 and time.perf_counter() - last_web[0] > 1 / 25:
-            web.show(loop.backend.data.qpos, "\n".join(": ".join(kv) for kv in zip(*map(str.splitlines,
+            web.show(sim.data.qpos, "\n".join(": ".join(kv) for kv in zip(*map(str.splitlines,
                                                                                     overlay_lines(loop)))))
             last_web[0] = time.perf_counter()
 
@@ -186,16 +194,16 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
     return result
 
 
-def _open_viewer(loop: ControlLoop):
+def _open_viewer(sim: MujocoBackend):
     from g1_control.sim.viewer import open_viewer
 
-    return open_viewer(loop.backend.model, loop.backend.data)
+    return open_viewer(sim.model, sim.data)
 
 
-def _open_web(loop: ControlLoop, port: int, title: str):
+def _open_web(sim: MujocoBackend, port: int, title: str):
     from g1_control.sim.web import WebView
 
-    web = WebView(loop.backend.model, port=port, title=title)
+    web = WebView(sim.model, port=port, title=title)
     print(f"browser view: {web.url}", flush=True)
     return web
 
@@ -231,7 +239,8 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, o
     run_dir.mkdir(parents=True)
     result.run_dir = run_dir
     (run_dir / "launch.yaml").write_text(yaml.safe_dump(dataclasses.asdict(launch), sort_keys=False))
-    np.savez_compressed(run_dir / "log.npz", **loop.log.arrays())
+    # numpy's stub has a keyword `allow_pickle: bool` that mypy matches against **dict[str, ndarray].
+    np.savez_compressed(run_dir / "log.npz", **loop.log.arrays())  # type: ignore[arg-type]
     if launch.output.plot:
         from g1_control.launch.plots import plot_run
 

@@ -17,7 +17,7 @@ from g1_control.loop.scheduler import Scheduler, Stage
 from g1_control.robot import g1
 from g1_control.rotations import quat_to_rot_rows, tilt_rad, yaw_of
 from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter
-from g1_control.types import Button, Command, RobotState
+from g1_control.types import Button, Command, JointReference, KinematicReference, RobotState
 
 
 @dataclass
@@ -112,8 +112,10 @@ class ControlLoop:
             Stage("log", r.tracker_hz, self._log),
         ]
         self.scheduler = Scheduler(r.lowlevel_hz, stages, wallclock=wallclock)
-        self._kin_ref = None
-        self._joint_ref = None
+        # The latest generator and retargeter outputs (None before their first tick: within a tick the
+        # stages run in the order listed above, so each is set before the next stage reads it).
+        self._kin_ref: KinematicReference | None = None
+        self._joint_ref: JointReference | None = None
         self._state_tick = -1
         self._misses_seen = 0
         self.safety.on_event = self._on_safety_event
@@ -196,6 +198,7 @@ class ControlLoop:
         self._kin_ref = self.generator.update(self.command, self.state)
 
     def _retarget(self) -> None:
+        assert self._kin_ref is not None  # the generator stage ran first
         self._joint_ref = self.retargeter.solve(self._kin_ref, self.state.q_rad)
 
     def _track(self) -> None:
@@ -204,6 +207,7 @@ class ControlLoop:
         state = self._read_state()
         if state is None:
             return
+        assert self._joint_ref is not None  # the retargeter stage ran first
         self._tracker_command = self.tracker.act(self._joint_ref, state)
 
     def _safety(self) -> None:

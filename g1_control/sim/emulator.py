@@ -123,6 +123,7 @@ class Gantry(Backend):
 
     def reset(self) -> RobotState:
         state = self.inner.reset()
+        assert state.base_pos_w_m is not None  # MuJoCo states carry the ground-truth base pose
         self.anchor = state.base_pos_w_m.copy()
         return state
 

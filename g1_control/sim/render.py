@@ -143,7 +143,9 @@ def _render(log_path: Path, out_path: Path, fps: float, size: tuple[int, int], q
             return
         frame_times = np.arange(t[0], t[-1], 1.0 / fps) if len(t) > 1 else t[:1]
         idx = np.searchsorted(t, frame_times).clip(0, len(t) - 1)
-        with imageio.get_writer(out_path, fps=fps, codec="libx264", quality=7, macro_block_size=8) as writer:
+        # Not `with ... as writer`: imageio's stub types __enter__ as its base class, which has no append_data.
+        writer = imageio.get_writer(out_path, fps=fps, codec="libx264", quality=7, macro_block_size=8)
+        with writer:
             for i in tqdm(idx, desc="render", unit="frame", disable=quiet):
                 writer.append_data(frame(int(i)))
     finally:

@@ -9,6 +9,8 @@ from the network; install it with `pip install 'g1-control[web]'` (scripts/setup
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from g1_control.errors import G1ControlError
@@ -41,7 +43,7 @@ class WebView:
         self.server.scene.add_grid("/ground", width=20.0, height=20.0, cell_size=0.5, position=(0.0, 0.0, 0.0))
         self.title = self.server.gui.add_markdown(f"**{title}**")
         self.text = self.server.gui.add_markdown("")
-        self.frames = {}
+        self.frames: dict[int, Any] = {}  # body id -> viser frame handle
         for g in range(model.ngeom):
             if model.geom_type[g] != mujoco.mjtGeom.mjGEOM_MESH or model.geom_group[g] != VISUAL_GROUP:
                 continue

@@ -29,7 +29,7 @@ def bench_launch(seconds: float) -> LaunchFile:
     step = seconds / 4
     launch.input.timeline = [Segment(step, label="stand"), Segment(step, vx_mps=0.5, label="forward"),
                              Segment(step, wz_radps=0.5, label="turn"), Segment(step, label="stand")]
-    launch.output.video = "off"
+    launch.output.video = False
     return launch
 
 

@@ -13,6 +13,7 @@ participant indices (ports 7400 + 250 * domain + 10 + 2 * index).
 from __future__ import annotations
 
 import threading
+from typing import Any
 from xml.sax.saxutils import quoteattr
 
 from g1_control.errors import TransportError
@@ -103,8 +104,9 @@ class DdsLink(Link):
         # the robot itself publishes in the default partition, so real use passes None.
         group_qos = Qos(Policy.Partition([partition])) if partition else None
         self._participant = participant
-        self._writer = DataWriter(Publisher(participant, qos=group_qos), out_topic)
-        self._reader = DataReader(
+        # LowCmd_ out and LowState_ in on the host side, the reverse on the robot side.
+        self._writer: DataWriter[Any] = DataWriter(Publisher(participant, qos=group_qos), out_topic)
+        self._reader: DataReader[Any] = DataReader(
             Subscriber(participant, qos=group_qos), in_topic,
             qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(history_depth)),
         )
