@@ -11,6 +11,7 @@ speed (docs/robot_facts.md).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -125,14 +126,20 @@ class LocomotionPolicyTracker(Tracker):
             spec.command_ranges.get("lin_vel_y", (-1.0, 1.0)),
             spec.command_ranges.get("ang_vel_yaw", (-1.0, 1.0)),
         ])
+        self._lower = tuple(float(v) for v in self._ranges[:, 0])
+        self._upper = tuple(float(v) for v in self._ranges[:, 1])
         self.last_action = np.zeros(g1.NUM_JOINTS)
         self.last_policy_command = np.zeros(3)
         self._phase = np.zeros(2)
         self._standing = True
         self._command = MotorCommand(q_rad=spec.default_q_rad.copy(), kp=spec.kp.copy(), kd=spec.kd.copy())
+        # Observation inputs, reused every tick (the builder copies them into its own vector).
+        self._cos_phase, self._sin_phase = np.zeros(2), np.zeros(2)
         self._dof_pos = np.zeros(g1.NUM_JOINTS)
         self._dof_vel = np.zeros(g1.NUM_JOINTS)
-        self._values: dict[str, np.ndarray] = {"dof_pos": self._dof_pos, "dof_vel": self._dof_vel}
+        self._values: dict[str, np.ndarray] = {"actions": self.last_action, "cos_phase": self._cos_phase,
+                                               "sin_phase": self._sin_phase, "dof_pos": self._dof_pos,
+                                               "dof_vel": self._dof_vel}
 
     def observe(self, estimate: EstimatedState) -> None:
         self.velocity_estimate = estimate.heading_velocity
@@ -164,18 +171,21 @@ class LocomotionPolicyTracker(Tracker):
         phase = self.spec.phase
         if phase is None:
             return
-        self._phase = np.fmod(self._phase + 2 * np.pi * self.dt_s / phase.period_s + np.pi, 2 * np.pi) - np.pi
-        if np.linalg.norm(cmd[:2]) < phase.stand_threshold and abs(cmd[2]) < phase.stand_threshold:
-            self._phase[:] = np.pi  # both feet in the same phase: stand
+        step = 2 * np.pi * self.dt_s / phase.period_s
+        p = self._phase
+        p[:] = [math.fmod(a + step + np.pi, 2 * np.pi) - np.pi for a in p.tolist()]
+        vx, vy, wz = cmd.tolist()
+        if math.sqrt(vx * vx + vy * vy) < phase.stand_threshold and abs(wz) < phase.stand_threshold:
+            p[:] = np.pi  # both feet in the same phase: stand
             self._standing = True
         elif self._standing:
-            self._phase = phase.offsets_rad.copy()  # start the gait from its initial phase
+            p[:] = phase.offsets_rad  # start the gait from its initial phase
             self._standing = False
 
     def act(self, reference: JointReference, state: RobotState) -> MotorCommand:
-        cmd = np.array([reference.root_linvel_h_mps[0], reference.root_linvel_h_mps[1], reference.root_angvel_h_radps[2]])
-        cmd = self.corrector(cmd, self.velocity_estimate)
-        cmd = np.clip(cmd, self._ranges[:, 0], self._ranges[:, 1])
+        lin, ang = reference.root_linvel_h_mps, reference.root_angvel_h_radps
+        cmd = self.corrector(np.array((float(lin[0]), float(lin[1]), float(ang[2]))), self.velocity_estimate)
+        cmd = np.array([min(max(c, lo), hi) for c, lo, hi in zip(cmd.tolist(), self._lower, self._upper)])
         self.last_policy_command = cmd
         self._advance_phase(cmd)
         styled = reference.upper_body_override
@@ -193,16 +203,16 @@ class LocomotionPolicyTracker(Tracker):
         else:
             self.upper_body.reset()
         v = self._values
-        v["actions"] = self.last_action
         v["base_ang_vel"] = state.imu_gyro_radps
         v["command_ang_vel"] = cmd[2:3]
         v["command_lin_vel"] = cmd[0:2]
-        v["cos_phase"] = np.cos(self._phase)
-        v["sin_phase"] = np.sin(self._phase)
+        np.cos(self._phase, out=self._cos_phase)
+        np.sin(self._phase, out=self._sin_phase)
         v["projected_gravity"] = projected_gravity(state.imu_quat_wxyz)
         action = self.runner(self.obs.build(v))
-        np.clip(action, -self.spec.action_clip, self.spec.action_clip, out=action)
-        self.last_action = action.astype(float)
+        clip = self.spec.action_clip
+        np.minimum(np.maximum(action, -clip, out=action), clip, out=action)  # np.clip's result, cheaper
+        np.copyto(self.last_action, action)
         out = self._command
         np.multiply(self.spec.action_scale, self.last_action, out=out.q_rad)
         out.q_rad += self.spec.default_q_rad
