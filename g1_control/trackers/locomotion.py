@@ -2,8 +2,9 @@
 closed-loop velocity correction.
 
 The reference's root velocity (heading frame) is the command. When the reference sets
-`upper_body_override`, the plan drives arms and waist yaw while the policy, observing the upper
-body it was trained with, keeps balancing (g1_control/trackers/styled.py). A reference
+`upper_body_override`, the plan drives the arms and the waist yaw (the waist roll/pitch lean to
+balance the arms) while the policy, observing the upper body it was trained with, keeps balancing
+(g1_control/trackers/styled.py). A reference
 `pelvis_height_m` crouches the legs under the policy. The correction closes the loop on the
 estimated base velocity, because the bare holosoma policies reach only ~80 % of the commanded
 speed (docs/robot_facts.md).
@@ -214,7 +215,7 @@ class LocomotionPolicyTracker(Tracker):
         np.minimum(np.maximum(action, -clip, out=action), clip, out=action)  # np.clip's result, cheaper
         np.copyto(self.last_action, action)
         out = self._command
-        np.multiply(self.spec.action_scale, self.last_action, out=out.q_rad)
+        np.multiply(self.last_action, self.spec.action_scale, out=out.q_rad)
         out.q_rad += self.spec.default_q_rad
         out.q_rad[LEGS] += crouch.offset[LEGS]
         out.dq_radps[:] = 0.0
