@@ -139,8 +139,7 @@ class LocomotionPolicyTracker(Tracker):
         self._dof_pos = np.zeros(g1.NUM_JOINTS)
         self._dof_vel = np.zeros(g1.NUM_JOINTS)
         self._values: dict[str, np.ndarray] = {"actions": self.last_action, "cos_phase": self._cos_phase,
-                                               "sin_phase": self._sin_phase, "dof_pos": self._dof_pos,
-                                               "dof_vel": self._dof_vel}
+                                               "sin_phase": self._sin_phase, "dof_pos": self._dof_pos}
 
     def observe(self, estimate: EstimatedState) -> None:
         self.velocity_estimate = estimate.heading_velocity
@@ -164,6 +163,8 @@ class LocomotionPolicyTracker(Tracker):
         self.obs.reset()
         self.upper_body.reset()
         self.crouch.reset()
+        self._command.dq_radps[:] = 0.0
+        self._command.tau_nm[:] = 0.0
         self._standing = True
         if self.spec.phase is not None:
             self._phase = np.full(2, np.pi)
@@ -194,16 +195,23 @@ class LocomotionPolicyTracker(Tracker):
         crouch.update(reference.pelvis_height_m, self.height_estimate)
         # What the policy observes: its joints, legs shifted back by the crouch, the upper body
         # as it was trained to see it when the plan drives it.
-        dof_pos, dof_vel = self._dof_pos, self._dof_vel
-        np.subtract(state.q_rad, self.spec.default_q_rad, out=dof_pos)
-        dof_pos -= crouch.offset
-        dof_vel[:] = state.dq_radps
-        if styled:
-            self.upper_body.begin(reference.q_rad)
-            self.upper_body.observation(dof_pos, dof_vel)
-        else:
-            self.upper_body.reset()
         v = self._values
+        dof_pos = self._dof_pos
+        np.subtract(state.q_rad, self.spec.default_q_rad, out=dof_pos)
+        if crouch.angle_rad:
+            dof_pos -= crouch.offset
+        out = self._command
+        if styled:
+            self._dof_vel[:] = state.dq_radps
+            v["dof_vel"] = self._dof_vel
+            self.upper_body.begin(reference.q_rad)
+            self.upper_body.observation(dof_pos, self._dof_vel)
+        else:
+            v["dof_vel"] = state.dq_radps
+            if self.upper_body.active:  # handed back: clear what the override wrote
+                self.upper_body.reset()
+                out.dq_radps[:] = 0.0
+                out.tau_nm[:] = 0.0
         v["base_ang_vel"] = state.imu_gyro_radps
         v["command_ang_vel"] = cmd[2:3]
         v["command_lin_vel"] = cmd[0:2]
@@ -214,12 +222,10 @@ class LocomotionPolicyTracker(Tracker):
         clip = self.spec.action_clip
         np.minimum(np.maximum(action, -clip, out=action), clip, out=action)  # np.clip's result, cheaper
         np.copyto(self.last_action, action)
-        out = self._command
         np.multiply(self.last_action, self.spec.action_scale, out=out.q_rad)
         out.q_rad += self.spec.default_q_rad
-        out.q_rad[LEGS] += crouch.offset[LEGS]
-        out.dq_radps[:] = 0.0
-        out.tau_nm[:] = 0.0
+        if crouch.angle_rad:
+            out.q_rad[LEGS] += crouch.offset[LEGS]
         if styled:
             self.upper_body.command(out, state.imu_quat_wxyz, state.q_rad)
         return out
