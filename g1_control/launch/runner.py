@@ -99,6 +99,16 @@ def segments_from_log(log: dict[str, np.ndarray], min_s: float = 1.0) -> list[tu
     return out
 
 
+def upper_body_rms(log: dict[str, np.ndarray], rows: np.ndarray) -> float | None:
+    """Waist and arm joints as measured vs the tracker's reference posture (the plan after the IK):
+    RMS (rad) over the ticks `rows` that have a reference; None when none has."""
+    rows = rows & ~np.isnan(log["q_ref_rad"][:, 0])
+    if not rows.any():
+        return None
+    err = log["q_rad"][rows][:, UPPER_BODY] - log["q_ref_rad"][rows][:, UPPER_BODY]
+    return float(np.sqrt(np.mean(err**2)))
+
+
 def upper_body_rms_by_style(log: dict[str, np.ndarray], window: np.ndarray | None = None,
                             settle_s: float = 1.0) -> dict[str, dict[str, float]]:
     """Waist and arm joints as measured vs the tracker's reference posture (the plan after the IK),
@@ -114,14 +124,13 @@ def upper_body_rms_by_style(log: dict[str, np.ndarray], window: np.ndarray | Non
             last = t[k]
         change_t[k] = last
     settled = window & (t - change_t >= settle_s) & ~np.isnan(log["q_ref_rad"][:, 0])
-    ub = list(g1.UPPER_BODY_JOINTS)
     out = {}
     for i, name in enumerate(log["style_names"]):
         rows = settled & (ids == i)
-        if rows.sum() < 5:
+        rms = upper_body_rms(log, rows)
+        if rows.sum() < 5 or rms is None:
             continue
-        err = log["q_rad"][rows][:, ub] - log["q_ref_rad"][rows][:, ub]
-        out[str(name)] = {"rms_rad": float(np.sqrt(np.mean(err**2))), "seconds": float(rows.sum() * np.median(np.diff(t)))}
+        out[str(name)] = {"rms_rad": rms, "seconds": float(rows.sum() * np.median(np.diff(t)))}
     return out
 
 
@@ -139,11 +148,7 @@ def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentR
         end = start + seg.duration_s
         window = (t >= start + min(STEADY_STATE_SKIP_S, seg.duration_s / 2)) & (t < end)
         mean = achieved[window].mean(axis=0) if window.any() else np.full(3, np.nan)
-        ub = None
-        rows = window & ~np.isnan(log["q_ref_rad"][:, 0])
-        if rows.any():
-            err = log["q_rad"][rows][:, UPPER_BODY] - log["q_ref_rad"][rows][:, UPPER_BODY]
-            ub = float(np.sqrt(np.mean(err**2)))
+        ub = upper_body_rms(log, window)
         out.append(SegmentResult(seg.label or "segment", start, end, (seg.vx_mps, seg.vy_mps, seg.wz_radps),
                                  (float(mean[0]), float(mean[1]), float(mean[2])), ub))
     return out

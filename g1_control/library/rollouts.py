@@ -17,6 +17,7 @@ import numpy as np
 
 from g1_control.generator.styles import ROLLOUT_STYLES, UpperBodyStyle
 from g1_control.launch.builder import build_loop, timeline_of
+from g1_control.launch.runner import upper_body_rms
 from g1_control.launch.schema import LaunchFile
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.interpolation import interpolate_positions, interpolate_quaternions
@@ -62,11 +63,11 @@ def pose_figures(log: dict[str, np.ndarray], n: int) -> dict[str, float]:
     """How well the recording holds the style's pose over its first n ticks: RMS of the waist and
     arm joints against the pose the tracker was given (the style's plan), and the mean waist pitch
     (the plan's is 0; the earlier override let it sag to the 0.52 rad joint limit)."""
-    if n == 0:
+    rows = np.arange(len(log["t_s"])) < n
+    rms = upper_body_rms(log, rows)
+    if rms is None:
         return {}
-    ub = list(g1.UPPER_BODY_JOINTS)
-    err = log["q_rad"][:n, ub] - log["q_ref_rad"][:n, ub]
-    return {"upper_body_rms_rad": float(np.sqrt(np.mean(err**2))),
+    return {"upper_body_rms_rad": rms,
             "waist_pitch_mean_rad": float(log["q_rad"][:n, g1.JOINT_INDEX["waist_pitch_joint"]].mean())}
 
 

@@ -19,7 +19,6 @@ from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
-from g1_control.robot import g1
 from g1_control.safety.fall import Fall
 from g1_control.scene import SceneConfig
 from g1_control.teleop.scripted import Segment
@@ -30,7 +29,6 @@ if TYPE_CHECKING:
 GAIT_PERIOD_S = 1.0
 """The holosoma walking policies' gait period: averages over whole periods cancel the sway."""
 STEADY_SKIP_S = 2.0
-UPPER_BODY = list(g1.UPPER_BODY_JOINTS)
 
 
 @dataclass(frozen=True)
@@ -98,9 +96,10 @@ class TrialResult:
 
     def upper_body_rms(self, index: int) -> float:
         """RMS (rad) over waist and arm joints of measured minus the tracker's reference posture."""
-        w = self.window(index)
-        err = self.log["q_rad"][w][:, UPPER_BODY] - self.log["q_ref_rad"][w][:, UPPER_BODY]
-        return float(np.sqrt(np.mean(err**2)))
+        from g1_control.launch.runner import upper_body_rms
+
+        rms = upper_body_rms(self.log, self.window(index))
+        return float("nan") if rms is None else rms
 
     def pelvis_height(self, index: int) -> float:
         return float(self.log["base_pos_m"][self.window(index), 2].mean())

@@ -8,13 +8,15 @@ compensating the upper body's gravity, the waist pitch sagged to its 0.52 rad li
 while the reference asks for the upper-body override:
 
   the policy observes   its arms at the default pose at rest (dof_pos 0, dof_vel 0: where it keeps
-                        its own arms while walking, within 0.02 rad), its waist yaw shifted by the
-                        plan's yaw offset, waist roll/pitch and legs as they are;
+                        its own arms while walking, within 0.02 rad), its waist shifted back by the
+                        waist offsets below, its legs as they are (minus the crouch);
   the motors follow     the plan on the arms (q* = plan, dq* = the plan's velocity, tau = inverse
                         dynamics of the plan's motion: pinocchio RNEA with the IMU's base
-                        orientation, the base held still, rotor armature included); waist yaw =
-                        the policy's target + the plan's offset; waist roll/pitch stay the
-                        policy's (it balances with them; the plan's are ignored); legs the policy's.
+                        orientation, the base held still, rotor armature included); the waist
+                        = the policy's targets + offsets: yaw the plan's, roll/pitch a lean that
+                        takes back half of the centre-of-mass shift of the plan's arms (ComBalance;
+                        the plan's own roll/pitch are ignored: the policy balances with them);
+                        legs the policy's.
 
 The crouch: hip pitch -a, knee +2a, ankle pitch -a on the policy's leg targets (pelvis level,
 feet flat), the policy observing its legs shifted back by the same offset. `a` starts from the
@@ -36,8 +38,6 @@ ARMS = slice(g1.ARM_JOINTS[0], g1.ARM_JOINTS[-1] + 1)
 LEGS = slice(0, len(g1.LEG_JOINTS))
 WAIST = slice(g1.WAIST_JOINTS[0], g1.WAIST_JOINTS[-1] + 1)
 WAIST_YAW = g1.JOINT_INDEX["waist_yaw_joint"]
-WAIST_ROLL = g1.JOINT_INDEX["waist_roll_joint"]
-WAIST_PITCH = g1.JOINT_INDEX["waist_pitch_joint"]
 _NV_BASE = 6
 """Pinocchio's free-flyer velocity rows before the joints."""
 
