@@ -174,7 +174,7 @@ def behaviours() -> list[Behaviour]:
                           "no fall in >= 90 %", lambda seed: push_trials(True, seed), judge_survive, min_success=0.9))
     from g1_control.tools.execution_goals import goal_behaviours
 
-    rows += goal_behaviours()
+    rows += goal_behaviours(Behaviour, Verdict)
     return rows
 
 

@@ -236,9 +236,9 @@ __all__ = ["box_layout", "box_outcome", "box_trials", "height_figures", "height_
 
 
 # -- rows --------------------------------------------------------------------------------------------
-def goal_behaviours() -> list:
-    """The rows above as bench_execution.Behaviour entries."""
-    from g1_control.tools.bench_execution import Behaviour, Verdict
+def goal_behaviours(Behaviour, Verdict) -> list:
+    """The rows above as bench_execution.Behaviour entries (its Behaviour and Verdict classes are
+    passed in: bench_execution imports this module)."""
 
     def judge_reach(result: TrialResult) -> Verdict:
         reaches = [o for o in result.goals if o.get("kind") == "reach"]
