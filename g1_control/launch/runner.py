@@ -176,6 +176,7 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
         from g1_control.launch.outcomes import GoalWatcher
 
         watcher = GoalWatcher(loop)
+        loop.goal_watcher = watcher  # type: ignore[attr-defined]  # the run folder saves what it saw
     view = _open_viewer(sim) if viewer else None
     web = _open_web(sim, web_port, launch.name) if web_port is not None else None
 
@@ -267,6 +268,9 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, o
     (run_dir / "launch.yaml").write_text(yaml.safe_dump(dataclasses.asdict(launch), sort_keys=False))
     # numpy's stub has a keyword `allow_pickle: bool` that mypy matches against **dict[str, ndarray].
     np.savez_compressed(run_dir / "log.npz", **loop.log.arrays())  # type: ignore[arg-type]
+    watcher = getattr(loop, "goal_watcher", None)
+    if watcher is not None:  # ground truth of the goals: hand points, soles, boxes (launch/outcomes.py)
+        np.savez_compressed(run_dir / "truth.npz", **watcher.arrays())
     if launch.output.plot:
         from g1_control.launch.plots import plot_run
 
@@ -278,11 +282,24 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, o
 
         overlay = run_overlay_rows(loop.log.arrays(), result.events, [dataclasses.asdict(s) for s in result.segments])
         backend = render_video(run_dir / "log.npz", run_dir / "video.mp4", launch.output.video_fps,
-                               launch.output.video_size, overlay=overlay)
+                               launch.output.video_size, overlay=overlay, extra=_scene_arrays(launch, loop))
         result.video = str(run_dir / "video.mp4") if backend else None
         result.extra["render_backend"] = backend
     (run_dir / "summary.json").write_text(json.dumps(summary_dict(result), indent=2))
     return run_dir
+
+
+def _scene_arrays(launch: LaunchFile, loop: ControlLoop) -> dict | None:
+    """The scene and where its boxes were (ground truth), for the video; None without a scene."""
+    watcher = getattr(loop, "goal_watcher", None)
+    if launch.scene.empty or watcher is None:
+        return None
+    truth = watcher.arrays()
+    out = {"scene_json": np.asarray(json.dumps(dataclasses.asdict(launch.scene))), "object_t_s": truth["t_s"]}
+    for key, rows in truth.items():
+        if key.startswith("box_") and len(rows):
+            out["object_" + key.removeprefix("box_")] = rows
+    return out
 
 
 def summary_dict(result: RunResult) -> dict:
