@@ -67,6 +67,8 @@ from g1_control.types import (
 )
 
 REACHED, FAILED = "reached", "failed"
+RAISE_AHEAD_M = 0.10
+"""Hands rise (and come back) this far ahead of the pelvis, above the box, on their way to it."""
 ARMS = np.array(g1.ARM_JOINTS)
 GRAVITY = 9.81
 
@@ -526,8 +528,9 @@ class GoalGenerator(Generator):
         width = grasp_width(box, heading)
         weight = box.mass_kg * GRAVITY
         t_cpu = time.process_time()
-        ahead = GRASP_DISTANCE_M - 0.22
-        via = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.06, ahead_m=-ahead)
+        # the hands rise close to the body first (a table's edge is ~0.22 m ahead of the pelvis:
+        # moving them straight to the box dragged them over the table top, measured)
+        via = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.08, ahead_m=-(GRASP_DISTANCE_M - RAISE_AHEAD_M))
         pre = hand_points(c, heading, width, cfg.pre_gap_m)
         con = hand_points(c, heading, width, -cfg.press_m)
         lift = hand_points(c, heading, width, -cfg.press_m, dz_m=cfg.lift_m)
@@ -537,6 +540,9 @@ class GoalGenerator(Generator):
         for name, targets, com_shift in (("via", via, None), ("pre-grasp", pre, None), ("contact", con, None),
                                           ("lift", lift, shift)):
             res = self.poses.hands_on(q, soles, targets, heading, com_shift)
+            if res.residual_m > 0.01:  # a poor warm start (the pose before): again from the stance
+                again = self.poses.hands_on(q0, soles, targets, heading, com_shift)
+                res = again if again.residual_m < res.residual_m else res
             if res.residual_m > 0.03 and name != "via":
                 raise ReachRefused(f"box '{box.name}': the hands get only within {res.residual_m * 100:.1f} cm of "
                                    f"the {name} points (out of reach)")
@@ -606,7 +612,7 @@ class GoalGenerator(Generator):
         t_cpu = time.process_time()
         down = hand_points(c, heading, width, -cfg.press_m, dz_m=0.005)
         opened = hand_points(c, heading, width, cfg.pre_gap_m, dz_m=0.005)
-        out = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.06, ahead_m=-(GRASP_DISTANCE_M - 0.22))
+        out = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.08, ahead_m=-(GRASP_DISTANCE_M - RAISE_AHEAD_M))
         q_down = self.poses.hands_on(q0, soles, down, heading, shift)
         if q_down.residual_m > 0.03:
             raise ReachRefused(f"the hands get only within {q_down.residual_m * 100:.1f} cm of where the box goes "
