@@ -105,6 +105,8 @@ def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
     from g1_control.trackers.layer import TrackingLayer
 
     config = GoalConfig()
+    # wall clock (a robot, a viewer): plans are made beside the loop; lockstep: inline (deterministic)
+    config.plan_in_background = launch.backend.mode == "wallclock" or launch.backend.type != "mujoco"
     if isinstance(tracker, TrackingLayer):  # the walking policy's own height range (its envelope)
         config.policy_height_m = tracker.policy.command_limits.pelvis_height_m
     goals = GoalGenerator(generator, launch.scene, config)

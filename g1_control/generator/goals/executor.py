@@ -114,6 +114,10 @@ class GoalConfig:
     policy_height_m: tuple[float, float] = (0.63, 0.78)
     """Pelvis heights the walking policy holds (its envelope); others stand under the WBC."""
     height_min_m: float = 0.45
+    plan_in_background: bool = False
+    """Plan in a worker thread while the robot holds its current reference (wall-clock runs: a
+    carry's footstep plan takes ~1-2 s of CPU, which would stall the loop). Off in lockstep, where
+    planning inline keeps runs deterministic (simulated time waits for it)."""
 
 
 @dataclass
@@ -141,6 +145,15 @@ class GoalGenerator(Generator):
         self.log: list[tuple[float, str]] = []
         self._ref = KinematicReference()
         self._joint = JointReference()
+        self._pool = None
+        if self.config.plan_in_background:
+            import sys
+            from concurrent.futures import ThreadPoolExecutor
+
+            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="goal-planner")
+            # The planner and the control thread share the GIL: switch often, so a tick waits
+            # at most ~1 ms for the planner's Python (default 5 ms).
+            sys.setswitchinterval(min(sys.getswitchinterval(), 0.001))
         self.reset_state()
 
     # -- lifecycle ------------------------------------------------------------------------------
@@ -287,9 +300,8 @@ class GoalGenerator(Generator):
         soles = flat_soles(self.ik, q0)
         ground = min(s[0][2] for s in soles)
         mean_pose = np.mean([style.pose(t) for t in np.linspace(0.0, 5.0, 26)], axis=0) if style.wave_hz else style.pose(0.0)
-        t_cpu = time.process_time()
-        q_goal = self.poses.stand(q0, soles, ground + height, mean_pose)
-        self.plan_cpu_s[f"height {height:.2f}"] = time.process_time() - t_cpu
+        q_goal = yield from self._compute(f"height {height:.2f}", lambda: self.poses.stand(
+            q0, soles, ground + height, mean_pose))
         duration = self.config.move_s * max(1.0, abs(q_goal[2] - q0[2]) / 0.15)
         self._height, self._style = height, style_name
         yield from self._run(keyframe_trajectory("height", [(0.0, q0), (duration, q_goal)]), keep=True)
@@ -301,7 +313,8 @@ class GoalGenerator(Generator):
         q0 = self._hold_q()
         soles = flat_soles(self.ik, q0)
         ground = min(s[0][2] for s in soles)
-        q_goal = self.poses.stand(q0, soles, ground + self.poses.nominal_pelvis_m, g1.DEFAULT_Q_RAD)
+        q_goal = yield from self._compute("stand up", lambda: self.poses.stand(
+            q0, soles, ground + self.poses.nominal_pelvis_m, g1.DEFAULT_Q_RAD))
         duration = self.config.move_s * max(0.6, abs(q_goal[2] - q0[2]) / 0.15)
         yield from self._run(keyframe_trajectory("stand", [(0.0, q0), (duration, q_goal)]))
         self._note("hand back to the walking policy")
@@ -354,7 +367,8 @@ class GoalGenerator(Generator):
         lift = min(p[2] - g for (p, _), g in zip(soles, ground))
         q[2] -= lift  # the lower sole exactly on its ground
         soles = [(np.array([p[0], p[1], g]), r) for (p, r), g in zip(soles, ground)]
-        q_stand = self.poses.stand(q, soles, min(ground) + self.poses.nominal_pelvis_m, g1.DEFAULT_Q_RAD)
+        q_stand = yield from self._compute("stand", lambda: self.poses.stand(
+            q, soles, min(ground) + self.poses.nominal_pelvis_m, g1.DEFAULT_Q_RAD))
         self._note("hand over to the whole-body controller")
         yield from self._run(keyframe_trajectory("stand", [(0.0, q), (self.config.stand_s, q_stand)]))
 
@@ -413,10 +427,8 @@ class GoalGenerator(Generator):
         steps += walk_steps(stance, mid_xy, heading, cfg, lambda xy: ground(xy), then=steps)
         if not steps:
             return
-        t_cpu = time.process_time()
-        plan = stepping_trajectory(self.ik, q0, steps, cfg, posture=posture, hand_forces=forces,
-                                   com_offset_h_m=com_shift, name=name)
-        self._cpu(name, t_cpu)
+        plan = yield from self._compute(name, lambda: stepping_trajectory(
+            self.ik, q0, steps, cfg, posture=posture, hand_forces=forces, com_offset_h_m=com_shift, name=name))
         self.last_steps = plan
         if plan.sole_error_m > 0.03:
             raise GoalFailed(f"{name}: the footsteps are out of the legs' reach (plan off by "
@@ -438,6 +450,23 @@ class GoalGenerator(Generator):
             yield from self._step_to(mid_plan, heading, cfg, posture=posture, forces=forces, com_shift=com_shift,
                                      name="correction")
 
+    def _compute(self, what: str, fn):
+        """fn() inline, or in the planner thread while the loop keeps ticking (the robot holds its
+        reference meanwhile); returns its result (use with `yield from`). Records the planning CPU
+        (inline) or wall time (background) under `what`."""
+        if self._pool is None:
+            t0 = time.process_time()
+            out = fn()
+            self._cpu(what, t0)
+            return out
+        start = time.perf_counter()
+        future = self._pool.submit(fn)
+        while not future.done():
+            yield
+        key = f"{self._goal.goal_id if self._goal else ''} {what} (background, wall)".strip()
+        self.plan_cpu_s[key] = self.plan_cpu_s.get(key, 0.0) + time.perf_counter() - start
+        return future.result()
+
     def _cpu(self, what: str, t0: float) -> None:
         key = f"{self._goal.goal_id if self._goal else ''} {what}".strip()
         self.plan_cpu_s[key] = self.plan_cpu_s.get(key, 0.0) + time.process_time() - t0
@@ -451,7 +480,6 @@ class GoalGenerator(Generator):
         soles = flat_soles(self.ik, q0)
         heading = stance_heading(soles)
         off = np.append(self._offset(), 0.0)
-        t_cpu = time.process_time()
         if goal.pos_w_m is not None:
             target = np.asarray(goal.pos_w_m, dtype=float) + off
         else:
@@ -462,14 +490,16 @@ class GoalGenerator(Generator):
             c, s = math.cos(heading), math.sin(heading)
             o = goal.offset_h_m
             target = base + np.array([c * o[0] - s * o[1], s * o[0] + c * o[1], o[2]])
-        if goal.hand == "both":
-            lateral = np.array([-math.sin(heading), math.cos(heading), 0.0])
-            res = self.poses.hands_on(q0, soles, (target + 0.1 * lateral, target - 0.1 * lateral), heading)
-            if res.residual_m > 0.03:
-                raise ReachRefused(f"both hands: the closest pose leaves a hand {res.residual_m * 100:.1f} cm off")
-        else:
-            res = self.poses.reach(q0, soles, 0 if goal.hand == "left" else 1, target)
-        self._cpu("reach", t_cpu)
+        def solve():
+            if goal.hand == "both":
+                lateral = np.array([-math.sin(heading), math.cos(heading), 0.0])
+                res = self.poses.hands_on(q0, soles, (target + 0.1 * lateral, target - 0.1 * lateral), heading)
+                if res.residual_m > 0.03:
+                    raise ReachRefused(f"both hands: the closest pose leaves a hand {res.residual_m * 100:.1f} cm off")
+                return res
+            return self.poses.reach(q0, soles, 0 if goal.hand == "left" else 1, target)
+
+        res = yield from self._compute("reach", solve)
         self._note(f"reach: {res.mode}, hand {res.residual_m * 100:.1f} cm from the point in the plan")
         move = cfg.move_s * max(1.0, float(np.abs(res.q[7:] - q0[7:]).max()) / 1.5)
         self._info.update(hand=goal.hand, target_w_m=(target - off).tolist(), mode=res.mode,
@@ -527,7 +557,6 @@ class GoalGenerator(Generator):
         c = center + np.append(self._offset(), 0.0)
         width = grasp_width(box, heading)
         weight = box.mass_kg * GRAVITY
-        t_cpu = time.process_time()
         # the hands rise close to the body first (a table's edge is ~0.22 m ahead of the pelvis:
         # moving them straight to the box dragged them over the table top, measured)
         via = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.08, ahead_m=-(GRASP_DISTANCE_M - RAISE_AHEAD_M))
@@ -535,21 +564,23 @@ class GoalGenerator(Generator):
         con = hand_points(c, heading, width, -cfg.press_m)
         lift = hand_points(c, heading, width, -cfg.press_m, dz_m=cfg.lift_m)
         shift = np.array([-box.mass_kg / self.poses.mass_kg * GRASP_DISTANCE_M, 0.0])
-        poses = []
-        q = q0
-        for name, targets, com_shift in (("via", via, None), ("pre-grasp", pre, None), ("contact", con, None),
-                                          ("lift", lift, shift)):
-            res = self.poses.hands_on(q, soles, targets, heading, com_shift)
-            if res.residual_m > 0.01:  # a poor warm start (the pose before): again from the stance
-                again = self.poses.hands_on(q0, soles, targets, heading, com_shift)
-                res = again if again.residual_m < res.residual_m else res
-            if res.residual_m > 0.03 and name != "via":
-                raise ReachRefused(f"box '{box.name}': the hands get only within {res.residual_m * 100:.1f} cm of "
-                                   f"the {name} points (out of reach)")
-            q = res.q
-            poses.append(q)
-        self._cpu("grasp", t_cpu)
-        q_via, q_pre, q_con, q_lift = poses
+        def solve():
+            poses = []
+            q = q0
+            for name, targets, com_shift in (("via", via, None), ("pre-grasp", pre, None), ("contact", con, None),
+                                              ("lift", lift, shift)):
+                res = self.poses.hands_on(q, soles, targets, heading, com_shift)
+                if res.residual_m > 0.01:  # a poor warm start (the pose before): again from the stance
+                    again = self.poses.hands_on(q0, soles, targets, heading, com_shift)
+                    res = again if again.residual_m < res.residual_m else res
+                if res.residual_m > 0.03 and name != "via":
+                    raise ReachRefused(f"box '{box.name}': the hands get only within {res.residual_m * 100:.1f} cm "
+                                       f"of the {name} points (out of reach)")
+                q = res.q
+                poses.append(q)
+            return poses
+
+        q_via, q_pre, q_con, q_lift = yield from self._compute("grasp", solve)
         t = {"via": 1.2, "pre": 2.2, "con": 3.0, "squeeze": 3.5, "lift": 4.7, "end": 5.7}
         full = hand_forces(heading, cfg.squeeze_n, weight)
         squeeze_only = hand_forces(heading, cfg.squeeze_n, 0.0)
@@ -609,19 +640,21 @@ class GoalGenerator(Generator):
         heading = stance_heading(soles)
         c = center_w + np.append(self._offset(), 0.0)
         width = grasp_width(box, heading)
-        t_cpu = time.process_time()
         down = hand_points(c, heading, width, -cfg.press_m, dz_m=0.005)
         opened = hand_points(c, heading, width, cfg.pre_gap_m, dz_m=0.005)
         out = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.08, ahead_m=-(GRASP_DISTANCE_M - RAISE_AHEAD_M))
-        q_down = self.poses.hands_on(q0, soles, down, heading, shift)
-        if q_down.residual_m > 0.03:
-            raise ReachRefused(f"the hands get only within {q_down.residual_m * 100:.1f} cm of where the box goes "
-                               "(out of reach)")
-        q_open = self.poses.hands_on(q_down.q, soles, opened, heading).q
-        q_out = self.poses.hands_on(q_open, soles, out, heading).q
-        ground = min(p[2] for p, _ in soles)
-        q_stand = self.poses.stand(q_out, soles, ground + self.poses.nominal_pelvis_m, g1.DEFAULT_Q_RAD)
-        self._cpu("release", t_cpu)
+        def solve():
+            down_pose = self.poses.hands_on(q0, soles, down, heading, shift)
+            if down_pose.residual_m > 0.03:
+                raise ReachRefused(f"the hands get only within {down_pose.residual_m * 100:.1f} cm of where the box "
+                                   "goes (out of reach)")
+            q_open = self.poses.hands_on(down_pose.q, soles, opened, heading).q
+            q_out = self.poses.hands_on(q_open, soles, out, heading).q
+            ground = min(p[2] for p, _ in soles)
+            return down_pose, q_open, q_out, self.poses.stand(q_out, soles, ground + self.poses.nominal_pelvis_m,
+                                                              g1.DEFAULT_Q_RAD)
+
+        q_down, q_open, q_out, q_stand = yield from self._compute("release", solve)
         t = {"down": 1.5, "release": 2.2, "open": 3.0, "out": 4.0, "stand": 5.5, "end": 6.0}
         full = hand_forces(heading, cfg.squeeze_n, weight)
         squeeze_only = hand_forces(heading, cfg.squeeze_n, 0.0)
@@ -653,17 +686,15 @@ class GoalGenerator(Generator):
         for st in steps:
             stance = stance.apply(st)
         steps += walk_steps(stance, mid_xy, heading, cfg.carry, lambda xy: ground(xy), then=steps)
-        t_cpu = time.process_time()
-        plan = stepping_trajectory(self.ik, q0, steps, cfg.carry, posture=posture,
-                                   hand_forces=hand_forces(stance_heading(flat_soles(self.ik, q0)), cfg.squeeze_n,
-                                                           weight),
-                                   com_offset_h_m=self.poses.com_offset_m + com_shift, name="carry")
+        forces = hand_forces(stance_heading(flat_soles(self.ik, q0)), cfg.squeeze_n, weight)
+        plan = yield from self._compute("carry", lambda: stepping_trajectory(
+            self.ik, q0, steps, cfg.carry, posture=posture, hand_forces=forces,
+            com_offset_h_m=self.poses.com_offset_m + com_shift, name="carry"))
         self.last_steps = plan
         traj = plan.trajectory
         # hand forces per sample, turned with the pelvis's heading
         yaws = traj.root_rpy_rad[:, 2]
         traj.hand_forces_w_n = np.array([hand_forces(y, cfg.squeeze_n, weight) for y in yaws])
-        self._cpu("carry", t_cpu)
         if plan.sole_error_m > 0.03:
             raise GoalFailed(f"carry: the footsteps are out of the legs' reach (plan off by "
                              f"{plan.sole_error_m * 100:.0f} cm)")
@@ -719,9 +750,8 @@ class GoalGenerator(Generator):
         stance = Stance.of(self.ik, q0)
         forward = SOLE_HALF_LENGTH_M + cfg.toe_gap_m + cfg.past_edge_m
         steps = level_steps(stance, forward, block.height_m, cfg.steps)
-        t_cpu = time.process_time()
-        plan = stepping_trajectory(self.ik, q0, steps, cfg.steps, name="step up")
-        self._cpu("step up", t_cpu)
+        plan = yield from self._compute("step up", lambda: stepping_trajectory(self.ik, q0, steps, cfg.steps,
+                                                                             name="step up"))
         yield from self._run(plan.trajectory)
         self.on_platform = block.name
         self._step_back = (forward, 0.0)
@@ -739,9 +769,8 @@ class GoalGenerator(Generator):
         if level > 0.0:
             level = 0.0
         steps = level_steps(stance, -forward, level, cfg.steps)
-        t_cpu = time.process_time()
-        plan = stepping_trajectory(self.ik, q0, steps, cfg.steps, name="step down")
-        self._cpu("step down", t_cpu)
+        plan = yield from self._compute("step down", lambda: stepping_trajectory(self.ik, q0, steps, cfg.steps,
+                                                                               name="step down"))
         yield from self._run(plan.trajectory)
         self.on_platform = None
         yield from self._hand_back()
