@@ -67,6 +67,13 @@ from g1_control.types import (
 )
 
 REACHED, FAILED = "reached", "failed"
+ARMS_BACK = g1.DEFAULT_Q_RAD.copy()
+"""Stepping up to a table: the arms swung back (hand points ~5 cm ahead of the pelvis instead of
+17 cm at table height), so the hands cannot catch the table's edge (it threw the robot over,
+measured)."""
+for _side in ("left", "right"):
+    ARMS_BACK[g1.JOINT_INDEX[f"{_side}_shoulder_pitch_joint"]] = 0.6
+    ARMS_BACK[g1.JOINT_INDEX[f"{_side}_elbow_joint"]] = 0.4
 RAISE_AHEAD_M = 0.10
 """Hands rise (and come back) this far ahead of the pelvis, above the box, on their way to it."""
 ARMS = np.array(g1.ARM_JOINTS)
@@ -81,7 +88,7 @@ class GoalFailed(RuntimeError):
 class GoalConfig:
     walk_speed_mps: float = 0.4
     turn_rate_radps: float = 0.6
-    approach_offset_m: float = 0.3
+    approach_offset_m: float = 0.2
     """The walking policy stops this much short of a work stance; the whole-body controller steps
     the rest (the policy stops within ~5-10 cm; footsteps are exact)."""
     approach_tolerance_m: float = 0.08
@@ -106,7 +113,10 @@ class GoalConfig:
     """Steps back from a table before turning with a box."""
     carry: SteppingConfig = field(default_factory=lambda: SteppingConfig(
         max_advance_m=0.10, max_turn_rad=0.18, single_support_s=0.6, double_support_s=0.25))
-    steps: SteppingConfig = field(default_factory=SteppingConfig)
+    steps: SteppingConfig = field(default_factory=lambda: SteppingConfig(
+        max_advance_m=0.08, max_side_m=0.06, single_support_s=0.5, double_support_s=0.2))
+    """Stepping into a work stance (and onto a platform): short, unhurried steps (a 0.24 m diagonal
+    step into a table's stance left the body behind and it fell, measured)."""
     toe_gap_m: float = 0.055
     """Stepping up: the toes stop this short of the platform's edge."""
     past_edge_m: float = 0.12
@@ -548,8 +558,9 @@ class GoalGenerator(Generator):
             yield from self._walk_to(approach, out_m=cfg.approach_offset_m)
             yield from self._enter_whole_body()
         off = self._offset()
-        yield from self._step_to(approach.mid_xy + off, approach.heading, cfg.steps, name="approach")
-        yield from self._correct_stance(approach.mid_xy, approach.heading, cfg.steps)
+        yield from self._step_to(approach.mid_xy + off, approach.heading, cfg.steps, name="approach",
+                                 posture=ARMS_BACK)
+        yield from self._correct_stance(approach.mid_xy, approach.heading, cfg.steps, posture=ARMS_BACK)
         # the grasp, from the stance the steps ended in
         q0 = self._hold_q()
         soles = flat_soles(self.ik, q0)
