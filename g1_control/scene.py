@@ -34,6 +34,11 @@ def _finite(values, n: int, where: str) -> np.ndarray:
     return arr
 
 
+def _check_name(name: str, where: str) -> None:
+    if not name or not name.replace("_", "").isalnum() or name != name.lower():
+        raise LaunchFileError(f"{where}.name: {name!r}; names are lower case letters, digits and _")
+
+
 def _rot2(yaw: float) -> np.ndarray:
     c, s = math.cos(yaw), math.sin(yaw)
     return np.array([[c, -s], [s, c]])
@@ -52,8 +57,7 @@ class Block:
     friction: float = 1.0
 
     def validate(self, where: str) -> None:
-        if not self.name or not self.name.replace("_", "").isalnum() or self.name != self.name.lower():
-            raise LaunchFileError(f"{where}.name: {self.name!r}; names are lower case letters, digits and _")
+        _check_name(self.name, where)
         _finite(self.center_xy_m, 2, f"{where}.center_xy_m")
         size = _finite(self.size_xy_m, 2, f"{where}.size_xy_m")
         if np.any(size <= 0.05) or np.any(size > 5.0):
@@ -123,8 +127,7 @@ class Box:
     yaw_rad: float = 0.0
 
     def validate(self, where: str) -> None:
-        if not self.name or not self.name.replace("_", "").isalnum() or self.name != self.name.lower():
-            raise LaunchFileError(f"{where}.name: {self.name!r}; names are lower case letters, digits and _")
+        _check_name(self.name, where)
         _finite(self.xy_m, 2, f"{where}.xy_m")
         size = _finite(self.size_m, 3, f"{where}.size_m")
         if np.any(size < 0.05) or np.any(size > 0.6):

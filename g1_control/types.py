@@ -320,6 +320,19 @@ class KinematicReference:
     controller follows them: manipulation, stepping onto platforms, heights a walking policy
     cannot hold). The tracking layer hands over between its controllers by this."""
 
+    def set_from(self, j: JointReference) -> KinematicReference:
+        """Root pose and twist, joints, contacts and phase from a joint reference (a whole-body
+        plan sampled as both); returns self."""
+        self.t_s = j.t_s
+        self.root_pos_w_m[:] = j.root_pos_w_m
+        self.root_quat_wxyz[:] = j.root_quat_wxyz
+        self.root_linvel_h_mps[:] = j.root_linvel_h_mps
+        self.root_angvel_h_radps[:] = j.root_angvel_h_radps
+        self.q_rad[:] = j.q_rad
+        self.contacts[:] = j.contacts
+        self.phase = j.phase
+        return self
+
 
 @dataclass
 class JointReference:

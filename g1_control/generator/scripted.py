@@ -52,15 +52,8 @@ class TrajectoryGenerator(Generator):
 
     def update(self, command: Command, state: RobotState) -> KinematicReference:
         j = self.trajectory.sample(state.t_s - self._t0, self._joint)
-        ref = self._ref
+        ref = self._ref.set_from(j)
         ref.t_s = state.t_s - self._t0
-        ref.root_pos_w_m[:] = j.root_pos_w_m
-        ref.root_quat_wxyz[:] = j.root_quat_wxyz
-        ref.root_linvel_h_mps[:] = j.root_linvel_h_mps
-        ref.root_angvel_h_radps[:] = j.root_angvel_h_radps
-        ref.q_rad[:] = j.q_rad
-        ref.contacts[:] = j.contacts
-        ref.phase = j.phase
         return ref
 
 

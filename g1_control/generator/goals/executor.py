@@ -230,15 +230,7 @@ class GoalGenerator(Generator):
                 q_now, q_next = style.pose(self._t - t0), style.pose(self._t - t0 + 0.01)
                 j.q_rad[ARMS] = q_now[ARMS]
                 j.dq_radps[ARMS] = (q_next[ARMS] - q_now[ARMS]) / 0.01
-            ref = self._ref
-            ref.t_s = j.t_s
-            ref.root_pos_w_m[:] = j.root_pos_w_m
-            ref.root_quat_wxyz[:] = j.root_quat_wxyz
-            ref.root_linvel_h_mps[:] = j.root_linvel_h_mps
-            ref.root_angvel_h_radps[:] = j.root_angvel_h_radps
-            ref.q_rad[:] = j.q_rad
-            ref.contacts[:] = j.contacts
-            ref.phase = PHASE_WHOLE_BODY
+            ref = self._ref.set_from(j)
             ref.upper_body_override = True
             ref.pelvis_height_m = None
             ref.style = command.style
