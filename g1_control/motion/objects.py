@@ -65,6 +65,20 @@ class ObjectShape:
         face = values.argmax(axis=1)
         return values[np.arange(face.shape[0]), face], face
 
+    def vertices(self) -> np.ndarray:
+        """(V, 3) corners of the polytope (object frame): where three or more faces meet."""
+        from scipy.optimize import linprog
+        from scipy.spatial import HalfspaceIntersection
+
+        normals, offsets = self.planes[:, :3], self.planes[:, 3]
+        # Chebyshev centre (a point strictly inside): max r with n . x + d + r |n| <= 0.
+        lp = linprog(np.r_[0.0, 0.0, 0.0, -1.0], A_ub=np.c_[normals, np.linalg.norm(normals, axis=1)],
+                     b_ub=-offsets, bounds=[(None, None)] * 3 + [(0, None)])
+        if not lp.success or lp.x[3] <= 0:
+            raise MotionFormatError(f"object '{self.name}': its faces enclose no volume")
+        corners = HalfspaceIntersection(self.planes, lp.x[:3]).intersections
+        return np.unique(np.round(corners, 12), axis=0)
+
     def scaled(self, factor: float) -> ObjectShape:
         """The shape grown by `factor` about the object origin (a human-to-robot scale)."""
         planes = self.planes.copy()
