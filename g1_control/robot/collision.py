@@ -41,6 +41,40 @@ class Geometry:
     bound_centre_j: np.ndarray
     """Centre of a sphere that holds the whole geometry (joint frame)."""
     bound_radius_m: float
+    capsule_j: tuple[np.ndarray, np.ndarray, float]
+    """A capsule (segment ends in the joint frame, radius) that holds the whole geometry: the IK's
+    cheap first test of which pairs may be close (see bounding_capsule)."""
+
+
+def bounding_capsule(points: np.ndarray, radius: float = 0.0) -> tuple[np.ndarray, np.ndarray, float]:
+    """A small capsule holding every point (N, 3) grown by `radius` (so, being convex, their whole
+    convex hull): axis along the points' principal direction through the middle of their spread
+    across it; of the radii from the tightest possible up to 3 cm more, the one whose capsule has
+    the least volume (a longer, thinner capsule or a shorter, fatter one)."""
+    points = np.asarray(points, dtype=float)
+    centre = points.mean(axis=0)
+    if points.shape[0] == 1:
+        return centre.copy(), centre.copy(), float(radius)
+    _, _, axes = np.linalg.svd(points - centre, full_matrices=False)
+    axis = axes[0]
+    across = (points - centre) - np.outer((points - centre) @ axis, axis)
+    for e in axes[1:]:  # centre the axis in the spread across it
+        u = across @ e
+        centre = centre + 0.5 * (u.max() + u.min()) * e
+    t = (points - centre) @ axis
+    perp = np.linalg.norm((points - centre) - np.outer(t, axis), axis=1)
+    best = None
+    for r in np.linspace(perp.max(), perp.max() + 0.03, 31):
+        half = np.sqrt(np.maximum(r * r - perp * perp, 0.0))
+        t0, t1 = (t + half).min(), (t - half).max()
+        if t0 > t1:  # a sphere holds them all at this radius
+            t0 = t1 = 0.5 * (t0 + t1)
+            r = float(np.sqrt(perp**2 + (t - t0) ** 2).max())
+        volume = np.pi * r * r * (t1 - t0) + 4.0 / 3.0 * np.pi * r**3
+        if best is None or volume < best[0]:
+            best = (volume, centre + t0 * axis, centre + t1 * axis, float(r))
+    _, p0, p1, r = best
+    return p0, p1, r + radius
 
 
 def _convex_hull(points: np.ndarray):
@@ -93,7 +127,8 @@ class CollisionModel:
             centre = 0.5 * (lo + hi)
             bound = float(np.linalg.norm(points - centre, axis=1).max()) + radius
             link = self.model.frames[go.parentFrame].name
-            geometries.append(Geometry(go.name, link, int(go.parentJoint), points, radius, centre, bound))
+            geometries.append(Geometry(go.name, link, int(go.parentJoint), points, radius, centre, bound,
+                                       bounding_capsule(points, radius)))
         self.geometry_model = gm
         self.geometries: tuple[Geometry, ...] = tuple(geometries)
         self.link_names: tuple[str, ...] = tuple(dict.fromkeys(g.link for g in geometries))
