@@ -20,14 +20,13 @@ from g1_control.ik.configuration import Configuration, foot_contact_points, sole
 from g1_control.ik.exceptions import InvalidReferenceError, NoSolutionFound, TaskDefinitionError
 from g1_control.ik.limits import (
     BaseVelocityLimit,
+    CollisionLimit,
     ContactLimit,
     GroundLimit,
     JointPositionLimit,
     JointVelocityLimit,
     Limit,
     MeshPairLimit,
-    SceneCollisionLimit,
-    SelfCollisionLimit,
     StepLimit,
     SwingFootLimit,
     SwingMode,
@@ -89,9 +88,10 @@ class IKConfig:
     self_collision: bool = False
     """Keep every pair of non-adjacent links apart (SelfCollisionLimit: the URDF's collision meshes);
     off online by default (a generator's references rarely need it), on in offline retargeting."""
-    scene_collision: bool = True
+    scene_collision: bool | None = None
     """Keep every link (not only the feet) above the floor and out of the scene shapes
-    (SceneCollisionLimit); the feet are the ground limit's (enforce_ground)."""
+    (SceneCollisionLimit); the feet are the ground limit's (enforce_ground). None: on when a `scene`
+    is given; offline retargeting turns it on always (the floor too)."""
     contact_tolerance_m: float = 1e-3
     """Held-foot drift above which a projection step puts the foot back (0 disables)."""
     swing_feet: bool = False
@@ -151,11 +151,12 @@ class IKRetargeter(Retargeter):
         self._anchored_on_support: dict[str, bool] = {}
         self.swing_limits = ([SwingFootLimit(f, cfg.swing_near_m, cfg.swing_clearance_m, cfg.swing_max_slide_m)
                               for f in cfg.contact_frames] if cfg.swing_feet else [])
-        self.self_collision_limit = SelfCollisionLimit() if cfg.self_collision else None
-        self.scene_collision_limit = (SceneCollisionLimit(cfg.scene, cfg.ground_height_m)
-                                      if cfg.scene_collision else None)
-        self._mesh_limits: list[MeshPairLimit] = [lim for lim in (self.self_collision_limit,
-                                                                  self.scene_collision_limit) if lim is not None]
+        scene_collision = bool(cfg.scene) if cfg.scene_collision is None else cfg.scene_collision
+        self.collision_limit = (CollisionLimit(cfg.self_collision, cfg.scene if scene_collision else (),
+                                               cfg.ground_height_m if scene_collision else None)
+                                if cfg.self_collision or scene_collision else None)
+        """Self pairs (IKConfig.self_collision) and links against the floor and scene (scene_collision)."""
+        self._mesh_limits: list[MeshPairLimit] = [self.collision_limit] if self.collision_limit is not None else []
         # Limits whose rows come only near contact, and which a large step can therefore miss.
         self._resolvable = self._mesh_limits + ([self.ground_limit] if self.ground_limit is not None and cfg.scene
                                                 else [])

@@ -79,6 +79,8 @@ class MocapRetargetConfig:
     self_collision: bool = True
     """Keep every pair of non-adjacent links apart, the URDF's collision meshes (human arms and
     thighs pass closer to the body than the G1's wider torso and hips allow)."""
+    scene_collision: bool = True
+    """Keep every link out of the floor and the scene's shapes (IKConfig.scene_collision)."""
     swing_feet: bool = True
     """A free foot near the ground lifts clear of it or crosses it slowly (IKConfig.swing_feet):
     human feet skim and shuffle over the floor between steps; the G1's would slide."""
@@ -260,6 +262,7 @@ class MocapRetargeter:
             posture_cost=tuple(cfg.wrist_posture_cost if "wrist" in n else cfg.posture_cost for n in g1.JOINT_NAMES),
             smoothness_cost=tuple(smoothness),
             velocity_limit_scale=cfg.velocity_limit_scale, self_collision=cfg.self_collision, swing_feet=cfg.swing_feet,
+            scene_collision=cfg.scene_collision,
             contact_free_yaw=cfg.free_yaw_stance,
         )
 

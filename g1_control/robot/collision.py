@@ -132,8 +132,7 @@ class CollisionModel:
         self.geometry_model = gm
         self.geometries: tuple[Geometry, ...] = tuple(geometries)
         self.link_names: tuple[str, ...] = tuple(dict.fromkeys(g.link for g in geometries))
-        pairs = [(i, k) for i, k in itertools.combinations(range(len(geometries)), 2)
-                 if not self.adjacent(geometries[i].joint, geometries[k].joint)]
+        pairs = non_adjacent_pairs(self.model.parents, [g.joint for g in geometries])
         for i, k in pairs:
             gm.addCollisionPair(pin.CollisionPair(i, k))
         self.self_pairs = np.array(pairs, dtype=np.int64).reshape(-1, 2)
@@ -144,12 +143,9 @@ class CollisionModel:
         self._bound_radii = np.array([g.bound_radius_m for g in geometries])
         self._joints = [g.joint for g in geometries]
         self._request = coal.DistanceRequest()
+        self._request.gjk_variant = coal.GJKVariant.NesterovAcceleration
         self._result = coal.DistanceResult()
 
-    def adjacent(self, joint_a: int, joint_b: int) -> bool:
-        """Same joint (one rigid link, fixed children included) or connected by one joint."""
-        parents = self.model.parents
-        return joint_a == joint_b or parents[joint_a] == joint_b or parents[joint_b] == joint_a
 
     # ------------------------------------------------------------------ one configuration
     def set_configuration(self, q: np.ndarray) -> None:
@@ -219,6 +215,15 @@ class CollisionModel:
         return out
 
 
+def non_adjacent_pairs(parents, joints: list[int]) -> list[tuple[int, int]]:
+    """Index pairs of geometries (moving with `joints`) on links that are not adjacent: not the same
+    joint (one rigid link, fixed children included) and not connected by one joint."""
+    def adjacent(a: int, b: int) -> bool:
+        return a == b or parents[a] == b or parents[b] == a
+
+    return [(i, k) for i, k in itertools.combinations(range(len(joints)), 2) if not adjacent(joints[i], joints[k])]
+
+
 @functools.cache
 def collision_model() -> CollisionModel:
     """The shared CollisionModel (built once per process, ~1 s: convex hulls of the meshes)."""
@@ -244,3 +249,111 @@ def mujoco_collision_spec(scene_vertices: tuple[np.ndarray, ...] = ()):
         spec.worldbody.add_geom(name=f"scene_{k}", type=mujoco.mjtGeom.mjGEOM_MESH, meshname=f"scene_{k}",
                                 contype=1, conaffinity=1)
     return spec
+
+
+# ---------------------------------------------------------------------------- the IK's copy
+@dataclass(frozen=True)
+class StandIn:
+    """One collision geometry as the IK builds it (see ik_stand_ins)."""
+
+    name: str
+    link: str
+    joint: int
+    placement: np.ndarray
+    """(4, 4) the shape's frame in its joint's frame."""
+    kind: str
+    """'sphere' (params: radius), 'cylinder' (radius, half length) or 'convex' (points: its hull's vertices)."""
+    points: np.ndarray
+    """(K, 3) convex: hull vertices (shape frame); sphere and cylinder: empty."""
+    params: tuple[float, ...]
+    capsule_j: tuple[np.ndarray, np.ndarray, float]
+    """A capsule (joint frame) holding the whole geometry."""
+
+    def coal_shape(self):
+        import coal
+
+        if self.kind == "sphere":
+            return coal.Sphere(self.params[0])
+        if self.kind == "cylinder":
+            return coal.Cylinder(self.params[0], 2.0 * self.params[1])
+        return _convex_hull(self.points)
+
+
+def _build_stand_ins(model: CollisionModel) -> list[StandIn]:
+    import coal
+
+    out = []
+    for go, geom in zip(model.geometry_model.geometryObjects, model.geometries):
+        g = go.geometry
+        placement = go.placement.homogeneous.copy()
+        if isinstance(g, coal.Sphere):
+            out.append(StandIn(geom.name, geom.link, geom.joint, placement, "sphere", np.zeros((0, 3)),
+                               (float(g.radius),), geom.capsule_j))
+        elif isinstance(g, coal.Cylinder):
+            out.append(StandIn(geom.name, geom.link, geom.joint, placement, "cylinder", np.zeros((0, 3)),
+                               (float(g.radius), float(g.halfLength)), geom.capsule_j))
+        else:
+            out.append(StandIn(geom.name, geom.link, geom.joint, placement, "convex", np.asarray(g.points()),
+                               (0.0,), geom.capsule_j))
+    return out
+
+
+STAND_IN_VERSION = 2
+
+
+@functools.cache
+def ik_shapes() -> tuple:
+    """The coal shapes of ik_stand_ins(), built once per process and shared (queries only read them)."""
+    return tuple(s.coal_shape() for s in ik_stand_ins())
+
+
+@functools.cache
+def ik_stand_ins() -> tuple[StandIn, ...]:
+    """The collision geometries as the IK needs them: the convex hulls' vertices (not the meshes),
+    placements, joints and bounding capsules, built once from the URDF (~2 s: loading 30 STL meshes
+    and their hulls) and kept in the user cache, keyed by the URDF's content, so that a process
+    starting the IK pays ~50 ms instead. The same shapes the clip checker measures."""
+    import hashlib
+
+    from g1_control.assets import cache_dir
+
+    digest = hashlib.sha256(description.urdf_path().read_bytes()).hexdigest()[:16]
+    path = cache_dir() / "collision" / f"g1_collision_v{STAND_IN_VERSION}_{digest}.npz"
+    if path.is_file():
+        try:
+            return _load_stand_ins(path)
+        except (OSError, ValueError, KeyError):
+            pass  # rebuilt below
+    stand_ins = tuple(_build_stand_ins(collision_model()))
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        _save_stand_ins(stand_ins, path)
+    except OSError:
+        pass  # a read-only cache only costs the rebuild next time
+    return stand_ins
+
+
+def _save_stand_ins(stand_ins: tuple[StandIn, ...], path) -> None:
+    arrays = {"names": np.array([s.name for s in stand_ins]), "links": np.array([s.link for s in stand_ins]),
+              "joints": np.array([s.joint for s in stand_ins]), "kinds": np.array([s.kind for s in stand_ins]),
+              "placements": np.array([s.placement for s in stand_ins]),
+              "params": np.array([list(s.params) + [0.0] * (2 - len(s.params)) for s in stand_ins]),
+              "capsules": np.array([np.r_[s.capsule_j[0], s.capsule_j[1], s.capsule_j[2]] for s in stand_ins])}
+    for k, s in enumerate(stand_ins):
+        arrays[f"points_{k}"] = s.points
+    tmp = path.with_name(path.stem + ".tmp.npz")
+    np.savez(tmp, **arrays)
+    tmp.replace(path)
+
+
+def _load_stand_ins(path) -> tuple[StandIn, ...]:
+    with np.load(path, allow_pickle=False) as data:
+        out = []
+        for k, name in enumerate(data["names"]):
+            kind = str(data["kinds"][k])
+            count = 2 if kind == "cylinder" else 1
+            cap = data["capsules"][k]
+            out.append(StandIn(str(name), str(data["links"][k]), int(data["joints"][k]), data["placements"][k],
+                               kind, data[f"points_{k}"], tuple(float(v) for v in data["params"][k][:count]),
+                               (cap[:3].copy(), cap[3:6].copy(), float(cap[6]))))
+    return tuple(out)

@@ -161,24 +161,35 @@ def test_touchdown_on_a_box_top_snaps_the_foot_onto_it():
     assert heights[:4].min() == pytest.approx(top, abs=2e-3) and heights[4:].max() < 1e-4  # right foot on the floor
 
 
-def test_self_collision_holds_when_one_step_carries_an_elbow_from_beyond_the_activation_distance():
-    # At 30 Hz the velocity limits let the shoulder turn 1.2 rad in one step: the elbow sphere,
-    # 11 cm clear of the chest (beyond the 10 cm activation distance, so no row in the QP), is
-    # pulled toward a target inside the chest. Without a re-solve it ends 8.7 cm inside.
+def _elbow_into_chest(resolve: bool, refine: bool = False) -> float:
+    # At 30 Hz the velocity limits let the shoulder turn 1.2 rad in one step: the elbow, clear of
+    # the chest by more than the activation distance (so no row in the QP), is pulled toward a
+    # target inside the chest. Returns the deepest self-overlap after one tick.
     ik = IKRetargeter(IKConfig(dt_s=1 / 30, self_collision=True, com_cost=(0.0, 0.0, 0.0), hold_contacts=False,
-                               enforce_ground=False, frame_costs={"left_elbow_link": (20.0, 0.0)}))
-    conf, limit = ik.configuration, ik.self_collision_limit
+                               enforce_ground=False, scene_collision=False, projection_steps=4 if refine else 0,
+                               step_halvings=3 if refine else 0, frame_costs={"left_elbow_link": (20.0, 0.0)}))
+    conf, limit = ik.configuration, ik.collision_limit
+    if not resolve:
+        limit.missed_pairs = lambda configuration: np.zeros(len(limit.pairs), dtype=bool)
     q = conf.q.copy()
     q[7 + g1.JOINT_INDEX["left_shoulder_roll_joint"]] = 0.6  # arm out to the side
     conf.update(q)
-    elbow = [i for i, (a, _) in enumerate(limit.pairs) if a.frame == "left_elbow_link"]
+    elbow = [k for k in range(len(limit.pairs)) if "left_elbow_link_0" in limit.pair_names(k)
+             and "torso_link_0" in limit.pair_names(k)]
     assert limit.distances(conf)[elbow].min() > limit.activation_m
     chest = conf.frame_placement(conf.frame_id("torso_link")).act(np.array([0.0, 0.0, 0.12]))
     ref = KinematicReference(root_pos_w_m=q[:3].copy(), root_quat_wxyz=np.array([q[6], *q[3:6]]),
                              q_rad=q[7:].copy(), frame_targets_w={"left_elbow_link": np.r_[chest, 1.0, 0.0, 0.0, 0.0]},
                              contacts=np.zeros(2, dtype=bool))
     q_new = ik.step(ref, q)
-    gaps = limit.distances(conf)
-    assert np.linalg.norm(q_new[7:] - q[7:]) > 0.3  # a large step was taken ...
-    assert gaps.min() > limit.margin_m - 5e-3  # ... and kept the margin, up to linearisation error
+    assert np.linalg.norm(q_new[7:] - q[7:]) > 0.3  # a large step was taken
     assert not limit.include.any()  # the re-solve's extra rows are not kept for the next step
+    return -limit.distances(conf).min()
+
+
+def test_self_collision_holds_when_one_step_carries_an_elbow_from_beyond_the_activation_distance():
+    assert _elbow_into_chest(resolve=False) > 0.02  # without the re-solve the arm ends inside the chest
+    # with it: the margin, up to the linearisation error of a 1 rad step...
+    assert _elbow_into_chest(resolve=True) < 0.012
+    # ... which the trust-region re-solve and the projection step take out
+    assert _elbow_into_chest(resolve=True, refine=True) < 0.002

@@ -28,7 +28,7 @@ def test_joint_placements_kernel_is_pinocchio_forward_kinematics():
     limit = SelfCollisionLimit()
     rng = np.random.default_rng(0)
     for _ in range(5):
-        q = pin.randomConfiguration(limit.model.model, -np.ones(36), np.ones(36))
+        q = pin.randomConfiguration(Configuration().model, -np.ones(36), np.ones(36))
         q[7:] = rng.uniform(g1.Q_MIN_RAD, g1.Q_MAX_RAD)
         conf = Configuration(q)
         limit.lower_bounds(conf)

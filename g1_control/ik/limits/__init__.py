@@ -2,6 +2,7 @@
 
 from g1_control.ik.limits.base import INF, BoxBounds, Limit, RowConstraint
 from g1_control.ik.limits.base_velocity_limit import BaseVelocityLimit
+from g1_control.ik.limits.collision_limit import CollisionLimit
 from g1_control.ik.limits.contact_limit import ContactLimit
 from g1_control.ik.limits.ground_limit import GroundLimit
 from g1_control.ik.limits.joint_position_limit import JointPositionLimit
@@ -16,6 +17,7 @@ __all__ = [
            "INF",
            "BaseVelocityLimit",
            "BoxBounds",
+           "CollisionLimit",
            "ContactLimit",
            "GroundLimit",
            "JointPositionLimit",

@@ -25,15 +25,17 @@ from g1_control.ik.configuration import Configuration
 from g1_control.ik.exceptions import LimitDefinitionError
 from g1_control.ik.limits.base import INF, Limit, RowConstraint
 from g1_control.motion.objects import ObjectShape
-from g1_control.robot.collision import CollisionModel, collision_model, convex_shape
+from g1_control.robot import description
+from g1_control.robot.collision import StandIn, convex_shape, ik_shapes, ik_stand_ins
 
 
 class MeshPairLimit(Limit):
     def __init__(self, geometry_pairs: list[tuple[int, int]], shape_pairs: list[tuple[int, int]] = (),
                  shapes: tuple[ObjectShape, ...] = (), floor_height_m: float | None = None,
                  margin_m: float = 0.002, activation_m: float = 0.03, max_push_m: float = 0.03,
-                 model: CollisionModel | None = None) -> None:
-        """geometry_pairs: (geometry, geometry) index pairs of the collision model; shape_pairs:
+                 stand_ins: tuple[StandIn, ...] | None = None) -> None:
+        """geometry_pairs: (geometry, geometry) index pairs of the robot's collision geometries
+        (robot/collision.py; the IK uses their stand-ins, ik_stand_ins, which hold them); shape_pairs:
         (geometry, shape) pairs, shape k < len(shapes) a scene shape (world coordinates), k ==
         len(shapes) the floor z = floor_height_m."""
         import coal
@@ -42,11 +44,14 @@ class MeshPairLimit(Limit):
         if margin_m < -0.01 or activation_m <= margin_m or max_push_m <= 0:
             raise LimitDefinitionError(f"{type(self).__name__} needs margin_m < activation_m and max_push_m > 0. "
                                        f"Got margin {margin_m} m, activation {activation_m} m, push {max_push_m} m")
-        self.model = model or collision_model()
+        self.stand_ins = stand_ins if stand_ins is not None else ik_stand_ins()
         self.margin_m, self.activation_m, self.max_push_m = float(margin_m), float(activation_m), float(max_push_m)
         self.shapes = tuple(shapes)
-        gm = self.model.geometry_model.copy()
-        gm.removeAllCollisionPairs()
+        gm = pin.GeometryModel()
+        shared = self.stand_ins is ik_stand_ins()
+        shapes_of = ik_shapes() if shared else tuple(s.coal_shape() for s in self.stand_ins)
+        for s, shape in zip(self.stand_ins, shapes_of):
+            gm.addGeometryObject(pin.GeometryObject(s.name, s.joint, pin.SE3(s.placement), shape))
         planes, shape_geoms = [], []
         for shape in self.shapes:
             obj = pin.GeometryObject(f"scene_{shape.name}", 0, pin.SE3.Identity(), convex_shape(shape.vertices()))
@@ -64,8 +69,12 @@ class MeshPairLimit(Limit):
             gm.addCollisionPair(pin.CollisionPair(a, b))
         self.geometry_model = gm
         self.geometry_data = pin.GeometryData(gm)
+        for request in self.geometry_data.distanceRequests:
+            # Nesterov-accelerated GJK: ~10x faster than the default on these 500-2000-point hulls
+            # (measured: pelvis/torso 34 -> 3.7 us), same distances.
+            request.gjk_variant = coal.GJKVariant.NesterovAcceleration
         self.pairs = all_pairs
-        geoms = self.model.geometries
+        geoms = self.stand_ins
         self._geom_joint = np.array([g.joint for g in geoms], dtype=np.int64)
         self._cap_ends = np.array([[g.capsule_j[0], g.capsule_j[1]] for g in geoms])
         self._cap_radius = np.array([g.capsule_j[2] for g in geoms])
@@ -74,7 +83,7 @@ class MeshPairLimit(Limit):
         self._pair_shape = np.array([p[2] for p in all_pairs], dtype=np.int64)
         self._planes = np.concatenate(planes) if planes else np.zeros((0, 4))
         self._plane_start = np.cumsum([0] + [len(p) for p in planes]).astype(np.int64)
-        pmodel = self.model.model
+        pmodel = description.pinocchio_model()
         self._parents = np.array(pmodel.parents, dtype=np.int64)
         self._place_rot = np.array([pmodel.jointPlacements[k].rotation for k in range(pmodel.njoints)])
         self._place_pos = np.array([pmodel.jointPlacements[k].translation for k in range(pmodel.njoints)])
@@ -95,6 +104,8 @@ class MeshPairLimit(Limit):
         """Pairs given rows whatever their distance (see `missed_pairs`); the caller sets and clears it."""
         self._rows = np.zeros(len(all_pairs), dtype=bool)
         """Pairs the last `compute` gave rows."""
+        self._version = 0
+        self._inside_cache = None
         self.relaxed = False
         """When set, a pair inside its margin is only kept from going deeper, not pushed out (the
         retargeter's fallback when pushing out is infeasible this step)."""
@@ -129,16 +140,13 @@ class MeshPairLimit(Limit):
 
         pin.updateGeometryPlacements(configuration.model, configuration.data, self.geometry_model,
                                      self.geometry_data)
-        k = len(pairs)
-        dist, pa, pb, normal = np.empty(k), np.empty((k, 3)), np.empty((k, 3)), np.empty((k, 3))
-        gm, gd = self.geometry_model, self.geometry_data
-        for i, p in enumerate(pairs):
-            res = pin.computeDistance(gm, gd, int(p))
-            dist[i] = res.min_distance
-            pa[i] = res.getNearestPoint1()
-            pb[i] = res.getNearestPoint2()
-            normal[i] = res.normal
-        return dist, pa, pb, normal
+        gm, gd, distance = self.geometry_model, self.geometry_data, pin.computeDistance
+        results = [distance(gm, gd, p) for p in np.asarray(pairs).tolist()]
+        if not results:
+            empty = np.zeros((0, 3))
+            return np.zeros(0), empty, empty.copy(), empty.copy()
+        return (np.array([r.min_distance for r in results]), np.array([r.getNearestPoint1() for r in results]),
+                np.array([r.getNearestPoint2() for r in results]), np.array([r.normal for r in results]))
 
     def distances(self, configuration: Configuration) -> np.ndarray:
         """(P,) exact signed distance of every pair (slow: for tests and checks)."""
@@ -146,6 +154,7 @@ class MeshPairLimit(Limit):
 
     # ------------------------------------------------------------------ the limit
     def compute(self, configuration: Configuration, dt_s: float) -> RowConstraint | None:
+        self._version += 1
         self._rows[:] = False
         if not self.pairs:
             return None
@@ -166,23 +175,32 @@ class MeshPairLimit(Limit):
         lower = np.minimum(self.margin_m - dist[keep], 0.0 if self.relaxed else self.max_push_m)
         return RowConstraint(rows, lower, np.full(chosen.size, INF))
 
+    def _inside(self, configuration: Configuration) -> tuple[np.ndarray, float]:
+        """(pairs inside the margin (P,) bool, the smallest signed distance among them or +inf) at
+        `configuration`; remembered until the configuration or the rows change (the retargeter
+        asks both questions after every step)."""
+        key = (configuration.q.tobytes(), self._version)
+        if self._inside_cache is not None and self._inside_cache[0] == key:
+            return self._inside_cache[1]
+        inside = np.zeros(len(self.pairs), dtype=bool)
+        deepest = float("inf")
+        if self.pairs:
+            candidates = np.flatnonzero(self.lower_bounds(configuration) < self.margin_m)
+            if candidates.size:
+                dist = self.exact(configuration, candidates)[0]
+                inside[candidates] = dist < self.margin_m
+                deepest = float(dist.min())
+        self._inside_cache = (key, (inside, deepest))
+        return inside, deepest
+
     def missed_pairs(self, configuration: Configuration) -> np.ndarray:
         """(P,) bool: pairs inside the margin at `configuration` that the last `compute` gave no row
         (a step carried them there from beyond the activation distance)."""
-        out = np.zeros(len(self.pairs), dtype=bool)
-        if not self.pairs:
-            return out
-        candidates = np.flatnonzero((self.lower_bounds(configuration) < self.margin_m) & ~self._rows)
-        if candidates.size:
-            out[candidates] = self.exact(configuration, candidates)[0] < self.margin_m
-        return out
+        return self._inside(configuration)[0] & ~self._rows
 
     def deepest(self, configuration: Configuration) -> float:
         """The smallest signed distance of any pair that may be inside the margin (else +inf)."""
-        if not self.pairs:
-            return float("inf")
-        candidates = np.flatnonzero(self.lower_bounds(configuration) < self.margin_m)
-        return float(self.exact(configuration, candidates)[0].min()) if candidates.size else float("inf")
+        return self._inside(configuration)[1]
 
     def pair_names(self, k: int) -> tuple[str, str]:
         a, b, _ = self.pairs[k]

@@ -10,20 +10,16 @@ hands and the pelvis stay out of a box the feet climb onto. See mesh_pairs.py fo
 
 from __future__ import annotations
 
-from g1_control.ik.limits.mesh_pairs import MeshPairLimit
+from g1_control.ik.limits.collision_limit import CollisionLimit
 from g1_control.motion.objects import ObjectShape
 from g1_control.robot import g1
-from g1_control.robot.collision import CollisionModel, collision_model
+from g1_control.robot.collision import StandIn
 
 
-class SceneCollisionLimit(MeshPairLimit):
+class SceneCollisionLimit(CollisionLimit):
     def __init__(self, scene: tuple[ObjectShape, ...] = (), ground_height_m: float | None = 0.0,
                  skip_links: tuple[str, ...] = g1.FOOT_BODIES, margin_m: float = 0.002, activation_m: float = 0.03,
-                 max_push_m: float = 0.03, model: CollisionModel | None = None) -> None:
+                 max_push_m: float = 0.03, stand_ins: tuple[StandIn, ...] | None = None) -> None:
         """ground_height_m: the floor's height, or None for no floor."""
-        model = model or collision_model()
-        geoms = [k for k, g in enumerate(model.geometries) if g.link not in skip_links]
-        count = len(scene) + (ground_height_m is not None)
-        super().__init__([], [(k, s) for k in geoms for s in range(count)], shapes=tuple(scene),
-                         floor_height_m=ground_height_m, margin_m=margin_m, activation_m=activation_m,
-                         max_push_m=max_push_m, model=model)
+        super().__init__(False, scene, ground_height_m, skip_links, margin_m=margin_m, activation_m=activation_m,
+                         max_push_m=max_push_m, stand_ins=stand_ins)
