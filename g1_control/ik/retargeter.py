@@ -41,7 +41,7 @@ from g1_control.ik.tasks import (
     Task,
 )
 from g1_control.interfaces import Retargeter
-from g1_control.motion.objects import support_height
+from g1_control.motion.objects import support_height, support_normal
 from g1_control.robot import description, g1
 from g1_control.types import JointReference, KinematicReference
 
@@ -81,7 +81,12 @@ class IKConfig:
     enforce_ground: bool = True
     ground_height_m: float = 0.0
     ground_snap_m: float = 0.03
-    """A foot touching down with its sole within this of the ground is put on it, level."""
+    """A foot touching down with its lowest point within this of the ground (or a box's top, a
+    ramp) is laid flat on it."""
+    touchdown_reach_m: float | None = None
+    """A foot touching down further than this above any support is not held (None: held wherever
+    it is). Offline retargeting sets it: a performer's contact the G1's foot cannot reach (its foot
+    beside the box the human stands on) would otherwise hold the foot in the air."""
     scene: tuple = ()
     """Static shapes (motion.objects.ObjectShape, world coordinates) the feet stand on besides the
     floor: the ground limit keeps feet on their tops and a touchdown snaps onto them."""
@@ -257,23 +262,42 @@ class IKRetargeter(Retargeter):
         q[7:] = q_prev
         return q
 
-    def _touchdown_anchor(self, frame: str) -> pin.SE3:
-        """Anchor for a foot starting contact: where it is, or flat on the ground when close to it.
+    def _touchdown_anchor(self, frame: str) -> pin.SE3 | None:
+        """Anchor for a foot starting contact: where it is, or flat on what it stands on when close
+        to it (the floor, a box's top, a ramp's slope), or None when it is further above any support
+        than `touchdown_reach_m` (a foot cannot stand in the air: it stays free this tick).
         Laying a tilted foot flat pivots it about its sole centre, which keeps its place on the
         ground (pivoting about the ankle would drag the sole by centimetres: measured as sliding)."""
         pose = pin.SE3(self.configuration.frame_placement(self.configuration.frame_id(frame)))
         depth = self._sole_depth[frame]
         centre = self._sole_centre[frame]
         centre_w = pose.rotation @ centre + pose.translation
-        sole_height = centre_w[2] - (depth + centre[2])
-        support = self._support_under(centre_w, sole_height)
-        self._anchored_on_support[frame] = sole_height >= support - 1e-9
-        if self.config.enforce_ground and sole_height - support < self.config.ground_snap_m:
-            yaw = np.arctan2(pose.rotation[1, 0], pose.rotation[0, 0])
-            level = pin.utils.rpyToMatrix(0.0, 0.0, yaw)
-            origin = centre_w - level @ centre
-            origin[2] = support + depth
-            pose = pin.SE3(level, origin)
+        # The sole's lowest point over what it stands on decides (a foot on its toes has its sole
+        # centre well above the ground: measured 5 cm, and was held hovering 2.5 cm up for a whole
+        # stance; on a ramp the heel and the toe stand on different heights).
+        cfg = self.config
+        spheres = foot_contact_points().get(frame)
+        if spheres is None:
+            bottoms = np.array([[centre_w[0], centre_w[1], centre_w[2] - (depth + centre[2])]])
+        else:
+            bottoms = np.array([pose.rotation @ c + pose.translation - [0.0, 0.0, r] for c, r in spheres])
+        supports = support_height(cfg.scene, bottoms, cfg.ground_height_m, cfg.ground_snap_m)
+        gaps = bottoms[:, 2] - supports
+        lowest = float(gaps.min())
+        if cfg.touchdown_reach_m is not None and lowest > cfg.touchdown_reach_m:
+            return None
+        support, normal = support_normal(cfg.scene, np.array([centre_w[0], centre_w[1], supports.max()]),
+                                         cfg.ground_height_m, cfg.ground_snap_m)
+        self._anchored_on_support[frame] = lowest >= -1e-9
+        if cfg.enforce_ground and lowest < cfg.ground_snap_m:
+            # flat on the surface, heading kept: z along its normal, x the heading projected onto it
+            heading = pose.rotation[:, 0] - (pose.rotation[:, 0] @ normal) * normal
+            if np.linalg.norm(heading) < 1e-6:
+                heading = np.cross(normal, pose.rotation[:, 1])
+            x = heading / np.linalg.norm(heading)
+            rot = np.column_stack([x, np.cross(normal, x), normal])
+            on_surface = np.array([centre_w[0], centre_w[1], support])  # the sole centre, on it
+            pose = pin.SE3(rot, on_surface - rot @ np.array([centre[0], centre[1], -depth]))
             self._anchored_on_support[frame] = True
         return self._out_of_scene(frame, pose)
 
@@ -313,7 +337,9 @@ class IKRetargeter(Retargeter):
             return
         for flag, contact in zip(np.asarray(ref.contacts, dtype=bool), self.contacts):
             if flag and not contact.active:
-                contact.set_anchor(self._touchdown_anchor(contact.frame))
+                anchor = self._touchdown_anchor(contact.frame)
+                if anchor is not None:
+                    contact.set_anchor(anchor)
             elif not flag and contact.active:
                 contact.release()
 

@@ -4,11 +4,12 @@ placed by forward kinematics of each frame's root pose and joint angles, never t
 body poses, contact labels or anything the retargeter decided.
 
 Per frame:
-- feet: the four URDF collision spheres of each foot; the lowest one is the foot's contact point.
-  It stands on the floor, or on the top of a scene shape under it (a top at most `near_m` above
-  it); `stance` = that sphere's bottom within `near_m` of what it stands on and its vertical speed
-  (from the previous frame) under `slow_mps`. Sliding = horizontal displacement of that sphere
-  since the previous frame, on stance frames.
+- feet: the four URDF collision spheres of each foot. Each stands on the floor, or on the top of a
+  scene shape under it (a top at most `near_m` above its bottom); the foot's contact sphere is the
+  one nearest what it stands on (on flat ground: the lowest; on a box's edge, one over the box).
+  `stance` = that sphere's bottom within `near_m` of its support and its vertical speed (from the
+  previous frame) under `slow_mps`. Sliding = horizontal displacement of that sphere since the
+  previous frame, on stance frames.
 - penetration: the deepest any collision geometry of any link reaches below the floor (z = 0) or
   into a scene shape (coal signed distance; convex scene shapes), with the link.
 - self-collision: the deepest overlap of any self-collision pair (every pair of non-adjacent links,
@@ -36,7 +37,7 @@ SLOW_MPS = 0.1
 class ClipGeometry:
     fps: float
     foot_bottom_m: np.ndarray
-    """(T, 2) height of the bottom of each foot's lowest sphere (left, right)."""
+    """(T, 2) height of the bottom of each foot's contact sphere (left, right)."""
     foot_support_m: np.ndarray
     """(T, 2) height of what that sphere stands on (floor 0 or a scene top)."""
     foot_vz_mps: np.ndarray
@@ -108,14 +109,17 @@ def measure(clip: MotionClip, scene: tuple[ObjectShape, ...] | None = None, near
             self_pair[k] = link_of_geom[model.self_pairs[p]]
         for side, spheres in enumerate(feet):
             centres[k, side] = model.sphere_centres_w(spheres)
-    lowest = (centres[..., 2] - radii).argmin(axis=2)  # (T, 2): which sphere is lowest
+    bottoms = centres.copy()
+    bottoms[..., 2] -= radii  # (T, 2, S, 3): each sphere's lowest point
+    supports = support_height(scene, bottoms.reshape(-1, 3), 0.0, near_m).reshape(bottoms.shape[:3])
+    # The foot's contact sphere: the one nearest what is under it (on flat ground, the lowest; a
+    # foot on a box's edge stands on the spheres over the box, not on the one hanging past it).
+    lowest = (bottoms[..., 2] - supports).argmin(axis=2)  # (T, 2)
     pick = lowest[..., None, None]
     point = np.take_along_axis(centres, pick, axis=2)[:, :, 0]  # (T, 2, 3)
     before = np.take_along_axis(np.roll(centres, 1, axis=0), pick, axis=2)[:, :, 0]
-    radius = np.take_along_axis(np.broadcast_to(radii, (t, 2, radii.shape[1])), lowest[..., None], axis=2)[..., 0]
-    bottom = point[..., 2] - radius
-    support = np.stack([support_height(scene, np.c_[point[:, s, :2], bottom[:, s]], 0.0, near_m)
-                        for s in range(2)], axis=1)
+    bottom = np.take_along_axis(bottoms[..., 2], lowest[..., None], axis=2)[..., 0]
+    support = np.take_along_axis(supports, lowest[..., None], axis=2)[..., 0]
     vz = np.zeros((t, 2))
     slide = np.zeros((t, 2))
     if t > 1:

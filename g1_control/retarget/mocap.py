@@ -81,6 +81,10 @@ class MocapRetargetConfig:
     thighs pass closer to the body than the G1's wider torso and hips allow)."""
     scene_collision: bool = True
     """Keep every link out of the floor and the scene's shapes (IKConfig.scene_collision)."""
+    touchdown_reach_m: float = 0.05
+    """A performer's contact starts the G1 foot's hold only when that foot is within this of a
+    support (IKConfig.touchdown_reach_m), and then lays it flat on that support
+    (IKConfig.ground_snap_m): a held foot never hovers."""
     swing_feet: bool = True
     """A free foot near the ground lifts clear of it or crosses it slowly (IKConfig.swing_feet):
     human feet skim and shuffle over the floor between steps; the G1's would slide."""
@@ -262,7 +266,8 @@ class MocapRetargeter:
             posture_cost=tuple(cfg.wrist_posture_cost if "wrist" in n else cfg.posture_cost for n in g1.JOINT_NAMES),
             smoothness_cost=tuple(smoothness),
             velocity_limit_scale=cfg.velocity_limit_scale, self_collision=cfg.self_collision, swing_feet=cfg.swing_feet,
-            scene_collision=cfg.scene_collision,
+            scene_collision=cfg.scene_collision, touchdown_reach_m=cfg.touchdown_reach_m,
+            ground_snap_m=cfg.touchdown_reach_m,
             contact_free_yaw=cfg.free_yaw_stance,
         )
 
