@@ -224,6 +224,52 @@ def non_adjacent_pairs(parents, joints: list[int]) -> list[tuple[int, int]]:
     return [(i, k) for i, k in itertools.combinations(range(len(joints)), 2) if not adjacent(joints[i], joints[k])]
 
 
+def pairs_that_can_meet(model: CollisionModel, grids: tuple[int, int, int] = (41, 41, 17),
+                        clear_m: float = 0.005) -> np.ndarray:
+    """(P,) bool over model.self_pairs: False for a pair that no configuration within the joint
+    limits brings closer than `clear_m` (MoveIt's "never in collision"): the IK need not watch it.
+    A pair whose links are joined through at most three joints depends on those joints only: its
+    distance is sampled on a grid over their ranges (41 values per joint, 17 for three joints),
+    then minimised from the three closest grid points (Nelder-Mead within the limits). Pairs
+    further apart in the tree are kept. On the G1 this drops, among others, the wrist links
+    against their neighbour but one (9.5 mm apart at rest, never closer) and the hip links against
+    the other leg's."""
+    import pinocchio as pin
+    from scipy.optimize import minimize
+
+    from g1_control.robot import g1
+
+    pmodel = model.model
+    data = pmodel.createData()
+    keep = np.ones(len(model.self_pairs), dtype=bool)
+    q0 = description.pinocchio_q(np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]), g1.DEFAULT_Q_RAD)
+    for k, (a, b) in enumerate(model.self_pairs):
+        ja, jb = model.geometries[a].joint, model.geometries[b].joint
+        path = sorted(set(pmodel.supports[ja]) ^ set(pmodel.supports[jb]))
+        if not 1 <= len(path) <= 3 or any(j < 2 for j in path):
+            continue
+        idx = [pmodel.joints[j].idx_q for j in path]
+        lo, hi = pmodel.lowerPositionLimit[idx], pmodel.upperPositionLimit[idx]
+
+        def distance(values: np.ndarray, k: int = k, idx: list = idx, lo=lo, hi=hi) -> float:
+            q = q0.copy()
+            q[idx] = np.clip(values, lo, hi)
+            pin.forwardKinematics(pmodel, data, q)
+            pin.updateGeometryPlacements(pmodel, data, model.geometry_model, model._geom_data)
+            return pin.computeDistance(model.geometry_model, model._geom_data, k).min_distance
+
+        grid = np.stack(np.meshgrid(*[np.linspace(lo[i], hi[i], grids[len(path) - 1]) for i in range(len(path))],
+                                    indexing="ij"), axis=-1).reshape(-1, len(path))
+        values = np.array([distance(v) for v in grid])
+        closest = values.min()
+        if closest > clear_m:
+            for start in grid[np.argsort(values)[:3]]:
+                closest = min(closest, minimize(distance, start, method="Nelder-Mead",
+                                                options={"xatol": 1e-3, "fatol": 1e-5, "maxiter": 200}).fun)
+        keep[k] = closest <= clear_m
+    return keep
+
+
 @functools.cache
 def collision_model() -> CollisionModel:
     """The shared CollisionModel (built once per process, ~1 s: convex hulls of the meshes)."""
@@ -298,7 +344,7 @@ def _build_stand_ins(model: CollisionModel) -> list[StandIn]:
     return out
 
 
-STAND_IN_VERSION = 2
+STAND_IN_VERSION = 3
 
 
 @functools.cache
@@ -307,12 +353,23 @@ def ik_shapes() -> tuple:
     return tuple(s.coal_shape() for s in ik_stand_ins())
 
 
-@functools.cache
 def ik_stand_ins() -> tuple[StandIn, ...]:
     """The collision geometries as the IK needs them: the convex hulls' vertices (not the meshes),
-    placements, joints and bounding capsules, built once from the URDF (~2 s: loading 30 STL meshes
-    and their hulls) and kept in the user cache, keyed by the URDF's content, so that a process
-    starting the IK pays ~50 ms instead. The same shapes the clip checker measures."""
+    placements, joints and bounding capsules. The same shapes the clip checker measures."""
+    return _ik_geometry()[0]
+
+
+def ik_self_pairs() -> list[tuple[int, int]]:
+    """The self-collision pairs the IK keeps apart: every non-adjacent pair that can meet within
+    the joint limits (pairs_that_can_meet: 530 of the 579 the checker measures)."""
+    return _ik_geometry()[1]
+
+
+@functools.cache
+def _ik_geometry() -> tuple[tuple[StandIn, ...], list[tuple[int, int]]]:
+    """Built once from the URDF (~10 s: loading 30 STL meshes and their hulls, sampling which pairs
+    can meet) and kept in the user cache, keyed by the URDF's content, so that a process starting
+    the IK pays ~50 ms instead."""
     import hashlib
 
     from g1_control.assets import cache_dir
@@ -324,16 +381,18 @@ def ik_stand_ins() -> tuple[StandIn, ...]:
             return _load_stand_ins(path)
         except (OSError, ValueError, KeyError):
             pass  # rebuilt below
-    stand_ins = tuple(_build_stand_ins(collision_model()))
+    model = collision_model()
+    stand_ins = tuple(_build_stand_ins(model))
+    pairs = [tuple(p) for p in model.self_pairs[pairs_that_can_meet(model)].tolist()]
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        _save_stand_ins(stand_ins, path)
+        _save_stand_ins(stand_ins, pairs, path)
     except OSError:
         pass  # a read-only cache only costs the rebuild next time
-    return stand_ins
+    return stand_ins, pairs
 
 
-def _save_stand_ins(stand_ins: tuple[StandIn, ...], path) -> None:
+def _save_stand_ins(stand_ins: tuple[StandIn, ...], pairs: list[tuple[int, int]], path) -> None:
     arrays = {"names": np.array([s.name for s in stand_ins]), "links": np.array([s.link for s in stand_ins]),
               "joints": np.array([s.joint for s in stand_ins]), "kinds": np.array([s.kind for s in stand_ins]),
               "placements": np.array([s.placement for s in stand_ins]),
@@ -341,12 +400,13 @@ def _save_stand_ins(stand_ins: tuple[StandIn, ...], path) -> None:
               "capsules": np.array([np.r_[s.capsule_j[0], s.capsule_j[1], s.capsule_j[2]] for s in stand_ins])}
     for k, s in enumerate(stand_ins):
         arrays[f"points_{k}"] = s.points
+    arrays["pairs"] = np.array(pairs, dtype=np.int64).reshape(-1, 2)
     tmp = path.with_name(path.stem + ".tmp.npz")
     np.savez(tmp, **arrays)
     tmp.replace(path)
 
 
-def _load_stand_ins(path) -> tuple[StandIn, ...]:
+def _load_stand_ins(path) -> tuple[tuple[StandIn, ...], list[tuple[int, int]]]:
     with np.load(path, allow_pickle=False) as data:
         out = []
         for k, name in enumerate(data["names"]):
@@ -356,4 +416,5 @@ def _load_stand_ins(path) -> tuple[StandIn, ...]:
             out.append(StandIn(str(name), str(data["links"][k]), int(data["joints"][k]), data["placements"][k],
                                kind, data[f"points_{k}"], tuple(float(v) for v in data["params"][k][:count]),
                                (cap[:3].copy(), cap[3:6].copy(), float(cap[6]))))
-    return tuple(out)
+        pairs = [tuple(p) for p in data["pairs"].tolist()]
+    return tuple(out), pairs

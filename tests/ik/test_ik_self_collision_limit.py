@@ -48,12 +48,12 @@ def test_capsule_bounds_never_exceed_the_exact_distance():
         assert (limit.lower_bounds(conf) <= limit.distances(conf) + 1e-9).all()
 
 
-def test_default_pose_is_clear_and_pairs_are_every_non_adjacent_pair():
+def test_default_pose_is_clear_and_pairs_are_those_that_can_meet():
     limit = SelfCollisionLimit()
-    assert len(limit.pairs) == 579
+    assert 500 < len(limit.pairs) < 579  # of the 579 non-adjacent pairs, those that can meet
     assert limit.distances(Configuration()).min() > 0.009
     names = {tuple(sorted(limit.pair_names(k))) for k in range(len(limit.pairs))}
-    assert ("pelvis_contour_link_0", "torso_link_0") in names  # no geometry between them: checked
+    assert ("left_hip_yaw_link_0", "torso_link_0") in names  # a raised thigh meets the chest
     assert ("left_hip_pitch_link_0", "pelvis_contour_link_0") not in names  # one joint apart: adjacent
 
 

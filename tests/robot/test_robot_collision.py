@@ -31,7 +31,11 @@ def test_the_ik_uses_the_checkers_shapes(tmp_path):
     model = collision.collision_model()
     stand_ins = collision.ik_stand_ins()
     assert [s.name for s in stand_ins] == [g.name for g in model.geometries]
+    pairs = collision.ik_self_pairs()
+    index = {tuple(p): k for k, p in enumerate(model.self_pairs.tolist())}
+    watched = [index[p] for p in pairs]
     limit = SelfCollisionLimit()
+    assert [(a, b) for a, b, _ in limit.pairs] == pairs
     rng = np.random.default_rng(4)
     conf = Configuration()
     for _ in range(3):
@@ -39,14 +43,33 @@ def test_the_ik_uses_the_checkers_shapes(tmp_path):
         q[7:] = rng.uniform(g1.Q_MIN_RAD, g1.Q_MAX_RAD)
         conf.update(q)
         model.set_configuration(q)
-        np.testing.assert_allclose(limit.distances(conf), model.self_distances(reach_m=np.inf), atol=1e-5)
+        np.testing.assert_allclose(limit.distances(conf), model.self_distances(reach_m=np.inf)[watched], atol=1e-5)
     path = tmp_path / "c.npz"
-    collision._save_stand_ins(stand_ins, path)
-    back = collision._load_stand_ins(path)
+    collision._save_stand_ins(stand_ins, pairs, path)
+    back, back_pairs = collision._load_stand_ins(path)
+    assert back_pairs == pairs
     for a, b in zip(stand_ins, back):
         assert (a.name, a.link, a.joint, a.kind, a.params) == (b.name, b.link, b.joint, b.kind, b.params)
         np.testing.assert_array_equal(a.points, b.points)
         np.testing.assert_array_equal(a.placement, b.placement)
+
+
+def test_pairs_that_never_meet_are_the_ones_the_ik_leaves_out():
+    model = collision.collision_model()
+    watched = set(collision.ik_self_pairs())
+    left_out = [tuple(p) for p in model.self_pairs.tolist() if tuple(p) not in watched]
+    names = {(model.geometries[a].name, model.geometries[b].name) for a, b in left_out}
+    assert 30 < len(left_out) < 80
+    assert ("left_elbow_link_0", "left_wrist_pitch_link_0") in names  # 9.5 mm apart whatever the wrist does
+    assert ("torso_link_0", "left_shoulder_roll_link_0") not in names  # the arm can swing into the chest
+    # sampled: none of the left-out pairs comes within 5 mm over random configurations
+    rng = np.random.default_rng(5)
+    index = {tuple(p): k for k, p in enumerate(model.self_pairs.tolist())}
+    for _ in range(200):
+        q = description.pinocchio_q(np.zeros(3), np.array([1.0, 0, 0, 0]), rng.uniform(g1.Q_MIN_RAD, g1.Q_MAX_RAD))
+        model.set_configuration(q)
+        gaps = model.self_distances(reach_m=0.02)
+        assert gaps[[index[p] for p in left_out]].min() > 0.005
 
 
 def test_mujoco_spec_collides_every_collision_geometry():

@@ -106,6 +106,9 @@ class MeshPairLimit(Limit):
         """Pairs the last `compute` gave rows."""
         self._version = 0
         self._inside_cache = None
+        self._bounds_key: bytes | None = None
+        self._exact_key: bytes | None = None
+        self._exact_cache: dict[int, tuple] = {}
         self.relaxed = False
         """When set, a pair inside its margin is only kept from going deeper, not pushed out (the
         retargeter's fallback when pushing out is infeasible this step)."""
@@ -126,27 +129,42 @@ class MeshPairLimit(Limit):
 
     def lower_bounds(self, configuration: Configuration) -> np.ndarray:
         """(P,) gap of every pair bounded from below by the bounding capsules (exact is larger)."""
+        key = configuration.q.tobytes()
+        if key == self._bounds_key:
+            return self._gaps
         kernels.joint_placements(configuration.q, self._parents, self._place_rot, self._place_pos, self._axes,
                                  self._joint_rot, self._joint_pos)
         kernels.capsule_gaps(self._joint_rot, self._joint_pos, self._geom_joint, self._cap_ends, self._cap_radius,
                              self._pair_a, self._pair_b, self._pair_shape, self._planes, self._plane_start,
                              self._ends, self._gaps)
+        self._bounds_key = key
         return self._gaps
 
     def exact(self, configuration: Configuration, pairs: np.ndarray
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Signed distance (K,), witness points on a and b (K, 3) and normal a -> b (K, 3) of pairs."""
+        """Signed distance (K,), witness points on a and b (K, 3) and normal a -> b (K, 3) of pairs.
+        Results are kept per configuration: a step's check of where it ended and the next step's
+        rows, taken at the same configuration, share their queries."""
         import pinocchio as pin
 
-        pin.updateGeometryPlacements(configuration.model, configuration.data, self.geometry_model,
-                                     self.geometry_data)
+        key = configuration.q.tobytes()
+        if key != self._exact_key:
+            self._exact_key, self._exact_cache = key, {}
+            pin.updateGeometryPlacements(configuration.model, configuration.data, self.geometry_model,
+                                         self.geometry_data)
+        cache = self._exact_cache
         gm, gd, distance = self.geometry_model, self.geometry_data, pin.computeDistance
-        results = [distance(gm, gd, p) for p in np.asarray(pairs).tolist()]
-        if not results:
+        wanted = np.asarray(pairs).tolist()
+        for p in wanted:
+            if p not in cache:
+                r = distance(gm, gd, p)
+                cache[p] = (r.min_distance, r.getNearestPoint1().copy(), r.getNearestPoint2().copy(), r.normal.copy())
+        if not wanted:
             empty = np.zeros((0, 3))
             return np.zeros(0), empty, empty.copy(), empty.copy()
-        return (np.array([r.min_distance for r in results]), np.array([r.getNearestPoint1() for r in results]),
-                np.array([r.getNearestPoint2() for r in results]), np.array([r.normal for r in results]))
+        rows = [cache[p] for p in wanted]
+        return (np.array([r[0] for r in rows]), np.array([r[1] for r in rows]), np.array([r[2] for r in rows]),
+                np.array([r[3] for r in rows]))
 
     def distances(self, configuration: Configuration) -> np.ndarray:
         """(P,) exact signed distance of every pair (slow: for tests and checks)."""
