@@ -4,8 +4,10 @@ Each tick it turns a KinematicReference (root pose, posture, named frame targets
 into a JointReference the G1 can take, by one or more differential-IK QP steps from the previous
 configuration. Tasks: root pose, every named frame target, centre of mass of the reference
 posture, posture, damping, temporal smoothness. Limits: joint positions, joint and base velocities
-(anchored at the tick's start), stance feet held where they touched down, feet above the ground.
-Weights and switches come from `IKConfig`.
+(anchored at the tick's start), stance feet held where they touched down, feet above the ground;
+optionally (offline retargeting turns them on) every pair of links apart and every link out of the
+floor and the scene (CollisionLimit, the URDF's collision meshes) and free feet off the ground when
+they move (SwingFootLimit). Weights and switches come from `IKConfig`.
 """
 
 from __future__ import annotations

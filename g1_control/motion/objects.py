@@ -11,7 +11,8 @@ object's surface; the retargeted clip keeps them so the metrics can check that t
 still there on those frames (contact preservation).
 
 Scene: static shapes in world coordinates (the boxes of the climbing sequences): the IK keeps the
-feet on and above them (GroundLimit) and the metrics count penetration into them.
+feet on and above them (GroundLimit) and every other link out of them (CollisionLimit), and the
+metrics count any link's penetration into them.
 """
 
 from __future__ import annotations

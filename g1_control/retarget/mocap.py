@@ -4,8 +4,10 @@ Per clip: resample to the output rate, scale the human to the G1 by height (and 
 configured), label foot contacts from the human feet, put the human's stance feet at the G1's
 sole height (an offset measured from the data per foot point, never a fixed constant), then run
 the same IKRetargeter as the online loop frame by frame: keypoint position targets, pelvis and
-torso orientation from the hips/shoulders, stance feet held, joint position and velocity limits,
-feet above the ground.
+torso orientation from the hips/shoulders, the performer's stance feet held flat on what they stand
+on, joint position and velocity limits, every link kept out of the floor, the scene and the other
+links (the URDF's collision meshes), free feet near the ground lifting clear or crossing slowly.
+The result is measured by retarget/metrics.py (definitions and figures: retarget/README.md).
 """
 
 from __future__ import annotations
