@@ -18,6 +18,7 @@ import numpy as np
 
 from g1_control.types import (
     Command,
+    CommandLimits,
     EstimatedState,
     JointReference,
     KinematicReference,
@@ -43,6 +44,14 @@ class Backend(ABC):
 
     def step(self, dt_s: float) -> None:
         """Advance `dt_s` seconds (lockstep only; a no-op on wall-clock backends)."""
+
+    def step_ticks(self, command: MotorCommand, dt_s: float, n: int) -> None:
+        """`n` low-level ticks of `command` in a row: write_command(command) then step(dt_s), n times
+        (lockstep). A backend that only stores the command may advance all n at once. The caller
+        does not modify `command` in place once written (a new command is a new object)."""
+        for _ in range(n):
+            self.write_command(command)
+            self.step(dt_s)
 
     def damp(self) -> None:
         """Put damping on the motors now, not at the next tick (signal handlers, faults)."""
@@ -106,6 +115,12 @@ class Tracker(ABC):
     def observe(self, estimate: EstimatedState) -> None:
         """The state estimator's latest output (at the estimator's rate); trackers that close
         loops on the base's velocity keep it."""
+
+    @property
+    def command_limits(self) -> CommandLimits | None:
+        """The operator command range this tracker can follow (None: no range of its own). The
+        loop builder intersects it with the launch file's limits; teleop sticks scale to it."""
+        return None
 
     @property
     def policy_command(self) -> np.ndarray | None:

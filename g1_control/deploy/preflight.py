@@ -15,14 +15,17 @@ import logging
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import yaml
 
 from g1_control.errors import G1ControlError, RobotNotConnectedError, VariantMismatchError
 from g1_control.launch.schema import InputConfig, LaunchFile, Segment
 from g1_control.robot import g1
 from g1_control.rotations import tilt_rad
+
+if TYPE_CHECKING:
+    from g1_control.launch.runner import RunResult
 
 log = logging.getLogger("g1_control.deploy")
 
@@ -47,6 +50,9 @@ PASS, FAIL, SKIP, NOT_RUN = "pass", "fail", "skip", "not run"
 class PreflightRefused(G1ControlError):
     """A preflight check failed and was not overridden: nothing was sent to the robot."""
 
+    report: Any = None
+    """The refused deploy's DeployReport (g1_control.deploy.session sets it, for --json)."""
+
 
 @dataclass
 class CheckResult:
@@ -65,8 +71,8 @@ class CheckResult:
 class Preflight:
     overrides: frozenset[str] = frozenset()
     results: dict[str, CheckResult] = field(default_factory=dict)
-    dry_run: object | None = None
-    """The dry run's RunResult (g1_control.launch.runner), when it ran."""
+    dry_run: RunResult | None = None
+    """The dry run's result, when it ran."""
 
     def __post_init__(self) -> None:
         unknown = set(self.overrides) - set(CHECKS)
@@ -109,11 +115,11 @@ class Preflight:
         return launch
 
     def check_policy(self, launch: LaunchFile):
-        from g1_control.trackers.policy_spec import load_spec, resolve_spec_path
+        from g1_control.trackers.policy_spec import load_spec, read_spec_file, resolve_spec_path
 
         try:
             spec = load_spec(launch.tracker.policy)
-            variant = (yaml.safe_load(resolve_spec_path(launch.tracker.policy).read_text()) or {}).get("variant")
+            variant = read_spec_file(resolve_spec_path(launch.tracker.policy)).variant
         except G1ControlError as exc:
             self.record("policy", FAIL, str(exc), overridable=False)
             return None, None

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from g1_control.errors import LaunchFileError
 from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, Tracker
@@ -24,6 +25,10 @@ from g1_control.launch.schema import LaunchFile
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.safety import SafetyConfig, SafetyFilter
 from g1_control.teleop.scripted import Segment, random_timeline
+from g1_control.types import CommandLimits
+
+if TYPE_CHECKING:
+    from g1_control.sim.mujoco_backend import MujocoBackend
 
 CHAIN_STAGES = ("generator", "retargeter", "tracker", "rates", "safety")
 """The parts of `loop.chain` that must be the same in a deploy's dry run and on the robot."""
@@ -62,7 +67,15 @@ def make_tracker(launch: LaunchFile) -> Tracker:
     raise LaunchFileError(f"tracker.type: unknown tracker '{cfg.type}'")
 
 
-def make_generator(launch: LaunchFile) -> tuple[Generator, Retargeter]:
+def command_limits(launch: LaunchFile, tracker_limits: CommandLimits | None) -> CommandLimits:
+    """The one source of operator velocity limits: the launch file's `limits` within the range the
+    tracker can follow (Tracker.command_limits). Teleop sticks scale to it; the generator clamps to it."""
+    lim = launch.limits
+    limits = CommandLimits.symmetric(lim.max_vx_mps, lim.max_vy_mps, lim.max_wz_radps)
+    return limits if tracker_limits is None else limits.intersect(tracker_limits)
+
+
+def make_generator(launch: LaunchFile, limits: CommandLimits | None = None) -> tuple[Generator, Retargeter]:
     cfg = launch.generator
     if cfg.type == "scripted":
         from g1_control.generator.scripted import TrajectoryGenerator, TrajectoryRetargeter, build_reference
@@ -71,16 +84,10 @@ def make_generator(launch: LaunchFile) -> tuple[Generator, Retargeter]:
         return TrajectoryGenerator(trajectory), TrajectoryRetargeter(trajectory)
     from g1_control.generator.factory import make_generator as make_named
 
-    return make_named(cfg.type, model=cfg.model or None, limits=launch.limits)
+    return make_named(cfg.type, model=cfg.model or None, limits=limits)
 
 
-def command_ranges(tracker: Tracker) -> dict | None:
-    """The walking policy's command ranges (what teleop sticks scale to), when the tracker has them."""
-    spec = getattr(tracker, "spec", None)
-    return spec.command_ranges if spec is not None else None
-
-
-def make_sim_backend(launch: LaunchFile) -> Backend:
+def make_sim_backend(launch: LaunchFile) -> MujocoBackend:
     if launch.backend.type != "mujoco":
         raise LaunchFileError(f"launch file '{launch.name}' drives a robot (backend.type {launch.backend.type}); "
                               "run it with `g1 deploy`, which checks the robot before anything moves")
@@ -119,13 +126,13 @@ def build_loop(launch: LaunchFile, *, backend: Backend | None = None, input_devi
     from g1_control.launch.inputs import make_input
 
     tracker = make_tracker(launch)
-    generator, retargeter = make_generator(launch)
+    limits = command_limits(launch, tracker.command_limits)
+    generator, retargeter = make_generator(launch, limits)
     chain = describe_chain(launch, generator, retargeter, tracker)
     if backend is None:
         backend = make_sim_backend(launch)
     if input_device is None:
-        input_device = make_input(launch, timeline_of(launch), command_ranges=command_ranges(tracker),
-                                  state_source=backend.read_state)
+        input_device = make_input(launch, timeline_of(launch), limits=limits, state_source=backend.read_state)
     safety = SafetyFilter(safety_config(launch))
     if wrap_tracker is not None:
         tracker = wrap_tracker(tracker, safety)

@@ -16,14 +16,19 @@ import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import yaml
 
 from g1_control.launch.builder import build_loop, make_sim_backend, timeline_of
+from g1_control.launch.overlay import overlay_lines
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.teleop.scripted import Segment
+
+if TYPE_CHECKING:
+    from g1_control.sim.mujoco_backend import MujocoBackend
 
 STEADY_STATE_SKIP_S = 2.0
 """Time after a segment starts before its velocity counts as steady state."""
@@ -39,9 +44,12 @@ class SegmentResult:
 
     def error_pct(self) -> tuple[float | None, float | None, float | None]:
         """Relative error per axis where the command is meaningfully non-zero."""
-        return tuple(
-            (100.0 * (a - c) / c) if abs(c) >= 0.1 else None for c, a in zip(self.commanded, self.achieved)
-        )  # type: ignore[return-value]
+
+        def pct(c: float, a: float) -> float | None:
+            return (100.0 * (a - c) / c) if abs(c) >= 0.1 else None
+
+        (c0, c1, c2), (a0, a1, a2) = self.commanded, self.achieved
+        return pct(c0, a0), pct(c1, a1), pct(c2, a2)
 
 
 @dataclass
@@ -84,6 +92,34 @@ def segments_from_log(log: dict[str, np.ndarray], min_s: float = 1.0) -> list[tu
     return out
 
 
+def upper_body_rms_by_style(log: dict[str, np.ndarray], window: np.ndarray | None = None,
+                            settle_s: float = 1.0) -> dict[str, dict[str, float]]:
+    """Waist and arm joints as measured vs the tracker's reference posture (the plan after the IK),
+    per operator style: RMS (rad) over the ticks in `window`, skipping the first `settle_s` after each
+    style change (the arms are still moving to the new pose)."""
+    from g1_control.robot import g1
+
+    ids, t = log["style_id"], log["t_s"]
+    if window is None:
+        window = np.ones(len(t), dtype=bool)
+    change_t = np.full(len(t), -np.inf)
+    last = -np.inf
+    for k in range(len(t)):
+        if k == 0 or ids[k] != ids[k - 1]:
+            last = t[k]
+        change_t[k] = last
+    settled = window & (t - change_t >= settle_s) & ~np.isnan(log["q_ref_rad"][:, 0])
+    ub = list(g1.UPPER_BODY_JOINTS)
+    out = {}
+    for i, name in enumerate(log["style_names"]):
+        rows = settled & (ids == i)
+        if rows.sum() < 5:
+            continue
+        err = log["q_rad"][rows][:, ub] - log["q_ref_rad"][rows][:, ub]
+        out[str(name)] = {"rms_rad": float(np.sqrt(np.mean(err**2))), "seconds": float(rows.sum() * np.median(np.diff(t)))}
+    return out
+
+
 def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentResult]:
     log = loop.log.arrays()
     t = log["t_s"]
@@ -99,15 +135,19 @@ def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentR
         window = (t >= start + min(STEADY_STATE_SKIP_S, seg.duration_s / 2)) & (t < end)
         mean = achieved[window].mean(axis=0) if window.any() else np.full(3, np.nan)
         out.append(SegmentResult(seg.label or "segment", start, end, (seg.vx_mps, seg.vy_mps, seg.wz_radps),
-                                 tuple(float(x) for x in mean)))
+                                 (float(mean[0]), float(mean[1]), float(mean[2]))))
     return out
 
 
 def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None = None,
-        progress: bool = True, viewer: bool = False) -> RunResult:
-    """Run `launch` to the end (or a fall); write the run folder when `out_root` is given."""
+        progress: bool = True, viewer: bool = False, web_port: int | None = None) -> RunResult:
+    """Run `launch` to the end (or a fall); write the run folder when `out_root` is given.
+
+    viewer: the MuJoCo viewer; web_port: the browser view (g1_control/sim/web.py) on that port.
+    """
     segments = timeline_of(launch)
-    loop = build_loop(launch, backend=make_sim_backend(launch))
+    sim = make_sim_backend(launch)
+    loop = build_loop(launch, backend=sim)
     loop.reset()
     duration = launch.total_duration_s
     bar = None
@@ -116,7 +156,8 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
 
         bar = tqdm(total=round(duration, 1), unit="sim s", desc=launch.name, bar_format="{l_bar}{bar}| {n:.1f}/{total} sim s [{elapsed}<{remaining}]")
     ticks_per_update = int(loop.rates.lowlevel_hz)
-    view = _open_viewer(loop) if viewer else None
+    view = _open_viewer(sim) if viewer else None
+    web = _open_web(sim, web_port, launch.name) if web_port is not None else None
 
     def on_tick(i: int) -> None:
         if bar is not None and (i + 1) % ticks_per_update == 0:
@@ -126,8 +167,13 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
         if view is not None and (i + 1) % 10 == 0 and time.perf_counter() - last_sync[0] > 1 / 30:
             _update_viewer(view, loop)  # at most 30 Hz: sync() waits for the viewer's render
             last_sync[0] = time.perf_counter()
+        if web is not None and (i + 1) % 10 == 0 and time.perf_counter() - last_web[0] > 1 / 25:
+            web.show(sim.data.qpos, "\n".join(": ".join(kv) for kv in zip(*map(str.splitlines,
+                                                                                    overlay_lines(loop)))))
+            last_web[0] = time.perf_counter()
 
     last_sync = [0.0]
+    last_web = [0.0]
     t0 = time.perf_counter()
     stop = (lambda: not view.is_running()) if view is not None else None
     try:
@@ -138,6 +184,8 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
             bar.close()
         if view is not None:
             view.close()
+        if web is not None:
+            web.close()
         loop.input.close()
         loop.backend.close()
     result = _result(launch, loop, segments, wall)
@@ -146,14 +194,21 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
     return result
 
 
-def _open_viewer(loop: ControlLoop):
+def _open_viewer(sim: MujocoBackend):
     from g1_control.sim.viewer import open_viewer
 
-    return open_viewer(loop.backend.model, loop.backend.data)
+    return open_viewer(sim.model, sim.data)
+
+
+def _open_web(sim: MujocoBackend, port: int, title: str):
+    from g1_control.sim.web import WebView
+
+    web = WebView(sim.model, port=port, title=title)
+    print(f"browser view: {web.url}", flush=True)
+    return web
 
 
 def _update_viewer(view, loop: ControlLoop) -> None:
-    from g1_control.launch.overlay import overlay_lines
     from g1_control.sim.viewer import update_viewer
 
     update_viewer(view, *overlay_lines(loop))
@@ -184,17 +239,20 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, o
     run_dir.mkdir(parents=True)
     result.run_dir = run_dir
     (run_dir / "launch.yaml").write_text(yaml.safe_dump(dataclasses.asdict(launch), sort_keys=False))
-    np.savez_compressed(run_dir / "log.npz", **loop.log.arrays())
+    # numpy's stub has a keyword `allow_pickle: bool` that mypy matches against **dict[str, ndarray].
+    np.savez_compressed(run_dir / "log.npz", **loop.log.arrays())  # type: ignore[arg-type]
     if launch.output.plot:
         from g1_control.launch.plots import plot_run
 
         plot_run(loop.log.arrays(), result, run_dir / "velocity.png")
     want_video = video if video is not None else launch.output.video in (True, "auto")
     if want_video:
+        from g1_control.launch.overlay import run_overlay_rows
         from g1_control.sim.render import render_video
 
+        overlay = run_overlay_rows(loop.log.arrays(), result.events, [dataclasses.asdict(s) for s in result.segments])
         backend = render_video(run_dir / "log.npz", run_dir / "video.mp4", launch.output.video_fps,
-                               launch.output.video_size)
+                               launch.output.video_size, overlay=overlay)
         result.video = str(run_dir / "video.mp4") if backend else None
         result.extra["render_backend"] = backend
     (run_dir / "summary.json").write_text(json.dumps(summary_dict(result), indent=2))

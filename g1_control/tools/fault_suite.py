@@ -109,18 +109,21 @@ class _Emulator:
             [sys.executable, "-m", "g1_control.cli.main", "sim-robot", "--physics", "mock", "--partition", partition,
              "--control-stdin"], cwd=_ROOT, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
             stderr=subprocess.PIPE, text=True, bufsize=1)
-        if self.proc.stdout.readline().strip() != "ready":
-            raise RuntimeError(f"emulator did not start: {self.proc.stderr.read()}")
+        stdin, stdout, stderr = self.proc.stdin, self.proc.stdout, self.proc.stderr
+        assert stdin is not None and stdout is not None and stderr is not None  # all three are pipes
+        self._stdin, self._stdout = stdin, stdout
+        if stdout.readline().strip() != "ready":
+            raise RuntimeError(f"emulator did not start: {stderr.read()}")
 
     def ask(self, word: str) -> dict:
-        self.proc.stdin.write(word + "\n")
-        self.proc.stdin.flush()
-        return json.loads(self.proc.stdout.readline())
+        self._stdin.write(word + "\n")
+        self._stdin.flush()
+        return json.loads(self._stdout.readline())
 
     def close(self) -> None:
         try:
-            self.proc.stdin.write("quit\n")
-            self.proc.stdin.flush()
+            self._stdin.write("quit\n")
+            self._stdin.flush()
             self.proc.wait(timeout=10)
         except (OSError, subprocess.TimeoutExpired):
             self.proc.kill()
@@ -171,6 +174,7 @@ def run_signal_fault(sig: str, emulator: _Emulator, partition: str) -> FaultResu
     env = {**os.environ, "PYTHONPATH": str(_ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
     host = subprocess.Popen([sys.executable, "-m", "g1_control.tools.fault_suite", "--host", partition],
                             cwd=_ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert host.stdout is not None and host.stderr is not None  # both opened as pipes just above
     try:
         if host.stdout.readline().strip() != "holding":
             raise RuntimeError(f"host did not start: {host.stderr.read()}")

@@ -22,7 +22,7 @@ DEFAULT_FPS = 30.0
 
 def read_g1_csv(path: str | Path, fps: float = DEFAULT_FPS, style: str = "default") -> MotionClip:
     path = Path(path)
-    rows = []
+    rows: list[list[float]] = []
     with path.open() as fh:
         for lineno, line in enumerate(fh, start=1):
             if not line.strip():
