@@ -13,6 +13,7 @@ from g1_control.ik.limits import SelfCollisionLimit
 from g1_control.ik.retargeter import IKConfig, IKRetargeter
 from g1_control.robot import g1
 from g1_control.types import KinematicReference
+from tests.ik.mesh_pair_checks import exact_distance_jacobian, random_configurations
 
 
 def _arm_in() -> Configuration:
@@ -39,12 +40,7 @@ def test_joint_placements_kernel_is_pinocchio_forward_kinematics():
 
 def test_capsule_bounds_never_exceed_the_exact_distance():
     limit = SelfCollisionLimit()
-    rng = np.random.default_rng(1)
-    conf = Configuration()
-    for _ in range(4):
-        q = conf.q.copy()
-        q[7:] = rng.uniform(g1.Q_MIN_RAD, g1.Q_MAX_RAD)
-        conf.update(q)
+    for conf in random_configurations(1, 4):
         assert (limit.lower_bounds(conf) <= limit.distances(conf) + 1e-9).all()
 
 
@@ -60,23 +56,14 @@ def test_default_pose_is_clear_and_pairs_are_those_that_can_meet():
 def test_rows_are_the_jacobian_of_the_exact_distances():
     conf = _arm_in()
     limit = SelfCollisionLimit(activation_m=0.05)
-    for request in limit.geometry_data.distanceRequests:  # tight GJK so that finite differences resolve
+    for request in limit.geometry_data.distanceRequests:  # tight GJK, as in the finite differences
         request.gjk_tolerance = request.epa_tolerance = 1e-10
     rows = limit.compute(conf, 0.02)
     active = np.flatnonzero(limit._rows)
     assert rows.matrix.shape[0] == active.size > 3
     dist = limit.exact(conf, active)[0]
     np.testing.assert_allclose(rows.lower, np.minimum(limit.margin_m - dist, limit.max_push_m), atol=1e-12)
-    q0, eps = conf.q.copy(), 1e-5
-    fd = np.zeros_like(rows.matrix)
-    for i in range(conf.nv):
-        step = np.zeros(conf.nv)
-        step[i] = eps
-        conf.update(pin.integrate(conf.model, q0, step))
-        plus = limit.exact(conf, active)[0]
-        conf.update(pin.integrate(conf.model, q0, -step))
-        fd[:, i] = (plus - limit.exact(conf, active)[0]) / (2 * eps)
-    np.testing.assert_allclose(rows.matrix, fd, atol=2e-4)
+    np.testing.assert_allclose(rows.matrix, exact_distance_jacobian(limit, conf, active), atol=2e-4)
 
 
 def test_bad_setups_are_refused():

@@ -3,9 +3,9 @@ apart are the same shapes."""
 
 import numpy as np
 
-from g1_control.ik.configuration import Configuration
 from g1_control.ik.limits import SelfCollisionLimit
 from g1_control.robot import collision, description, g1
+from tests.ik.mesh_pair_checks import random_configurations
 
 
 def test_geometries_come_from_the_urdf_and_pairs_skip_adjacent_links():
@@ -36,13 +36,8 @@ def test_the_ik_uses_the_checkers_shapes(tmp_path):
     watched = [index[p] for p in pairs]
     limit = SelfCollisionLimit()
     assert [(a, b) for a, b, _ in limit.pairs] == pairs
-    rng = np.random.default_rng(4)
-    conf = Configuration()
-    for _ in range(3):
-        q = conf.q.copy()
-        q[7:] = rng.uniform(g1.Q_MIN_RAD, g1.Q_MAX_RAD)
-        conf.update(q)
-        model.set_configuration(q)
+    for conf in random_configurations(4, 3):
+        model.set_configuration(conf.q)
         np.testing.assert_allclose(limit.distances(conf), model.self_distances(reach_m=np.inf)[watched], atol=1e-5)
     path = tmp_path / "c.npz"
     collision._save_stand_ins(stand_ins, pairs, path)
