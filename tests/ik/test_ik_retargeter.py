@@ -193,3 +193,31 @@ def test_self_collision_holds_when_one_step_carries_an_elbow_from_beyond_the_act
     assert _elbow_into_chest(resolve=True) < 0.012
     # ... which the trust-region re-solve and the projection step take out
     assert _elbow_into_chest(resolve=True, refine=True) < 0.002
+
+
+def test_touchdown_lays_the_foot_along_a_ramp_and_holds_no_foot_out_of_reach():
+    """The anchor of a touching-down foot is flat on the slope under it; a foot further than
+    touchdown_reach_m above any support is not held at all."""
+    from g1_control.ik.configuration import foot_contact_points
+    from g1_control.motion.objects import ObjectShape, support_height
+
+    probe = IKRetargeter()
+    foot = probe.configuration.frame_placement(probe.configuration.frame_id("left_ankle_roll_link")).translation
+    tilt = pin.utils.rpyToMatrix(0.2, 0.0, 0.0)  # a ramp rising toward -y (roll 0.2 rad), under the left foot
+    ramp = ObjectShape.box("ramp", (0.3, 0.3, 0.05)).transformed(tilt, np.array([foot[0], foot[1], -0.04]))
+    ik = IKRetargeter(IKConfig(scene=(ramp,), ground_snap_m=0.05))
+    anchor = ik._touchdown_anchor("left_ankle_roll_link")
+    normal = ramp.top_normal(np.array([foot[:2]]))[0]
+    np.testing.assert_allclose(anchor.rotation[:, 2], normal, atol=1e-9)  # sole along the slope
+    spheres = np.array([anchor.rotation @ c + anchor.translation - [0, 0, r]
+                        for c, r in foot_contact_points()["left_ankle_roll_link"]])
+    gaps = spheres[:, 2] - support_height((ramp,), spheres, 0.0, 0.05)
+    assert gaps.min() > -2e-3 and gaps.max() < 0.02  # every sphere on (or just over) the slope
+
+    high = IKRetargeter(IKConfig(touchdown_reach_m=0.05))
+    q = high.configuration.q.copy()
+    q[2] += 0.2  # the whole robot 20 cm up: no foot can stand anywhere
+    high.reset(q)
+    assert high._touchdown_anchor("left_ankle_roll_link") is None
+    out = high.solve(_reference(high), q)
+    assert out.contacts.tolist() == [False, False]

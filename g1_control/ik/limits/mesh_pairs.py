@@ -13,7 +13,8 @@ so the rows keep apart exactly the shapes the clip checker measures. A pair alre
 the margin is pushed out by at most `max_push_m` per step (asking for more could make the step
 infeasible under the velocity limits). A pair a large step carries from beyond the activation
 distance into the margin gets no row in that step's QP: `missed_pairs` finds it after the step, and
-the retargeter solves the step again with it in `include`.
+the retargeter solves the step again with it in `include`. Bounds and coal's answers are kept per
+configuration, so a step's check of where it ended and the next step's rows share them.
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ class MeshPairLimit(Limit):
                  margin_m: float = 0.002, activation_m: float = 0.03, max_push_m: float = 0.03,
                  stand_ins: tuple[StandIn, ...] | None = None) -> None:
         """geometry_pairs: (geometry, geometry) index pairs of the robot's collision geometries
-        (robot/collision.py; the IK uses their stand-ins, ik_stand_ins, which hold them); shape_pairs:
+        (robot.collision.ik_stand_ins: the checker's own hulls, built for the IK); shape_pairs:
         (geometry, shape) pairs, shape k < len(shapes) a scene shape (world coordinates), k ==
         len(shapes) the floor z = floor_height_m."""
         import coal
