@@ -57,6 +57,12 @@ class Backend(ABC):
         """Put damping on the motors now, not at the next tick (signal handlers, faults)."""
         self.write_command(MotorCommand.damping())
 
+    def ground_contacts(self) -> tuple[str, ...] | None:
+        """Robot bodies other than the feet touching the ground (the static scene) now: () when
+        none; None when the backend cannot tell (a robot has no such sensor). A simulator's
+        ground truth, for judging falls (g1_control/safety/fall.py)."""
+        return None
+
     @property
     def bad_crc(self) -> int:
         """States dropped so far for a bad checksum (robot links; 0 for simulators)."""

@@ -243,6 +243,9 @@ class KinematicReference:
     upper_body_override: bool = False
     """True when the plan's waist and arm posture is meant to be followed; False leaves them to a
     balancing tracker's own judgement (a walking policy's own arm swing)."""
+    pelvis_height_m: float | None = None
+    """A pelvis height above the ground the tracker must hold (an operator's or a task's request);
+    None leaves the height to the tracker (a walking policy's own)."""
 
 
 @dataclass
@@ -261,6 +264,8 @@ class JointReference:
     contacts: np.ndarray = field(default_factory=lambda: np.ones(2, dtype=bool))
     upper_body_override: bool = False
     """When True, a balancing tracker takes waist/arm targets from q_rad instead of its own."""
+    pelvis_height_m: float | None = None
+    """The pelvis height to hold (KinematicReference.pelvis_height_m); None: the tracker's own."""
 
 
 @dataclass
@@ -276,6 +281,8 @@ class EstimatedState:
     yaw_rad: float = 0.0
     heading_velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
     """(vx, vy, wz): base linear velocity in the heading frame and the yaw rate."""
+    pelvis_height_m: float | None = None
+    """Pelvis height above the lower foot's sole (leg kinematics: the ground under a standing foot)."""
 
 
 @dataclass

@@ -15,6 +15,11 @@ BENCHMARKS = {
     "wbc": ("g1_control.tools.bench_wbc:main", "whole-body QP solve p50/p99 per tick vs RNEA+CRBA and cold solves; loop real-time factor"),
     "generator": ("g1_control.tools.bench_generator:main",
                   "in-betweening L2P/L2Q/NPSS vs interpolation + motion matching; replan p50/p99; frames/s; 10-min rollout"),
+    "execution": ("g1_control.tools.bench_execution:main",
+                  "the repertoire in physics: one row per behaviour (success, falls, velocity/upper-body/hand/object "
+                  "error, real-time factor); exits 1 on a fall"),
+    "envelope": ("g1_control.tools.bench_envelope:main",
+                 "the walking tracker's achievable velocity per axis and style; --write ships it as the command limits"),
 }
 
 
@@ -29,6 +34,12 @@ def register(subparsers) -> None:
     parser.add_argument("name", choices=sorted(BENCHMARKS), help="which benchmark")
     parser.add_argument("--seconds", type=float, default=20.0, help="simulated/measured duration (default 20)")
     parser.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
+    parser.add_argument("--only", metavar="PREFIXES", help="execution/envelope: only rows (styles) starting with these "
+                        "comma-separated prefixes")
+    parser.add_argument("--seed", type=int, default=0, help="execution: the suite's seed (push timing; default 0)")
+    parser.add_argument("--video", metavar="DIR", help="execution: a video per behaviour into DIR")
+    parser.add_argument("--write", action="store_true", help="envelope: write the measured envelope next to the "
+                        "policy spec (the loop builder's command limits)")
     parser.set_defaults(func=_run)
 
 

@@ -263,8 +263,8 @@ class Preflight:
         what = (f"{result.duration_s:.1f} s lockstep MuJoCo of policy {launch.tracker.policy} at the launch "
                 f"file's rates ({result.wall_s:.1f} s wall)" + (f"; {moved}" if moved else ""))
         if result.fell:
-            trip = next((e for e in result.events if e["kind"] == "tilt"), None)
-            when = f" at {trip['t_s']:.1f} s" if trip else ""
+            fall = result.fall or {}
+            when = f" at {fall['t_s']:.1f} s ({fall['detail']})" if fall else ""
             return self.record("dry_run", FAIL, f"FELL in simulation{when}: "
                                f"{what}; do not run this policy/launch file on the robot")
         faults = [e for e in result.events if "damping" in e["detail"]]

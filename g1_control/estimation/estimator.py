@@ -112,6 +112,7 @@ class StateEstimator:
         est.base_quat_wxyz = quat.copy()
         est.base_angvel_b_radps = state.imu_gyro_radps.copy()
         est.stance_weight = np.array((w_left, w_right))
+        est.pelvis_height_m = -float(min(height_left, height_right))
         yaw = est.yaw_rad = yaw_of(quat)
         c, s = math.cos(yaw), math.sin(yaw)
         vx, vy, _ = linvel

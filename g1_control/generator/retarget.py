@@ -28,4 +28,5 @@ class GeneratorRetargeter(Retargeter):
     def solve(self, reference: KinematicReference, q_prev: np.ndarray) -> JointReference:
         out = self.ik.solve(reference, q_prev)
         out.upper_body_override = self.upper_body_override
+        out.pelvis_height_m = reference.pelvis_height_m
         return out

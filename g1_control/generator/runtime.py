@@ -39,6 +39,9 @@ from g1_control.interfaces import Generator
 from g1_control.robot import g1
 from g1_control.types import Command, KinematicReference, RobotState
 
+_WAIST_LEAN = [F.JOINTS.start + g1.JOINT_INDEX[name] for name in ("waist_roll_joint", "waist_pitch_joint")]
+"""Feature columns of waist roll and pitch."""
+
 OBJECT_GOALS = ("box_pick", "box_climb")
 """EffectorGoal.frame values that name an object goal instead of a robot frame; pos_w_m is then
 the centre of a box standing on the floor."""
@@ -59,6 +62,11 @@ class RuntimeConfig:
     velocity_window_frames: int = 30
     velocity_deadband_mps: float = 0.06
     yaw_rate_deadband_radps: float = 0.06
+    max_waist_lean_rad: float = 0.2
+    """Plans keep waist roll and pitch within this. The library's style recordings made before the
+    styled-walking tracker sagged the waist pitch to its 0.52 rad limit (carry, wave, reach_up in
+    style_stats.json: 0.48-0.52), which no style intends; the tracker leaves waist roll/pitch to
+    the walking policy in any case."""
 
 
 @dataclass
@@ -181,6 +189,8 @@ class InbetweeningGenerator(Generator):
         if style != "default" or obj is not None:
             ub = [9 + j for j in g1.UPPER_BODY_JOINTS]
             values[ub] = pose[list(g1.UPPER_BODY_JOINTS)]
+            lean = cfg.max_waist_lean_rad
+            values[_WAIST_LEAN] = np.clip(values[_WAIST_LEAN], -lean, lean)
             given[ub] = True
         for goal in command.goals:
             if goal.frame in OBJECT_GOALS:
@@ -224,6 +234,7 @@ class InbetweeningGenerator(Generator):
             last = self.history[-1]
             frames = interpolate(last[None], np.where(key.given, key.values, last)[None], key.gap)[0]
         frames[:, F.JOINTS] = np.clip(frames[:, F.JOINTS], g1.Q_MIN_RAD, g1.Q_MAX_RAD)
+        frames[:, _WAIST_LEAN] = np.clip(frames[:, _WAIST_LEAN], -cfg.max_waist_lean_rad, cfg.max_waist_lean_rad)
         lo, _, hi = self._style_stats(key.style).pelvis_height_m
         floor = min(lo, key.values[2]) - cfg.height_margin_m
         ceil = max(hi, key.values[2]) + cfg.height_margin_m
@@ -298,4 +309,5 @@ class InbetweeningGenerator(Generator):
         ref.contacts = feet[:, 2] < 0.034 + 0.025
         ref.frame_targets_w = dict(self._frame_targets)
         ref.style = self._style
+        ref.pelvis_height_m = self._last_cmd.pelvis_height_m if self._last_cmd is not None else None
         return ref

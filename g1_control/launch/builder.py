@@ -24,6 +24,7 @@ from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, T
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.safety import SafetyConfig, SafetyFilter
+from g1_control.safety.fall import FallMonitor
 from g1_control.teleop.scripted import Segment, random_timeline
 from g1_control.types import CommandLimits
 
@@ -55,7 +56,8 @@ def make_tracker(launch: LaunchFile) -> Tracker:
         from g1_control.trackers.locomotion import LocomotionPolicyTracker, VelocityCorrectionConfig
         from g1_control.trackers.policy_spec import load_spec
 
-        return LocomotionPolicyTracker(load_spec(cfg.policy), VelocityCorrectionConfig(enabled=cfg.velocity_correction))
+        return LocomotionPolicyTracker(load_spec(cfg.policy), VelocityCorrectionConfig(enabled=cfg.velocity_correction),
+                                       envelope_limits=cfg.envelope_limits)
     if cfg.type == "wbc":
         from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
 
@@ -142,7 +144,8 @@ def build_loop(launch: LaunchFile, *, backend: Backend | None = None, input_devi
     r = launch.rates
     capacity = log_capacity if log_capacity is not None else int(launch.total_duration_s * r.tracker_hz) + 2
     loop = ControlLoop(backend, input_device, generator, retargeter, tracker, r, wallclock=wallclock,
-                       safety=safety, log_capacity=capacity)
+                       safety=safety, log_capacity=capacity,
+                       falls=FallMonitor(launch.fall, max_tilt_rad=safety.config.max_tilt_rad))
     chain["input"] = type(input_device).__name__
     chain["backend"] = backend.describe()
     loop.chain = chain

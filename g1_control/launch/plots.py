@@ -95,7 +95,7 @@ def plot_run(log: dict[str, np.ndarray], result, out: Path) -> None:
         Line2D([], [], color="0.55", lw=0.9, ls=":", label="sent to the policy (after velocity correction)"),
         Patch(facecolor="0.93", edgecolor="0.75", label="command segments"),
     ]
-    status = "FELL" if result.fell else "no fall"
+    status = "no fall" if result.fall is None else f"FELL at {result.fall['t_s']:.1f} s"
     fig.suptitle(f"{result.name}: {status}, real-time factor {result.real_time_factor:.1f}x", y=0.995)
     fig.legend(handles=handles, loc="upper center", ncol=3, fontsize=8, frameon=False, bbox_to_anchor=(0.5, 0.97))
     fig.tight_layout(rect=(0, 0, 1, 0.925))

@@ -25,6 +25,7 @@ from g1_control.launch.builder import build_loop, make_sim_backend, timeline_of
 from g1_control.launch.overlay import overlay_lines
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.control_loop import ControlLoop
+from g1_control.robot import g1
 from g1_control.teleop.scripted import Segment
 
 if TYPE_CHECKING:
@@ -32,6 +33,7 @@ if TYPE_CHECKING:
 
 STEADY_STATE_SKIP_S = 2.0
 """Time after a segment starts before its velocity counts as steady state."""
+UPPER_BODY = list(g1.UPPER_BODY_JOINTS)
 
 
 @dataclass
@@ -41,6 +43,9 @@ class SegmentResult:
     end_s: float
     commanded: tuple[float, float, float]
     achieved: tuple[float, float, float]
+    upper_body_rms_rad: float | None = None
+    """Waist and arm joints, measured vs the tracker's reference posture (the plan after the IK),
+    RMS over the same steady-state window; None without a reference."""
 
     def error_pct(self) -> tuple[float | None, float | None, float | None]:
         """Relative error per axis where the command is meaningfully non-zero."""
@@ -69,6 +74,8 @@ class RunResult:
     run_dir: Path | None = None
     video: str | None = None
     extra: dict = field(default_factory=dict)
+    fall: dict | None = None
+    """The first fall (g1_control/safety/fall.py): {t_s, kind, detail}; None when the robot stayed up."""
 
     @property
     def real_time_factor(self) -> float:
@@ -92,13 +99,21 @@ def segments_from_log(log: dict[str, np.ndarray], min_s: float = 1.0) -> list[tu
     return out
 
 
+def upper_body_rms(log: dict[str, np.ndarray], rows: np.ndarray) -> float | None:
+    """Waist and arm joints as measured vs the tracker's reference posture (the plan after the IK):
+    RMS (rad) over the ticks `rows` that have a reference; None when none has."""
+    rows = rows & ~np.isnan(log["q_ref_rad"][:, 0])
+    if not rows.any():
+        return None
+    err = log["q_rad"][rows][:, UPPER_BODY] - log["q_ref_rad"][rows][:, UPPER_BODY]
+    return float(np.sqrt(np.mean(err**2)))
+
+
 def upper_body_rms_by_style(log: dict[str, np.ndarray], window: np.ndarray | None = None,
                             settle_s: float = 1.0) -> dict[str, dict[str, float]]:
     """Waist and arm joints as measured vs the tracker's reference posture (the plan after the IK),
     per operator style: RMS (rad) over the ticks in `window`, skipping the first `settle_s` after each
     style change (the arms are still moving to the new pose)."""
-    from g1_control.robot import g1
-
     ids, t = log["style_id"], log["t_s"]
     if window is None:
         window = np.ones(len(t), dtype=bool)
@@ -109,14 +124,13 @@ def upper_body_rms_by_style(log: dict[str, np.ndarray], window: np.ndarray | Non
             last = t[k]
         change_t[k] = last
     settled = window & (t - change_t >= settle_s) & ~np.isnan(log["q_ref_rad"][:, 0])
-    ub = list(g1.UPPER_BODY_JOINTS)
     out = {}
     for i, name in enumerate(log["style_names"]):
         rows = settled & (ids == i)
-        if rows.sum() < 5:
+        rms = upper_body_rms(log, rows)
+        if rows.sum() < 5 or rms is None:
             continue
-        err = log["q_rad"][rows][:, ub] - log["q_ref_rad"][rows][:, ub]
-        out[str(name)] = {"rms_rad": float(np.sqrt(np.mean(err**2))), "seconds": float(rows.sum() * np.median(np.diff(t)))}
+        out[str(name)] = {"rms_rad": rms, "seconds": float(rows.sum() * np.median(np.diff(t)))}
     return out
 
 
@@ -134,8 +148,9 @@ def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentR
         end = start + seg.duration_s
         window = (t >= start + min(STEADY_STATE_SKIP_S, seg.duration_s / 2)) & (t < end)
         mean = achieved[window].mean(axis=0) if window.any() else np.full(3, np.nan)
+        ub = upper_body_rms(log, window)
         out.append(SegmentResult(seg.label or "segment", start, end, (seg.vx_mps, seg.vy_mps, seg.wz_radps),
-                                 (float(mean[0]), float(mean[1]), float(mean[2]))))
+                                 (float(mean[0]), float(mean[1]), float(mean[2])), ub))
     return out
 
 
@@ -221,8 +236,10 @@ def _result(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], wall
     if valid.sum() > 10:
         err = log["velocity_est"][valid, :2] - log["velocity_true"][valid, :2]
         est_rms = float(np.sqrt((err**2).sum(axis=1).mean()))
+    fall = loop.fall
     return RunResult(
-        name=launch.name, fell=loop.fell, duration_s=loop.time_s, wall_s=wall,
+        name=launch.name, fell=fall is not None, fall=dataclasses.asdict(fall) if fall else None,
+        duration_s=loop.time_s, wall_s=wall,
         segments=segment_results(loop, segments), timings=loop.scheduler.report(),
         deadline_misses=loop.scheduler.deadline_misses, overruns=loop.scheduler.overruns,
         events=[dataclasses.asdict(e) for e in loop.events], estimator_rms_mps=est_rms, chain=dict(loop.chain),
@@ -267,18 +284,25 @@ def summary_dict(result: RunResult) -> dict:
     return d
 
 
+def fall_text(fall: dict | None) -> str:
+    """'no fall', or 'FELL at 12.34 s: left_knee_link on the ground'."""
+    return "no fall" if fall is None else f"FELL at {fall['t_s']:.2f} s: {fall['detail']}"
+
+
 def format_summary(result: RunResult) -> str:
     lines = [
-        (f"run '{result.name}': {'FELL' if result.fell else 'no fall'}; {result.duration_s:.1f} s simulated in "
+        (f"run '{result.name}': {fall_text(result.fall)}; {result.duration_s:.1f} s simulated in "
         f"{result.wall_s:.1f} s wall (real-time factor {result.real_time_factor:.1f}x)"),
         "",
-        f"{'segment':<12} {'time (s)':>11}   {'commanded vx vy wz':>22}   {'achieved vx vy wz':>22}   error %",
+        f"{'segment':<12} {'time (s)':>11}   {'commanded vx vy wz':>22}   {'achieved vx vy wz':>22}   "
+        f"{'error %':<20} ub rms",
     ]
     for s in result.segments:
         err = " ".join("   -  " if e is None else f"{e:+5.1f}" for e in s.error_pct())
         cmd = " ".join(f"{v:+6.2f}" for v in s.commanded)
         ach = " ".join(f"{v:+6.2f}" for v in s.achieved)
-        lines.append(f"{s.label[:12]:<12} {s.start_s:5.1f}-{s.end_s:5.1f}   {cmd:>22}   {ach:>22}   {err}")
+        ub = "-" if s.upper_body_rms_rad is None else f"{s.upper_body_rms_rad:.3f}"
+        lines.append(f"{s.label[:12]:<12} {s.start_s:5.1f}-{s.end_s:5.1f}   {cmd:>22}   {ach:>22}   {err:<20} {ub}")
     lines += ["", f"{'stage':<12} {'calls':>7} {'p50 us':>8} {'p99 us':>8} {'max us':>8}"]
     for name, t in result.timings.items():
         lines.append(f"{name:<12} {t['calls']:>7} {t['p50_us']:>8.1f} {t['p99_us']:>8.1f} {t['max_us']:>8.1f}")

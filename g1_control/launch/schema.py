@@ -16,6 +16,7 @@ from g1_control.config import apply_overrides, from_dict
 from g1_control.errors import LaunchFileError, SafetyConfigError
 from g1_control.loop.rates import LoopRates
 from g1_control.safety.config import SafetyConfig
+from g1_control.safety.fall import FallConfig
 from g1_control.teleop.scripted import RandomTimelineConfig, Segment
 
 ROBOT_BACKENDS = ("unitree_dds", "can", "serial")
@@ -142,6 +143,9 @@ class TrackerConfig:
     policy: str = "holosoma_loco_ppo"
     """Built-in spec name (g1 policies list) or a path to a spec YAML."""
     velocity_correction: bool = True
+    envelope_limits: bool = True
+    """Operator command limits from the policy's measured envelope (`g1 bench envelope`, shipped next
+    to its spec); false: from the range it was trained on (what the envelope bench measures)."""
 
 
 @dataclass
@@ -235,6 +239,8 @@ class LaunchFile:
     output: OutputConfig = field(default_factory=OutputConfig)
     safety: SafetyConfig = field(default_factory=SafetyConfig)
     """Runtime safety thresholds (g1_control.safety.SafetyConfig); limits.max_tilt_rad still caps the tilt."""
+    fall: FallConfig = field(default_factory=FallConfig)
+    """What counts as a fall besides the tilt (g1_control/safety/fall.py): pelvis height, allowed ground contacts."""
     deploy: DeployConfig = field(default_factory=DeployConfig)
     viewer: bool | Literal["auto"] = "auto"
     """true/false, or auto: open the MuJoCo viewer when a display exists."""

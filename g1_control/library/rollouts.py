@@ -3,8 +3,10 @@ per rollout, recorded as MotionClips.
 
 The loop is the project's own, built from a launch file like every other (MuJoCo in lockstep,
 the velocity generator with the style's pose, holosoma's loco policy, the safety filter), so the recorded motion is what the robot's physics and policy produce: real gait
-timing, foot contacts and the ~80 % speed response (docs/robot_facts.md), not an idealized gait. Frames
-after a fall are dropped.
+timing, foot contacts and speed response (docs/robot_facts.md), not an idealized gait. The styled-walking tracker
+(g1_control/trackers/styled.py) holds the style's arms and keeps the torso up (waist pitch within
+a few 0.1 rad: the lean that balances arms held forward) instead of the 0.5 rad sag the earlier
+upper-body override recorded. Frames after a fall are dropped.
 """
 
 from __future__ import annotations
@@ -15,9 +17,11 @@ import numpy as np
 
 from g1_control.generator.styles import ROLLOUT_STYLES, UpperBodyStyle
 from g1_control.launch.builder import build_loop, timeline_of
+from g1_control.launch.runner import upper_body_rms
 from g1_control.launch.schema import LaunchFile
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.interpolation import interpolate_positions, interpolate_quaternions
+from g1_control.robot import g1
 from g1_control.teleop.scripted import RandomTimelineConfig
 
 
@@ -55,6 +59,18 @@ def random_commands(config: RolloutConfig) -> list[tuple[float, float, float, fl
     return out
 
 
+def pose_figures(log: dict[str, np.ndarray], n: int) -> dict[str, float]:
+    """How well the recording holds the style's pose over its first n ticks: RMS of the waist and
+    arm joints against the pose the tracker was given (the style's plan), and the mean waist pitch
+    (the plan's is 0; the earlier override let it sag to the 0.52 rad joint limit)."""
+    rows = np.arange(len(log["t_s"])) < n
+    rms = upper_body_rms(log, rows)
+    if rms is None:
+        return {}
+    return {"upper_body_rms_rad": rms,
+            "waist_pitch_mean_rad": float(log["q_rad"][:n, g1.JOINT_INDEX["waist_pitch_joint"]].mean())}
+
+
 def record_rollout(style: UpperBodyStyle, config: RolloutConfig) -> tuple[MotionClip | None, dict]:
     """One rollout; returns (clip at config.fps or None if it fell at once, info)."""
     launch = rollout_launch(style, config)
@@ -77,7 +93,7 @@ def record_rollout(style: UpperBodyStyle, config: RolloutConfig) -> tuple[Motion
     n = int(np.argmin(valid)) if not valid.all() else len(valid)
     info = {"style": style.name, "seed": config.seed, "fell": bool(loop.fell),
             "fault": trip.kind.value if trip is not None else None, "recorded_s": float(n / 50.0),
-            "commands": segments}
+            "commands": segments, **pose_figures(log, n)}
     if n < 60:
         return None, info
     src_fps = 50.0

@@ -16,7 +16,8 @@ from g1_control.loop.rates import LoopRates
 from g1_control.loop.scheduler import Scheduler, Stage
 from g1_control.robot import g1
 from g1_control.rotations import quat_to_rot_rows, tilt_rad, yaw_of
-from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter
+from g1_control.safety import SafetyConfig, SafetyFilter
+from g1_control.safety.fall import Fall, FallMonitor
 from g1_control.types import Button, Command, JointReference, KinematicReference, RobotState
 
 
@@ -80,17 +81,23 @@ class ControlLoop:
     stale or non-finite state, NaN output, e-stop, lost operator input, ...), in simulation as on
     the robot. Time for the safety checks is the loop's own clock: simulated time in lockstep,
     the monotonic clock otherwise (the robot's states are stamped with it on arrival).
+
+    Falls are judged every tracker tick by a FallMonitor (g1_control/safety/fall.py) from the
+    simulator's ground truth (pelvis height, ground contacts) or, on the robot, from the IMU and
+    the estimator's pelvis height; the first fall damps the robot like any trip, and the
+    monitor keeps watching after another trip (a damped robot that collapses has fallen).
     """
 
     def __init__(self, backend: Backend, input_device: InputDevice, generator: Generator, retargeter: Retargeter,
                  tracker: Tracker, rates: LoopRates | None = None, *, estimator: StateEstimator | None = None,
                  wallclock: bool = False, max_tilt_rad: float = 1.0, log_capacity: int = 0,
-                 safety: SafetyFilter | None = None):
+                 safety: SafetyFilter | None = None, falls: FallMonitor | None = None):
         self.backend, self.input, self.generator = backend, input_device, generator
         self.retargeter, self.tracker = retargeter, tracker
         self.rates = rates or LoopRates()
         self.estimator = estimator or StateEstimator()
         self.safety = safety or SafetyFilter(SafetyConfig(max_tilt_rad=max_tilt_rad))
+        self.falls = falls or FallMonitor(max_tilt_rad=self.safety.config.max_tilt_rad)
         self.command = Command()
         self.state = RobotState()
         self.motor_command = self.safety.damping()
@@ -123,6 +130,7 @@ class ControlLoop:
     # -- lifecycle ---------------------------------------------------------------------------------
     def reset(self) -> RobotState:
         self.state = self.backend.reset()
+        self.falls.reset()
         self.estimator.reset(self.state)
         self.tracker.reset(self.state)
         self.generator.reset(self.state)
@@ -147,9 +155,13 @@ class ControlLoop:
         return self.safety.tripped
 
     @property
+    def fall(self) -> Fall | None:
+        """The first fall (g1_control/safety/fall.py), or None."""
+        return self.falls.fall
+
+    @property
     def fell(self) -> bool:
-        trip = self.safety.trip_event
-        return trip is not None and trip.kind == SafetyEventKind.TILT
+        return self.falls.fall is not None
 
     def _on_safety_event(self, event) -> None:
         self._event(event.kind.value, event.detail + ("; damping" if event.trips else ""))
@@ -217,7 +229,20 @@ class ControlLoop:
         if self.scheduler.wallclock and not self.backend.lockstep:
             self.safety.report_deadline(self.scheduler.deadline_misses > self._misses_seen, self.now_s())
             self._misses_seen = self.scheduler.deadline_misses
-        self.motor_command = self.safety.filter(self._tracker_command, self.state, self.now_s())
+        now = self.now_s()
+        self.motor_command = self.safety.filter(self._tracker_command, self.state, now)
+        if self.falls.fall is None:
+            self._check_fall(now)
+
+    def _check_fall(self, now: float) -> None:
+        s = self.state
+        # Ground truth where the simulator gives it, else the estimator's leg-kinematics height.
+        height = float(s.base_pos_w_m[2]) if s.base_pos_w_m is not None else self.estimator.estimate.pelvis_height_m
+        fall = self.falls.update(now, s.imu_quat_wxyz, height, self.backend.ground_contacts())
+        if fall is not None:
+            self._event("fall", fall.detail)
+            self.safety.report_fall(fall.detail, now)
+            self.motor_command = self.safety.damping()
 
     def _fault(self, detail: str) -> None:
         self.safety.estop(detail, self.now_s())

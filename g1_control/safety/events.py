@@ -18,6 +18,8 @@ class SafetyEventKind(str, Enum):
     """Not a trip: velocity commands zeroed while the operator input is late."""
     INPUT_LOST = "input_lost"
     OVER_TEMPERATURE = "over_temperature"
+    FALL = "fall"
+    """The robot fell (g1_control/safety/fall.py: tilt, pelvis low, a body other than the feet on the ground)."""
     ESTOP = "estop"
 
 

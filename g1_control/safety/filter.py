@@ -185,6 +185,10 @@ class SafetyFilter:
         """Trip at once (e-stop button, SIGINT/SIGTERM, a fault found elsewhere)."""
         self._trip(now_s, SafetyEventKind.ESTOP, reason)
 
+    def report_fall(self, detail: str, now_s: float) -> None:
+        """The robot fell (judged by safety/fall.py): trip, unless already tripped."""
+        self._trip(now_s, SafetyEventKind.FALL, detail)
+
     def vet_input(self, command: Command | None, now_s: float) -> Command:
         """The operator command to act on: `command` when fresh (None = nothing new from the device);
         the last one with zero velocity once input is late; an e-stop button trips."""

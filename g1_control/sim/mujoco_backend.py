@@ -82,6 +82,13 @@ class MujocoBackend(Backend):
         self._push_until_s = -1.0
         self._pushing = False
         self._push_body = self.model.body(g1.BASE_BODY).id
+        # Fall evidence: which geoms are the ground (the world body's: floor, fixed scenery) and
+        # which belong to robot bodies other than the feet.
+        m = self.model
+        feet = {m.body(name).id for name in g1.FOOT_BODIES}
+        self._ground_geoms = frozenset(int(g) for g in np.nonzero(m.geom_bodyid == 0)[0])
+        self._watched_geoms = frozenset(int(g) for g in range(m.ngeom) if m.body_rootid[m.geom_bodyid[g]] ==
+                                        self._push_body and m.geom_bodyid[g] not in feet)
         self.closed = False
 
     def _compile(self) -> mujoco.MjModel:
@@ -169,6 +176,19 @@ class MujocoBackend(Backend):
         # A simulated robot left alone is damped, like the real one after close().
         self.write_command(MotorCommand.damping(g1.KD_DEFAULT))
         self.closed = True
+
+    def ground_contacts(self) -> tuple[str, ...]:
+        d = self.data
+        if d.ncon == 0:
+            return ()
+        ground, watched = self._ground_geoms, self._watched_geoms
+        bodies = set()
+        for a, b in d.contact.geom.tolist():  # a handful of contacts: plain Python is cheapest
+            if a in ground and b in watched:
+                bodies.add(int(self.model.geom_bodyid[b]))
+            elif b in ground and a in watched:
+                bodies.add(int(self.model.geom_bodyid[a]))
+        return tuple(sorted(self.model.body(i).name for i in bodies)) if bodies else ()
 
     # -- simulation only ----------------------------------------------------------------------------
     def push(self, force_w_n, duration_s: float) -> None:

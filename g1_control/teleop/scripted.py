@@ -23,10 +23,14 @@ class Segment:
     wz_radps: float = 0.0
     label: str = ""
     style: str = "default"
+    pelvis_height_m: float | None = None
+    """A pelvis height to hold (m above the ground); None: the tracker's own."""
 
     def validate(self, where: str) -> None:
         if self.duration_s <= 0:
             raise LaunchFileError(f"{where}.duration_s: must be > 0, got {self.duration_s}")
+        if self.pelvis_height_m is not None and not 0.3 <= self.pelvis_height_m <= 1.0:
+            raise LaunchFileError(f"{where}.pelvis_height_m: {self.pelvis_height_m} m is outside [0.3, 1.0] m")
 
 
 @dataclass
@@ -52,7 +56,8 @@ class ScriptedInput(InputDevice):
         self.start_s = start_s
         self.starts = np.concatenate([[0.0], np.cumsum([s.duration_s for s in self.segments])])
         self._commands = [
-            Command(vx_mps=s.vx_mps, vy_mps=s.vy_mps, wz_radps=s.wz_radps, style=s.style).validate()
+            Command(vx_mps=s.vx_mps, vy_mps=s.vy_mps, wz_radps=s.wz_radps, style=s.style,
+                    pelvis_height_m=s.pelvis_height_m).validate()
             for s in self.segments
         ] + [Command()]
 

@@ -92,7 +92,7 @@ def main(args) -> int:
           f"low-level {launch.rates.lowlevel_hz:.0f} Hz, tracker {launch.rates.tracker_hz:.0f} Hz; "
           f"loop and physics interleaved in {SLICE_S:.0f} s slices")
     print(f"  full loop:     {loop_wall:7.2f} s wall  -> real-time factor {rtf:6.1f}x  (goal >= 20x)"
-          f"{'  FELL' if loop.fell else ''}")
+          f"{'  FELL: ' + str(loop.fall) if loop.fell else ''}")
     print(f"  physics only:  {base_wall:7.2f} s wall  -> real-time factor {seconds / base_wall:6.1f}x  (baseline)")
     print(f"  loop / physics-only wall time: {loop_wall / base_wall:.2f}x   (per slice: median "
           f"{np.median(per_slice):.2f}x, range {per_slice.min():.2f}-{per_slice.max():.2f}x)")
@@ -105,5 +105,6 @@ def main(args) -> int:
             "seconds": seconds, "loop_wall_s": loop_wall, "real_time_factor": rtf,
             "physics_only_wall_s": base_wall, "ratio_loop_to_physics": loop_wall / base_wall,
             "ratio_per_slice": per_slice.tolist(), "loop_cpu_s": loop_cpu, "physics_only_cpu_s": base_cpu,
-            "ratio_loop_to_physics_cpu": loop_cpu / base_cpu, "stages": timings, "fell": loop.fell}, indent=2))
-    return 0
+            "ratio_loop_to_physics_cpu": loop_cpu / base_cpu, "stages": timings, "fell": loop.fell,
+            "fall": str(loop.fall) if loop.fall else None}, indent=2))
+    return 1 if loop.fell else 0

@@ -98,7 +98,9 @@ def main(args) -> int:
     cold50, cold99 = _pct(cold_samples)
     rtf = figures.duration_s / figures.wall_s
     print(f"g1 bench wbc: {figures.duration_s:.1f} s simulated walk at 0.3 m/s, WBC at {DEFAULT_TRACKER_HZ:.0f} Hz, "
-          f"physics 500 Hz, {len(records)} controller ticks{'  FELL' if figures.fell else ''}")
+          f"physics 500 Hz, {len(records)} controller ticks")
+    if figures.fell:
+        print(f"  FELL: {figures.fall_detail}")
     print(f"  {'per tick':<34} {'p50 us':>8} {'p99 us':>8}")
     print(f"  {'QP solve (warm-started)':<34} {qp50:8.1f} {qp99:8.1f}   goal p99 <= 1000")
     print(f"  {'QP solve cold (baseline)':<34} {cold50:8.1f} {cold99:8.1f}   warm/cold p50 {qp50 / cold50:.2f}x"
@@ -115,9 +117,9 @@ def main(args) -> int:
           "(p99 figures above 1 ms on a loaded machine are preemption, not solver work)")
     if args.json:
         Path(args.json).write_text(json.dumps({
-            "simulated_s": figures.duration_s, "ticks": len(records), "fell": figures.fell,
+            "simulated_s": figures.duration_s, "ticks": len(records), "fell": figures.fell, "fall": figures.fall_detail,
             "qp_p50_us": qp50, "qp_p99_us": qp99, "qp_cold_p50_us": cold50, "qp_cold_p99_us": cold99,
             "rnea_crba_p50_us": dyn50, "rnea_crba_p99_us": dyn99, "act_p50_us": act50, "act_p99_us": act99,
             "qp_iterations_p50": float(np.percentile(iters, 50)), "qp_iterations_p99": float(np.percentile(iters, 99)),
             "load_average_1min": load1, "loop_wall_s": figures.wall_s, "real_time_factor": rtf, "physics_only_wall_s": physics}, indent=2))
-    return 0
+    return 1 if figures.fell else 0

@@ -46,6 +46,8 @@ class TrackingFigures:
     tracker_p99_us: float = 0.0
     hand_error_m: float | None = None
     """lean_reach only: simulated right hand to the target point, mean over the hold."""
+    fall_detail: str = ""
+    """How and when it fell (g1_control/safety/fall.py); empty when it did not."""
 
     def row(self) -> str:
         return (f"{self.reference:<14} {self.controller:<6} {'FELL' if self.fell else 'ok':<5} {self.duration_s:6.1f} "
@@ -137,7 +139,8 @@ def figures_of(trajectory, loop, controller: str, wall_s: float) -> TrackingFigu
         joint_rms_rad=float(np.sqrt(np.mean(joint_err**2))),
         pelvis_height_rms_m=float(np.sqrt(np.mean(z_err**2))), pelvis_height_max_m=float(np.abs(z_err).max()),
         base_drift_final_m=float(xy_err[-1]), base_drift_max_m=float(xy_err.max()), wall_s=wall_s,
-        tracker_p50_us=timing["p50_us"], tracker_p99_us=timing["p99_us"], hand_error_m=hand_error)
+        tracker_p50_us=timing["p50_us"], tracker_p99_us=timing["p99_us"], hand_error_m=hand_error,
+        fall_detail=str(loop.fall) if loop.fall else "")
 
 
 def _hand_error(trajectory, log) -> float:

@@ -22,6 +22,7 @@ from g1_control import assets
 from g1_control.config import from_dict
 from g1_control.errors import PolicyMismatchError
 from g1_control.robot import g1
+from g1_control.trackers.envelope import Envelope, envelope_path, read_envelope
 from g1_control.trackers.observation import ObservationSpec
 from g1_control.types import CommandLimits
 
@@ -127,6 +128,9 @@ class PolicySpec:
     phase: PhaseSpec | None
     command_ranges: dict[str, tuple[float, float]]
     metadata: dict[str, str]
+    envelope: Envelope | None = None
+    """What the tracker delivers with this policy, measured (g1 bench envelope; `<spec>.envelope.json`)."""
+    spec_file: Path | None = None
 
     @property
     def command_limits(self) -> CommandLimits:
@@ -234,6 +238,7 @@ def _build(d: PolicySpecFile, spec_file: Path, onnx_path: Path, meta: dict) -> P
         observation=ObservationSpec.from_dict({"terms": terms, "history": obs.history},
                                               f"{spec_file.name}: observation"),
         input_name=obs.input, phase=phase, command_ranges=ranges, metadata=meta,
+        envelope=read_envelope(envelope_path(spec_file)), spec_file=spec_file,
     )
 
 

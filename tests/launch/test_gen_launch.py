@@ -34,12 +34,13 @@ def test_generator_session_in_physics_follows_styles_and_directions_without_a_fa
     launch.duration_s = 40.0  # the first segments: stand, sidestep (carry), fast (arms out)
     result = run(launch, progress=False)
     assert not result.fell and not result.events
-    stand, fast = result.segments[0], result.segments[2]
+    stand, side, fast = result.segments[:3]
     assert np.abs(stand.achieved).max() < 0.05
-    # Walks forward with the arms out. After 25 s of walking, float rounding alone moves this speed
-    # within about 0.35-0.40 m/s (1e-12 rad/s nudges to the start state, on the same code), so the
-    # bound sits below that spread.
-    assert fast.achieved[0] > 0.3
-    # (the carry sidestep is not checked: the loco policy walks backwards with the arms held
-    # forward, with or without the generator - measured, see the issue notes)
+    # Styled walking: the carry sidestep at its commanded speed, the fast segment near the tracker's
+    # envelope (0.53 for 0.6 measured over 300 s; float rounding alone moves a speed after 25 s of
+    # walking by a few cm/s, so the bound sits below that), the upper body on the plan.
+    assert side.achieved[1] == pytest.approx(side.commanded[1], rel=0.15) and abs(side.achieved[0]) < 0.1
+    assert fast.achieved[0] > 0.45
+    for seg in (side, fast):
+        assert seg.upper_body_rms_rad < 0.1, f"{seg.label}: upper body {seg.upper_body_rms_rad:.3f} rad RMS from the plan"
     assert result.timings["generator"]["p50_us"] < 5000

@@ -1,6 +1,9 @@
 """The loop's walk is the one the reference code produced: 0.5 s standing, then 1 s walking and
 turning, against tests/loop/data/walk_reference.npz (written by the code of commit da5b7cd, before
-the loop-overhead work of issue 11, with this file run as a script). Only float rounding may differ:
+the loop-overhead work of issue 11, with this file run as a script; re-recorded for issue 17, whose
+velocity correction waits 1 s before integrating and holds uncommanded axes: with the earlier
+corrector swapped back in, that code still reproduced the da5b7cd run within these tolerances,
+so only the correction changed the walk). Only float rounding may differ:
 it grows through the contacts, so the tolerances sit far below anything a behaviour change gives
 (a changed motor-law integration misses them by three orders of magnitude)."""
 
