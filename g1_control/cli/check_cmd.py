@@ -58,7 +58,7 @@ def _scene(args):
         return ()
     if not args.scene:
         return None
-    shapes = []
+    shapes: list = []
     for item in args.scene:
         path = Path(item)
         shapes += load_scene(path) if path.is_dir() else [ObjectShape.from_points(path.stem, read_obj_vertices(path))]

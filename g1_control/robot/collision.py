@@ -63,7 +63,7 @@ def bounding_capsule(points: np.ndarray, radius: float = 0.0) -> tuple[np.ndarra
         centre = centre + 0.5 * (u.max() + u.min()) * e
     t = (points - centre) @ axis
     perp = np.linalg.norm((points - centre) - np.outer(t, axis), axis=1)
-    best = None
+    best: tuple[float, np.ndarray, np.ndarray, float] | None = None
     for r in np.linspace(perp.max(), perp.max() + 0.03, 31):
         half = np.sqrt(np.maximum(r * r - perp * perp, 0.0))
         t0, t1 = (t + half).min(), (t - half).max()
@@ -73,6 +73,7 @@ def bounding_capsule(points: np.ndarray, radius: float = 0.0) -> tuple[np.ndarra
         volume = np.pi * r * r * (t1 - t0) + 4.0 / 3.0 * np.pi * r**3
         if best is None or volume < best[0]:
             best = (volume, centre + t0 * axis, centre + t1 * axis, float(r))
+    assert best is not None  # the loop above runs at least once
     _, p0, p1, r = best
     return p0, p1, r + radius
 
@@ -402,7 +403,7 @@ def _save_stand_ins(stand_ins: tuple[StandIn, ...], pairs: list[tuple[int, int]]
         arrays[f"points_{k}"] = s.points
     arrays["pairs"] = np.array(pairs, dtype=np.int64).reshape(-1, 2)
     tmp = path.with_name(path.stem + ".tmp.npz")
-    np.savez(tmp, **arrays)
+    np.savez(tmp, **arrays)  # type: ignore[arg-type]
     tmp.replace(path)
 
 

@@ -57,9 +57,13 @@ def urdf_joint_limits() -> dict[str, np.ndarray]:
     missing = [n for n in g1.JOINT_NAMES if found.get(n) is None]
     if missing:
         raise RobotDescriptionError(f"the G1 URDF has no <limit> for {missing}")
-    out = {key: np.array([float(found[n].get(key)) for n in g1.JOINT_NAMES])
+    limits = {n: found[n] for n in g1.JOINT_NAMES}
+    out = {key: np.array([float(lim.get(key, "nan")) if lim is not None else np.nan for lim in limits.values()])
            for key in ("lower", "upper", "velocity", "effort")}
-    for arr in out.values():
+    for key, arr in out.items():
+        if not np.all(np.isfinite(arr)):
+            bad = [n for n, v in zip(g1.JOINT_NAMES, arr) if not np.isfinite(v)]
+            raise RobotDescriptionError(f"the G1 URDF's <limit> of {bad} has no number for '{key}'")
         arr.setflags(write=False)
     return out
 

@@ -31,7 +31,7 @@ from g1_control.robot.collision import StandIn, convex_shape, ik_shapes, ik_stan
 
 
 class MeshPairLimit(Limit):
-    def __init__(self, geometry_pairs: list[tuple[int, int]], shape_pairs: list[tuple[int, int]] = (),
+    def __init__(self, geometry_pairs: list[tuple[int, int]], shape_pairs: list[tuple[int, int]] | tuple[()] = (),
                  shapes: tuple[ObjectShape, ...] = (), floor_height_m: float | None = None,
                  margin_m: float = 0.002, activation_m: float = 0.03, max_push_m: float = 0.03,
                  stand_ins: tuple[StandIn, ...] | None = None) -> None:
@@ -106,7 +106,7 @@ class MeshPairLimit(Limit):
         self._rows = np.zeros(len(all_pairs), dtype=bool)
         """Pairs the last `compute` gave rows."""
         self._version = 0
-        self._inside_cache = None
+        self._inside_cache: tuple[tuple[bytes, int], tuple[np.ndarray, float]] | None = None
         self._bounds_key: bytes | None = None
         self._exact_key: bytes | None = None
         self._exact_cache: dict[int, tuple] = {}
