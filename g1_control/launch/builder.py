@@ -149,4 +149,16 @@ def build_loop(launch: LaunchFile, *, backend: Backend | None = None, input_devi
     chain["input"] = type(input_device).__name__
     chain["backend"] = backend.describe()
     loop.chain = chain
+    attach_program(loop)
     return loop
+
+
+def attach_program(loop: ControlLoop) -> None:
+    """A program input (itself, or inside g1 deploy's OperatorButtons) reads the loop's estimator,
+    state and goal verdicts (g1_control/program/device.py)."""
+    from g1_control.program.device import ProgramInput
+
+    device = loop.input
+    for candidate in (device, getattr(device, "inner", None)):
+        if isinstance(candidate, ProgramInput):
+            candidate.attach(loop)

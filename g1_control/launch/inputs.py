@@ -17,6 +17,8 @@ def make_input(launch: LaunchFile, segments: list[Segment], limits: CommandLimit
     cfg = launch.input
     if cfg.type in ("scripted", "random"):
         return ScriptedInput(segments)
+    if cfg.type == "program":
+        return make_program_input(launch)
     from g1_control.teleop.factory import make_input_device
 
     if cfg.type == "gamepad_script":
@@ -38,3 +40,18 @@ def make_input(launch: LaunchFile, segments: list[Segment], limits: CommandLimit
             print("input: no gamepad found; using the keyboard (see g1_control/teleop/README.md for keys)")
             return make_input_device(keyboard_cfg, "input.device", limits=limits)
         raise
+
+
+def program_world(launch: LaunchFile):
+    """The named places a program in `launch` may refer to: input.places."""
+    return launch.input.world()
+
+
+def make_program_input(launch: LaunchFile, program=None, **kwargs):
+    """A ProgramInput for `program` (default: the launch file's input.program / instruction) against
+    the launch file's places; steering by input.pose. build_loop attaches it to the loop."""
+    from g1_control.program.device import ProgramInput
+
+    cfg = launch.input
+    return ProgramInput(program if program is not None else cfg.parsed_program(), program_world(launch),
+                        pose=cfg.pose, start_delay_s=cfg.start_delay_s, **kwargs)

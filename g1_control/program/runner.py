@@ -141,6 +141,41 @@ class RunnerConfig:
     continue_after_failure: bool = False
 
 
+PLACE_WALK_BUDGET_S = 60.0
+"""time_budget_s: a walk to a place, whose length is known only when it starts."""
+
+
+def time_budget_s(program: Program, config: RunnerConfig | None = None) -> float:
+    """An upper bound on how long `program` runs: every step's timeout (or its time), repeats
+    expanded, as the runner would give them (a walk to a place: PLACE_WALK_BUDGET_S unless it has
+    a timeout). Launch files size a program run by it; the run ends early when the program does."""
+    cfg = config or RunnerConfig()
+    leaves: list[_Leaf] = []
+    _flatten(program.steps, "", leaves)
+
+    def budget(step: Step) -> float:
+        if isinstance(step, Parallel):
+            return budget(step.main)
+        timeout = getattr(step, "timeout_s", None)
+        if timeout is not None:
+            return timeout
+        if isinstance(step, Walk):
+            if step.distance_m is None:
+                return step.duration_s if step.duration_s is not None else PLACE_WALK_BUDGET_S
+            speed = step.speed_mps or cfg.walk_speed_mps[step.direction]
+            return cfg.timeout_factor * step.distance_m / speed + cfg.timeout_margin_s
+        if isinstance(step, Turn):
+            rate = step.yaw_rate_radps or cfg.yaw_rate_radps
+            angle = step.angle_rad if step.angle_rad is not None else math.pi
+            return cfg.timeout_factor * angle / rate + cfg.timeout_margin_s
+        if isinstance(step, (Stand, Style, Height)):
+            hold = step.duration_s
+            return hold if hold is not None else cfg.height_settle_s
+        return cfg.goal_timeout_s[step.kind]
+
+    return sum(budget(leaf.step) for leaf in leaves)
+
+
 @dataclass
 class _Leaf:
     label: str
@@ -231,6 +266,14 @@ class ProgramRunner:
 
     def summary(self) -> str:
         return "\n".join(o.describe() for o in self.outcomes)
+
+    def step_of(self, label: str) -> Step:
+        """The step an outcome's label names ('3', '2.1#2')."""
+        return next(leaf.step for leaf in self._leaves if leaf.label == label)
+
+    def hold_command(self) -> Command:
+        """Stand still with the style and height the program has set so far (before it starts, after it ends)."""
+        return self._idle()
 
     # --- step life cycle ---------------------------------------------------------------------
     def _finish(self, a: _Active, status: str, measured: dict[str, float], now_s: float) -> None:
@@ -452,5 +495,6 @@ __all__ = [
     "ProgramRunner",
     "RunnerConfig",
     "StepOutcome",
+    "time_budget_s",
     "wrap_angle",
 ]
