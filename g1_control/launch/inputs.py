@@ -33,13 +33,27 @@ def make_input(launch: LaunchFile, segments: list[Segment], limits: CommandLimit
     assert cfg.type in TELEOP_DEVICES
     device_cfg = dict(cfg.device, type=cfg.type)
     try:
-        return make_input_device(device_cfg, "input.device", limits=limits, state_source=state_source)
+        return _instructed(launch, make_input_device(device_cfg, "input.device", limits=limits,
+                                                     state_source=state_source))
     except InputDeviceError:
         if cfg.type == "gamepad" and cfg.fallback == "keyboard":
             keyboard_cfg = {"type": "keyboard"}
             print("input: no gamepad found; using the keyboard (see g1_control/teleop/README.md for keys)")
-            return make_input_device(keyboard_cfg, "input.device", limits=limits)
+            return _instructed(launch, make_input_device(keyboard_cfg, "input.device", limits=limits))
         raise
+
+
+def _instructed(launch: LaunchFile, device: InputDevice) -> InputDevice:
+    """A keyboard takes typed instructions ('/' then a line; g1_control/program/instructed.py); on a
+    robot each program is shown and runs only once the operator confirms it."""
+    from g1_control.teleop.keyboard import TerminalKeyboard
+
+    if not isinstance(device, TerminalKeyboard):
+        return device
+    from g1_control.program.instructed import InstructedInput
+
+    return InstructedInput(device, program_world(launch), pose=launch.input.pose,
+                           confirm=launch.backend.type != "mujoco")
 
 
 def program_world(launch: LaunchFile):

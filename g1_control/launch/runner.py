@@ -157,11 +157,13 @@ def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentR
 
 def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None = None,
         progress: bool = True, viewer: bool = False, web_port: int | None = None,
-        input_device: InputDevice | None = None) -> RunResult:
+        input_device: InputDevice | None = None, end_with_program: bool = True) -> RunResult:
     """Run `launch` to the end (or a fall); write the run folder when `out_root` is given.
 
     viewer: the MuJoCo viewer; web_port: the browser view (g1_control/sim/web.py) on that port;
     input_device: instead of the launch file's input (g1 say hands in its program input).
+    end_with_program: a program run ends PROGRAM_END_HOLD_S after its last step (False: it runs
+    the launch file's whole duration, as the deploy's dry run does).
     """
     segments = timeline_of(launch)
     sim = make_sim_backend(launch)
@@ -195,7 +197,7 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
     t0 = time.perf_counter()
     stop = (lambda: not view.is_running()) if view is not None else None
     program = program_input(loop)
-    if program is not None:  # a program run ends PROGRAM_END_HOLD_S after its last step
+    if program is not None and end_with_program:  # ends PROGRAM_END_HOLD_S after its last step
         from g1_control.launch.schema import PROGRAM_END_HOLD_S
 
         viewer_closed = stop

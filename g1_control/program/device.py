@@ -116,6 +116,9 @@ class ProgramInput(InputDevice):
         """Stand this long (loop clock) before the first step: the walking policy settles."""
         self.operator = operator
         self.on_record = on_record
+        self.program_clock: Callable[[], float] | None = None
+        """The program's own clock (g1 deploy: seconds since control started, 0 before); None: the
+        loop's. The operator device is always polled with the loop's clock."""
         self.records: list[StepRecord] = []
         self.truth_start: PlanarPose | None = None
         self.started_s: float | None = None
@@ -144,6 +147,11 @@ class ProgramInput(InputDevice):
     def lost(self) -> bool:
         return self.operator.lost if self.operator is not None else False
 
+    @property
+    def mapper(self):
+        """The operator device's button mapping (g1 deploy names its keys), if any."""
+        return getattr(self.operator, "mapper", None)
+
     def close(self) -> None:
         if self.operator is not None:
             self.operator.close()
@@ -160,6 +168,8 @@ class ProgramInput(InputDevice):
 
     def poll(self, now_s: float) -> Command:
         op = self.operator.poll(now_s) if self.operator is not None else None
+        if self.program_clock is not None:
+            now_s = self.program_clock()
         truth = self._truth()
         pose = self._pose(truth)
         if truth is not None and self._last_truth_yaw is not None:

@@ -30,8 +30,11 @@ from g1_control.types import BUTTONS
 AXIS_FIELDS = {"vx": STICK, "vy": STICK, "wz": STICK, "speed_scale": TRIGGER, "pelvis_height": TRIGGER}
 """Command fields an axis can drive, and the kind of axis each expects."""
 SLEW_FIELDS = ("vx", "vy", "wz")
-ACTIONS = BUTTONS | {"zero_velocity"}
-"""What a button can do: every Command button, plus zero_velocity (handled inside the mapping)."""
+LINE_ACTION = "instruction"
+"""Keyboard: enter line mode to type an English instruction (teleop/keyboard.py); stops the robot."""
+ACTIONS = BUTTONS | {"zero_velocity", LINE_ACTION}
+"""What a button can do: every Command button, plus zero_velocity (handled inside the mapping) and,
+on a keyboard, instruction (line mode)."""
 YAW_MODES = ("rate", "heading")
 
 
@@ -236,6 +239,8 @@ def _buttons(spec: Mapping[str, Any], where: str, layout: DeviceLayout) -> dict[
             raise LaunchFileError(f"{where}.{name}: two actions bound to one button ({list(action)}); bind one")
         if action not in ACTIONS:
             raise LaunchFileError(f"{where}.{name} is {action!r}, not an action; known: {', '.join(sorted(ACTIONS))}")
+        if action == LINE_ACTION and (layout.kind != "keyboard" or len(chord) != 1):
+            raise LaunchFileError(f"{where}.{name}: '{LINE_ACTION}' (typing a line) is a single keyboard key")
         if chord in buttons:
             raise LaunchFileError(
                 f"{where}.{name}: two actions bound to one button: '{spelled[chord]}' is already "
