@@ -17,6 +17,7 @@ RunnerConfig.continue_after_failure.
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -120,7 +121,7 @@ class RunnerConfig:
     yaw_rate_radps: float = 0.6
     min_speed_mps: float = 0.08
     """Walks slow down as they near the end (speed = gain x remaining) but not below this."""
-    slowdown_gain_per_s: float = 1.2
+    slowdown_gain_per_s: float = 0.8
     distance_tolerance_m: float = 0.02
     place_tolerance_m: float = 0.05
     min_yaw_rate_radps: float = 0.12
@@ -138,6 +139,22 @@ class RunnerConfig:
     """None: the generator's own height for the style."""
     height_settle_s: float = 1.5
     """A height step without a duration completes after this (the body gets there)."""
+    walk_settle_max_s: float = 2.0
+    """A walk that reached its end commands zero velocity until the robot is at rest (moved less than
+    still_speed_mps x still_window_s over the last still_window_s), at most this long; its outcome is
+    measured there, so the next step starts from rest and a walk's figures include its run-out
+    (0: complete at once, still moving)."""
+    still_speed_mps: float = 0.05
+    still_window_s: float = 0.3
+    walk_corrections: int = 2
+    """A walk by a distance that came to rest more than correction_tolerance_m off (by odometry, which
+    reads without sway at rest) walks the rest (or back) at correction_speed_mps, up to this often."""
+    correction_tolerance_m: float = 0.03
+    correction_speed_mps: float = 0.12
+    gait_period_s: float = 1.0
+    """The walking policy's gait period (holosoma: 1 s): walks judge their progress on the position
+    averaged over one period (the pelvis sways +-3-5 cm sideways with each step), brought up to
+    now by half the period's displacement. 0: the raw position."""
     continue_after_failure: bool = False
 
 
@@ -209,6 +226,12 @@ class _Active:
         self.stop_m = 0.0
         self.walk_dir_w = np.array([1.0, 0.0])
         self.hold_heading = p.yaw_rad
+        self.reached_xy: tuple[float, float] | None = None
+        self.corrections = 0
+        self.settle_t0: float | None = None
+        """When a walk reached its end and started coming to rest (elapsed s); None while walking."""
+        self.track: deque[tuple[float, float, float]] = deque()
+        """(elapsed, x, y) over the last RunnerConfig.still_window_s, for telling rest."""
 
 
 class ProgramRunner:
@@ -429,12 +452,49 @@ class ProgramRunner:
         assert isinstance(step, Walk)
         speed = step.speed_mps or cfg.walk_speed_mps[step.direction]
         pos = np.array([p.x_m, p.y_m])
+        a.track.append((elapsed, p.x_m, p.y_m))
+        while a.track and a.track[0][0] < elapsed - max(cfg.still_window_s, cfg.gait_period_s):
+            a.track.popleft()
+        if cfg.gait_period_s > 0 and a.track[-1][0] - a.track[0][0] >= 0.95 * cfg.gait_period_s:
+            # sway-free position: the mean over one gait period is where the robot was half a period
+            # ago; the displacement over the period (also sway-free) brings it up to now
+            track = np.asarray(a.track)
+            pos = track[:, 1:].mean(axis=0) + (track[-1, 1:] - track[0, 1:]) / 2
+        if a.settle_t0 is None:
+            reached = False
+            if step.target is not None:
+                reached = float(np.hypot(*(a.target_xy - pos))) - a.stop_m <= cfg.place_tolerance_m
+            elif step.distance_m is not None:
+                remaining = step.distance_m - float((pos - [a.x0, a.y0]) @ a.walk_dir_w)
+                reached = (abs(remaining) if a.corrections else remaining) <= cfg.distance_tolerance_m
+            elif step.duration_s is not None:
+                reached = elapsed >= step.duration_s
+            if reached:
+                a.settle_t0 = elapsed
+                a.reached_xy = (p.x_m, p.y_m)
+        if a.settle_t0 is not None:  # coming to rest: zero velocity, heading held
+            t0, x0, y0 = next(e for e in a.track if e[0] >= elapsed - cfg.still_window_s - 1e-9)
+            window = elapsed - a.settle_t0 >= cfg.still_window_s and elapsed - t0 >= 0.8 * cfg.still_window_s
+            still = window and math.hypot(p.x_m - x0, p.y_m - y0) <= cfg.still_speed_mps * cfg.still_window_s
+            if still and step.distance_m is not None and a.corrections < cfg.walk_corrections:
+                # at rest, where odometry reads without sway: close the loop on what is left
+                left = step.distance_m - float((np.array([p.x_m, p.y_m]) - [a.x0, a.y0]) @ a.walk_dir_w)
+                if abs(left) > cfg.correction_tolerance_m:
+                    a.corrections += 1
+                    a.settle_t0 = None
+                    return self._tick_main(a, step, cmd, elapsed, p)
+            if still or elapsed - a.settle_t0 >= cfg.walk_settle_max_s:
+                return cmd, (COMPLETED, self._measure(a, step, p))
+            if step.target is None:
+                err = wrap_angle(a.hold_heading - p.yaw_rad)
+                cmd.heading_rad = a.hold_heading
+                cmd.wz_radps = float(np.clip(cfg.heading_hold_gain_per_s * err, -cfg.yaw_rate_radps,
+                                             cfg.yaw_rate_radps))
+            return cmd, None
         if step.target is not None:
             d = a.target_xy - pos
             dist = float(np.hypot(*d))
             remaining = dist - a.stop_m
-            if remaining <= cfg.place_tolerance_m:
-                return cmd, (COMPLETED, self._measure(a, step, p))
             bearing = math.atan2(d[1], d[0])
             err = wrap_angle(bearing - p.yaw_rad)
             v = min(speed, max(cfg.min_speed_mps, cfg.slowdown_gain_per_s * remaining))
@@ -443,15 +503,10 @@ class ProgramRunner:
             cmd.wz_radps = float(np.clip(cfg.heading_hold_gain_per_s * err, -cfg.yaw_rate_radps, cfg.yaw_rate_radps))
             return cmd, None
         if step.distance_m is not None:
-            covered = float((pos - [a.x0, a.y0]) @ a.walk_dir_w)
-            remaining = step.distance_m - covered
-            if remaining <= cfg.distance_tolerance_m:
-                return cmd, (COMPLETED, self._measure(a, step, p))
-            v = min(speed, max(cfg.min_speed_mps, cfg.slowdown_gain_per_s * remaining))
+            remaining = step.distance_m - float((pos - [a.x0, a.y0]) @ a.walk_dir_w)
+            v = math.copysign(min(speed, max(cfg.correction_speed_mps if a.corrections else cfg.min_speed_mps,
+                                             cfg.slowdown_gain_per_s * abs(remaining))), remaining)
         else:
-            assert step.duration_s is not None  # a valid Walk has a target, a distance or a duration
-            if elapsed >= step.duration_s:
-                return cmd, (COMPLETED, self._measure(a, step, p))
             v = speed
         # velocity in the heading frame along the walk's world direction, heading held
         c, s = math.cos(p.yaw_rad), math.sin(p.yaw_rad)
@@ -473,6 +528,10 @@ class ProgramRunner:
             along = float(moved @ a.walk_dir_w)
             side = float(moved[0] * -a.walk_dir_w[1] + moved[1] * a.walk_dir_w[0])
             out = {"distance_m": along, "lateral_m": side}
+            if a.reached_xy is not None:  # how far it ran on after the velocity went to zero
+                out["runout_m"] = float((pos - a.reached_xy) @ a.walk_dir_w)
+            if a.corrections:
+                out["corrections"] = float(a.corrections)
             if step.distance_m is not None:
                 out["error_m"] = along - step.distance_m
             return out
