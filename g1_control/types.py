@@ -151,6 +151,65 @@ class EffectorGoal:
     t_s: float | None = None
 
 
+GOAL_KINDS = ("reach", "pick", "place", "step_up", "step_down")
+"""What the execution layer (g1_control/generator/goals/) can be asked to do."""
+HANDS = ("left", "right", "both")
+
+
+@dataclass
+class TaskGoal:
+    """A goal for the execution layer, against the scene (g1_control/scene.py):
+
+    reach      put `hand` (left/right/both) at pos_w_m (world point), or at its standing position
+               moved by offset_h_m (heading frame: x forward, y left, z up); then hold it there
+    pick       pick box `object` (None: the nearest box in front) with both hands and hold it
+    place      set the held box down: on table/platform `target` (at pos_w_m's xy if given, else
+               the middle of its near edge), or at pos_w_m (floor), or (neither) in front
+    step_up    step onto platform `target` (None: the nearest in front) and stand on it
+    step_down  step off the platform the robot stands on (back where it came from) and stand
+
+    A goal is started the first tick a Command carries its `goal_id` and runs to its end even
+    when later commands no longer carry it; goals queue in the order they arrive.
+    """
+
+    kind: str
+    goal_id: str = ""
+    hand: str = "right"
+    object: str | None = None
+    target: str | None = None
+    pos_w_m: np.ndarray | None = None
+    offset_h_m: np.ndarray | None = None
+
+    def validate(self) -> TaskGoal:
+        if self.kind not in GOAL_KINDS:
+            raise InvalidCommandError(f"TaskGoal.kind '{self.kind}' is not one of {', '.join(GOAL_KINDS)}")
+        if self.hand not in HANDS:
+            raise InvalidCommandError(f"TaskGoal.hand '{self.hand}' is not one of {', '.join(HANDS)}")
+        if self.pos_w_m is not None:
+            pos = np.asarray(self.pos_w_m, dtype=float)
+            if pos.shape != (3,) or not np.all(np.isfinite(pos)):
+                raise InvalidCommandError(f"TaskGoal '{self.goal_id}' ({self.kind}) has position {self.pos_w_m!r}; "
+                                          "it must be 3 finite numbers")
+        if self.offset_h_m is not None:
+            off = np.asarray(self.offset_h_m, dtype=float)
+            if off.shape != (3,) or not np.all(np.isfinite(off)):
+                raise InvalidCommandError(f"TaskGoal '{self.goal_id}' has offset {self.offset_h_m!r}; "
+                                          "it must be 3 finite numbers")
+        if self.kind == "reach" and (self.pos_w_m is None) == (self.offset_h_m is None):
+            raise InvalidCommandError(f"TaskGoal '{self.goal_id}': a reach needs pos_w_m or offset_h_m (one of them)")
+        return self
+
+    def describe(self) -> str:
+        what = {"reach": f"reach {self.hand} hand", "pick": f"pick {self.object or 'the box in front'}",
+                "place": "place" + (f" {self.object}" if self.object else ""), "step_up": "step up",
+                "step_down": "step down"}[self.kind]
+        if self.target:
+            what += f" {'on' if self.kind != 'reach' else 'to'} {self.target}"
+        if self.pos_w_m is not None:
+            what += " at (" + ", ".join(f"{v:.2f}" for v in self.pos_w_m) + ")"
+        return what
+
+
 @dataclass
 class Command:
     """Operator intent for one tick."""
@@ -162,6 +221,8 @@ class Command:
     style: str = "default"
     pelvis_height_m: float | None = None
     goals: list[EffectorGoal] = field(default_factory=list)
+    tasks: list[TaskGoal] = field(default_factory=list)
+    """Goals for the execution layer (reach, pick, place, step up/down; see TaskGoal)."""
     buttons: frozenset[str] = frozenset()
 
     def validate(self) -> Command:
@@ -177,6 +238,8 @@ class Command:
                     f"Command goal for frame '{goal.frame}' has position {goal.pos_w_m!r}; "
                     "it must be 3 finite numbers"
                 )
+        for task in self.tasks:
+            task.validate()
         if not BUTTONS.issuperset(self.buttons):
             unknown = set(self.buttons) - BUTTONS
             raise InvalidCommandError(
@@ -223,6 +286,11 @@ class RobotState:
         return self
 
 
+PHASE_LOCOMOTION = "locomotion"
+PHASE_WHOLE_BODY = "whole_body"
+PHASES = (PHASE_LOCOMOTION, PHASE_WHOLE_BODY)
+
+
 @dataclass
 class KinematicReference:
     """Whole-body target from the generator: root pose and twist, posture, named frame targets, contacts."""
@@ -246,6 +314,11 @@ class KinematicReference:
     pelvis_height_m: float | None = None
     """A pelvis height above the ground the tracker must hold (an operator's or a task's request);
     None leaves the height to the tracker (a walking policy's own)."""
+    phase: str = "locomotion"
+    """PHASE_LOCOMOTION: the plan walks or stands by a root velocity (a walking policy follows it);
+    PHASE_WHOLE_BODY: root pose, joints and the contact schedule are all meant (a whole-body
+    controller follows them: manipulation, stepping onto platforms, heights a walking policy
+    cannot hold). The tracking layer hands over between its controllers by this."""
 
 
 @dataclass
@@ -266,6 +339,23 @@ class JointReference:
     """When True, a balancing tracker takes waist/arm targets from q_rad instead of its own."""
     pelvis_height_m: float | None = None
     """The pelvis height to hold (KinematicReference.pelvis_height_m); None: the tracker's own."""
+    phase: str = "locomotion"
+    """KinematicReference.phase."""
+    hand_forces_w_n: np.ndarray = field(default_factory=lambda: np.zeros((2, 3)))
+    """Known forces a held object exerts on the (left, right) hand point, world axes (N): the
+    reaction to the squeeze and the object's weight. A whole-body controller puts them in its
+    dynamics, so its torques hold the object and its balance accounts for it."""
+
+    def copy_from(self, src: JointReference) -> JointReference:
+        """Copy every field of `src` into this reference's own arrays (no allocation); returns self."""
+        self.t_s = src.t_s
+        for name in ("q_rad", "dq_radps", "root_pos_w_m", "root_quat_wxyz", "root_linvel_h_mps",
+                     "root_angvel_h_radps", "contacts", "hand_forces_w_n"):
+            getattr(self, name)[:] = getattr(src, name)
+        self.upper_body_override = src.upper_body_override
+        self.pelvis_height_m = src.pelvis_height_m
+        self.phase = src.phase
+        return self
 
 
 @dataclass

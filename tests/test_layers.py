@@ -42,7 +42,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("sim",),
     ("hardware",),
     ("interfaces",),
-    ("types",),
+    ("types", "scene"),
     ("robot",),
     ("config", "assets", "rotations", "resources"),
     ("errors",),

@@ -110,6 +110,6 @@ def _program(args):
         from g1_control.launch.schema import load_launch
         from g1_control.program import parse_instruction
 
-        world = load_launch(args.file).input.world()
+        world = load_launch(args.file).program_world()
         return parse_instruction(args.say, places=world.names() if world.places else None), args.say
     return None, ""

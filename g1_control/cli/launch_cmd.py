@@ -97,4 +97,5 @@ def _run(args) -> int:
     print(format_summary(result))
     if result.run_dir is not None:
         print(f"look again: g1 replay {result.run_dir}")
-    return 1 if result.fell else 0
+    missed = [g for g in result.extra.get("goals", []) if g["status"] != "reached"]
+    return 1 if result.fell or missed else 0

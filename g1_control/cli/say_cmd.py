@@ -8,6 +8,9 @@ from pathlib import Path
 
 DEFAULT_LAUNCH = "sim_program"
 """The launch file whose loop runs the program (its input is replaced by the instruction)."""
+SCENE_LAUNCH = "sim_scene_program"
+"""... and the one when the instruction names a place: tables, a box, a platform, a door; goals
+(reach, pick, place, step) executed by the goal generator and the tracking layer."""
 
 
 def register(subparsers) -> None:
@@ -32,7 +35,9 @@ def register(subparsers) -> None:
     parser.add_argument("instruction", help="the instruction, in quotes")
     parser.add_argument("--dry-run", action="store_true", help="print the program and exit (nothing runs)")
     parser.add_argument("--launch", default=None, metavar="FILE",
-                        help=f"launch file whose loop (and places) runs the program (default: {DEFAULT_LAUNCH})")
+                        help=f"launch file whose loop (and places) runs the program (default: {DEFAULT_LAUNCH}; "
+                        f"{SCENE_LAUNCH}, a scene with tables, a box, a platform and a door, when the instruction "
+                        "names a place)")
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                         help="override a launch-file key (as g1 launch --set)")
     parser.add_argument("--pose", choices=("estimator", "ground_truth"),
@@ -64,7 +69,14 @@ def _run(args) -> int:
     from g1_control.program import ProgramError
     from g1_control.resources import resolve_launch
 
-    path, _ = resolve_launch(args.launch or DEFAULT_LAUNCH)
+    name = args.launch
+    if name is None:  # a scene when the instruction names a place (parsed with the default place words)
+        from g1_control.program import parse_instruction
+        from g1_control.program.steps import iter_named_places
+
+        named = {n for step in parse_instruction(args.instruction).steps for _, n in iter_named_places(step)}
+        name = SCENE_LAUNCH if named - {"start"} else DEFAULT_LAUNCH
+    path, _ = resolve_launch(name)
     launch = load_launch(path, overrides=args.overrides)
     program, world = say_program(args.instruction, launch)
     print(f'"{args.instruction}"\n' + program.describe(), flush=True)
@@ -98,6 +110,10 @@ def _run(args) -> int:
                  viewer=viewer, input_device=device)
     summary = result.extra.get("program", {"steps": [], "finished": False, "pose": launch.input.pose})
     print(program_summary(summary).splitlines()[0])
+    for step in summary["steps"]:  # goal steps: judged after the run from the execution layer's ground truth
+        if "goal_id" in step and "verdict" in step:
+            v = step["verdict"]
+            print(f"  {step['label']}. {step['description']} (ground truth): {v['text']} {'OK' if v['ok'] else 'MISSED'}")
     print(f"{fall_text(result.fall)}; {result.duration_s:.1f} s simulated in {result.wall_s:.1f} s wall")
     if result.run_dir is not None:
         print(f"run folder: {result.run_dir}" + (f" (video: {Path(result.video).name})" if result.video else ""))

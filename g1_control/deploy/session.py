@@ -133,7 +133,7 @@ def _confirm_program(launch: LaunchFile, options: DeployOptions, say, ask) -> bo
     if launch.input.pose != "estimator":
         raise LaunchFileError("input.pose: a robot steers a program by its own estimate; set input.pose: estimator")
     try:
-        program.validate(launch.input.world())
+        program.validate(launch.program_world())
     except ProgramError as exc:
         raise LaunchFileError(f"program: {exc}") from None
     origin = f'from "{options.program_text}"' if options.program_text else "from the program file"
@@ -192,7 +192,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             from g1_control.program.device import ProgramInput, describe_record
 
             # motion from the program, buttons and loss from the operator's device
-            device = ProgramInput(options.program, launch.input.world(), pose="estimator",
+            device = ProgramInput(options.program, launch.program_world(), pose="estimator",
                                   start_delay_s=launch.input.start_delay_s, operator=device,
                                   on_record=lambda r: say("program step " + describe_record(r)))
         if spec is not None:

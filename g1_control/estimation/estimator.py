@@ -69,7 +69,10 @@ class StateEstimator:
         self.estimate = EstimatedState()
         self._last_t = None
 
-    def update(self, state: RobotState) -> EstimatedState:
+    def update(self, state: RobotState, contacts: np.ndarray | None = None) -> EstimatedState:
+        """contacts: (left, right) feet known to be in stance (a controller's contact schedule);
+        None: the lower foot is taken as the stance foot. Known contacts matter on uneven ground:
+        a foot swinging up from the floor next to one standing on a step is the lower one."""
         # Small vectors are handled as Python floats: this runs at 100 Hz and numpy's per-call cost
         # dominates 3-vector arithmetic.
         pin, model, data = self._pin, self.model, self.data
@@ -90,9 +93,12 @@ class StateEstimator:
         height_right = pin.updateFramePlacement(model, data, right).translation[2]
         vel_left = pin.getFrameVelocity(model, data, left, pin.LOCAL_WORLD_ALIGNED).linear.tolist()
         vel_right = pin.getFrameVelocity(model, data, right, pin.LOCAL_WORLD_ALIGNED).linear.tolist()
-        # Soft stance: the lower foot carries the weight.
-        d = float(height_right - height_left) / self.config.stance_height_scale_m
-        w_left = 1.0 / (1.0 + math.exp(-min(50.0, max(-50.0, d))))
+        if contacts is not None and (contacts[0] or contacts[1]):
+            w_left = float(bool(contacts[0])) / (float(bool(contacts[0])) + float(bool(contacts[1])))
+        else:
+            # Soft stance: the lower foot carries the weight.
+            d = float(height_right - height_left) / self.config.stance_height_scale_m
+            w_left = 1.0 / (1.0 + math.exp(-min(50.0, max(-50.0, d))))
         w_right = 1.0 - w_left
         v_kin = [-(w_left * a + w_right * b) for a, b in zip(vel_left, vel_right)]
 

@@ -1,10 +1,10 @@
 """Scripted whole-body references for the WBC's tests and figures.
 
-Each builder returns a WholeBodyTrajectory: root pose, joint angles and the contact schedule
-sampled in time, played back through cubic splines (so joint and root velocities are smooth and
-exact). Poses that must keep the feet planted or put a hand somewhere come from a small
-damped-least-squares whole-body IK (WholeBodyIK); stepping references take their CoM from ZMP
-preview control over a footstep plan (zmp_preview.py).
+Each builder returns a WholeBodyTrajectory (generator/whole_body.py): root pose, joint angles and
+the contact schedule sampled in time, played back through cubic splines. Poses that must keep the
+feet planted or put a hand somewhere come from the whole-body IK (WholeBodyIK, joint limits inside
+its iteration); stepping references take their CoM from ZMP preview control over a footstep plan
+(zmp_preview.py).
 
     stand          the default pose, still
     arm_wave       both arms swinging in antiphase (shoulder pitch +-0.6 rad, elbows, 0.5 Hz)
@@ -19,96 +19,23 @@ In the loop: a launch file with `generator: {type: scripted, reference: NAME}` (
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from g1_control.errors import WbcConfigError
+from g1_control.generator.whole_body import (
+    WholeBodyIK,
+    WholeBodyTrajectory,
+    smoothstep,
+    trajectory_from_configurations,
+)
 from g1_control.generator.zmp_preview import ZmpPreviewController
 from g1_control.interfaces import Generator, Retargeter
 from g1_control.robot import g1
-from g1_control.robot.dynamics import SOLE_FRAMES, build_model
-from g1_control.rotations import quat_to_rot, rot_to_rpy, rotation_error, rpy_to_quat
+from g1_control.robot.dynamics import SOLE_FRAMES
 from g1_control.types import Command, JointReference, KinematicReference, RobotState
 
-
-def smoothstep(x: np.ndarray | float) -> np.ndarray:
-    """Quintic 0 -> 1 with zero velocity and acceleration at both ends."""
-    x = np.clip(x, 0.0, 1.0)
-    return x**3 * (10 - 15 * x + 6 * x * x)
-
-
-@dataclass
-class WholeBodyTrajectory:
-    """Samples of a whole-body reference; sample(t) interpolates with cubic splines."""
-
-    name: str
-    t_s: np.ndarray
-    root_pos_w_m: np.ndarray
-    root_rpy_rad: np.ndarray
-    q_rad: np.ndarray
-    contacts: np.ndarray
-    """(n, 2) bool per sample; held constant from one sample to the next."""
-    extras: dict = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        from scipy.interpolate import CubicSpline
-
-        n = len(self.t_s)
-        shapes = {"root_pos_w_m": (n, 3), "root_rpy_rad": (n, 3), "q_rad": (n, g1.NUM_JOINTS), "contacts": (n, 2)}
-        for name, shape in shapes.items():
-            if getattr(self, name).shape != shape:
-                raise WbcConfigError(f"WholeBodyTrajectory.{name} has shape {getattr(self, name).shape}; expected {shape}")
-        if n < 2 or np.any(np.diff(self.t_s) <= 0):
-            raise WbcConfigError("WholeBodyTrajectory needs at least 2 samples at increasing times")
-        if not np.all(self.contacts.any(axis=1)):
-            raise WbcConfigError("WholeBodyTrajectory has samples with no foot in contact")
-        # One spline over all 35 columns (root xyz, root rpy, joints): two evaluations per sample.
-        self._spline = CubicSpline(self.t_s, np.hstack([self.root_pos_w_m, self.root_rpy_rad, self.q_rad]),
-                                   bc_type="clamped")
-        self._last: tuple[float, JointReference] | None = None
-
-    @property
-    def duration_s(self) -> float:
-        return float(self.t_s[-1])
-
-    def sample(self, t_s: float, out: JointReference | None = None) -> JointReference:
-        out = out or JointReference()
-        if self._last is not None and self._last[0] == t_s:  # generator and retargeter ask for the same tick
-            _copy_reference(self._last[1], out)
-            return out
-        t = float(np.clip(t_s, self.t_s[0], self.t_s[-1]))
-        x, dx = self._spline(t), self._spline(t, 1)
-        out.t_s = t_s
-        out.q_rad[:] = x[6:]
-        out.dq_radps[:] = dx[6:]
-        out.root_pos_w_m[:] = x[:3]
-        rpy, drpy = x[3:6], dx[3:6]
-        out.root_quat_wxyz[:] = rpy_to_quat(rpy)
-        vel_w = dx[:3]
-        c, s = np.cos(rpy[2]), np.sin(rpy[2])
-        out.root_linvel_h_mps[:] = (c * vel_w[0] + s * vel_w[1], -s * vel_w[0] + c * vel_w[1], vel_w[2])
-        # ZYX Euler rates -> world angular velocity -> heading frame
-        _, p, y = rpy
-        w_world = np.array([-np.sin(y) * drpy[1] + np.cos(y) * np.cos(p) * drpy[0],
-                            np.cos(y) * drpy[1] + np.sin(y) * np.cos(p) * drpy[0],
-                            drpy[2] - np.sin(p) * drpy[0]])
-        out.root_angvel_h_radps[:] = (c * w_world[0] + s * w_world[1], -s * w_world[0] + c * w_world[1], w_world[2])
-        k = int(np.searchsorted(self.t_s, t, side="right")) - 1
-        out.contacts[:] = self.contacts[min(max(k, 0), len(self.t_s) - 1)]
-        if self._last is None:
-            self._last = (t_s, JointReference())
-        self._last = (t_s, self._last[1])
-        _copy_reference(out, self._last[1])
-        return out
-
-
-def _copy_reference(src: JointReference, dst: JointReference) -> None:
-    dst.t_s = src.t_s
-    for name in ("q_rad", "dq_radps", "root_pos_w_m", "root_quat_wxyz", "root_linvel_h_mps", "root_angvel_h_radps",
-                 "contacts"):
-        getattr(dst, name)[:] = getattr(src, name)
-    dst.upper_body_override = src.upper_body_override
+_trajectory = trajectory_from_configurations
 
 
 class TrajectoryGenerator(Generator):
@@ -133,6 +60,7 @@ class TrajectoryGenerator(Generator):
         ref.root_angvel_h_radps[:] = j.root_angvel_h_radps
         ref.q_rad[:] = j.q_rad
         ref.contacts[:] = j.contacts
+        ref.phase = j.phase
         return ref
 
 
@@ -146,105 +74,6 @@ class TrajectoryRetargeter(Retargeter):
 
     def solve(self, reference: KinematicReference, q_prev: np.ndarray) -> JointReference:
         return self.trajectory.sample(reference.t_s, self._out)
-
-
-LEG_LIGHT_POSTURE_WEIGHT = np.where(np.isin(np.arange(g1.NUM_JOINTS), g1.LEG_JOINTS), 0.002, 0.05)
-"""The legs are fixed by the feet and pelvis targets; a posture pull as strong as the upper body's
-would leave a 15 cm crouch 2 cm short."""
-
-
-# -- whole-body IK for the reference poses -------------------------------------------------------------------
-class WholeBodyIK:
-    """Damped least squares on the floating-base configuration: soles at their targets, CoM xy,
-    pelvis height and orientation, an optional hand point, posture as a weak regulariser."""
-
-    def __init__(self):
-        import pinocchio as pin
-
-        self.pin = pin
-        self.model = build_model()
-        self.data = self.model.createData()
-        self.sole_ids = [self.model.getFrameId(n) for n in SOLE_FRAMES]
-        self.pelvis_id = self.model.getFrameId(g1.BASE_BODY)
-
-    def nominal(self) -> np.ndarray:
-        """Default pose with the soles flat on z = 0 and the pelvis above the origin."""
-        q = np.concatenate([[0, 0, 0, 0, 0, 0, 1.0], g1.DEFAULT_Q_RAD])
-        self.pin.framesForwardKinematics(self.model, self.data, q)
-        q[2] = -self.data.oMf[self.sole_ids[0]].translation[2]
-        return q
-
-    def frame_pose(self, q: np.ndarray, name: str) -> tuple[np.ndarray, np.ndarray]:
-        self.pin.framesForwardKinematics(self.model, self.data, q)
-        placement = self.data.oMf[self.model.getFrameId(name)]
-        return placement.translation.copy(), placement.rotation.copy()
-
-    def com(self, q: np.ndarray) -> np.ndarray:
-        return self.pin.centerOfMass(self.model, self.data, q).copy()
-
-    def solve(self, q0: np.ndarray, soles: list[tuple[np.ndarray, np.ndarray]], com_xy: np.ndarray | None,
-              pelvis_z: float | None, pelvis_rot: np.ndarray, posture: np.ndarray, *,
-              hand: tuple[str, np.ndarray] | None = None, hand_weight: float = 10.0,
-              pelvis_rot_weight=(10.0, 10.0, 10.0),
-              posture_weight: np.ndarray | float | None = None, iterations: int = 30, tol: float = 1e-6) -> np.ndarray:
-        pin, m, d = self.pin, self.model, self.data
-        if posture_weight is None:
-            posture_weight = LEG_LIGHT_POSTURE_WEIGHT
-        q = q0.copy()
-        lwa = pin.LOCAL_WORLD_ALIGNED
-        nv = m.nv
-        for _ in range(iterations):
-            pin.computeJointJacobians(m, d, q)
-            pin.updateFramePlacements(m, d)
-            rows, errs, weights = [], [], []
-            for fid, (pos, rot) in zip(self.sole_ids, soles):
-                J = pin.getFrameJacobian(m, d, fid, lwa)
-                rows.append(J)
-                errs.append(np.concatenate([pos - d.oMf[fid].translation, rotation_error(rot, d.oMf[fid].rotation)]))
-                weights.append(np.full(6, 100.0))
-            Jp = pin.getFrameJacobian(m, d, self.pelvis_id, lwa)
-            rows.append(Jp[3:])
-            errs.append(rotation_error(pelvis_rot, d.oMf[self.pelvis_id].rotation))
-            weights.append(np.asarray(pelvis_rot_weight, dtype=float))
-            if pelvis_z is not None:
-                rows.append(Jp[2:3])
-                errs.append(np.array([pelvis_z - d.oMf[self.pelvis_id].translation[2]]))
-                weights.append(np.array([30.0]))
-            if com_xy is not None:
-                Jc = pin.jacobianCenterOfMass(m, d, q)
-                rows.append(Jc[:2])
-                errs.append(com_xy - d.com[0][:2])
-                weights.append(np.full(2, 30.0))
-            if hand is not None:
-                fid = m.getFrameId(hand[0])
-                rows.append(pin.getFrameJacobian(m, d, fid, lwa)[:3])
-                errs.append(hand[1] - d.oMf[fid].translation)
-                weights.append(np.full(3, hand_weight))
-            Jpost = np.zeros((g1.NUM_JOINTS, nv))
-            Jpost[:, 6:] = np.eye(g1.NUM_JOINTS)
-            rows.append(Jpost)
-            errs.append(posture - q[7:])
-            weights.append(np.broadcast_to(np.asarray(posture_weight, dtype=float), (g1.NUM_JOINTS,)))
-            J, e, w = np.vstack(rows), np.concatenate(errs), np.concatenate(weights)
-            H = J.T @ (J * w[:, None]) + 1e-6 * np.eye(nv)
-            dv = np.linalg.solve(H, J.T @ (w * e))
-            q = pin.integrate(m, q, dv)
-            q[7:] = np.clip(q[7:], g1.Q_MIN_RAD + 0.02, g1.Q_MAX_RAD - 0.02)
-            if np.abs(dv).max() < tol:
-                break
-        return q
-
-
-def _trajectory(name: str, t: np.ndarray, qs: np.ndarray, contacts: np.ndarray, **extras) -> WholeBodyTrajectory:
-    """From pinocchio configurations (n, 36) to a trajectory."""
-    rpy = np.zeros((len(t), 3))
-    for k, qk in enumerate(qs):
-        x, y, z, w = qk[3:7]
-        rpy[k] = rot_to_rpy(quat_to_rot(np.array([w, x, y, z])))
-    rpy[:, 2] = np.unwrap(rpy[:, 2])
-    return WholeBodyTrajectory(name, t, qs[:, :3].copy(), rpy, qs[:, 7:].copy(), contacts, dict(extras))
-
-
 
 
 # -- the references ------------------------------------------------------------------------------------------
@@ -303,7 +132,7 @@ def lean_reach(ahead_m: float = 0.5, height_m: float = 0.8, side_m: float = -0.2
     qs, q = [], q0
     for sk in s:
         goal = hand0 + sk * (target - hand0)
-        q = ik.solve(q, soles, com_xy, None, np.eye(3), g1.DEFAULT_Q_RAD, hand=("right_hand", goal), hand_weight=100.0,
+        q = ik.solve(q, soles, com_xy, None, np.eye(3), g1.DEFAULT_Q_RAD, hands=[("right_hand", goal)], hand_weight=100.0,
                      pelvis_rot_weight=(10.0, 0.5, 10.0), posture_weight=0.05, iterations=10)
         qs.append(q)
     achieved, _ = ik.frame_pose(qs[int(np.argmax(s))], "right_hand")

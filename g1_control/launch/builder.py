@@ -66,6 +66,15 @@ def make_tracker(launch: LaunchFile) -> Tracker:
         from g1_control.trackers.wbt import WbtPolicyTracker
 
         return WbtPolicyTracker()
+    if cfg.type == "layer":
+        from g1_control.trackers.layer import TrackingLayer
+        from g1_control.trackers.locomotion import LocomotionPolicyTracker, VelocityCorrectionConfig
+        from g1_control.trackers.policy_spec import load_spec
+        from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
+
+        policy = LocomotionPolicyTracker(load_spec(cfg.policy), VelocityCorrectionConfig(enabled=cfg.velocity_correction),
+                                         envelope_limits=cfg.envelope_limits)
+        return TrackingLayer(policy, WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz)), launch.rates.tracker_hz)
     raise LaunchFileError(f"tracker.type: unknown tracker '{cfg.type}'")
 
 
@@ -77,7 +86,10 @@ def command_limits(launch: LaunchFile, tracker_limits: CommandLimits | None) -> 
     return limits if tracker_limits is None else limits.intersect(tracker_limits)
 
 
-def make_generator(launch: LaunchFile, limits: CommandLimits | None = None) -> tuple[Generator, Retargeter]:
+def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
+                   tracker: Tracker | None = None) -> tuple[Generator, Retargeter]:
+    """The generator and retargeter; with tracker.type layer, the launch file's generator inside a
+    GoalGenerator that executes task goals against the scene (g1_control/generator/goals/)."""
     cfg = launch.generator
     if cfg.type == "scripted":
         from g1_control.generator.scripted import TrajectoryGenerator, TrajectoryRetargeter, build_reference
@@ -86,7 +98,17 @@ def make_generator(launch: LaunchFile, limits: CommandLimits | None = None) -> t
         return TrajectoryGenerator(trajectory), TrajectoryRetargeter(trajectory)
     from g1_control.generator.factory import make_generator as make_named
 
-    return make_named(cfg.type, model=cfg.model or None, limits=limits)
+    generator, retargeter = make_named(cfg.type, model=cfg.model or None, limits=limits)
+    if launch.tracker.type != "layer":
+        return generator, retargeter
+    from g1_control.generator.goals.executor import GoalConfig, GoalGenerator, GoalRetargeter
+    from g1_control.trackers.layer import TrackingLayer
+
+    config = GoalConfig()
+    if isinstance(tracker, TrackingLayer):  # the walking policy's own height range (its envelope)
+        config.policy_height_m = tracker.policy.command_limits.pelvis_height_m
+    goals = GoalGenerator(generator, launch.scene, config)
+    return goals, GoalRetargeter(goals, retargeter)
 
 
 def make_sim_backend(launch: LaunchFile) -> MujocoBackend:
@@ -95,7 +117,7 @@ def make_sim_backend(launch: LaunchFile) -> MujocoBackend:
                               "run it with `g1 deploy`, which checks the robot before anything moves")
     from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
 
-    return MujocoBackend(MujocoConfig(physics_dt_s=launch.backend.physics_dt_s, lockstep=True))
+    return MujocoBackend(MujocoConfig(physics_dt_s=launch.backend.physics_dt_s, lockstep=True), scene=launch.scene)
 
 
 def describe_chain(launch: LaunchFile, generator: Generator, retargeter: Retargeter, tracker: Tracker) -> dict[str, str]:
@@ -129,7 +151,7 @@ def build_loop(launch: LaunchFile, *, backend: Backend | None = None, input_devi
 
     tracker = make_tracker(launch)
     limits = command_limits(launch, tracker.command_limits)
-    generator, retargeter = make_generator(launch, limits)
+    generator, retargeter = make_generator(launch, limits, tracker)
     chain = describe_chain(launch, generator, retargeter, tracker)
     if backend is None:
         backend = make_sim_backend(launch)

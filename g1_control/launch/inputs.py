@@ -57,8 +57,9 @@ def _instructed(launch: LaunchFile, device: InputDevice) -> InputDevice:
 
 
 def program_world(launch: LaunchFile):
-    """The named places a program in `launch` may refer to: input.places."""
-    return launch.input.world()
+    """The named places a program in `launch` may refer to: the scene's tables, platforms and boxes
+    and input.places."""
+    return launch.program_world()
 
 
 def make_program_input(launch: LaunchFile, program=None, **kwargs):

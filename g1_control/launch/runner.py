@@ -176,10 +176,18 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
 
         bar = tqdm(total=round(duration, 1), unit="sim s", desc=launch.name, bar_format="{l_bar}{bar}| {n:.1f}/{total} sim s [{elapsed}<{remaining}]")
     ticks_per_update = int(loop.rates.lowlevel_hz)
+    watcher = None
+    if launch.tracker.type == "layer":  # goals: judged from ground truth (g1_control/launch/outcomes.py)
+        from g1_control.launch.outcomes import GoalWatcher
+
+        watcher = GoalWatcher(loop)
+        loop.goal_watcher = watcher  # type: ignore[attr-defined]  # the run folder saves what it saw
     view = _open_viewer(sim) if viewer else None
     web = _open_web(sim, web_port, launch.name) if web_port is not None else None
 
     def on_tick(i: int) -> None:
+        if watcher is not None:
+            watcher.tick(i)
         if bar is not None and (i + 1) % ticks_per_update == 0:
             bar.update(1.0)
             if loop.faulted:
@@ -218,8 +226,16 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
         loop.input.close()
         loop.backend.close()
     result = _result(launch, loop, segments, wall)
+    if watcher is not None:
+        result.extra["goals"] = watcher.outcomes()
     if program is not None:
         from g1_control.program.device import record_dict
+        from g1_control.program.judge import goal_verdict
+
+        by_goal = {o["goal_id"]: o for o in result.extra.get("goals", [])}
+        for r in program.records:  # goal steps: judged by the execution layer's ground-truth figures
+            if r.goal_id in by_goal:
+                r.verdict = goal_verdict(by_goal[r.goal_id])
 
         result.extra["program"] = {"steps": [record_dict(r) for r in program.records],
                                    "finished": program.done and not program.runner.stopped,
@@ -285,6 +301,9 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, o
     (run_dir / "launch.yaml").write_text(yaml.safe_dump(dataclasses.asdict(launch), sort_keys=False))
     # numpy's stub has a keyword `allow_pickle: bool` that mypy matches against **dict[str, ndarray].
     np.savez_compressed(run_dir / "log.npz", **loop.log.arrays())  # type: ignore[arg-type]
+    watcher = getattr(loop, "goal_watcher", None)
+    if watcher is not None:  # ground truth of the goals: hand points, soles, boxes (launch/outcomes.py)
+        np.savez_compressed(run_dir / "truth.npz", **watcher.arrays())
     if launch.output.plot:
         from g1_control.launch.plots import plot_run
 
@@ -296,11 +315,24 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, o
 
         overlay = run_overlay_rows(loop.log.arrays(), result.events, [dataclasses.asdict(s) for s in result.segments])
         backend = render_video(run_dir / "log.npz", run_dir / "video.mp4", launch.output.video_fps,
-                               launch.output.video_size, overlay=overlay)
+                               launch.output.video_size, overlay=overlay, extra=_scene_arrays(launch, loop))
         result.video = str(run_dir / "video.mp4") if backend else None
         result.extra["render_backend"] = backend
     (run_dir / "summary.json").write_text(json.dumps(summary_dict(result), indent=2))
     return run_dir
+
+
+def _scene_arrays(launch: LaunchFile, loop: ControlLoop) -> dict | None:
+    """The scene and where its boxes were (ground truth), for the video; None without a scene."""
+    watcher = getattr(loop, "goal_watcher", None)
+    if launch.scene.empty or watcher is None:
+        return None
+    truth = watcher.arrays()
+    out = {"scene_json": np.asarray(json.dumps(dataclasses.asdict(launch.scene))), "object_t_s": truth["t_s"]}
+    for key, rows in truth.items():
+        if key.startswith("box_") and len(rows):
+            out["object_" + key.removeprefix("box_")] = rows
+    return out
 
 
 def summary_dict(result: RunResult) -> dict:
@@ -354,6 +386,10 @@ def format_summary(result: RunResult) -> str:
         lines.append(f"state estimator velocity RMS error vs ground truth: {result.estimator_rms_mps:.3f} m/s")
     for e in result.events:
         lines.append(f"event at {e['t_s']:.2f} s: {e['kind']}: {e['detail']}")
+    if result.extra.get("goals"):
+        from g1_control.launch.outcomes import outcome_line
+
+        lines += ["", "goals (ground truth):"] + ["  " + outcome_line(o) for o in result.extra["goals"]]
     if result.extra.get("program"):
         lines += ["", program_summary(result.extra["program"])]
     if result.run_dir:

@@ -89,6 +89,8 @@ class StepRecord:
     truth_end: PlanarPose | None = None
     truth_turned_rad: float | None = None
     goal_id: str | None = None
+    message: str | None = None
+    """Why the execution layer failed the step's goal (GoalGenerator.goal_messages), if it did."""
     verdict: Verdict | None = None
     """Set by the judge (g1_control/program/judge.py) when ground truth exists."""
 
@@ -126,6 +128,7 @@ class ProgramInput(InputDevice):
         self._odometry: Odometry | None = None
         self._truth: Callable[[], PlanarPose | None] = lambda: None
         self._goal_status: Mapping[str, str] = {}
+        self._goal_messages: Mapping[str, str] = {}
         self._open: dict[str, _Open] = {}
         self._last_truth_yaw: float | None = None
         self._t0: float | None = None
@@ -138,6 +141,8 @@ class ProgramInput(InputDevice):
         self._truth = lambda: truth_pose(loop.state)
         status = getattr(loop.generator, "goal_status", None)
         self._goal_status = status if isinstance(status, Mapping) else {}
+        messages = getattr(loop.generator, "goal_messages", None)
+        self._goal_messages = messages if isinstance(messages, Mapping) else {}
 
     @property
     def done(self) -> bool:
@@ -199,7 +204,8 @@ class ProgramInput(InputDevice):
         for outcome in runner.outcomes[n:]:
             opened = self._open.pop(outcome.label, None) or _Open(truth)
             record = StepRecord(outcome, runner.step_of(outcome.label), opened.truth_start, truth,
-                                opened.turned if truth is not None else None, opened.goal_id)
+                                opened.turned if truth is not None else None, opened.goal_id,
+                                self._goal_messages.get(opened.goal_id) if opened.goal_id else None)
             if truth is not None:
                 from g1_control.program.judge import judge
 
@@ -230,6 +236,8 @@ def record_dict(record: StepRecord) -> dict:
     out["truth_turned_rad"] = record.truth_turned_rad
     if record.goal_id is not None:
         out["goal_id"] = record.goal_id
+    if record.message:
+        out["message"] = record.message
     if record.verdict is not None:
         v = record.verdict
         out["verdict"] = {"ok": v.ok, "text": v.text, "values": dict(v.values)}

@@ -6,8 +6,9 @@ started in; a turn within 10 degrees (the yaw turned by ground truth, accumulate
 so 360-degree turns count); a walk to a place within 10 % of the way there (at least 5 cm) of
 its stop point; a turn to a heading or a place within 10 degrees of it; a height step within
 5 cm of the height asked for (posture "normal": the walking policy's own, not judged); a goal
-step (reach, pick, place, step) by the execution layer's verdict, which it takes from ground
-truth itself; stands, styles and timed walks by having run their time.
+step (reach, pick, place, step) by the execution layer's ground-truth figures (goal_verdict, from
+g1_control/launch/outcomes.py: where the hand, the box and the feet really were); stands, styles
+and timed walks by having run their time.
 """
 
 from __future__ import annotations
@@ -66,8 +67,9 @@ def judge(record: StepRecord, world: World, program_start: PlanarPose | None,
                        {"pelvis_height_m": got, "error_m": err})
     if isinstance(main, Style):
         return Verdict(done, f"{main.name} held {record.outcome.ended_s - record.outcome.started_s:.1f} s")
-    # goal steps: the execution layer's verdict (it judges reach/pick/place/step from ground truth)
-    return Verdict(done, f"execution layer: {record.outcome.status}")
+    # goal steps: the execution layer's status until its ground-truth figures replace it (goal_verdict,
+    # after the run: g1_control/launch/runner.py)
+    return Verdict(done, f"execution layer: {record.outcome.status}" + (f" ({record.message})" if record.message else ""))
 
 
 def _place_xy(name: str, world: World, program_start: PlanarPose | None) -> tuple[float, float, float]:
@@ -121,4 +123,43 @@ def _turn(t: Turn, turned: float, a: PlanarPose, b: PlanarPose, world: World,
                    {"error_rad": err})
 
 
-__all__ = ["DISTANCE_TOLERANCE", "HEADING_TOLERANCE_RAD", "HEIGHT_TOLERANCE_M", "Verdict", "judge"]
+REACH_TOLERANCE_M = 0.03
+"""A reach: the hand's mean distance to the point over the hold (the execution layer's 3 cm)."""
+PLACE_TOLERANCE_M = 0.05
+PLACE_TILT_DEG = 10.0
+PICK_MIN_RISE_M = 0.05
+
+
+def goal_verdict(outcome: dict) -> Verdict:
+    """A goal step judged from the execution layer's ground-truth figures (g1_control/launch/outcomes.py:
+    judge_goal): reach: mean hand error within 3 cm over the hold; pick: box lifted >= 5 cm and not
+    dropped; place: box within 5 cm of where it was to go, tilted under 10 degrees, not dropped;
+    step up: both feet on the platform at the end; step down: both on the floor. A goal the layer
+    did not reach is missed whatever the figures."""
+    kind, status = outcome.get("kind"), outcome.get("status")
+    reached = status == "reached"
+    why = f" ({outcome['message']})" if outcome.get("message") else ""
+    if kind == "reach" and "hand_error_mean_m" in outcome:
+        err = outcome["hand_error_mean_m"]
+        return Verdict(reached and err <= REACH_TOLERANCE_M, f"hand {err * 1000:.0f} mm from the point (mean over "
+                       f"the hold)" + why, {"hand_error_m": err})
+    if kind == "pick" and "box_rise_m" in outcome:
+        rise, dropped = outcome["box_rise_m"], outcome.get("dropped", False)
+        return Verdict(reached and rise >= PICK_MIN_RISE_M and not dropped,
+                       f"box lifted {rise * 100:.1f} cm" + (", DROPPED" if dropped else "") + why, {"box_rise_m": rise})
+    if kind == "place" and "place_error_xy_m" in outcome:
+        xy, z, tilt = outcome["place_error_xy_m"], outcome["place_error_z_m"], outcome["box_tilt_deg"]
+        ok = reached and xy <= PLACE_TOLERANCE_M and abs(z) <= PLACE_TOLERANCE_M and tilt <= PLACE_TILT_DEG \
+            and not outcome.get("dropped", False)
+        return Verdict(ok, f"box {xy * 100:.1f} cm from its place (z {z * 100:+.1f} cm, tilt {tilt:.1f} deg)" + why,
+                       {"place_error_xy_m": xy, "place_error_z_m": z, "box_tilt_deg": tilt})
+    if kind == "step_up" and "on_top_at_end" in outcome:
+        return Verdict(reached and outcome["on_top_at_end"], f"both feet on the platform {outcome['both_feet_on_top_s']:.1f} s"
+                       + ("" if outcome["on_top_at_end"] else ", NOT on it at the end") + why)
+    if kind == "step_down" and "on_floor_at_end" in outcome:
+        return Verdict(reached and outcome["on_floor_at_end"], ("both feet on the floor" if outcome["on_floor_at_end"]
+                                                                else "NOT back on the floor") + why)
+    return Verdict(False, f"execution layer: {status}" + why)
+
+
+__all__ = ["DISTANCE_TOLERANCE", "HEADING_TOLERANCE_RAD", "HEIGHT_TOLERANCE_M", "Verdict", "goal_verdict", "judge"]

@@ -4,8 +4,9 @@ Each tick the loop fills a ProgramProgress (base x/y/yaw from ground truth or th
 the status of the goals the execution layer is working on) and calls `update(now_s, progress)`.
 The runner turns the current step into a Command (velocity in the heading frame, heading, style,
 pelvis height) and, for reach/pick/place/step steps, a GoalRequest for the execution layer
-(`active_goals`; `Command.goals` carries what the current generator can already express, see
-GoalRequest.to_effector_goals). When a step's condition is met it records a StepOutcome with the
+(`active_goals`; `Command.tasks` carries it as a types.TaskGoal for the goal generator of
+tracker.type layer, GoalRequest.to_task_goal; `Command.goals` what the kinematic generator can
+express, GoalRequest.to_effector_goals). When a step's condition is met it records a StepOutcome with the
 measured value (distance covered, heading error, distance to the place, ...) and moves on.
 
 Walk distances are measured from odometry as the displacement along the direction the walk
@@ -40,7 +41,7 @@ from g1_control.program.steps import (
 )
 from g1_control.program.world import START, World
 from g1_control.robot import g1
-from g1_control.types import Command, EffectorGoal
+from g1_control.types import Command, EffectorGoal, TaskGoal
 
 COMPLETED, TIMED_OUT, FAILED = "completed", "timed_out", "failed"
 REACHED, GOAL_FAILED = "reached", "failed"
@@ -68,6 +69,27 @@ class GoalRequest:
     target: str | None = None
     target_w_m: np.ndarray | None = None
     offset_b_m: np.ndarray | None = None
+    target_kind: str | None = None
+    """The World's kind of `target` (object / surface / platform / point); None without one."""
+
+    def to_task_goal(self) -> TaskGoal:
+        """The goal for the execution layer (types.TaskGoal, g1_control/generator/goals/): same id,
+        so GoalGenerator.goal_status[goal_id] answers ProgramProgress.goal_status. Places are
+        passed by name (a table or platform of the launch file's scene is found by it: a place goes
+        where the execution layer can reach, the middle of the table's near edge) and by point (a
+        named point, the start)."""
+        hand = self.hand if self.hand in ("left", "right", "both") else "right"
+        if self.kind == "reach":
+            return TaskGoal("reach", self.goal_id, hand, pos_w_m=None if self.target_w_m is None else self.target_w_m.copy(),
+                            offset_h_m=None if self.target_w_m is not None or self.offset_b_m is None
+                            else self.offset_b_m.copy())
+        if self.kind == "pick":
+            return TaskGoal("pick", self.goal_id, hand, object=self.object)
+        if self.kind == "place":
+            on_block = self.target_kind in ("surface", "platform")
+            return TaskGoal("place", self.goal_id, hand, object=self.object, target=self.target if on_block else None,
+                            pos_w_m=None if self.target_w_m is None or on_block else self.target_w_m.copy())
+        return TaskGoal(self.kind, self.goal_id, hand, target=self.target)
 
     def to_effector_goals(self) -> list[EffectorGoal]:
         """What today's generator can express (generator.runtime OBJECT_GOALS and hand frames);
@@ -133,7 +155,9 @@ class RunnerConfig:
     timeout_margin_s: float = 5.0
     """A step without timeout_s gets factor x the nominal time + margin (walk/turn), or goal_timeout_s."""
     goal_timeout_s: dict[str, float] = field(default_factory=lambda: {
-        "reach": 15.0, "pick": 45.0, "place": 45.0, "step_up": 30.0, "step_down": 30.0})
+        "reach": 30.0, "pick": 60.0, "place": 90.0, "step_up": 45.0, "step_down": 45.0})
+    """Upper bounds on the execution layer's goals, walking to the work included (MuJoCo, tracker.type
+    layer: pick ~16 s, a 3 m carry and place ~45-50 s, step up ~20 s; notes 15_part2.md)."""
     posture_height_m: dict[str, float | None] = field(default_factory=lambda: {
         "crouch": 0.62, "normal": None, "tall": 0.8})
     """None: the generator's own height for the style."""
@@ -380,12 +404,13 @@ class ProgramRunner:
                 target_w = target_w + np.array([c * off[0] - s * off[1], s * off[0] + c * off[1], off[2]])
             else:
                 offset_b = off
+        kind = None if name is None else "point" if name == START else self.world.get(name, where).kind
         return GoalRequest(
             gid, step.kind,
             hand=getattr(step, "hand", None) or getattr(step, "hands", None),
             object=step.object if isinstance(step, (Pick, Place)) else None,
             target=name if not isinstance(step, Pick) else None,
-            target_w_m=target_w, offset_b_m=offset_b)
+            target_w_m=target_w, offset_b_m=offset_b, target_kind=kind)
 
     # --- per-tick behaviour ------------------------------------------------------------------
     def _turn_remaining(self, a: _Active, t: Turn, p: ProgramProgress) -> float:
@@ -409,6 +434,7 @@ class ProgramRunner:
                     cmd.pelvis_height_m = self._height(s)
             for g in a.goals:
                 cmd.goals.extend(g.to_effector_goals())
+                cmd.tasks.append(g.to_task_goal())
             return self._tick_main(a, step.main, cmd, elapsed, p)
         if isinstance(step, (Walk, Turn, Stand)):
             return self._tick_main(a, step, cmd, elapsed, p)
@@ -428,6 +454,7 @@ class ProgramRunner:
         # goal steps: the execution layer moves; the runner waits for its verdict
         g = a.goals[0]
         cmd.goals.extend(g.to_effector_goals())
+        cmd.tasks.append(g.to_task_goal())
         status = p.goal_status.get(g.goal_id)
         if status == REACHED:
             return cmd, (COMPLETED, {"duration_s": elapsed})

@@ -84,6 +84,11 @@ class WbcModel:
         """Both soles' 6 x nv Jacobians in their LOCAL frames, stacked (left, right)."""
         self.contact_drift_local = np.zeros(12)
         self.contact_vel_local = np.zeros(12)
+        self.hand_forces_w_n = np.zeros((2, 3))
+        """Known forces on the (left, right) hand frames, world axes: what a held object does to
+        the hands (its weight share, the squeeze's reaction). update() folds them into `bias`
+        (bias - J^T f), so the QP's dynamics, torque limits and foot forces account for them and
+        its torques push back."""
 
     def update(self, q: np.ndarray, v: np.ndarray) -> None:
         """Compute M, bias (C v + g), CoM terms and the soles' contact Jacobians at (q, v)."""
@@ -106,6 +111,9 @@ class WbcModel:
             self.contact_jac_local[rows] = pin.getFrameJacobian(m, d, fid, pin.LOCAL)
             self.contact_drift_local[rows] = pin.getFrameAcceleration(m, d, fid, pin.LOCAL).vector
             self.contact_vel_local[rows] = pin.getFrameVelocity(m, d, fid, pin.LOCAL).vector
+        if self.hand_forces_w_n.any():
+            for fid, force in zip(self.hand_ids, self.hand_forces_w_n):
+                self.bias -= pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED)[:3].T @ force
 
     def frame(self, frame_id: int) -> FrameTerms:
         """Kinematics of one frame at the state of the last update()."""

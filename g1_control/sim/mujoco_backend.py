@@ -28,6 +28,7 @@ import numpy as np
 
 from g1_control.interfaces import Backend
 from g1_control.robot import description, g1
+from g1_control.scene import SceneConfig
 from g1_control.types import MotorCommand, RobotState
 
 
@@ -58,11 +59,22 @@ class MujocoConfig:
 
 
 class MujocoBackend(Backend):
-    def __init__(self, config: MujocoConfig | None = None):
+    def __init__(self, config: MujocoConfig | None = None, scene: SceneConfig | None = None):
+        """scene: tables, platforms and boxes around the robot (g1_control/sim/scene.py). The
+        robot's state is read through its own joint addresses, so free boxes in the model do not
+        shift it."""
         self.config = config or MujocoConfig()
         self.lockstep = self.config.lockstep
+        self.scene = scene or SceneConfig()
         self.model = self._compile()
         self.data = mujoco.MjData(self.model)
+        m = self.model
+        base = m.joint(0)  # the robot's floating base is the model's first joint
+        qa, va = int(m.jnt_qposadr[base.id]), int(m.jnt_dofadr[base.id])
+        self._base_q, self._base_v = slice(qa, qa + 7), slice(va, va + 6)
+        # The robot's joints follow its base in the model (objects are added after the robot).
+        self._q = slice(qa + 7, qa + 7 + g1.NUM_JOINTS)
+        self._v = slice(va + 6, va + 6 + g1.NUM_JOINTS)
         self._bias = self.model.actuator_biasprm[:, :3]
         """(b0, b1, b2) per joint: a view into the model, rewritten by write_command."""
         self._law = np.zeros((3, g1.NUM_JOINTS))
@@ -75,8 +87,8 @@ class MujocoBackend(Backend):
         self._quat = slice(adr[self.model.sensor("imu_quat").id], adr[self.model.sensor("imu_quat").id] + 4)
         # What read_state reports, as views into MjData's arrays (MuJoCo keeps them in place).
         d = self.data
-        self._views = (d.qpos[7:], d.qvel[6:], d.actuator_force, d.sensordata[self._quat], d.sensordata[self._gyro],
-                       d.sensordata[self._acc], d.qpos[0:3], d.qvel[0:3])
+        self._views = (d.qpos[self._q], d.qvel[self._v], d.actuator_force, d.sensordata[self._quat],
+                       d.sensordata[self._gyro], d.sensordata[self._acc], d.qpos[qa:qa + 3], d.qvel[va:va + 3])
         self._temperature = np.full(g1.NUM_JOINTS, float(self.config.motor_temperature_c))
         self._push_force_w = np.zeros(3)
         self._push_until_s = -1.0
@@ -92,24 +104,31 @@ class MujocoBackend(Backend):
         self.closed = False
 
     def _compile(self) -> mujoco.MjModel:
-        return motor_law_scene(self.config.physics_dt_s).compile()
+        spec = motor_law_scene(self.config.physics_dt_s)
+        if not self.scene.empty:
+            from g1_control.sim.scene import build_scene
+
+            build_scene(spec, self.scene)
+        return spec.compile()
 
     # -- Backend ---------------------------------------------------------------------------------
     def reset(self, q_rad: np.ndarray | None = None, base_pos_xy_m=(0.0, 0.0), yaw_rad: float = 0.0) -> RobotState:
         """Stand the robot at `q_rad` (default pose) with its lowest foot point on the floor."""
         mujoco.mj_resetData(self.model, self.data)
         q = g1.DEFAULT_Q_RAD if q_rad is None else np.asarray(q_rad, dtype=float)
-        self.data.qpos[7:] = q
-        self.data.qpos[3:7] = [np.cos(yaw_rad / 2), 0.0, 0.0, np.sin(yaw_rad / 2)]
-        self.data.qpos[0:2] = base_pos_xy_m
-        self.data.qpos[2] = 1.0
+        base = self.data.qpos[self._base_q]
+        self.data.qpos[self._q] = q
+        base[3:7] = [np.cos(yaw_rad / 2), 0.0, 0.0, np.sin(yaw_rad / 2)]
+        base[0:2] = base_pos_xy_m
+        base[2] = 1.0
         mujoco.mj_kinematics(self.model, self.data)
+        m, robot = self.model, self.model.body(g1.BASE_BODY).id
         lowest = min(
-            self.data.geom_xpos[i][2] - (self.model.geom_size[i][0] if self.model.geom_type[i] == mujoco.mjtGeom.mjGEOM_SPHERE else 0.0)
-            for i in range(self.model.ngeom)
-            if self.model.geom_conaffinity[i] and self.model.geom_bodyid[i] != 0
+            self.data.geom_xpos[i][2] - (m.geom_size[i][0] if m.geom_type[i] == mujoco.mjtGeom.mjGEOM_SPHERE else 0.0)
+            for i in range(m.ngeom)
+            if m.geom_conaffinity[i] and m.geom_bodyid[i] != 0 and m.body_rootid[m.geom_bodyid[i]] == robot
         )
-        self.data.qpos[2] += -lowest + self.config.init_height_clearance_m
+        base[2] += -lowest + self.config.init_height_clearance_m
         self.write_command(MotorCommand(q_rad=q.copy(), kp=g1.KP_DEFAULT.copy(), kd=g1.KD_DEFAULT.copy()))
         self._tick = 0
         self._push_until_s = -1.0
@@ -196,6 +215,12 @@ class MujocoBackend(Backend):
         self._push_force_w = np.asarray(force_w_n, dtype=float)
         self._push_until_s = self.data.time + duration_s
         self._pushing = True
+
+    def object_pose(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """(position, quaternion wxyz) of a scene box, from the simulator's state."""
+        from g1_control.sim.scene import free_body_pose
+
+        return free_body_pose(self.model, self.data, name)
 
     @property
     def time_s(self) -> float:

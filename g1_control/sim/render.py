@@ -7,7 +7,9 @@ Without a GPU both render in software; without multisampling, shadows and reflec
 ~0.04 s per 480x360 frame instead of ~1 s.
 
 The trajectory file holds t_s, base_pos_m, base_quat_wxyz and q_rad per row (a run's log.npz is
-one) and optionally `overlay`: one text per row, drawn in the frame's top-left corner.
+one) and optionally `overlay`: one text per row, drawn in the frame's top-left corner; `scene_json`
+(a SceneConfig, g1_control/scene.py: its tables, platforms and boxes are drawn) with
+`object_t_s` and `object_<box>` (position + quaternion per sample: where each box was).
 """
 
 from __future__ import annotations
@@ -25,16 +27,21 @@ TRAJECTORY_KEYS = ("t_s", "base_pos_m", "base_quat_wxyz", "q_rad")
 
 
 def render_video(log_path: Path, out_path: Path, fps: float = 10.0, size=(480, 360), quiet: bool = False,
-                 overlay: Sequence[str] | None = None, frame_at_s: float | None = None) -> str | None:
+                 overlay: Sequence[str] | None = None, frame_at_s: float | None = None,
+                 extra: dict | None = None) -> str | None:
     """Render the trajectory in `log_path` to `out_path` (MP4); returns the GL backend used, or None
     if none works. `overlay`: one text per row of the log, drawn on each frame. `frame_at_s`: write
-    only the frame at that time, as a PNG."""
-    if overlay is not None:
+    only the frame at that time, as a PNG. `extra`: more arrays for the trajectory file (the scene
+    and its boxes, module docstring)."""
+    if overlay is not None or extra:
         import numpy as np
 
         with np.load(log_path) as log, tempfile.TemporaryDirectory(prefix="g1-render-") as tmp:
             traj = Path(tmp) / "trajectory.npz"
-            np.savez(traj, overlay=np.asarray(list(overlay), dtype=str), **{k: log[k] for k in TRAJECTORY_KEYS})
+            more = dict(extra or {})
+            if overlay is not None:
+                more["overlay"] = np.asarray(list(overlay), dtype=str)
+            np.savez(traj, **more, **{k: log[k] for k in TRAJECTORY_KEYS})
             return render_video(traj, out_path, fps, size, quiet, None, frame_at_s)
     cmd = [sys.executable, "-m", "g1_control.sim.render", str(log_path), str(out_path),
            "--fps", str(fps), "--size", str(size[0]), str(size[1])]
@@ -55,12 +62,21 @@ def render_video(log_path: Path, out_path: Path, fps: float = 10.0, size=(480, 3
     return None
 
 
-def _video_model():
+def _video_model(scene_json: str | None = None):
     """The scene without multisampling and shadow maps: in software rendering those cost ~25x
     (1.1 s vs 0.04 s per 320x240 frame, measured with Mesa's llvmpipe)."""
     from g1_control.robot import description
 
-    model = description.mujoco_spec().compile()
+    spec = description.mujoco_spec()
+    if scene_json:
+        import json
+
+        from g1_control.config import from_dict
+        from g1_control.scene import SceneConfig
+        from g1_control.sim.scene import build_scene
+
+        build_scene(spec, from_dict(SceneConfig, json.loads(scene_json), "scene"))
+    model = spec.compile()
     model.vis.quality.offsamples = 0
     model.vis.quality.shadowsize = 0
     return model
@@ -120,8 +136,15 @@ def _render(log_path: Path, out_path: Path, fps: float, size: tuple[int, int], q
     overlay = log["overlay"] if "overlay" in log.files else None
     if len(t) == 0 or np.isnan(pos).all():
         raise SystemExit("log has no ground-truth base pose to replay")
-    model = _video_model()
+    scene_json = str(log["scene_json"]) if "scene_json" in log.files else None
+    model = _video_model(scene_json)
     data = mujoco.MjData(model)
+    objects = []  # (qpos address, samples, their times) per box
+    if scene_json:
+        for key in log.files:
+            if key.startswith("object_") and key != "object_t_s":
+                joint = model.joint(f"{key.removeprefix('object_')}_free")
+                objects.append((int(model.jnt_qposadr[joint.id]), log[key], log["object_t_s"]))
     renderer = mujoco.Renderer(model, height=size[1], width=size[0])
     camera = mujoco.MjvCamera()
     camera.type = mujoco.mjtCamera.mjCAMERA_TRACKING
@@ -129,7 +152,10 @@ def _render(log_path: Path, out_path: Path, fps: float, size: tuple[int, int], q
     camera.distance, camera.elevation, camera.azimuth = 3.0, -15.0, 135.0
 
     def frame(i: int):
-        data.qpos[:3], data.qpos[3:7], data.qpos[7:] = pos[i], quat[i], q[i]
+        data.qpos[:3], data.qpos[3:7], data.qpos[7:7 + q.shape[1]] = pos[i], quat[i], q[i]
+        for adr, poses, times in objects:
+            k = int(np.searchsorted(times, t[i]).clip(0, len(times) - 1))
+            data.qpos[adr:adr + 7] = poses[k]
         mujoco.mj_forward(model, data)  # also the subtree CoM the tracking camera follows
         renderer.update_scene(data, camera)
         _cheap_scene(renderer)

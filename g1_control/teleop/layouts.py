@@ -9,6 +9,10 @@ rest at 0 in [0, 1]). Default mappings follow the conventions operators of the G
   forward/back -> vx, left stick left/right -> vy, right stick left/right -> yaw rate.
 - Amazon FAR's holosoma-inference 0.1.3 (inputs/impl/joystick.py, interface.py): `A` start,
   `B` stop, `L1+R1` kill, `X` switch mode; vx = ly, vy = -lx, wz = -rx with a 0.1 deadzone.
+
+Goal buttons (issue 17; executed by tracker.type layer against the launch file's scene): `Y` picks
+the box in front, `LB+Y` / `L1+Y` sets it down in front, d-pad up steps onto the platform in front,
+d-pad down steps back off it (keyboard: p, l, u, n).
 """
 
 from __future__ import annotations
@@ -58,6 +62,7 @@ GAMEPAD_DEFAULT_MAPPING: dict[str, Any] = {
     "buttons": {
         "start": "start", "A": "run", "B": "stop", "back": "damp", "LB+RB": "estop",
         "X": "policy_switch", "dpad_right": "style_next", "dpad_left": "style_prev",
+        "Y": "pick", "LB+Y": "place", "dpad_up": "step_up", "dpad_down": "step_down",
     },
     "slew_rate": {"vx": 1.0, "vy": 1.0, "wz": 2.0},
     "speed_scale_range": [0.5, 1.0],
@@ -78,6 +83,7 @@ REMOTE_DEFAULT_MAPPING: dict[str, Any] = {
     "buttons": {
         "start": "start", "A": "run", "B": "stop", "select": "damp", "L1+R1": "estop",
         "X": "policy_switch", "right": "style_next", "left": "style_prev",
+        "Y": "pick", "L1+Y": "place", "up": "step_up", "down": "step_down",
     },
     "slew_rate": {"vx": 1.0, "vy": 1.0, "wz": 2.0},
 }
@@ -112,6 +118,7 @@ KEYBOARD_DEFAULT_MAPPING: dict[str, Any] = {
     "buttons": {
         "enter": "start", "r": "run", "o": "stop", "x": "damp", "esc": "estop",
         "space": "zero_velocity", "tab": "policy_switch", "]": "style_next", "[": "style_prev",
+        "p": "pick", "l": "place", "u": "step_up", "n": "step_down",
         "/": "instruction",
     },
     "slew_rate": {"vx": 1.0, "vy": 1.0, "wz": 2.0},

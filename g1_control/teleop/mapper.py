@@ -11,9 +11,9 @@ import math
 from dataclasses import dataclass
 
 from g1_control.teleop.layouts import STICK
-from g1_control.teleop.mapping import LINE_ACTION, MappingConfig
+from g1_control.teleop.mapping import GOAL_ACTIONS, LINE_ACTION, MappingConfig
 from g1_control.teleop.snapshot import InputSnapshot
-from g1_control.types import BUTTONS, Button, Command, CommandLimits
+from g1_control.types import BUTTONS, Button, Command, CommandLimits, TaskGoal
 
 _STOPPING_ACTIONS = frozenset({Button.ESTOP, Button.DAMP, Button.STOP, "zero_velocity", LINE_ACTION})
 """Typing a line (LINE_ACTION) stops the robot too: it stands while the operator types."""
@@ -44,6 +44,7 @@ class CommandMapper:
         self._style_index = 0
         self._prev_held: frozenset[str] = frozenset()
         self._last_t_s: float | None = None
+        self._goals = 0
 
     @property
     def style(self) -> str:
@@ -111,8 +112,12 @@ class CommandMapper:
         if "pelvis_height" in self.config.axes:
             low, high = self.limits.pelvis_height_m
             height = high - (high - low) * self._shaped("pelvis_height", snapshot)
+        tasks = []
+        for action in sorted(actions & set(GOAL_ACTIONS)):  # a goal per press (its id is new each time)
+            self._goals += 1
+            tasks.append(TaskGoal(GOAL_ACTIONS[action], goal_id=f"teleop.{self._goals}"))
         return Command(vx_mps=vx, vy_mps=vy, wz_radps=wz, heading_rad=heading, style=self.style,
-                       pelvis_height_m=height, buttons=frozenset(actions & BUTTONS))
+                       pelvis_height_m=height, buttons=frozenset(actions & BUTTONS), tasks=tasks)
 
     # -- parts ------------------------------------------------------------------------------
     def _raw_axis(self, name: str, snapshot: InputSnapshot) -> float:

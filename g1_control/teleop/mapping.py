@@ -30,10 +30,14 @@ from g1_control.types import BUTTONS
 AXIS_FIELDS = {"vx": STICK, "vy": STICK, "wz": STICK, "speed_scale": TRIGGER, "pelvis_height": TRIGGER}
 """Command fields an axis can drive, and the kind of axis each expects."""
 SLEW_FIELDS = ("vx", "vy", "wz")
+GOAL_ACTIONS = {"pick": "pick", "place": "place", "step_up": "step_up", "step_down": "step_down"}
+"""Actions that start a task goal (types.TaskGoal) against the scene: pick the box in front, set
+the held box down in front (on a table or platform there, else on the floor), step onto the
+platform in front, step back down. Executed by tracker.type layer (g1_control/generator/goals/)."""
 LINE_ACTION = "instruction"
 """Keyboard: enter line mode to type an English instruction (teleop/keyboard.py); stops the robot."""
-ACTIONS = BUTTONS | {"zero_velocity", LINE_ACTION}
-"""What a button can do: every Command button, plus zero_velocity (handled inside the mapping) and,
+ACTIONS = BUTTONS | {"zero_velocity", LINE_ACTION} | set(GOAL_ACTIONS)
+"""What a button can do: every Command button, zero_velocity (handled inside the mapping), goals and,
 on a keyboard, instruction (line mode)."""
 YAW_MODES = ("rate", "heading")
 

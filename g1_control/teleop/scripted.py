@@ -4,13 +4,46 @@ from __future__ import annotations
 
 import bisect
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
 from g1_control.errors import LaunchFileError
 from g1_control.interfaces import InputDevice
-from g1_control.types import Command
+from g1_control.types import Command, TaskGoal
+
+
+@dataclass
+class GoalEntry:
+    """A goal in a timeline segment (g1_control.types.TaskGoal, as a launch file writes it)."""
+
+    kind: Literal["reach", "pick", "place", "step_up", "step_down"]
+    hand: Literal["left", "right", "both"] = "right"
+    object: str | None = None
+    """pick / place: a box of the scene (none: the nearest box in front / the one held)."""
+    target: str | None = None
+    """place: a table or platform of the scene; step_up: a platform (none: the nearest in front)."""
+    pos_w_m: tuple[float, float, float] | None = None
+    """reach: the point (world); place: where the box's centre goes (xy; z from the surface)."""
+    offset_h_m: tuple[float, float, float] | None = None
+    """reach: the hand's standing position moved by this (x forward, y left, z up)."""
+
+    def validate(self, where: str) -> None:
+        if self.kind == "reach" and (self.pos_w_m is None) == (self.offset_h_m is None):
+            raise LaunchFileError(f"{where}: a reach goal needs pos_w_m or offset_h_m (one of them)")
+        if self.kind != "reach" and self.offset_h_m is not None:
+            raise LaunchFileError(f"{where}.offset_h_m: only a reach goal takes an offset")
+        if self.kind in ("step_up", "step_down", "pick") and self.pos_w_m is not None:
+            raise LaunchFileError(f"{where}.pos_w_m: a {self.kind} goal takes no point (name the "
+                                  f"{'object' if self.kind == 'pick' else 'target'} instead)")
+        if self.kind == "pick" and self.target is not None:
+            raise LaunchFileError(f"{where}.target: a pick goal names its box with `object`")
+
+    def to_goal(self, goal_id: str) -> TaskGoal:
+        return TaskGoal(self.kind, goal_id, self.hand, self.object, self.target,
+                        None if self.pos_w_m is None else np.asarray(self.pos_w_m, dtype=float),
+                        None if self.offset_h_m is None else np.asarray(self.offset_h_m, dtype=float))
 
 
 @dataclass
@@ -25,6 +58,9 @@ class Segment:
     style: str = "default"
     pelvis_height_m: float | None = None
     """A pelvis height to hold (m above the ground); None: the tracker's own."""
+    goals: list[GoalEntry] = field(default_factory=list)
+    """Goals started when the segment starts (they run to their end, past the segment's if need be;
+    the next ones queue behind them). Their ids are 'seg<i>.<j>'."""
 
     def validate(self, where: str) -> None:
         if self.duration_s <= 0:
@@ -57,8 +93,9 @@ class ScriptedInput(InputDevice):
         self.starts = np.concatenate([[0.0], np.cumsum([s.duration_s for s in self.segments])])
         self._commands = [
             Command(vx_mps=s.vx_mps, vy_mps=s.vy_mps, wz_radps=s.wz_radps, style=s.style,
-                    pelvis_height_m=s.pelvis_height_m).validate()
-            for s in self.segments
+                    pelvis_height_m=s.pelvis_height_m,
+                    tasks=[g.to_goal(f"seg{i}.{j}") for j, g in enumerate(s.goals)]).validate()
+            for i, s in enumerate(self.segments)
         ] + [Command()]
 
     @property

@@ -63,6 +63,11 @@ class Verdict:
     hand_error_m: float | None = None
     object_error_m: float | None = None
     note: str = ""
+    count: int = 1
+    """How many goals the trial judged (a sequence of reaches, of heights); 1 for one behaviour."""
+    successes: int | None = None
+    """Of those, how many met the goal (None: the trial's `success`)."""
+    height_error_m: float | None = None
 
 
 @dataclass
@@ -167,6 +172,9 @@ def behaviours() -> list[Behaviour]:
                           lambda seed: push_trials(False, seed), judge_survive, min_success=0.9))
     rows.append(Behaviour("push.walk.vx0.3", f"{PUSH_N:.0f} N x {PUSH_S} s from 4 directions walking at 0.3 m/s: "
                           "no fall in >= 90 %", lambda seed: push_trials(True, seed), judge_survive, min_success=0.9))
+    from g1_control.tools.execution_goals import goal_behaviours
+
+    rows += goal_behaviours(Behaviour, Verdict)
     return rows
 
 
@@ -177,14 +185,18 @@ def _worst(values: list[float | None]) -> float | None:
 
 
 def run_behaviour(behaviour: Behaviour, seed: int = 0, video_dir: Path | None = None,
-                  timings: list[np.ndarray] | None = None) -> Row:
-    """Run every trial of `behaviour`; `timings` collects the tracker stage's per-tick seconds."""
+                  timings: list[np.ndarray] | None = None,
+                  layer_cpu: list[tuple[np.ndarray, np.ndarray]] | None = None) -> Row:
+    """Run every trial of `behaviour`; `timings` collects the tracker stage's per-tick seconds (50 Hz
+    trials), `layer_cpu` the tracking layer's per-tick CPU time and what ran (layer trials)."""
     trials = behaviour.trials(seed)
     verdicts, sim_s, wall_s, falls = [], 0.0, 0.0, 0
     video = None
     for i, trial in enumerate(trials):
         log_path = video_dir / f"{behaviour.name}.npz" if (video_dir is not None and i == 0) else None
-        result = run_trial(trial, log_path=log_path, samples=timings)
+        result = run_trial(trial, log_path=log_path, samples=timings if trial.tracker != "layer" else None)
+        if layer_cpu is not None and result.layer_cpu is not None:
+            layer_cpu.append(result.layer_cpu)
         verdicts.append(behaviour.judge(result))
         sim_s += result.sim_s
         wall_s += result.wall_s
@@ -194,14 +206,15 @@ def run_behaviour(behaviour: Behaviour, seed: int = 0, video_dir: Path | None = 
 
             out = log_path.with_suffix(".mp4")
             video = str(out) if render_video(log_path, out, fps=15, size=(480, 360), quiet=True) else None
-    successes = sum(v.success for v in verdicts)
+    successes = sum(int(v.success) if v.successes is None else v.successes for v in verdicts)
+    count = sum(v.count for v in verdicts)
     notes = [f"{t.name}: {v.note}" for t, v in zip(trials, verdicts) if v.note and (not v.success or len(trials) == 1)]
     return Row(
-        behaviour.name, behaviour.goal, len(trials), successes, falls,
+        behaviour.name, behaviour.goal, count, successes, falls,
         _worst([v.velocity_error_pct for v in verdicts]), _worst([v.drift for v in verdicts]),
         _worst([v.upper_body_rms_rad for v in verdicts]), _worst([v.hand_error_m for v in verdicts]),
         _worst([v.object_error_m for v in verdicts]), sim_s / wall_s if wall_s > 0 else math.inf,
-        successes >= math.ceil(behaviour.min_success * len(trials) - 1e-9), notes, video)
+        successes >= math.ceil(behaviour.min_success * count - 1e-9), notes, video)
 
 
 def _fmt(value: float | None, spec: str) -> str:
@@ -285,8 +298,9 @@ def main(args) -> int:
     print(HEADER)
     rows: list[Row] = []
     samples: list[np.ndarray] = []
+    layer_cpu: list[tuple[np.ndarray, np.ndarray]] = []
     for behaviour in chosen:
-        row = run_behaviour(behaviour, seed, video_dir, samples)
+        row = run_behaviour(behaviour, seed, video_dir, samples, layer_cpu)
         rows.append(row)
         print(format_row(row), flush=True)
     cost = cost_summary(samples)
@@ -296,6 +310,12 @@ def main(args) -> int:
           f"p99 {cost['p99_us']:.0f} us, max {cost['max_us']:.0f} us -> margin {cost['margin_p99']:.1f}x at p99 "
           f"(goal >= 2x); full loop real-time factor {min(rtf):.1f}-{max(rtf):.1f}x over {sim} trials; "
           f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    goal_layer = None
+    if layer_cpu:
+        from g1_control.tools.execution_goals import layer_cpu_summary
+
+        goal_layer = layer_cpu_summary(layer_cpu)
+        print(goal_layer["text"])
     layer = layer_cost()
     st, bare = layer["styled"], layer["bare"]
     print(f"tracking layer act() replayed ({layer['ticks']} ticks, interleaved), wall p50/p99: styled "
@@ -311,6 +331,7 @@ def main(args) -> int:
     if args.json:
         Path(args.json).write_text(json.dumps({"seed": seed, "rows": [dataclasses.asdict(r) for r in rows],
                                                "tracking_cost": cost, "layer_cost": layer,
+                                               "goal_layer_cost": goal_layer,
                                                "load_average_1min": os.getloadavg()[0]}, indent=1))
     if fell or missed:
         print(f"FAILED: {sum(r.falls for r in rows)} trial(s) fell; goals missed: {', '.join(missed) or 'none'}")

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, cast
 import numpy as np
 
 from g1_control.safety.fall import Fall
+from g1_control.scene import SceneConfig
 from g1_control.teleop.scripted import Segment
 
 if TYPE_CHECKING:
@@ -47,6 +48,10 @@ class Trial:
     policy: str = "holosoma_loco_ppo"
     envelope_limits: bool = True
     """False: the policy's trained command range instead of the measured envelope (the envelope bench)."""
+    tracker: str = "policy"
+    """'layer': the tracking layer (walking policy + WBC) that executes goals, at tracker_hz."""
+    tracker_hz: float = 50.0
+    scene: SceneConfig | None = None
 
 
 @dataclass
@@ -58,6 +63,10 @@ class TrialResult:
     wall_s: float
     tracker_us: tuple[float, float]
     """The tracker stage's p50 and p99 (us) in this run."""
+    goals: list[dict] = field(default_factory=list)
+    """Goal outcomes from ground truth (g1_control/launch/outcomes.py), tracker 'layer' only."""
+    layer_cpu: tuple[np.ndarray, np.ndarray] | None = None
+    """The tracking layer's act() thread CPU time (s) and what ran (0 policy, 1 WBC, 2 both)."""
 
     @property
     def fell(self) -> bool:
@@ -113,6 +122,11 @@ def trial_launch(trial: Trial):
     launch.generator.type = trial.generator  # type: ignore[assignment]
     launch.tracker.policy = trial.policy
     launch.tracker.envelope_limits = trial.envelope_limits
+    launch.tracker.type = trial.tracker  # type: ignore[assignment]
+    launch.rates.tracker_hz = trial.tracker_hz
+    if trial.scene is not None:
+        launch.scene = trial.scene
+    launch.validate("trial")
     launch.output.video, launch.output.plot, launch.viewer = False, False, False
     return launch
 
@@ -135,6 +149,11 @@ def run_trial(trial: Trial, *, log_path: Path | None = None, stop_on_fall: bool 
     launch = trial_launch(trial)
     loop = build_loop(launch)
     loop.reset()
+    watcher = None
+    if trial.tracker == "layer":
+        from g1_control.launch.outcomes import GoalWatcher
+
+        watcher = GoalWatcher(loop)
     duration = launch.total_duration_s
     marks = sorted({p.t_s for p in trial.pushes if p.t_s < duration} | set(np.arange(1.0, duration, 1.0).tolist()))
     marks.append(duration)
@@ -143,7 +162,7 @@ def run_trial(trial: Trial, *, log_path: Path | None = None, stop_on_fall: bool 
     try:
         for mark in marks:
             if mark > loop.time_s + 1e-9:
-                loop.run(mark - loop.time_s)
+                loop.run(mark - loop.time_s, progress=watcher.tick if watcher is not None else None)
             push = pushes.get(mark)
             if push is not None:
                 sim = cast("MujocoBackend", loop.backend)
@@ -161,4 +180,6 @@ def run_trial(trial: Trial, *, log_path: Path | None = None, stop_on_fall: bool 
     if samples is not None:
         times = loop.scheduler.times["tracker"]
         samples.append(times.samples[: min(times.count, times.capacity)].copy())
-    return TrialResult(trial, log, loop.fall, float(loop.time_s), wall, (timing["p50_us"], timing["p99_us"]))
+    layer_cpu = loop.tracker.cpu_samples() if hasattr(loop.tracker, "cpu_samples") else None
+    return TrialResult(trial, log, loop.fall, float(loop.time_s), wall, (timing["p50_us"], timing["p99_us"]),
+                       watcher.outcomes() if watcher is not None else [], layer_cpu)

@@ -172,7 +172,9 @@ class WholeBodyTracker(Tracker):
         stance = scheduled | unloading
 
         # 1. floating-base state
-        est = self.estimator.update(state)
+        # Leg-kinematics velocity from the scheduled stance feet (the lower foot is not the stance
+        # foot on a step: with it, a trailing foot swinging up read as the body falling, measured).
+        est = self.estimator.update(state, scheduled if scheduled.all() or not stance.all() else stance)
         quat = state.imu_quat_wxyz
         rot = quat_to_rot(quat)
         q, v = self._q, self._v
@@ -182,6 +184,7 @@ class WholeBodyTracker(Tracker):
         v[:3] = rot.T @ est.base_linvel_w_mps
         v[3:6] = state.imu_gyro_radps
         v[6:] = state.dq_radps
+        dyn.hand_forces_w_n[:] = reference.hand_forces_w_n
         dyn.update(q, v)
         sole_pos_before = np.array([dyn.data.oMf[f].translation for f in dyn.sole_ids])
         offsets = sole_pos_before - q[:3]

@@ -1,0 +1,158 @@
+"""Goals judged from the simulator's ground truth: where the hands, the boxes and the feet really
+were, against what each goal asked (not against the generator's own status).
+
+    watcher = GoalWatcher(loop)          # a loop built from a launch file with a scene or goals
+    loop.run(T, progress=watcher.tick)   # records at `record_hz`
+    watcher.outcomes()                   # one dict per goal (see judge_goal)
+
+Figures per goal kind:
+  reach      hand point (wrist-yaw link + 0.1 m, the controller's hand frame) vs the point over the
+             goal's hold window: mean and max error, fraction of the hold within REACH_TOLERANCE_M
+  pick       box rise above where it stood (held), slip (box sinking relative to the hands while
+             held), dropped (box more than DROP_M below its held height, or back on a surface
+             before a place)
+  place      box centre at the end vs where it was to go (horizontal and vertical), box tilt
+  step_up    time with both soles on the platform's top; step_down: both soles on the floor at the end
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from g1_control.robot import g1
+from g1_control.robot.dynamics import HAND_OFFSET_M, SOLE_OFFSET_M
+
+if TYPE_CHECKING:
+    from g1_control.loop.control_loop import ControlLoop
+
+REACH_TOLERANCE_M = 0.03
+DROP_M = 0.05
+
+
+class GoalWatcher:
+    """Records ground truth while a loop runs (MuJoCo backends only) and judges its goals."""
+
+    def __init__(self, loop: ControlLoop, record_hz: float = 50.0):
+        self.loop = loop
+        sim = loop.backend
+        self.model, self.data = sim.model, sim.data  # type: ignore[attr-defined]
+        m = self.model
+        self.every = max(1, round(loop.rates.lowlevel_hz / record_hz))
+        self.hands = [m.body(n).id for n in g1.HAND_BODIES]
+        self.feet = [m.body(n).id for n in g1.FOOT_BODIES]
+        scene = getattr(sim, "scene", None)
+        self.boxes = [b.name for b in scene.boxes] if scene is not None else []
+        self.t: list[float] = []
+        self.hand_w: list[np.ndarray] = []
+        self.sole_w: list[np.ndarray] = []
+        self.box_w: dict[str, list[np.ndarray]] = {b: [] for b in self.boxes}
+
+    def tick(self, i: int) -> None:
+        if i % self.every:
+            return
+        d = self.data
+        self.t.append(float(d.time))
+        self.hand_w.append(np.array([d.xpos[b] + d.xmat[b].reshape(3, 3) @ HAND_OFFSET_M for b in self.hands]))
+        self.sole_w.append(np.array([d.xpos[b] + d.xmat[b].reshape(3, 3) @ SOLE_OFFSET_M for b in self.feet]))
+        for name in self.boxes:
+            pos, quat = self.loop.backend.object_pose(name)  # type: ignore[attr-defined]
+            self.box_w[name].append(np.concatenate([pos, quat]))
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        out = {"t_s": np.array(self.t), "hands_w_m": np.array(self.hand_w), "soles_w_m": np.array(self.sole_w)}
+        for name, rows in self.box_w.items():
+            out[f"box_{name}"] = np.array(rows)
+        return out
+
+    def outcomes(self) -> list[dict]:
+        gen = self.loop.generator
+        info = getattr(gen, "goal_info", {})
+        messages = getattr(gen, "goal_messages", {})
+        a = self.arrays()
+        return [dict(judge_goal(gid, dict(i), a), message=messages.get(gid)) for gid, i in info.items()]
+
+
+def judge_goal(goal_id: str, info: dict, a: dict[str, np.ndarray]) -> dict:
+    """Ground-truth figures for one goal (module docstring); `info` from GoalGenerator.goal_info."""
+    out = {"goal_id": goal_id, "kind": info.get("kind"), "describe": info.get("describe"),
+           "status": info.get("status") or "unfinished", "start_s": info.get("start_s"), "end_s": info.get("end_s")}
+    t = a["t_s"]
+    if len(t) == 0:
+        return out
+    kind = info.get("kind")
+    if kind == "reach" and "hold_s" in info:
+        t0, t1 = info["hold_s"]
+        rows = (t >= t0) & (t <= t1)
+        target = np.asarray(info["target_w_m"])
+        hands = {"left": [0], "right": [1], "both": [0, 1]}[info.get("hand", "right")]
+        if rows.any() and info.get("hand") != "both":
+            err = np.linalg.norm(a["hands_w_m"][rows][:, hands[0]] - target, axis=1)
+            out.update(hand_error_mean_m=float(err.mean()), hand_error_max_m=float(err.max()),
+                       within_tolerance=float((err <= REACH_TOLERANCE_M).mean()), hold_samples=int(rows.sum()))
+    elif kind == "pick" and info.get("box") and f"box_{info['box']}" in a:
+        box = a[f"box_{info['box']}"][:, :3]
+        start = np.asarray(info["box_start_w_m"])
+        held = t >= info.get("held_from_s", np.inf)
+        end = t <= (info.get("end_s") or t[-1])
+        rows = held & end
+        if rows.any():
+            rise = box[rows, 2] - start[2]
+            hands_z = a["hands_w_m"][rows][:, :, 2].mean(axis=1)
+            rel = (box[rows, 2] - hands_z) - (box[rows, 2][0] - hands_z[0])
+            out.update(box_rise_m=float(rise.mean()), slip_m=float(max(0.0, -rel.min())),
+                       dropped=bool(rise.min() < info.get("lift_m", 0.1) - DROP_M))
+    elif kind == "place" and info.get("box") and f"box_{info['box']}" in a:
+        rows = a[f"box_{info['box']}"]
+        final, target = rows[-1], np.asarray(info["target_w_m"])
+        qx, qy = final[4], final[5]
+        up = 1.0 - 2.0 * (qx * qx + qy * qy)  # the box's z axis against the world's
+        out.update(place_error_xy_m=float(np.linalg.norm(final[:2] - target[:2])),
+                   place_error_z_m=float(final[2] - target[2]),
+                   box_tilt_deg=float(math.degrees(math.acos(max(-1.0, min(1.0, up))))),
+                   box_final_w_m=final[:3].tolist())
+        if "start_s" in info:
+            carried = (t >= info["start_s"]) & (t <= info.get("released_s", t[-1]))
+            if carried.any():
+                hands_z = a["hands_w_m"][carried][:, :, 2].mean(axis=1)
+                rel = rows[carried, 2] - hands_z
+                out["dropped"] = bool(rel.min() < rel[0] - DROP_M)
+    elif kind in ("step_up", "step_down"):
+        soles = a["soles_w_m"]
+        h = info.get("height_m", 0.15)
+        window = (t >= (out["start_s"] or 0.0)) & (t <= (out["end_s"] or t[-1]))
+        up = (soles[:, :, 2] > h - 0.015).all(axis=1)
+        if kind == "step_up":
+            out["both_feet_on_top_s"] = float(up[window].sum() * np.median(np.diff(t))) if window.any() else 0.0
+            out["on_top_at_end"] = bool(up[window][-1]) if window.any() else False
+        else:
+            down = (soles[:, :, 2] < 0.015).all(axis=1)
+            out["on_floor_at_end"] = bool(down[window][-1]) if window.any() else False
+    return out
+
+
+def outcome_line(o: dict) -> str:
+    """One line per goal for a run summary."""
+    text = f"goal {o['goal_id']} ({o.get('describe')}): {o['status']}"
+    msg = o.get("message")
+    if o.get("kind") == "reach" and "hand_error_mean_m" in o:
+        text += (f"; hand within {REACH_TOLERANCE_M * 100:.0f} cm {100 * o['within_tolerance']:.0f} % of the hold, "
+                 f"mean error {o['hand_error_mean_m'] * 1000:.0f} mm")
+    if "box_rise_m" in o:
+        text += f"; box lifted {o['box_rise_m'] * 100:.1f} cm, slip {o['slip_m'] * 1000:.0f} mm" + \
+            (", DROPPED" if o["dropped"] else "")
+    if "place_error_xy_m" in o:
+        text += (f"; box {o['place_error_xy_m'] * 100:.1f} cm from where it was to go (z {o['place_error_z_m'] * 100:+.1f} cm, "
+                 f"tilt {o['box_tilt_deg']:.1f} deg)") + (", DROPPED on the way" if o.get("dropped") else "")
+    if "both_feet_on_top_s" in o:
+        text += f"; both feet on the platform {o['both_feet_on_top_s']:.1f} s"
+    if "on_floor_at_end" in o:
+        text += "; both feet on the floor at the end" if o["on_floor_at_end"] else "; NOT back on the floor"
+    if msg:
+        text += f" ({msg})"
+    return text
+
+
+__all__ = ["GoalWatcher", "judge_goal", "outcome_line"]
