@@ -10,7 +10,8 @@ DEFAULT_LAUNCH = "sim_program"
 """The launch file whose loop runs the program (its input is replaced by the instruction)."""
 SCENE_LAUNCH = "sim_scene_program"
 """... and the one when the instruction names a place: tables, a box, a platform, a door; goals
-(reach, pick, place, step) executed by the goal generator and the tracking layer."""
+(reach, pick, place, step) executed by the goal generator and the tracking layer
+(launch/inputs.py:program_launch_name)."""
 
 
 def register(subparsers) -> None:
@@ -71,11 +72,10 @@ def _run(args) -> int:
 
     name = args.launch
     if name is None:  # a scene when the instruction names a place (parsed with the default place words)
+        from g1_control.launch.inputs import program_launch_name
         from g1_control.program import parse_instruction
-        from g1_control.program.steps import iter_named_places
 
-        named = {n for step in parse_instruction(args.instruction).steps for _, n in iter_named_places(step)}
-        name = SCENE_LAUNCH if named - {"start"} else DEFAULT_LAUNCH
+        name = program_launch_name(parse_instruction(args.instruction))
     path, _ = resolve_launch(name)
     launch = load_launch(path, overrides=args.overrides)
     program, world = say_program(args.instruction, launch)

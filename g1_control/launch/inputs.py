@@ -70,3 +70,18 @@ def make_program_input(launch: LaunchFile, program=None, **kwargs):
     cfg = launch.input
     return ProgramInput(program if program is not None else cfg.parsed_program(), program_world(launch),
                         pose=cfg.pose, start_delay_s=cfg.start_delay_s, **kwargs)
+
+
+PROGRAM_LAUNCH = "sim_program"
+SCENE_PROGRAM_LAUNCH = "sim_scene_program"
+
+
+def program_launch_name(program) -> str:
+    """The shipped launch file for running `program`: sim_scene_program (tables, a box, a platform,
+    a door; the execution layer) when it names a place other than the start or has a goal step
+    (reach, pick, place, step up/down), else sim_program."""
+    from g1_control.program.steps import GOAL_STEPS, iter_named_places, iter_steps
+
+    named = {name for step in program.steps for _, name in iter_named_places(step)}
+    goals = any(isinstance(s, GOAL_STEPS) for step in program.steps for s in iter_steps(step))
+    return SCENE_PROGRAM_LAUNCH if goals or named - {"start"} else PROGRAM_LAUNCH

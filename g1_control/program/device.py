@@ -32,13 +32,16 @@ from g1_control.program.runner import ProgramProgress, ProgramRunner, RunnerConf
 from g1_control.program.steps import Step
 from g1_control.program.world import World
 from g1_control.rotations import yaw_of
-from g1_control.types import Command, RobotState
+from g1_control.types import PHASE_LOCOMOTION, Command, RobotState
 
 if TYPE_CHECKING:
     from g1_control.estimation.estimator import StateEstimator
     from g1_control.program.judge import Verdict
 
 POSE_SOURCES = ("estimator", "ground_truth")
+HAND_BACK_SETTLE_S = 0.5
+"""After the execution layer hands the robot back to the walking policy (its 0.3 s blend), a
+locomotion step that was waiting for it starts this much later."""
 
 
 @dataclass(frozen=True)
@@ -129,6 +132,9 @@ class ProgramInput(InputDevice):
         self._truth: Callable[[], PlanarPose | None] = lambda: None
         self._goal_status: Mapping[str, str] = {}
         self._goal_messages: Mapping[str, str] = {}
+        self._phase: Callable[[], str] = lambda: PHASE_LOCOMOTION
+        self._handed_back_s: float | None = None
+        self._restart_label: str | None = None
         self._open: dict[str, _Open] = {}
         self._last_truth_yaw: float | None = None
         self._t0: float | None = None
@@ -143,6 +149,8 @@ class ProgramInput(InputDevice):
         self._goal_status = status if isinstance(status, Mapping) else {}
         messages = getattr(loop.generator, "goal_messages", None)
         self._goal_messages = messages if isinstance(messages, Mapping) else {}
+        generator = loop.generator
+        self._phase = lambda: getattr(generator, "phase", PHASE_LOCOMOTION)
 
     @property
     def done(self) -> bool:
@@ -200,6 +208,7 @@ class ProgramInput(InputDevice):
         goals = runner.active_goals
         status = {g.goal_id: self._goal_status[g.goal_id] for g in goals if g.goal_id in self._goal_status}
         progress = ProgramProgress(pose.x_m, pose.y_m, pose.yaw_rad, status, pose.pelvis_height_m)
+        self._after_hand_back(now_s, progress, truth)
         command = runner.update(now_s, progress)
         for outcome in runner.outcomes[n:]:
             opened = self._open.pop(outcome.label, None) or _Open(truth)
@@ -220,6 +229,27 @@ class ProgramInput(InputDevice):
         if runner.done and self.ended_s is None:
             self.ended_s = now_s
         return command
+
+    def _after_hand_back(self, now_s: float, progress: ProgramProgress, truth: PlanarPose | None) -> None:
+        """A walk, turn or wait that starts while the execution layer still holds the robot in a
+        whole-body phase (after a reach, a place, a step down) commands motion, which makes the layer
+        hand back to the walking policy; the step then starts over HAND_BACK_SETTLE_S after the
+        policy has it, so its distance, heading and time are the walk's, not the hand-over's."""
+        label = self.runner.current_label
+        if label is None or not self.runner.active_is_locomotion:
+            self._restart_label = None
+            return
+        if self._phase() != PHASE_LOCOMOTION:
+            self._restart_label, self._handed_back_s = label, None
+            return
+        if self._restart_label != label:
+            return
+        if self._handed_back_s is None:
+            self._handed_back_s = now_s
+        if now_s - self._handed_back_s >= HAND_BACK_SETTLE_S:
+            self.runner.restart_active(now_s, progress)
+            self._open[label] = _Open(truth)
+            self._restart_label = None
 
     def summary(self) -> str:
         return "\n".join(describe_record(r) for r in self.records)

@@ -98,7 +98,12 @@ class World:
                 places[b.name] = Landmark(b.name, np.array([*b.center, b.height_m]), kind,
                                           float(max(b.half)) + SCENE_CLEARANCE_M)
         for box in scene.boxes:
-            places[box.name] = Landmark(box.name, np.asarray(scene.box_center(box), dtype=float), "object")
+            under = scene.block(box.stands_on)
+            standoff = None  # on the floor: the object default
+            if under is not None:  # on a table: stop as far from its edge as from a box on the floor
+                inside = float(np.min(under.half - np.abs(under.local_xy(np.asarray(box.xy_m, dtype=float)))))
+                standoff = DEFAULT_STANDOFF_M["object"] + max(0.0, inside)
+            places[box.name] = Landmark(box.name, np.asarray(scene.box_center(box), dtype=float), "object", standoff)
         for name, p in (extra.places if extra is not None else {}).items():
             if name in places:
                 raise ProgramError(f"world.places.{name}: the scene already has a '{name}'; name it otherwise")

@@ -7,7 +7,7 @@ within 10 % of its distance, a turn within 10 degrees, a height within 5 cm, goa
 execution layer's verdict. Falls are the loop's fall monitor's (ground truth). Prints one line
 per step and a table per instruction; exits 1 on a fall or a missed step.
 
-    g1 bench program                 # the 20 instructions below
+    g1 bench program                 # the 20 instructions below (15 walk/turn/style/height/wait, 5 with goals)
     g1 bench program --only 3,7      # some of them (1-based)
     g1 bench program --json out.json
 """
@@ -22,9 +22,7 @@ from pathlib import Path
 INSTRUCTIONS: tuple[str, ...] = (
     "walk forward 1 meter, turn left 90 degrees, walk forward 1 meter, then turn right 90 degrees",
     "walk forward two meters, then turn left ninety degrees and wave for 3 seconds, then walk backward 1 meter",
-    "turn right 45 degrees, walk forward 1.5 meters, turn left 45 degrees and wait 2 seconds",
     "walk backward 1 meter, turn around, walk forward 1 meter and look around for 3 seconds",
-    "sidestep left half a meter, then sidestep right half a meter, turn left 30 degrees and turn right 30 degrees",
     "walk forward 1 m while waving, turn right 90 degrees, walk forward 1 m with your arms out, then stand still "
     "for 2 seconds",
     "walk forward 1 meter and turn left 90 degrees, repeat that 4 times",
@@ -32,43 +30,48 @@ INSTRUCTIONS: tuple[str, ...] = (
     "walk forward 2 meters slowly, turn right 90 degrees quickly, walk forward 1 meter quickly, then dance for 3 "
     "seconds",
     "spin left 360 degrees, walk forward 1 meter, spin right 360 degrees and wave",
-    "walk forward 80 cm; turn right 120 degrees; walk forward 80 cm; turn right 120 degrees; walk forward 80 cm",
     "switch to the guard style, walk forward 1.5 meters, turn around, walk forward 1.5 meters and switch to the "
     "default style",
     "walk forward 3 feet, turn left a quarter turn, walk forward 3 feet, then make a half turn",
     "walk to the left 1 meter, walk forward 1 meter, walk to the right 1 meter and walk backward 1 meter",
     "lower your pelvis to 0.68 meters, walk forward 1 meter, raise your pelvis to 0.75 meters and turn right 60 "
     "degrees",
-    "turn left 90 degrees twice, walk forward 1 meter, then turn right 90 degrees twice",
-    "walk forward 1.2 meters at 0.3 m/s, turn left 60 degrees at 0.4 rad/s, walk forward 1.2 meters at 0.6 m/s "
-    "and wait 1 second",
-    "walk forward 1 meter, wait 2 seconds, walk backward half a meter, wait 2 seconds and turn right 90 degrees",
+    "take three steps forward, turn left 90 degrees twice, walk forward 1 meter and come back",
     "swing your arms while walking forward 2 meters, turn around while looking around, then walk forward 2 meters "
     "and raise your arms",
-    "after walking forward one meter, turn right 90 degrees; then walk forward one meter, turn right 90 degrees "
-    "and walk forward one meter",
+    "sidestep left half a meter, then sidestep right half a meter, turn left 30 degrees and turn right 30 degrees",
+    # goals, in launch/sim_scene_program.yaml (a table with a 2 kg box, another table, a 0.15 m platform)
+    "walk forward half a meter, turn left 30 degrees, pick up the box and put it on the other table",
+    "turn right 90 degrees, walk forward 1 meter, step onto the platform, wait 2 seconds and step down",
+    "reach forward 20 cm with your right hand, walk backward half a meter, reach 15 cm to the left with your left "
+    "hand and turn left 45 degrees",
+    "walk to the table, pick up the box, bring it to the other table, then walk backward half a meter",
+    "step onto the platform, step down, turn left 90 degrees and wave for 3 seconds",
 )
 
 
-def run_instruction(text: str, launch_name: str = "sim_program", pose: str = "estimator") -> dict:
-    """Parse and run one instruction; the per-step records (ground-truth verdicts), fall, times."""
-    from g1_control.launch.inputs import make_program_input
+def run_instruction(text: str, launch_name: str | None = None, pose: str = "estimator") -> dict:
+    """Parse and run one instruction; the per-step records (ground-truth verdicts), fall, times.
+    launch_name: default sim_program, or sim_scene_program when the instruction names a place."""
+    from g1_control.launch.inputs import make_program_input, program_launch_name
     from g1_control.launch.runner import run
     from g1_control.launch.schema import load_launch
     from g1_control.program import parse_instruction
     from g1_control.program.device import record_dict
     from g1_control.resources import resolve_launch
 
-    launch = load_launch(resolve_launch(launch_name)[0])
+    launch = load_launch(resolve_launch(launch_name or program_launch_name(parse_instruction(text)))[0])
+    world = launch.program_world()
     c0 = time.thread_time()
-    program = parse_instruction(text)
+    program = parse_instruction(text, places=world.names() if world.places else None)
     parse_ms = (time.thread_time() - c0) * 1e3
     launch.name, launch.input.type = "bench_program", "program"
     launch.input.program, launch.input.instruction, launch.input.pose = [s.to_dict() for s in program.steps], "", pose
     device = make_program_input(launch, program)
     result = run(launch, progress=False, video=False, input_device=device)
     steps = [record_dict(r) for r in device.records]
-    return {"instruction": text, "program": program.describe().splitlines(), "primitives": program.count_primitives(),
+    return {"instruction": text, "launch": launch.name, "program": program.describe().splitlines(),
+            "primitives": program.count_primitives(), "goals": result.extra.get("goals", []),
             "parse_cpu_ms": parse_ms, "fell": result.fell, "fall": result.fall,
             "finished": device.done and not device.runner.stopped, "steps": steps,
             "sim_s": result.duration_s, "wall_s": result.wall_s}
