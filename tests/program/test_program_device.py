@@ -240,3 +240,41 @@ def test_judge_height_and_stand():
 
 def test_judge_needs_ground_truth():
     assert judge(rec(Walk(distance_m=1.0), None, None), World(), None) is None
+
+
+def test_a_walk_after_a_goal_starts_over_once_the_walking_policy_has_the_robot():
+    """The execution layer holds the robot in a whole-body phase until the walk's motion makes it
+    hand back; what the robot does meanwhile is not the walk's."""
+    loop = FakeLoop()
+    loop.generator.phase = "whole_body"
+    device = ProgramInput(parse_instruction("walk forward 1 meter"), start_delay_s=0.0)
+    device.attach(loop)
+    for _ in range(100):  # 1 s in the whole-body phase: the robot is moved 0.3 m by the hand-over
+        cmd = device.poll(loop.t)
+        assert cmd.vx_mps > 0, "the walk commands motion, which makes the layer hand back"
+        loop.x += 0.003
+        loop.step(Command(), 0.01)
+    loop.generator.phase = "locomotion"
+    while not device.done and loop.t < 30:
+        loop.step(device.poll(loop.t), 0.01)
+    (walk,) = device.records
+    assert walk.outcome.started_s >= 1.0 + 0.5 - 1e-6, "restarted HAND_BACK_SETTLE_S after the hand-back"
+    assert walk.truth_start.x_m > 0.3, "measured from the restart, not from where the hand-over began"
+    assert walk.verdict.ok and walk.truth_end.x_m - walk.truth_start.x_m == pytest.approx(1.0, abs=0.05)
+
+
+def test_goal_verdicts_from_the_execution_layers_ground_truth():
+    from g1_control.program.judge import goal_verdict
+
+    assert goal_verdict({"kind": "reach", "status": "reached", "hand_error_mean_m": 0.004}).ok
+    assert not goal_verdict({"kind": "reach", "status": "reached", "hand_error_mean_m": 0.05}).ok
+    assert goal_verdict({"kind": "pick", "status": "reached", "box_rise_m": 0.1, "dropped": False}).ok
+    assert not goal_verdict({"kind": "pick", "status": "reached", "box_rise_m": 0.1, "dropped": True}).ok
+    place = {"kind": "place", "status": "reached", "place_error_xy_m": 0.006, "place_error_z_m": 0.0, "box_tilt_deg": 1.0}
+    assert goal_verdict(place).ok
+    assert not goal_verdict(dict(place, status="unfinished")).ok, "a box in place is no success the layer did not report"
+    assert not goal_verdict(dict(place, place_error_xy_m=0.08)).ok
+    assert goal_verdict({"kind": "step_up", "status": "reached", "both_feet_on_top_s": 2.0, "on_top_at_end": True}).ok
+    assert not goal_verdict({"kind": "step_down", "status": "reached", "on_floor_at_end": False}).ok
+    v = goal_verdict({"kind": "reach", "status": "failed", "message": "out of reach"})
+    assert not v.ok and "out of reach" in v.text

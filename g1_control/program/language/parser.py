@@ -165,6 +165,10 @@ class InstructionParser:
             sugg = tuple(s for s, _, _ in found)
             lo, hi = max(0, i - 4), min(len(words), i + 5)
             context = ("... " if lo else "") + _join(words[lo:hi]) + (" ..." if hi < len(words) else "")
+            if any(w in phrase.split() for phrase in L.DEFAULT_PLACES):  # a place word, not a place here
+                places = sorted({n for n in self.places.values()})
+                raise UnknownWordError(f"'{w}' in \"{context}\" is not a place here; places: {', '.join(places)}",
+                                       w, tuple(places))
             hint = f"closest known words: {', '.join(sugg)}" if sugg else "no known word is close"
             raise UnknownWordError(f"unknown word '{w}' in \"{context}\"; {hint}", w, sugg)
 
