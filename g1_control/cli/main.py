@@ -27,6 +27,7 @@ SUBCOMMAND_MODULES = (
     "g1_control.cli.input_cmd",
     "g1_control.cli.sim_robot_cmd",
     "g1_control.cli.retarget_cmd",
+    "g1_control.cli.check_cmd",
     "g1_control.cli.deploy_cmd",
     "g1_control.cli.library_cmd",
     "g1_control.cli.train_cmd",

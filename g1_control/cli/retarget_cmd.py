@@ -20,7 +20,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict
 from pathlib import Path
 
-SUPPORTED = (".npy", ".pt", ".bvh", ".csv", ".npz")
+SUPPORTED = (".npy", ".pt", ".bvh", ".csv", ".npz", ".pkl")
 
 
 def register(subparsers) -> None:

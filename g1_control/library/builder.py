@@ -16,8 +16,9 @@ from pathlib import Path
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.library import INDEX_NAME, LibraryError, MotionLibrary
 
-BUILD_VERSION = 1
-"""Bumped when the builder's output changes for the same configuration (invalidates caches)."""
+BUILD_VERSION = 2
+"""Bumped when the builder's output changes for the same configuration (invalidates caches).
+2: demo mocap retargeted with the collision-aware IK and the URDF's ankle/waist limits (issue 12)."""
 
 LICENSES = {
     "rollout": "generated here (g1-control) with holosoma-inference 0.1.3's loco policy (Apache-2.0 upstream)",

@@ -26,11 +26,12 @@ def stance_from_trajectory(pos_w_m: np.ndarray, fps: float, max_speed_mps: float
     if max_height_above_lowest_m is not None:
         stance &= pos[:, 2] < pos[:, 2].min() + max_height_above_lowest_m
     if min_frames > 1:
-        stance = _drop_short_runs(stance, min_frames)
+        stance = drop_short_runs(stance, min_frames)
     return stance
 
 
-def _drop_short_runs(mask: np.ndarray, min_len: int) -> np.ndarray:
+def drop_short_runs(mask: np.ndarray, min_len: int) -> np.ndarray:
+    """`mask` with its runs of True shorter than min_len set False."""
     out = mask.copy()
     start = None
     for i, v in enumerate(np.append(mask, False)):

@@ -11,7 +11,8 @@ object's surface; the retargeted clip keeps them so the metrics can check that t
 still there on those frames (contact preservation).
 
 Scene: static shapes in world coordinates (the boxes of the climbing sequences): the IK keeps the
-feet on and above them (GroundLimit) and the metrics count penetration into them.
+feet on and above them (GroundLimit) and every other link out of them (CollisionLimit), and the
+metrics count any link's penetration into them.
 """
 
 from __future__ import annotations
@@ -65,6 +66,20 @@ class ObjectShape:
         face = values.argmax(axis=1)
         return values[np.arange(face.shape[0]), face], face
 
+    def vertices(self) -> np.ndarray:
+        """(V, 3) corners of the polytope (object frame): where three or more faces meet."""
+        from scipy.optimize import linprog
+        from scipy.spatial import HalfspaceIntersection
+
+        normals, offsets = self.planes[:, :3], self.planes[:, 3]
+        # Chebyshev centre (a point strictly inside): max r with n . x + d + r |n| <= 0.
+        lp = linprog(np.r_[0.0, 0.0, 0.0, -1.0], A_ub=np.c_[normals, np.linalg.norm(normals, axis=1)],
+                     b_ub=-offsets, bounds=[(None, None)] * 3 + [(0, None)])
+        if not lp.success or lp.x[3] <= 0:
+            raise MotionFormatError(f"object '{self.name}': its faces enclose no volume")
+        corners = HalfspaceIntersection(self.planes, lp.x[:3]).intersections
+        return np.unique(np.round(corners, 12), axis=0)
+
     def scaled(self, factor: float) -> ObjectShape:
         """The shape grown by `factor` about the object origin (a human-to-robot scale)."""
         planes = self.planes.copy()
@@ -88,6 +103,15 @@ class ObjectShape:
         bottom = (-lin[:, down] / n[down, 2]).max(axis=1) if down.any() else np.full(xy.shape[0], -np.inf)
         inside = (lin[:, side] <= 0.0).all(axis=1) & (top >= bottom)
         return np.where(inside, top, -np.inf)
+
+    def top_normal(self, xy: np.ndarray) -> np.ndarray:
+        """(N, 2) points inside the footprint -> (N, 3) unit normal of the upper face above each
+        (the face top_height reads: a ramp's slope, a box's (0, 0, 1))."""
+        n, d = self.planes[:, :3], self.planes[:, 3]
+        up = np.flatnonzero(n[:, 2] > 1e-6)
+        heights = -(xy @ n[up, :2].T + d[up]) / n[up, 2]
+        normal = n[up[heights.argmin(axis=1)]]
+        return normal / np.linalg.norm(normal, axis=1, keepdims=True)
 
     def transformed(self, rot: np.ndarray, shift_m: np.ndarray) -> ObjectShape:
         """The shape moved by x -> rot x + shift (for a static scene object in world coordinates)."""
@@ -224,6 +248,19 @@ def support_height(scene: tuple[ObjectShape, ...], points_w: np.ndarray, ground_
         on = np.isfinite(top) & (top <= points_w[:, 2] + reach_m)
         out = np.where(on, np.maximum(out, top), out)
     return out
+
+
+def support_normal(scene: tuple[ObjectShape, ...], point_w: np.ndarray, ground_m: float = 0.0,
+                   reach_m: float = np.inf) -> tuple[float, np.ndarray]:
+    """(height, unit normal) of what a point stands on: support_height's surface, the floor's
+    (0, 0, 1) or the top face of the scene shape under it (a ramp's slope)."""
+    point = np.asarray(point_w, dtype=float).reshape(1, 3)
+    best, normal = float(ground_m), np.array([0.0, 0.0, 1.0])
+    for shape in scene:
+        top = shape.top_height(point[:, :2])
+        if np.isfinite(top[0]) and top[0] <= point[0, 2] + reach_m and top[0] > best:
+            best, normal = float(top[0]), shape.top_normal(point[:, :2])[0]
+    return best, normal
 
 
 def scene_depth(scene: tuple[ObjectShape, ...], points_w: np.ndarray) -> np.ndarray:

@@ -1,16 +1,24 @@
-"""Quality report for any G1 clip: penetration, foot sliding, joint-limit and velocity-limit
-violations, smoothness; a PNG plot per clip and a table for a batch.
+"""Quality report for any G1 clip, measured as an independent checker would: from each frame's root
+pose and joint angles only (never the clip's contact labels or the retargeter's own bookkeeping),
+against the robot's description (URDF limits, collision geometry); a table for a batch, a PNG per
+clip. Per-frame geometry: retarget/clip_geometry.py.
 
-Definitions (thresholds are parameters, defaults as in the project's acceptance figures):
-- penetration depth of a frame: how far the lowest foot collision sphere (from the URDF) is below
-  the ground z = 0, or how deep a foot sphere is inside a static scene shape (clip.scene, e.g. the
-  boxes of a climb), whichever is more; a frame "penetrates" when deeper than `penetration_m` (1 cm).
-- sliding of a stance foot: horizontal displacement of its sole point between two consecutive
-  frames that are both labelled stance; a stance frame "slides" when that exceeds `sliding_m`
-  (1 cm per frame).
-- joint-limit violation: a joint angle outside g1.Q_MIN_RAD/Q_MAX_RAD by more than `tolerance`.
-- velocity-limit violation: a per-frame joint speed |q[t+1] - q[t]| * fps above
-  g1.VELOCITY_LIMIT_RADPS by more than `tolerance`.
+Definitions (thresholds are parameters; defaults are the acceptance figures of issue 12):
+- joint-limit violation: a (frame, joint) pair outside the URDF's position limits by more than
+  `tolerance` rad.
+- velocity-limit violation: a (frame, joint) pair whose speed |q[t+1] - q[t]| * fps exceeds the
+  URDF's velocity limit by more than the relative `tolerance`.
+- penetration: a frame where any collision geometry of any link (the URDF's meshes as convex
+  hulls, its foot spheres) is more than `penetration_m` (1 cm) below the floor z = 0 or inside a
+  scene shape (the clip's own scene, or the one given).
+- near-ground (stance) frame: a foot's lowest collision sphere is within 2 cm of what it stands on
+  (the floor or a scene shape's top under it) and moves vertically slower than 0.1 m/s; a frame is
+  near-ground when either foot is.
+- sliding: on a near-ground frame, the horizontal displacement of that foot's lowest sphere since the
+  previous frame; a near-ground frame "slides" when it exceeds `sliding_m` (1 cm) for a stance foot.
+  The sliding fraction is of near-ground frames.
+- self-collision: a frame where a pair of non-adjacent links' collision geometries overlap by more
+  than `penetration_m` (1 cm) (robot/collision.py: every such pair, 579 of them).
 - contact preservation (clips that handle an object, clip.object): of the (frame, hand) pairs the
   source motion labels as touching the object (its wrist within 6 cm of the surface, see
   MocapRetargetConfig.object_contact_m), the share where the G1's hand point is within
@@ -27,7 +35,9 @@ import numpy as np
 
 from g1_control import rotations as quat
 from g1_control.motion.clip import MotionClip
-from g1_control.robot import g1
+from g1_control.motion.objects import ObjectShape
+from g1_control.retarget.clip_geometry import ClipGeometry, measure
+from g1_control.robot import description
 
 
 @dataclass
@@ -36,26 +46,30 @@ class ClipMetrics:
     num_frames: int
     duration_s: float
     joint_limit_violations: int
-    """(frame, joint) pairs outside the position limits."""
+    """(frame, joint) pairs outside the URDF's position limits."""
     velocity_limit_violations: int
-    """(frame, joint) pairs above the velocity limits."""
+    """(frame, joint) pairs above the URDF's velocity limits."""
     max_velocity_ratio: float
     """Largest |dq| / velocity limit over the clip (<= 1 within limits)."""
     penetration_frames: int
+    """Frames with any link more than penetration_m inside the floor or a scene shape."""
     penetration_fraction: float
-    penetration_duration_s: float
     max_penetration_m: float
-    stance_frames: int
+    penetration_link: str
+    """The link reaching max_penetration_m ('' when nothing penetrates)."""
+    near_ground_frames: int
+    """Frames where a foot is near the ground and slow (geometric stance, see the module docstring)."""
     sliding_frames: int
     sliding_fraction: float
-    """Of stance frames."""
-    sliding_duration_s: float
+    """Of near-ground frames."""
     max_sliding_m_per_frame: float
+    self_collision_frames: int
+    """Frames where two non-adjacent links' collision geometries overlap by more than penetration_m."""
+    max_self_penetration_m: float
+    self_collision_pair: str
+    """The pair reaching max_self_penetration_m ('' when none overlaps)."""
     joint_acc_rms_radps2: float
     """RMS joint acceleration: a jitter measure."""
-    self_collision_frames: int = 0
-    """Frames where a body-part sphere pair (arms vs torso, leg vs leg; ik.limits.self_collision_limit)
-    overlaps by more than `penetration_m`."""
     object_contact_frames: int = 0
     """(frame, hand) pairs where the source motion's hand is at the object (clip.object labels)."""
     object_contacts_kept: int = 0
@@ -70,71 +84,34 @@ class ClipMetrics:
         """Share of the source's hand-object contacts the G1 keeps (None: no object or no contact)."""
         return self.object_contacts_kept / self.object_contact_frames if self.object_contact_frames else None
 
-    def passes(self, max_penetration_fraction: float = 0.01, max_sliding_fraction: float = 0.02,
-               min_object_contact_fraction: float = 0.95) -> bool:
+    def passes(self, max_sliding_fraction: float = 0.01, min_object_contact_fraction: float = 0.95) -> bool:
+        """The acceptance figures: no limit violation, no penetration or self-collision frame,
+        sliding on at most 1 % of near-ground frames, object contacts kept."""
         kept = self.object_contact_preserved_fraction
         return (self.joint_limit_violations == 0 and self.velocity_limit_violations == 0
-                and self.penetration_fraction <= max_penetration_fraction
+                and self.penetration_frames == 0 and self.self_collision_frames == 0
                 and self.sliding_fraction <= max_sliding_fraction
                 and (kept is None or kept >= min_object_contact_fraction))
 
 
-@dataclass
-class FootSeries:
-    lowest_height_m: np.ndarray
-    """(T, 2) lowest sphere bottom of each foot above the ground."""
-    sole_xy_m: np.ndarray
-    """(T, 2, 2) sole point of each foot, horizontal."""
-    slide_m: np.ndarray
-    """(T, 2) horizontal sole displacement from the previous frame (0 at frame 0)."""
-    scene_depth_m: np.ndarray
-    """(T, 2) deepest point of each foot inside a scene shape (clip.scene; 0 when none)."""
-
-
-def foot_series(clip: MotionClip) -> FootSeries:
-    from g1_control.ik.configuration import foot_contact_points
-
-    spheres = foot_contact_points()
-    t = clip.num_frames
-    lowest = np.empty((t, 2))
-    sole = np.empty((t, 2, 2))
-    inside = np.zeros((t, 2))
-    for side, link in enumerate(g1.FOOT_BODIES):
-        b = clip.body_index(link)
-        rot = quat.to_matrix(clip.body_quat_wxyz[:, b])
-        pos = clip.body_pos_w_m[:, b]
-        centres = np.array([c for c, _ in spheres[link]])
-        radii = np.array([r for _, r in spheres[link]])
-        world = np.einsum("tij,kj->tki", rot, centres) + pos[:, None, :]
-        lowest[:, side] = (world[:, :, 2] - radii).min(axis=1)
-        sole[:, side] = world[:, :, :2].mean(axis=1)
-        for shape in clip.scene:  # a sphere is inside a shape by its radius minus its centre's distance
-            inside[:, side] = np.maximum(inside[:, side], (radii - shape.signed_distance(world)).max(axis=1))
-    slide = np.zeros((t, 2))
-    slide[1:] = np.linalg.norm(np.diff(sole, axis=0), axis=-1)
-    return FootSeries(lowest, sole, slide, inside)
-
-
-def compute_metrics(clip: MotionClip, penetration_m: float = 0.01, sliding_m: float = 0.01,
-                    tolerance: float = 1e-6, object_contact_m: float = 0.08) -> ClipMetrics:
+def compute_metrics(clip: MotionClip, scene: tuple[ObjectShape, ...] | None = None, penetration_m: float = 0.01,
+                    sliding_m: float = 0.01, tolerance: float = 1e-6, object_contact_m: float = 0.08,
+                    geometry: ClipGeometry | None = None) -> ClipMetrics:
+    """Metrics of `clip` against `scene` (default: the clip's own). `geometry`: a measure() of this
+    clip already computed (the plot needs it too)."""
+    limits = description.urdf_joint_limits()
     q = clip.joint_pos_rad
-    below = q < (g1.Q_MIN_RAD - tolerance)
-    above = q > (g1.Q_MAX_RAD + tolerance)
+    outside = (q < limits["lower"] - tolerance) | (q > limits["upper"] + tolerance)
     speed = np.abs(np.diff(q, axis=0)) * clip.fps if clip.num_frames > 1 else np.zeros((0, q.shape[1]))
-    ratio = speed / g1.VELOCITY_LIMIT_RADPS
-    vel_viol = speed > g1.VELOCITY_LIMIT_RADPS * (1 + tolerance)
-    feet = foot_series(clip)
-    depth = np.maximum(0.0, np.maximum(-feet.lowest_height_m.min(axis=1), feet.scene_depth_m.max(axis=1)))
-    pen = depth > penetration_m
-    stance = clip.contacts.copy()
-    stance[0] = False
-    stance[1:] &= clip.contacts[:-1]  # both frames of the step are stance
-    slides = (feet.slide_m > sliding_m) & stance
-    n_stance = int(stance.sum())
-    sliding_frames = int(slides.any(axis=1).sum())
-    stance_frames = int(stance.any(axis=1).sum())
+    ratio = speed / limits["velocity"]
+    geo = geometry if geometry is not None else measure(clip, scene)
+    pen = geo.penetration_m > penetration_m
+    worst = int(geo.penetration_m.argmax())
+    slides = ((geo.foot_slide_m > sliding_m) & geo.stance).any(axis=1)
+    near = geo.stance.any(axis=1)
+    collides = geo.self_penetration_m > penetration_m
+    hit = int(geo.self_penetration_m.argmax())
     acc = np.diff(q, n=2, axis=0) * clip.fps**2 if clip.num_frames > 2 else np.zeros((1, q.shape[1]))
-    collisions = int((self_collision_distances(clip).min(axis=1) < -penetration_m).sum())
     contact_pairs = kept = 0
     max_gap = max_inside = 0.0
     if clip.object is not None:
@@ -146,16 +123,19 @@ def compute_metrics(clip: MotionClip, penetration_m: float = 0.01, sliding_m: fl
         max_inside = float(max(0.0, -dist.min()))
     return ClipMetrics(
         source=clip.source, num_frames=clip.num_frames, duration_s=clip.duration_s,
-        joint_limit_violations=int(below.sum() + above.sum()),
-        velocity_limit_violations=int(vel_viol.sum()),
+        joint_limit_violations=int(outside.sum()),
+        velocity_limit_violations=int((ratio > 1.0 + tolerance).sum()),
         max_velocity_ratio=float(ratio.max()) if ratio.size else 0.0,
         penetration_frames=int(pen.sum()), penetration_fraction=float(pen.mean()),
-        penetration_duration_s=float(pen.sum() / clip.fps), max_penetration_m=float(depth.max()),
-        stance_frames=stance_frames if n_stance else 0, sliding_frames=sliding_frames,
-        sliding_fraction=float(sliding_frames / stance_frames) if stance_frames else 0.0,
-        sliding_duration_s=float(sliding_frames / clip.fps),
-        max_sliding_m_per_frame=float(feet.slide_m[stance].max()) if n_stance else 0.0,
-        joint_acc_rms_radps2=float(np.sqrt(np.mean(acc**2))), self_collision_frames=collisions,
+        max_penetration_m=float(geo.penetration_m[worst]),
+        penetration_link=geo.links[geo.penetration_link[worst]] if geo.penetration_link[worst] >= 0 else "",
+        near_ground_frames=int(near.sum()), sliding_frames=int(slides.sum()),
+        sliding_fraction=float(slides.sum() / near.sum()) if near.any() else 0.0,
+        max_sliding_m_per_frame=float(geo.foot_slide_m[geo.stance].max()) if geo.stance.any() else 0.0,
+        self_collision_frames=int(collides.sum()), max_self_penetration_m=float(geo.self_penetration_m[hit]),
+        self_collision_pair=("/".join(geo.links[i] for i in geo.self_pair[hit]) if geo.self_pair[hit, 0] >= 0
+                             else ""),
+        joint_acc_rms_radps2=float(np.sqrt(np.mean(acc**2))),
         object_contact_frames=contact_pairs, object_contacts_kept=kept, max_object_gap_m=max_gap,
         max_object_penetration_m=max_inside,
     )
@@ -184,27 +164,12 @@ def object_hand_distances(clip: MotionClip) -> np.ndarray:
     return clip.object.distance(np.stack(points, axis=1))
 
 
-def self_collision_distances(clip: MotionClip) -> np.ndarray:
-    """(T, pairs) surface distances (m) of the default self-collision sphere pairs."""
-    from g1_control.ik.configuration import Configuration
-    from g1_control.ik.limits.self_collision_limit import SelfCollisionLimit
-    from g1_control.robot import description
-
-    conf = Configuration()
-    limit = SelfCollisionLimit()
-    out = np.empty((clip.num_frames, len(limit.pairs)))
-    for k in range(clip.num_frames):
-        quat_k = clip.root_quat_wxyz[k] / np.linalg.norm(clip.root_quat_wxyz[k])
-        conf.update(description.pinocchio_q(clip.root_pos_w_m[k], quat_k, clip.joint_pos_rad[k]), check=False)
-        out[k] = limit.distances(conf)
-    return out
-
-
 TABLE_COLUMNS = (("source", "clip", "{}"), ("num_frames", "frames", "{:d}"),
                  ("joint_limit_violations", "jlim", "{:d}"), ("velocity_limit_violations", "vlim", "{:d}"),
                  ("max_velocity_ratio", "v/vmax", "{:.2f}"), ("penetration_fraction", "pen>1cm", "{:.2%}"),
-                 ("max_penetration_m", "pen max m", "{:.4f}"), ("sliding_fraction", "slide>1cm", "{:.2%}"),
-                 ("max_sliding_m_per_frame", "slide max m", "{:.4f}"), ("self_collision_frames", "self-coll", "{:d}"),
+                 ("max_penetration_m", "pen max m", "{:.3f}"), ("sliding_fraction", "slide>1cm", "{:.2%}"),
+                 ("max_sliding_m_per_frame", "slide max m", "{:.3f}"), ("self_collision_frames", "self>1cm", "{:d}"),
+                 ("max_self_penetration_m", "self max m", "{:.3f}"),
                  ("object_contact_preserved_fraction", "obj contact kept", "{:.1%}"),
                  ("max_object_gap_m", "obj gap max m", "{:.3f}"), ("joint_acc_rms_radps2", "acc rms", "{:.1f}"))
 
@@ -227,49 +192,61 @@ def format_table(rows: list[ClipMetrics]) -> str:
     return "\n".join(lines)
 
 
-def plot_metrics(clip: MotionClip, path: str | Path, metrics: ClipMetrics | None = None) -> Path:
-    """PNG: foot heights with stance shading, stance sliding, velocity ratio, joint-limit margin."""
+def plot_metrics(clip: MotionClip, path: str | Path, metrics: ClipMetrics | None = None,
+                 geometry: ClipGeometry | None = None, scene: tuple[ObjectShape, ...] | None = None) -> Path:
+    """PNG: foot height over its support with stance shading, stance sliding, penetration and
+    self-collision depth, velocity ratio, joint-limit margin (and the hands' distance to a handled object)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    metrics = metrics or compute_metrics(clip)
-    feet = foot_series(clip)
+    geo = geometry if geometry is not None else measure(clip, scene)
+    metrics = metrics or compute_metrics(clip, scene, geometry=geo)
+    limits = description.urdf_joint_limits()
     t = np.arange(clip.num_frames) / clip.fps
-    rows = 5 if clip.object is not None else 4
-    fig, axes = plt.subplots(rows, 1, figsize=(10, 9 + 2 * (rows - 4)), sharex=True)
+    rows = 6 if clip.object is not None else 5
+    fig, axes = plt.subplots(rows, 1, figsize=(10, 11 + 2 * (rows - 5)), sharex=True)
     for side, name, color in ((0, "left", "tab:blue"), (1, "right", "tab:orange")):
-        axes[0].plot(t, feet.lowest_height_m[:, side] * 100, color=color, label=f"{name} foot")
-        axes[0].fill_between(t, 0, 2, where=clip.contacts[:, side], color=color, alpha=0.15, step="mid")
-        slide = np.where(clip.contacts[:, side], feet.slide_m[:, side] * 100, np.nan)
-        axes[1].plot(t, slide, color=color, label=f"{name} stance")
-    axes[0].axhline(-1, color="red", lw=0.8, ls="--")
-    axes[0].set_ylabel("lowest point (cm)")
+        axes[0].plot(t, (geo.foot_bottom_m[:, side] - geo.foot_support_m[:, side]) * 100, color=color,
+                     label=f"{name} foot")
+        axes[0].fill_between(t, 0, 2, where=geo.stance[:, side], color=color, alpha=0.15, step="mid")
+        slide = np.where(geo.stance[:, side], geo.foot_slide_m[:, side] * 100, np.nan)
+        axes[1].plot(t, slide, color=color, label=f"{name} near ground")
+    axes[0].axhline(2, color="grey", lw=0.8, ls=":")
+    axes[0].set_ylim(-3, 20)
+    axes[0].set_ylabel("lowest sphere over\nsupport (cm)")
     axes[0].legend(loc="upper right")
     axes[1].axhline(1, color="red", lw=0.8, ls="--")
-    axes[1].set_ylabel("stance slide (cm/frame)")
-    if clip.num_frames > 1:
-        ratio = np.abs(np.diff(clip.joint_pos_rad, axis=0)) * clip.fps / g1.VELOCITY_LIMIT_RADPS
-        axes[2].plot(t[1:], ratio.max(axis=1), color="k")
+    axes[1].set_ylabel("near-ground\nslide (cm/frame)")
+    axes[1].legend(loc="upper right")
+    axes[2].plot(t, geo.penetration_m * 100, color="k", label="into floor / scene")
+    axes[2].plot(t, geo.self_penetration_m * 100, color="tab:red", label="self-collision")
     axes[2].axhline(1, color="red", lw=0.8, ls="--")
-    axes[2].set_ylabel("max |dq| / limit")
-    margin = np.minimum(clip.joint_pos_rad - g1.Q_MIN_RAD, g1.Q_MAX_RAD - clip.joint_pos_rad).min(axis=1)
-    axes[3].plot(t, margin, color="k")
-    axes[3].axhline(0, color="red", lw=0.8, ls="--")
-    axes[3].set_ylabel("min limit margin (rad)")
+    axes[2].set_ylabel("depth (cm)")
+    axes[2].legend(loc="upper right")
+    if clip.num_frames > 1:
+        ratio = np.abs(np.diff(clip.joint_pos_rad, axis=0)) * clip.fps / limits["velocity"]
+        axes[3].plot(t[1:], ratio.max(axis=1), color="k")
+    axes[3].axhline(1, color="red", lw=0.8, ls="--")
+    axes[3].set_ylabel("max |dq| / limit")
+    margin = np.minimum(clip.joint_pos_rad - limits["lower"], limits["upper"] - clip.joint_pos_rad).min(axis=1)
+    axes[4].plot(t, margin, color="k")
+    axes[4].axhline(0, color="red", lw=0.8, ls="--")
+    axes[4].set_ylabel("min limit margin (rad)")
     if clip.object is not None:
         dist = object_hand_distances(clip)
         for side, name, color in ((0, "left", "tab:blue"), (1, "right", "tab:orange")):
-            axes[4].plot(t, dist[:, side] * 100, color=color, label=f"G1 {name} hand")
-            axes[4].fill_between(t, 0, 8, where=clip.object.hand_contacts[:, side], color=color, alpha=0.15,
+            axes[5].plot(t, dist[:, side] * 100, color=color, label=f"G1 {name} hand")
+            axes[5].fill_between(t, 0, 8, where=clip.object.hand_contacts[:, side], color=color, alpha=0.15,
                                  step="mid")
-        axes[4].axhline(8, color="red", lw=0.8, ls="--")
-        axes[4].set_ylim(-5, 40)
-        axes[4].set_ylabel(f"hand to {clip.object.shape.name} (cm)")
-        axes[4].legend(loc="upper right")
+        axes[5].axhline(8, color="red", lw=0.8, ls="--")
+        axes[5].set_ylim(-5, 40)
+        axes[5].set_ylabel(f"hand to {clip.object.shape.name} (cm)")
+        axes[5].legend(loc="upper right")
     axes[-1].set_xlabel("time (s)")
-    fig.suptitle(f"{clip.source}: pen>1cm {metrics.penetration_fraction:.2%}, slide>1cm {metrics.sliding_fraction:.2%}, "
+    fig.suptitle(f"{clip.source}: pen>1cm {metrics.penetration_fraction:.2%}, self>1cm "
+                 f"{metrics.self_collision_frames} frames, slide>1cm {metrics.sliding_fraction:.2%}, "
                  f"jlim {metrics.joint_limit_violations}, vlim {metrics.velocity_limit_violations}"
                  + (f", object contacts kept {metrics.object_contact_preserved_fraction:.1%}"
                     if metrics.object_contact_preserved_fraction is not None else ""))

@@ -4,8 +4,10 @@ Per clip: resample to the output rate, scale the human to the G1 by height (and 
 configured), label foot contacts from the human feet, put the human's stance feet at the G1's
 sole height (an offset measured from the data per foot point, never a fixed constant), then run
 the same IKRetargeter as the online loop frame by frame: keypoint position targets, pelvis and
-torso orientation from the hips/shoulders, stance feet held, joint position and velocity limits,
-feet above the ground.
+torso orientation from the hips/shoulders, the performer's stance feet held flat on what they stand
+on, joint position and velocity limits, every link kept out of the floor, the scene and the other
+links (the URDF's collision meshes), free feet near the ground lifting clear or crossing slowly.
+The result is measured by retarget/metrics.py (definitions and figures: retarget/README.md).
 """
 
 from __future__ import annotations
@@ -24,11 +26,11 @@ from g1_control.ik.configuration import Configuration, sole_depth_m
 from g1_control.ik.exceptions import IKError
 from g1_control.ik.retargeter import IKConfig, IKRetargeter
 from g1_control.motion.clip import MotionClip
-from g1_control.motion.contacts import stance_from_trajectory
+from g1_control.motion.contacts import drop_short_runs, stance_from_trajectory
 from g1_control.motion.exceptions import UnknownJointError
 from g1_control.motion.human import HumanMotion
 from g1_control.motion.interpolation import interpolate_positions, resample_times
-from g1_control.motion.objects import ObjectShape, ObjectTrack
+from g1_control.motion.objects import ObjectShape, ObjectTrack, support_height
 from g1_control.motion.skeletons import Skeleton, detect_skeleton, read_joint_map
 from g1_control.robot import description, g1
 from g1_control.types import KinematicReference
@@ -72,6 +74,11 @@ class MocapRetargetConfig:
     """Wrists are nearly free under hand position targets; a firmer posture pull stops them
     wandering between equivalent solutions (measured: chatter at the wrist velocity limit)."""
     smoothness_cost: float = 0.2
+    arm_smoothness_cost: float = 1.0
+    """Arms (shoulders to wrists) are smoothed harder: pressed against the torso by the
+    self-collision rows (human arms pass closer to the body than the G1's torso allows), they
+    chattered between near-equal solutions (measured on climb 3: arm joint acceleration RMS 197
+    rad/s^2 at 0.2, 32 at 1.0, hand tracking error 0.12 -> 0.07 m)."""
     iterations: int = 2
     warmup_iterations: int = 30
     stance_speed_mps: float = 0.25
@@ -85,8 +92,20 @@ class MocapRetargetConfig:
     """Stance feet may pivot about the vertical (IKConfig.contact_free_yaw). Off: on the demo
     climbing clips it raised stance sliding (seq 4: 0.9 % -> 6.3 % of stance frames)."""
     self_collision: bool = True
-    """Keep the arms out of the torso and the legs apart (human arms pass closer to the body than
-    the G1's wider torso allows)."""
+    """Keep every pair of non-adjacent links apart, the URDF's collision meshes (human arms and
+    thighs pass closer to the body than the G1's wider torso and hips allow)."""
+    scene_collision: bool = True
+    """Keep every link out of the floor and the scene's shapes (IKConfig.scene_collision)."""
+    touchdown_reach_m: float = 0.05
+    """A performer's contact starts the G1 foot's hold only when that foot is within this of a
+    support (IKConfig.touchdown_reach_m), and then lays it flat on that support
+    (IKConfig.ground_snap_m): a held foot never hovers."""
+    swing_feet: bool = True
+    """A free foot near the ground lifts clear of it or crosses it slowly (IKConfig.swing_feet):
+    human feet skim and shuffle over the floor between steps; the G1's would slide."""
+    contact_height_m: float = 0.04
+    """A performer's foot is in contact when slow (stance_speed_mps) and its sole, at robot scale,
+    within this of what it stands on (the floor or a scene top under it)."""
 
     def validate(self) -> MocapRetargetConfig:
         if not self.fps > 0:
@@ -180,6 +199,8 @@ def prepare_targets(motion: HumanMotion, skeleton: Skeleton, config: MocapRetarg
             side = foot_points[human]
             target[:, 2] += robot_sole_heights[frame] - _stance_height(target[:, 2], contacts[:, side])
         keypoints[frame] = target
+    scene = tuple(shape.scaled(scale) for shape in motion.scene)
+    contacts = _near_support(contacts, skeleton, keypoints, robot_sole_heights, scene, config)
     pelvis_rot = frame_from_left_up(p(skeleton.left_hip) - p(skeleton.right_hip), p(skeleton.spine_top) - p(skeleton.pelvis))
     torso_rot = frame_from_left_up(p(skeleton.left_shoulder) - p(skeleton.right_shoulder),
                                    0.5 * (p(skeleton.left_shoulder) + p(skeleton.right_shoulder)) - p(skeleton.pelvis))
@@ -194,9 +215,33 @@ def prepare_targets(motion: HumanMotion, skeleton: Skeleton, config: MocapRetarg
         found = [h for h in hands if h is not None]
         if len(found) == len(hands):
             track.hand_contacts = track.distance(np.stack([p(h) for h in found], axis=1)) < config.object_contact_m
-    scene = tuple(shape.scaled(scale) for shape in motion.scene)
     return PreparedTargets(config.fps, keypoints, root, pelvis_rot, torso_rot, foot_rot, contacts, scale, track,
                            scene)
+
+
+def _near_support(slow: np.ndarray, skeleton: Skeleton, keypoints: dict[str, np.ndarray],
+                  sole_heights: dict[str, float], scene: tuple[ObjectShape, ...],
+                  config: MocapRetargetConfig) -> np.ndarray:
+    """The performer's foot contacts: slow (`slow`, from foot speed) and with the sole, at robot
+    scale, within config.contact_height_m of the floor or of a scene top under it. A slow foot in
+    the air (the top of a high step) is no contact."""
+    out = slow.copy()
+    for side, points in enumerate(((skeleton.left_ankle, skeleton.left_toe), (skeleton.right_ankle, skeleton.right_toe))):
+        soles = []
+        for human in points:
+            frame = skeleton.frame_map.get(human)
+            if frame in keypoints and frame in sole_heights:
+                sole = keypoints[frame].copy()
+                sole[:, 2] -= sole_heights[frame]
+                soles.append(sole)
+        if not soles:
+            continue
+        lowest = np.min(np.stack(soles), axis=0)  # per axis; only z matters below
+        lowest[:, :2] = np.mean([s[:, :2] for s in soles], axis=0)
+        support = support_height(scene, lowest, 0.0, config.contact_height_m)
+        out[:, side] &= lowest[:, 2] - support < config.contact_height_m
+        out[:, side] = drop_short_runs(out[:, side], 3)
+    return out
 
 
 @functools.cache
@@ -228,12 +273,17 @@ class MocapRetargeter:
         for foot in g1.FOOT_BODIES:
             costs[foot] = (costs.get(foot, (cfg.end_effector_cost, 0.0))[0], cfg.foot_orientation_cost)
         costs[g1.TORSO_BODY] = (0.0, cfg.torso_orientation_cost)
+        smoothness = [cfg.smoothness_cost] * 6 + [cfg.arm_smoothness_cost if i in g1.ARM_JOINTS else cfg.smoothness_cost
+                                                  for i in range(g1.NUM_JOINTS)]
         return IKConfig(
             dt_s=1.0 / cfg.fps, iterations=cfg.iterations,
             root_cost=(cfg.root_position_cost, cfg.pelvis_orientation_cost), frame_costs=costs,
             com_cost=(0.0, 0.0, 0.0),
-            posture_cost=tuple(cfg.wrist_posture_cost if "wrist" in n else cfg.posture_cost for n in g1.JOINT_NAMES), smoothness_cost=cfg.smoothness_cost,
-            velocity_limit_scale=cfg.velocity_limit_scale, self_collision=cfg.self_collision,
+            posture_cost=tuple(cfg.wrist_posture_cost if "wrist" in n else cfg.posture_cost for n in g1.JOINT_NAMES),
+            smoothness_cost=tuple(smoothness),
+            velocity_limit_scale=cfg.velocity_limit_scale, self_collision=cfg.self_collision, swing_feet=cfg.swing_feet,
+            scene_collision=cfg.scene_collision, touchdown_reach_m=cfg.touchdown_reach_m,
+            ground_snap_m=cfg.touchdown_reach_m,
             contact_free_yaw=cfg.free_yaw_stance,
         )
 

@@ -46,6 +46,29 @@ def mesh_dir() -> Path:
 
 
 @functools.cache
+def urdf_joint_limits() -> dict[str, np.ndarray]:
+    """The 29 joints' `<limit>` as the URDF states them, in g1.JOINT_NAMES order: 'lower', 'upper'
+    (rad), 'velocity' (rad/s), 'effort' (N m). Read from the file, not from g1.py, so that checks
+    of g1.py and of clips have an independent reference."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(urdf_path()).getroot()
+    found = {j.get("name"): j.find("limit") for j in root.iter("joint")}
+    missing = [n for n in g1.JOINT_NAMES if found.get(n) is None]
+    if missing:
+        raise RobotDescriptionError(f"the G1 URDF has no <limit> for {missing}")
+    limits = {n: found[n] for n in g1.JOINT_NAMES}
+    out = {key: np.array([float(lim.get(key, "nan")) if lim is not None else np.nan for lim in limits.values()])
+           for key in ("lower", "upper", "velocity", "effort")}
+    for key, arr in out.items():
+        if not np.all(np.isfinite(arr)):
+            bad = [n for n, v in zip(g1.JOINT_NAMES, arr) if not np.isfinite(v)]
+            raise RobotDescriptionError(f"the G1 URDF's <limit> of {bad} has no number for '{key}'")
+        arr.setflags(write=False)
+    return out
+
+
+@functools.cache
 def pinocchio_model():
     """pinocchio.Model of the G1 with a free-flyer root (nq 36, nv 35)."""
     import pinocchio as pin

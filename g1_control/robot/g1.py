@@ -1,7 +1,9 @@
 """Unitree G1 facts: the one place every other module reads them from.
 
 Joint order, limits and motor families follow Unitree's G1 description (identical in
-example-robot-data's URDF, MuJoCo Menagerie's g1.xml and holosoma's policy metadata).
+example-robot-data's URDF, MuJoCo Menagerie's g1.xml and holosoma's policy metadata). Position,
+velocity and effort limits are the URDF's (tests/robot check them against the file); the
+safety layer, the IK and the clip metrics all read them from here.
 Armature (reflected rotor inertia) per motor family is the value mjlab / BeyondMimic derive
 from each family's rotor inertias and planetary gear stages; the policies were trained with it.
 Gains follow the same recipe as those projects: kp = armature * wn^2, kd = 2 * zeta * armature * wn
@@ -92,7 +94,12 @@ class MotorFamily:
 
 # Armature values: mjlab's G1 constants (reflected inertia of each family's rotor and gears).
 MOTOR_5020 = MotorFamily("5020", 25.0, 37.0, 0.003609725)
-MOTOR_5020_X2 = MotorFamily("5020x2", 50.0, 37.0, 2 * 0.003609725)  # ankles, waist roll/pitch
+MOTOR_5020_X2 = MotorFamily("5020x2", 35.0, 30.0, 2 * 0.003609725)
+"""Ankles and waist roll/pitch: two 5020 motors driving the joint through a parallel linkage. Limits
+as Unitree's description states them (example-robot-data 6.0.0, g1_29dof_rev_1_0.urdf: effort 35,
+velocity 30), the values an independent checker reads; Menagerie and holosoma's training used
+50 N m / 37 rad/s. Measured (issue 12): the holosoma walking policy never needs more than 23 N m or
+6 rad/s on these joints (sim_walk, sim_random), and its walking is identical under either value."""
 MOTOR_7520_14 = MotorFamily("7520-14", 88.0, 32.0, 0.010177520)
 MOTOR_7520_22 = MotorFamily("7520-22", 139.0, 20.0, 0.025101925)
 MOTOR_4010 = MotorFamily("4010", 5.0, 22.0, 0.00425)

@@ -161,24 +161,63 @@ def test_touchdown_on_a_box_top_snaps_the_foot_onto_it():
     assert heights[:4].min() == pytest.approx(top, abs=2e-3) and heights[4:].max() < 1e-4  # right foot on the floor
 
 
-def test_self_collision_holds_when_one_step_carries_an_elbow_from_beyond_the_activation_distance():
-    # At 30 Hz the velocity limits let the shoulder turn 1.2 rad in one step: the elbow sphere,
-    # 11 cm clear of the chest (beyond the 10 cm activation distance, so no row in the QP), is
-    # pulled toward a target inside the chest. Without a re-solve it ends 8.7 cm inside.
+def _elbow_into_chest(resolve: bool, refine: bool = False) -> float:
+    # At 30 Hz the velocity limits let the shoulder turn 1.2 rad in one step: the elbow, clear of
+    # the chest by more than the activation distance (so no row in the QP), is pulled toward a
+    # target inside the chest. Returns the deepest self-overlap after one tick.
     ik = IKRetargeter(IKConfig(dt_s=1 / 30, self_collision=True, com_cost=(0.0, 0.0, 0.0), hold_contacts=False,
-                               enforce_ground=False, frame_costs={"left_elbow_link": (20.0, 0.0)}))
-    conf, limit = ik.configuration, ik.self_collision_limit
+                               enforce_ground=False, scene_collision=False, projection_steps=4 if refine else 0,
+                               step_halvings=3 if refine else 0, frame_costs={"left_elbow_link": (20.0, 0.0)}))
+    conf, limit = ik.configuration, ik.collision_limit
+    if not resolve:
+        limit.missed_pairs = lambda configuration: np.zeros(len(limit.pairs), dtype=bool)
     q = conf.q.copy()
     q[7 + g1.JOINT_INDEX["left_shoulder_roll_joint"]] = 0.6  # arm out to the side
     conf.update(q)
-    elbow = [i for i, (a, _) in enumerate(limit.pairs) if a.frame == "left_elbow_link"]
+    elbow = [k for k in range(len(limit.pairs)) if "left_elbow_link_0" in limit.pair_names(k)
+             and "torso_link_0" in limit.pair_names(k)]
     assert limit.distances(conf)[elbow].min() > limit.activation_m
     chest = conf.frame_placement(conf.frame_id("torso_link")).act(np.array([0.0, 0.0, 0.12]))
     ref = KinematicReference(root_pos_w_m=q[:3].copy(), root_quat_wxyz=np.array([q[6], *q[3:6]]),
                              q_rad=q[7:].copy(), frame_targets_w={"left_elbow_link": np.r_[chest, 1.0, 0.0, 0.0, 0.0]},
                              contacts=np.zeros(2, dtype=bool))
     q_new = ik.step(ref, q)
-    gaps = limit.distances(conf)
-    assert np.linalg.norm(q_new[7:] - q[7:]) > 0.3  # a large step was taken ...
-    assert gaps.min() > limit.margin_m - 5e-3  # ... and kept the margin, up to linearisation error
+    assert np.linalg.norm(q_new[7:] - q[7:]) > 0.3  # a large step was taken
     assert not limit.include.any()  # the re-solve's extra rows are not kept for the next step
+    return -limit.distances(conf).min()
+
+
+def test_self_collision_holds_when_one_step_carries_an_elbow_from_beyond_the_activation_distance():
+    assert _elbow_into_chest(resolve=False) > 0.02  # without the re-solve the arm ends inside the chest
+    # with it: the margin, up to the linearisation error of a 1 rad step...
+    assert _elbow_into_chest(resolve=True) < 0.012
+    # ... which the trust-region re-solve and the projection step take out
+    assert _elbow_into_chest(resolve=True, refine=True) < 0.002
+
+
+def test_touchdown_lays_the_foot_along_a_ramp_and_holds_no_foot_out_of_reach():
+    """The anchor of a touching-down foot is flat on the slope under it; a foot further than
+    touchdown_reach_m above any support is not held at all."""
+    from g1_control.ik.configuration import foot_contact_points
+    from g1_control.motion.objects import ObjectShape, support_height
+
+    probe = IKRetargeter()
+    foot = probe.configuration.frame_placement(probe.configuration.frame_id("left_ankle_roll_link")).translation
+    tilt = pin.utils.rpyToMatrix(0.2, 0.0, 0.0)  # a ramp rising toward -y (roll 0.2 rad), under the left foot
+    ramp = ObjectShape.box("ramp", (0.3, 0.3, 0.05)).transformed(tilt, np.array([foot[0], foot[1], -0.04]))
+    ik = IKRetargeter(IKConfig(scene=(ramp,), ground_snap_m=0.05))
+    anchor = ik._touchdown_anchor("left_ankle_roll_link")
+    normal = ramp.top_normal(np.array([foot[:2]]))[0]
+    np.testing.assert_allclose(anchor.rotation[:, 2], normal, atol=1e-9)  # sole along the slope
+    spheres = np.array([anchor.rotation @ c + anchor.translation - [0, 0, r]
+                        for c, r in foot_contact_points()["left_ankle_roll_link"]])
+    gaps = spheres[:, 2] - support_height((ramp,), spheres, 0.0, 0.05)
+    assert gaps.min() > -2e-3 and gaps.max() < 0.02  # every sphere on (or just over) the slope
+
+    high = IKRetargeter(IKConfig(touchdown_reach_m=0.05))
+    q = high.configuration.q.copy()
+    q[2] += 0.2  # the whole robot 20 cm up: no foot can stand anywhere
+    high.reset(q)
+    assert high._touchdown_anchor("left_ankle_roll_link") is None
+    out = high.solve(_reference(high), q)
+    assert out.contacts.tolist() == [False, False]

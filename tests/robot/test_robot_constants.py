@@ -34,9 +34,18 @@ def test_gains_reproduce_holosoma_policy_metadata():
                                                     0.907222843, 1.068141502], rtol=1e-8)
 
 
-def test_effort_limits_use_training_values_for_parallel_joints():
-    assert g1.EFFORT_LIMIT_NM[g1.JOINT_INDEX["left_ankle_pitch_joint"]] == 50.0
-    assert g1.EFFORT_LIMIT_NM[g1.JOINT_INDEX["waist_roll_joint"]] == 50.0
+def test_limits_are_the_urdf_limits():
+    # One documented value per limit, the description's (issue 12): read from the URDF file itself.
+    from g1_control.robot import description
+
+    urdf = description.urdf_joint_limits()
+    np.testing.assert_array_equal(g1.Q_MIN_RAD, urdf["lower"])
+    np.testing.assert_array_equal(g1.Q_MAX_RAD, urdf["upper"])
+    np.testing.assert_array_equal(g1.VELOCITY_LIMIT_RADPS, urdf["velocity"])
+    np.testing.assert_array_equal(g1.EFFORT_LIMIT_NM, urdf["effort"])
+    ankle, waist_roll = g1.JOINT_INDEX["left_ankle_pitch_joint"], g1.JOINT_INDEX["waist_roll_joint"]
+    assert g1.VELOCITY_LIMIT_RADPS[ankle] == g1.VELOCITY_LIMIT_RADPS[waist_roll] == 30.0
+    assert g1.EFFORT_LIMIT_NM[ankle] == g1.EFFORT_LIMIT_NM[waist_roll] == 35.0
     assert g1.EFFORT_LIMIT_NM[g1.JOINT_INDEX["left_knee_joint"]] == 139.0
 
 

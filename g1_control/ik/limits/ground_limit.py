@@ -34,6 +34,11 @@ class GroundLimit(Limit):
             (link, centre, radius) for link in links for centre, radius in spheres[link]
         ]
         self._rows: RowConstraint | None = None
+        self.include = np.zeros((len(self.points), len(self.scene)), dtype=bool)
+        """(sphere, shape) pairs given a scene row whatever their distance (see `missed_pairs`)."""
+        self._scene_rowed = np.zeros((len(self.points), len(self.scene)), dtype=bool)
+        self.miss_tolerance_m = 2e-3
+        """A sphere this far inside a shape after a step, with no row for it, counts as missed."""
         self.skip_links: frozenset[str] = frozenset()
         """Links whose rows are left out this step: a foot held by a ContactLimit anchored on or
         above the ground is already kept there, and its four rows would only duplicate the hold
@@ -84,7 +89,8 @@ class GroundLimit(Limit):
         the shape, linearised on the shape's face nearest to it (the face whose plane is furthest
         from the centre; for a convex shape that plane gives the signed distance)."""
         matrices, lowers = [], []
-        for link, centres, radii, _ in self._grouped():
+        self._scene_rowed[:] = False
+        for link, centres, radii, rows in self._grouped():
             if link in self.skip_links:
                 continue
             fid = configuration.frame_id(link)
@@ -92,12 +98,13 @@ class GroundLimit(Limit):
             arms = centres @ placement.rotation.T
             world = arms + placement.translation
             jac = None
-            for shape in self.scene:
+            for k, shape in enumerate(self.scene):
                 distance, face = shape.nearest_face(world)
                 clearance = distance - radii
-                near = np.flatnonzero(clearance < self.reach_m)
+                near = np.flatnonzero((clearance < self.reach_m) | self.include[rows, k])
                 if near.size == 0:
                     continue
+                self._scene_rowed[rows.start + near, k] = True
                 if jac is None:
                     jac = configuration.frame_jacobian(fid)
                 normals = shape.planes[face[near], :3]
@@ -108,6 +115,29 @@ class GroundLimit(Limit):
             return None
         lower = np.concatenate(lowers)
         return RowConstraint(np.concatenate(matrices), lower, np.full(lower.shape, INF))
+
+    def deepest_in_scene(self, configuration: Configuration) -> float:
+        """Smallest clearance (m; < 0 inside) of a sphere of a foot not in skip_links to a scene shape."""
+        if not self.scene:
+            return float("inf")
+        clear = self.scene_clearances(configuration)
+        for link, _, _, rows in self._grouped():
+            if link in self.skip_links:
+                clear[rows] = np.inf
+        return float(clear.min())
+
+    def missed_pairs(self, configuration: Configuration) -> np.ndarray:
+        """(spheres, shapes) bool: sphere-shape pairs more than miss_tolerance_m inside each other
+        that the last `compute` gave no row: a step carried the foot into a box from beyond the
+        rows' reach (a foot moves 10 cm and more in one tick of fast mocap). The retargeter solves
+        the step again with them in `include`. Held feet (skip_links) are never missed."""
+        if not self.scene:
+            return self.include.copy()
+        missed = (self.scene_clearances(configuration) < -self.miss_tolerance_m) & ~self._scene_rowed
+        for link, _, _, rows in self._grouped():
+            if link in self.skip_links:
+                missed[rows] = False
+        return missed
 
     def _floor_rows(self, configuration: Configuration) -> RowConstraint | None:
         m, nv = len(self.points), configuration.nv

@@ -4,18 +4,21 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.exceptions import MotionFormatError
 from g1_control.motion.human import HumanMotion
 
 HUMAN_EXTENSIONS = (".npy", ".pt", ".bvh")
-ROBOT_EXTENSIONS = (".csv", ".npz")
+ROBOT_EXTENSIONS = (".csv", ".npz", ".pkl")
 
 
 def load_motion(path: str | Path, joint_names: tuple[str, ...] | None = None, fps: float | None = None,
                 height_m: float | None = None) -> HumanMotion | MotionClip:
-    """A HumanMotion (.npy, .pt, .bvh) or a MotionClip (.csv, .npz) from `path`."""
-    from g1_control.motion.formats import bvh, clip_npz, g1_csv, joint_positions
+    """A HumanMotion (.npy, .pt, .bvh) or a MotionClip (.csv: Unitree G1 CSV; .npz: motion library /
+    BeyondMimic / mjlab, or a holosoma result with qpos; .pkl: a GMR motion) from `path`."""
+    from g1_control.motion.formats import bvh, clip_npz, g1_csv, joint_positions, robot_qpos
 
     path = Path(path)
     if not path.is_file():
@@ -31,7 +34,16 @@ def load_motion(path: str | Path, joint_names: tuple[str, ...] | None = None, fp
     if ext == ".csv":
         return g1_csv.read_g1_csv(path, fps or g1_csv.DEFAULT_FPS)
     if ext == ".npz":
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                keys = list(data.files)
+        except (OSError, ValueError) as exc:
+            raise MotionFormatError(f"{path}: not a readable npz file ({exc})") from None
+        if robot_qpos.is_holosoma_npz(keys):
+            return robot_qpos.read_holosoma_npz(path, fps)
         return clip_npz.read_clip_npz(path)
+    if ext == ".pkl":
+        return robot_qpos.read_gmr_pkl(path, fps)
     raise MotionFormatError(f"{path}: unknown motion file type '{ext}'; known: "
                             f"{', '.join(HUMAN_EXTENSIONS + ROBOT_EXTENSIONS)}")
 
