@@ -230,12 +230,8 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
         result.extra["goals"] = watcher.outcomes()
     if program is not None:
         from g1_control.program.device import record_dict
-        from g1_control.program.judge import goal_verdict
 
-        by_goal = {o["goal_id"]: o for o in result.extra.get("goals", [])}
-        for r in program.records:  # goal steps: judged by the execution layer's ground-truth figures
-            if r.goal_id in by_goal:
-                r.verdict = goal_verdict(by_goal[r.goal_id])
+        finish_program_verdicts(program.records, result.extra.get("goals", []), result.fall)
 
         result.extra["program"] = {"steps": [record_dict(r) for r in program.records],
                                    "finished": program.done and not program.runner.stopped,
@@ -243,6 +239,20 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
     if out_root is not None:
         write_run_folder(result, launch, loop, Path(out_root), video)
     return result
+
+
+def finish_program_verdicts(records: list, goals: list[dict], fall: dict | None) -> None:
+    """After a run: goal steps take the execution layer's ground-truth verdict (program.judge.goal_verdict
+    on launch/outcomes.py's figures); a step the robot fell in, or after, is missed whatever it measured."""
+    from g1_control.program.judge import goal_verdict
+
+    by_goal = {o["goal_id"]: o for o in goals}
+    for r in records:
+        if r.goal_id in by_goal:
+            r.verdict = goal_verdict(by_goal[r.goal_id])
+        if fall is not None and r.verdict is not None and r.outcome.ended_s >= fall["t_s"]:
+            r.verdict.ok = False
+            r.verdict.text += f"; FELL at {fall['t_s']:.2f} s"
 
 
 def program_input(loop: ControlLoop):

@@ -72,3 +72,22 @@ def test_two_step_program_reaches_its_targets_in_mujoco(tmp_path):
     assert walk["verdict"]["ok"] and turn["verdict"]["ok"]
     # the run ended with the program, not at its time budget
     assert result.duration_s < launch.total_duration_s - 5.0
+
+
+def test_steps_the_robot_fell_in_are_missed_and_goal_steps_take_ground_truth():
+    from g1_control.launch.runner import finish_program_verdicts
+    from g1_control.program.device import StepRecord
+    from g1_control.program.judge import Verdict
+    from g1_control.program.runner import StepOutcome
+    from g1_control.program.steps import Pick, Stand, Turn
+
+    def rec(step, t0, t1, goal_id=None):
+        return StepRecord(StepOutcome("1", step.kind, step.describe(), "completed", t0, t1), step, goal_id=goal_id,
+                          verdict=Verdict(True, "fine"))
+
+    turn, pick, stand = rec(Turn(angle_rad=1.0), 0.0, 3.0), rec(Pick("box"), 3.0, 9.0, "g1"), rec(Stand(2.0), 9.0, 11.0)
+    goals = [{"goal_id": "g1", "kind": "pick", "status": "reached", "box_rise_m": 0.01, "dropped": False}]
+    finish_program_verdicts([turn, pick, stand], goals, {"t_s": 10.0, "kind": "tilt", "detail": "x"})
+    assert turn.verdict.ok
+    assert not pick.verdict.ok and "box lifted 1.0 cm" in pick.verdict.text, "the box barely rose"
+    assert not stand.verdict.ok and "FELL at 10.00 s" in stand.verdict.text
