@@ -18,6 +18,7 @@ import json
 import time
 from collections import Counter
 from pathlib import Path
+from typing import Literal
 
 INSTRUCTIONS: tuple[str, ...] = (
     "walk forward 1 meter, turn left 90 degrees, walk forward 1 meter, then turn right 90 degrees",
@@ -50,7 +51,8 @@ INSTRUCTIONS: tuple[str, ...] = (
 )
 
 
-def run_instruction(text: str, launch_name: str | None = None, pose: str = "estimator") -> dict:
+def run_instruction(text: str, launch_name: str | None = None,
+                    pose: Literal["estimator", "ground_truth"] = "estimator") -> dict:
     """Parse and run one instruction; the per-step records (ground-truth verdicts), fall, times.
     launch_name: default sim_program, or sim_scene_program when the instruction names a place."""
     from g1_control.launch.inputs import make_program_input, program_launch_name
