@@ -18,6 +18,11 @@ BENCHMARKS = {
     "execution": ("g1_control.tools.bench_execution:main",
                   "the repertoire in physics: one row per behaviour (success, falls, velocity/upper-body/hand/object "
                   "error, real-time factor); exits 1 on a fall"),
+    "program": ("g1_control.tools.bench_program:main",
+                "20 multi-step English instructions in physics: every step judged from ground truth (distance "
+                "10 %, heading 10 deg), falls; --only 1,5 picks instructions"),
+    "parser": ("g1_control.program.language.bench:bench_main",
+               "instruction parser latency (30-word instructions): CPU and wall p50/p99, interleaved with a baseline"),
     "envelope": ("g1_control.tools.bench_envelope:main",
                  "the walking tracker's achievable velocity per axis and style; --write ships it as the command limits"),
 }
@@ -35,7 +40,7 @@ def register(subparsers) -> None:
     parser.add_argument("--seconds", type=float, default=20.0, help="simulated/measured duration (default 20)")
     parser.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
     parser.add_argument("--only", metavar="PREFIXES", help="execution/envelope: only rows (styles) starting with these "
-                        "comma-separated prefixes")
+                        "comma-separated prefixes; program: instruction numbers (1,5)")
     parser.add_argument("--seed", type=int, default=0, help="execution: the suite's seed (push timing; default 0)")
     parser.add_argument("--video", metavar="DIR", help="execution: a video per behaviour into DIR")
     parser.add_argument("--write", action="store_true", help="envelope: write the measured envelope next to the "

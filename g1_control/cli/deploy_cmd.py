@@ -41,6 +41,8 @@ examples:
   g1 deploy launch/robot.yaml --preflight-only         # checklist only; nothing is sent
   g1 deploy launch/robot.yaml --no-release-motion-service   # robot already in debug mode
   g1 deploy launch/robot.yaml --override temperatures  # a check you verified yourself (logged)
+  g1 deploy launch/robot.yaml --program square.yaml    # a behaviour program drives once you press run
+  g1 deploy launch/sim2sim.yaml --yes --say "walk forward 1 m and turn left"   # shown; y asked on a robot
 """
 
 
@@ -66,6 +68,14 @@ def register(subparsers) -> None:
                         "(default: the launch file's duration_s, or until stopped)")
     parser.add_argument("--preflight-only", action="store_true", help="run the checklist and exit; nothing is sent")
     parser.add_argument("--json", type=Path, help="write the deploy report (preflight, states, link stats) as JSON")
+    program = parser.add_mutually_exclusive_group()
+    program.add_argument("--program", type=Path, metavar="FILE",
+                         help="a behaviour program (.yaml/.json, g1_control/program/README.md) that drives the robot "
+                         "once control starts; the operator device keeps start/run/stop/e-stop; dry-run in MuJoCo "
+                         "first")
+    program.add_argument("--say", metavar="TEXT",
+                         help="an English instruction: parsed, shown, and run only after you confirm it (y); "
+                         "--yes answers only on sim2sim")
     parser.set_defaults(func=_run)
 
 
@@ -74,9 +84,11 @@ def _run(args) -> int:
     from g1_control.deploy.session import DeployOptions, deploy, write_report
 
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    program, text = _program(args)
     options = DeployOptions(yes=args.yes, overrides=frozenset(args.override), release_motion_service=args.release,
                             interface=args.interface, domain=args.domain, partition=args.partition,
-                            duration_s=args.duration, preflight_only=args.preflight_only)
+                            duration_s=args.duration, preflight_only=args.preflight_only, program=program,
+                            program_text=text)
     try:
         report = deploy(args.file, options)
     except PreflightRefused as exc:
@@ -86,3 +98,18 @@ def _run(args) -> int:
     if args.json:
         write_report(report, args.json)
     return 3 if report.sequence and report.fault else 0
+
+
+def _program(args):
+    """(program, the English it came from) for --program / --say; (None, "") without either."""
+    if args.program is not None:
+        from g1_control.program import load_program
+
+        return load_program(args.program), ""
+    if args.say is not None:
+        from g1_control.launch.schema import load_launch
+        from g1_control.program import parse_instruction
+
+        world = load_launch(args.file).program_world()
+        return parse_instruction(args.say, places=world.names() if world.places else None), args.say
+    return None, ""

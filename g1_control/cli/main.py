@@ -17,6 +17,7 @@ from g1_control.errors import G1ControlError
 
 SUBCOMMAND_MODULES = (
     "g1_control.cli.launch_cmd",
+    "g1_control.cli.say_cmd",
     "g1_control.cli.replay_cmd",
     "g1_control.cli.view_cmd",
     "g1_control.cli.init_cmd",

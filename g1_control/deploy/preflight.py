@@ -228,7 +228,7 @@ class Preflight:
         if open_error is not None:
             return self.record("estop_input", FAIL, open_error, overridable=False)
         kind = launch.input.type
-        if kind in ("scripted", "random", "gamepad_script"):
+        if kind in ("scripted", "random", "gamepad_script", "program"):
             if launch.backend.type == "unitree_dds" and launch.backend.interface == "lo":
                 return self.record("estop_input", PASS, f"{kind} input against the emulator on lo (sim2sim): no "
                                    "operator e-stop; Ctrl-C or SIGTERM damps")
@@ -250,12 +250,13 @@ class Preflight:
                                "input.device.mapping.buttons")
         return self.record("estop_input", PASS, f"{kind} answering; e-stop on {', '.join(bound)}")
 
-    def check_dry_run(self, launch: LaunchFile) -> bool:
+    def check_dry_run(self, launch: LaunchFile, program=None) -> bool:
+        """A lockstep MuJoCo run of the launch file (with `program`: of that behaviour program) must not fall."""
         from g1_control.launch.runner import run as run_sim
 
-        sim = dry_run_launch(launch)
+        sim = dry_run_launch(launch, program)
         try:
-            result = run_sim(sim, progress=False)
+            result = run_sim(sim, progress=False, end_with_program=False)
         except G1ControlError as exc:
             return self.record("dry_run", FAIL, f"the simulated dry run could not run: {exc}")
         self.dry_run = result
@@ -271,6 +272,13 @@ class Preflight:
         if faults:
             return self.record("dry_run", FAIL, f"the safety layer tripped in simulation: {faults[0]['kind']}: "
                                f"{faults[0]['detail']}")
+        ran = result.extra.get("program")
+        if ran is not None:
+            missed = [s["label"] for s in ran["steps"] if not s.get("verdict", {}).get("ok", True)]
+            what += (f"; program {'finished' if ran['finished'] else 'STOPPED'}, {len(ran['steps'])} steps"
+                     + (f", missed by ground truth: {', '.join(missed)}" if missed else ""))
+            if not ran["finished"]:
+                return self.record("dry_run", FAIL, f"the program did not finish in simulation: {what}")
         return self.record("dry_run", PASS, f"no fall: {what}")
 
     # -- verdict -----------------------------------------------------------------------------------------
@@ -308,12 +316,24 @@ DRY_RUN_EXERCISE = (("stand", 2.0, 0.0, 0.0), ("forward", 4.0, 0.5, 0.0), ("turn
 dry run of a launch file whose commands come from an operator (unknown in advance)."""
 
 
-def dry_run_launch(launch: LaunchFile) -> LaunchFile:
+def dry_run_launch(launch: LaunchFile, program=None) -> LaunchFile:
     """The same launch file on lockstep MuJoCo: same policy, rates, limits and safety thresholds; the
+    behaviour program when there is one (`program`, or input.type program: run to its end), the
     scripted timeline when there is one, else a stand-walk-turn-stand exercise."""
     from g1_control.launch.schema import BackendConfig
 
     duration = launch.deploy.dry_run_s
+    if program is not None or launch.input.type == "program":
+        cfg = launch.input
+        steps = [s.to_dict() for s in program.steps] if program is not None else list(cfg.program)
+        text = "" if program is not None else cfg.instruction
+        run_input = InputConfig(type="program", program=steps, instruction=text, places=dict(cfg.places),
+                                pose="estimator", start_delay_s=cfg.start_delay_s)
+        dry = dataclasses.replace(launch, name=f"{launch.name}-dry-run", duration_s=None, input=run_input,
+                                  backend=BackendConfig(type="mujoco", mode="lockstep",
+                                                        physics_dt_s=launch.backend.physics_dt_s), viewer=False)
+        dry.duration_s = max(duration, dry.total_duration_s)
+        return dry
     if launch.input.type == "scripted":
         timeline = list(launch.input.timeline)
     else:

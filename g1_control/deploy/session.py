@@ -19,6 +19,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from g1_control.deploy.preflight import CHECKS, FAIL, Preflight
 from g1_control.deploy.state_machine import DeployState, DeployTracker, OperatorButtons, Transition
@@ -47,6 +48,12 @@ class DeployOptions:
     duration_s: float | None = None
     """Length of the control phase (None: the launch file's duration_s, or until stopped)."""
     preflight_only: bool = False
+    program: Any = None
+    """A behaviour program (g1_control.program.Program) that drives the robot once control starts;
+    the operator device keeps its buttons (start, run, stop, e-stop). Dry-run in MuJoCo first."""
+    program_text: str = ""
+    """The English instruction `program` was parsed from: it is shown and must be confirmed (y) on
+    a robot; --yes answers only on sim2sim."""
 
 
 @dataclass
@@ -117,8 +124,33 @@ def _open_input(launch: LaunchFile, backend, spec):
     return device, None
 
 
-def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say) -> DeployReport:
-    """Run one deploy session; raise PreflightRefused (after printing the table) when refused."""
+def _confirm_program(launch: LaunchFile, options: DeployOptions, say, ask) -> bool:
+    """Show the program; one typed in English runs only after the operator answers y (--yes: on
+    sim2sim only, which _apply_cli has checked). Places must be in the launch file's input.places."""
+    from g1_control.program import ProgramError
+
+    program = options.program
+    if launch.input.pose != "estimator":
+        raise LaunchFileError("input.pose: a robot steers a program by its own estimate; set input.pose: estimator")
+    try:
+        program.validate(launch.program_world())
+    except ProgramError as exc:
+        raise LaunchFileError(f"program: {exc}") from None
+    origin = f'from "{options.program_text}"' if options.program_text else "from the program file"
+    say(f"behaviour program ({origin}), run once control starts:\n{program.describe()}")
+    if not options.program_text or options.yes:
+        return True
+    answer = ask("run this program on the robot? type y and Enter (anything else: no): ")
+    if answer.strip().lower() in ("y", "yes"):
+        return True
+    say("not confirmed: nothing was sent to the robot")
+    return False
+
+
+def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say,
+           ask: Callable[[str], str] = input) -> DeployReport:
+    """Run one deploy session; raise PreflightRefused (after printing the table) when refused.
+    `ask`: the operator's answer to a question (confirming a program typed in English)."""
     report = DeployReport(launch=str(path))
     pf = Preflight(frozenset(options.overrides))
     launch = pf.check_launch_file(path)
@@ -131,6 +163,10 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
     if launch is None:
         pf.not_run([n for n in CHECKS if n != "launch_file"], "no valid launch file")
         return _refuse(pf, report, say)
+    if options.program is not None and not _confirm_program(launch, options, say, ask):
+        report.refused = True
+        report.end_reason = "program not confirmed by the operator"
+        return report
 
     spec, policy_variant = pf.check_policy(launch)
     backend = device = None
@@ -152,9 +188,18 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             pf.not_run(["estop_input"], "the remote's bytes ride in the robot's LowState_, and none arrived")
         else:
             pf.check_input(device, launch, open_error)
+        if device is not None and options.program is not None:
+            from g1_control.program.device import ProgramInput, describe_record
+
+            # motion from the program, buttons and loss from the operator's device
+            device = ProgramInput(options.program, launch.program_world(), pose="estimator",
+                                  start_delay_s=launch.input.start_delay_s, operator=device,
+                                  on_record=lambda r: say("program step " + describe_record(r)))
         if spec is not None:
-            say(f"simulated dry run ({launch.deploy.dry_run_s:.0f} s lockstep MuJoCo) ...")
-            pf.check_dry_run(launch)
+            say(f"simulated dry run ({launch.deploy.dry_run_s:.0f} s lockstep MuJoCo"
+                + (", the whole program" if options.program is not None or launch.input.type == "program" else "")
+                + ") ...")
+            pf.check_dry_run(launch, options.program)
         else:
             pf.not_run(["dry_run"], "no valid policy")
         report.preflight = pf.as_dict()
@@ -216,8 +261,13 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
     loop = build_loop(launch, backend=backend, input_device=buttons, wrap_tracker=deploy_state_machine,
                       wallclock=True, log_capacity=int(expected_s * r.tracker_hz))
     tracker, safety = wrapped[0], loop.safety
-    # A scripted timeline starts when control starts.
+    # A scripted timeline starts when control starts; so does a behaviour program (its own clock:
+    # the operator device keeps the loop's).
     buttons.timeline_clock = tracker.control_elapsed_s
+    from g1_control.program.device import ProgramInput
+
+    if isinstance(device, ProgramInput):
+        device.program_clock = tracker.control_elapsed_s
     report.chain = dict(loop.chain)
     dry = pf.dry_run.chain if pf.dry_run is not None else {}
     report.dry_run_chain = dict(dry)
@@ -300,6 +350,12 @@ def _fill_report(report: DeployReport, loop, tracker: DeployTracker, backend, sa
                           "velocity_est_mean": est.mean(axis=0).tolist() if len(est) else None,
                           "command_mean": cmd.mean(axis=0).tolist() if len(cmd) else None,
                           "upper_body_vs_plan": upper_body_rms_by_style(log_arrays, (t_mono >= start) & (t_mono < end))}
+    from g1_control.program.device import ProgramInput, record_dict
+
+    program = next((d for d in (loop.input, getattr(loop.input, "inner", None)) if isinstance(d, ProgramInput)), None)
+    if program is not None:
+        report.control["program"] = {"steps": [record_dict(r) for r in program.records],
+                                     "finished": program.done and not program.runner.stopped}
     report.loop = {"deadline_misses": loop.scheduler.deadline_misses, "ticks": loop.scheduler.tick_index,
                    "tick_p99_us": loop.scheduler.report()["tick"]["p99_us"],
                    "clamped_commands": safety.clamps.commands}

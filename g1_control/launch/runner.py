@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import yaml
 
+from g1_control.interfaces import InputDevice
 from g1_control.launch.builder import build_loop, make_sim_backend, timeline_of
 from g1_control.launch.overlay import overlay_lines
 from g1_control.launch.schema import LaunchFile
@@ -155,14 +156,18 @@ def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentR
 
 
 def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None = None,
-        progress: bool = True, viewer: bool = False, web_port: int | None = None) -> RunResult:
+        progress: bool = True, viewer: bool = False, web_port: int | None = None,
+        input_device: InputDevice | None = None, end_with_program: bool = True) -> RunResult:
     """Run `launch` to the end (or a fall); write the run folder when `out_root` is given.
 
-    viewer: the MuJoCo viewer; web_port: the browser view (g1_control/sim/web.py) on that port.
+    viewer: the MuJoCo viewer; web_port: the browser view (g1_control/sim/web.py) on that port;
+    input_device: instead of the launch file's input (g1 say hands in its program input).
+    end_with_program: a program run ends PROGRAM_END_HOLD_S after its last step (False: it runs
+    the launch file's whole duration, as the deploy's dry run does).
     """
     segments = timeline_of(launch)
     sim = make_sim_backend(launch)
-    loop = build_loop(launch, backend=sim)
+    loop = build_loop(launch, backend=sim, input_device=input_device)
     loop.reset()
     duration = launch.total_duration_s
     bar = None
@@ -199,6 +204,15 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
     last_web = [0.0]
     t0 = time.perf_counter()
     stop = (lambda: not view.is_running()) if view is not None else None
+    program = program_input(loop)
+    if program is not None and end_with_program:  # ends PROGRAM_END_HOLD_S after its last step
+        from g1_control.launch.schema import PROGRAM_END_HOLD_S
+
+        viewer_closed = stop
+
+        def stop() -> bool:
+            over = program.ended_s is not None and loop.now_s() - program.ended_s >= PROGRAM_END_HOLD_S
+            return over or (viewer_closed is not None and viewer_closed())
     try:
         loop.scheduler.run(round(duration * loop.rates.lowlevel_hz), stop=stop, progress=on_tick)
     finally:
@@ -214,9 +228,38 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
     result = _result(launch, loop, segments, wall)
     if watcher is not None:
         result.extra["goals"] = watcher.outcomes()
+    if program is not None:
+        from g1_control.program.device import record_dict
+
+        finish_program_verdicts(program.records, result.extra.get("goals", []), result.fall)
+
+        result.extra["program"] = {"steps": [record_dict(r) for r in program.records],
+                                   "finished": program.done and not program.runner.stopped,
+                                   "pose": program.pose_source}
     if out_root is not None:
         write_run_folder(result, launch, loop, Path(out_root), video)
     return result
+
+
+def finish_program_verdicts(records: list, goals: list[dict], fall: dict | None) -> None:
+    """After a run: goal steps take the execution layer's ground-truth verdict (program.judge.goal_verdict
+    on launch/outcomes.py's figures); a step the robot fell in, or after, is missed whatever it measured."""
+    from g1_control.program.judge import goal_verdict
+
+    by_goal = {o["goal_id"]: o for o in goals}
+    for r in records:
+        if r.goal_id in by_goal:
+            r.verdict = goal_verdict(by_goal[r.goal_id])
+        if fall is not None and r.verdict is not None and r.outcome.ended_s >= fall["t_s"]:
+            r.verdict.ok = False
+            r.verdict.text += f"; FELL at {fall['t_s']:.2f} s"
+
+
+def program_input(loop: ControlLoop):
+    """The loop's ProgramInput (g1_control/program/device.py), or None."""
+    from g1_control.program.device import ProgramInput
+
+    return loop.input if isinstance(loop.input, ProgramInput) else None
 
 
 def _open_viewer(sim: MujocoBackend):
@@ -310,6 +353,22 @@ def summary_dict(result: RunResult) -> dict:
     return d
 
 
+def program_summary(program: dict) -> str:
+    """The steps of a program run, each with the runner's outcome and the ground-truth verdict."""
+    steps = program["steps"]
+    judged = [s for s in steps if "verdict" in s]
+    ok = sum(s["verdict"]["ok"] for s in judged)
+    lines = [f"program (steered by {program['pose']}): {len(steps)} steps ran"
+             + ("" if program["finished"] else ", STOPPED before the end")
+             + (f"; {ok}/{len(judged)} met by ground truth" if judged else "")]
+    for s in steps:
+        line = f"  {s['label']}. {s['description']}: {s['status']} after {s['ended_s'] - s['started_s']:.1f} s"
+        if "verdict" in s:
+            line += f" | {s['verdict']['text']} {'OK' if s['verdict']['ok'] else 'MISSED'}"
+        lines.append(line)
+    return "\n".join(lines)
+
+
 def fall_text(fall: dict | None) -> str:
     """'no fall', or 'FELL at 12.34 s: left_knee_link on the ground'."""
     return "no fall" if fall is None else f"FELL at {fall['t_s']:.2f} s: {fall['detail']}"
@@ -341,6 +400,8 @@ def format_summary(result: RunResult) -> str:
         from g1_control.launch.outcomes import outcome_line
 
         lines += ["", "goals (ground truth):"] + ["  " + outcome_line(o) for o in result.extra["goals"]]
+    if result.extra.get("program"):
+        lines += ["", program_summary(result.extra["program"])]
     if result.run_dir:
         lines.append(f"run folder: {result.run_dir}" + (f" (video: {Path(result.video).name})" if result.video else ""))
     return "\n".join(lines)

@@ -25,6 +25,9 @@ ROBOT_BACKENDS = ("unitree_dds", "can", "serial")
 
 VARIANT_NAMES = ("g1_23dof", "g1_29dof", "g1_29dof_locked_waist")
 
+PROGRAM_END_HOLD_S = 1.0
+"""A program run goes on this long after its last step (the robot comes to rest; measured)."""
+
 MIN_WBC_TRACKER_HZ = 100.0
 """The whole-body controller's slowest rate in use: every task of issue 17 (standing at any height,
 reaching, holding and carrying a box, stepping onto a platform) was tracked at 100 Hz as at
@@ -188,17 +191,37 @@ class InputConfig:
     played through the real evdev gamepad reader, for recorded demos and tests.
     """
 
-    type: Literal["scripted", "random", "gamepad", "keyboard", "unitree_remote", "gamepad_script"] = "scripted"
+    type: Literal["scripted", "random", "gamepad", "keyboard", "unitree_remote", "gamepad_script",
+                  "program"] = "scripted"
     timeline: list[Segment] = field(default_factory=list)
     random: RandomTimelineConfig = field(default_factory=RandomTimelineConfig)
     device: dict[str, Any] = field(default_factory=dict)
     fallback: Literal["keyboard"] | None = None
     """For a gamepad with path 'auto': use the keyboard when no gamepad is plugged in."""
     gamepad_script: list[dict[str, Any]] = field(default_factory=list)
+    program: list[dict[str, Any]] = field(default_factory=list)
+    """type program: the behaviour program's steps (g1_control/program/README.md), e.g.
+    [{kind: walk, distance_m: 2.0}, {kind: turn, angle_rad: 1.5708}]."""
+    instruction: str = ""
+    """type program: an English instruction instead of `program` (parsed when the file is loaded)."""
+    places: dict[str, dict[str, Any]] = field(default_factory=dict)
+    """type program: named places besides the scene's ({door: {pos_w_m: [3, 0, 0], kind: point}})."""
+    pose: Literal["estimator", "ground_truth"] = "estimator"
+    """type program: what the runner steers by: the robot's own estimate (IMU yaw, leg odometry), or,
+    in simulation only, the simulator's pose. Steps are judged from ground truth either way."""
+    start_delay_s: float = 1.0
+    """type program: standing time before the first step."""
 
     def validate(self, where: str) -> None:
         if self.type == "scripted" and not self.timeline:
             raise LaunchFileError(f"{where}.timeline: a scripted input needs at least one segment")
+        if self.type == "program":
+            self.parsed_program(where)
+        elif self.program or self.instruction:
+            raise LaunchFileError(f"{where}.{'program' if self.program else 'instruction'}: only input.type program "
+                                  f"runs a program (got type {self.type})")
+        if self.start_delay_s < 0:
+            raise LaunchFileError(f"{where}.start_delay_s: must be >= 0, got {self.start_delay_s}")
         if self.type == "gamepad_script":
             from g1_control.teleop.gamepad_script import parse_gamepad_script
 
@@ -211,6 +234,34 @@ class InputConfig:
             if "type" in self.device:
                 raise LaunchFileError(f"{where}.device.type: the device type is input.type ({self.type})")
             MappingConfig.from_dict(self.device.get("mapping"), f"{where}.device.mapping", layout=LAYOUTS[kind])
+
+    def parsed_program(self, where: str = "input"):
+        """The program (g1_control.program.Program) `program` or `instruction` describes; errors name the key."""
+        from g1_control.program import InstructionError, Program, ProgramError, parse_instruction
+        from g1_control.program.steps import Step
+
+        if bool(self.program) == bool(self.instruction):
+            raise LaunchFileError(f"{where}: input.type program needs `program` (a list of steps) or `instruction` "
+                                  "(English), one of them")
+        if self.instruction:
+            try:
+                return parse_instruction(self.instruction)
+            except InstructionError as exc:
+                raise LaunchFileError(f"{where}.instruction: {exc}") from None
+        try:
+            steps = [Step.from_dict(s, f"{where}.program[{i}]") for i, s in enumerate(self.program)]
+            return Program(steps).validate()
+        except ProgramError as exc:
+            raise LaunchFileError(str(exc)) from None
+
+    def world(self, where: str = "input"):
+        """The named places of `places` (g1_control.program.World)."""
+        from g1_control.program import ProgramError, World
+
+        try:
+            return World.from_dict(self.places)
+        except ProgramError as exc:
+            raise LaunchFileError(f"{where}.{str(exc).removeprefix('world.')}") from None
 
 
 @dataclass
@@ -291,6 +342,13 @@ class LaunchFile:
             raise LaunchFileError(f"rates.tracker_hz: tracker.type wbt runs at the policy's 50 Hz, got "
                                   f"{self.rates.tracker_hz:g}")
         self._validate_goals()
+        if self.input.type == "program":
+            from g1_control.program import ProgramError
+
+            try:
+                self.input.parsed_program().validate(self.program_world())
+            except ProgramError as exc:
+                raise LaunchFileError(f"input.program: {exc}") from None
         lim = self.limits
         for i, seg in enumerate(self.input.timeline):
             for name, limit in (("vx_mps", lim.max_vx_mps), ("vy_mps", lim.max_vy_mps), ("wz_radps", lim.max_wz_radps)):
@@ -324,6 +382,17 @@ class LaunchFile:
                 if goal.kind == "step_up" and not sc.platforms:
                     raise LaunchFileError(f"{where}: a step_up goal needs a platform in scene.platforms")
 
+    def program_world(self):
+        """Places a behaviour program may name (g1_control.program.World): the scene's tables,
+        platforms and boxes, and input.places."""
+        from g1_control.program import ProgramError, World
+
+        extra = self.input.world()
+        try:
+            return World.from_scene(self.scene, extra)
+        except ProgramError as exc:
+            raise LaunchFileError(f"input.{str(exc).removeprefix('world.')}") from None
+
     @property
     def total_duration_s(self) -> float:
         if self.duration_s is not None:
@@ -332,6 +401,10 @@ class LaunchFile:
             return sum(s.duration_s for s in self.input.timeline)
         if self.input.type == "gamepad_script" and self.input.gamepad_script:
             return float(self.input.gamepad_script[-1]["t_s"]) + 3.0
+        if self.input.type == "program":  # an upper bound: the run ends when the program does
+            from g1_control.program.runner import time_budget_s
+
+            return self.input.start_delay_s + time_budget_s(self.input.parsed_program()) + PROGRAM_END_HOLD_S
         return 60.0
 
 

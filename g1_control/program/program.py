@@ -80,6 +80,8 @@ class Program:
 def load_program(path: str | Path) -> Program:
     """A program from a .json or .yaml/.yml file."""
     path = Path(path)
+    if not path.is_file():
+        raise ProgramError(f"{path}: no such program file")
     text = path.read_text()
     if path.suffix in (".yaml", ".yml"):
         import yaml

@@ -18,6 +18,7 @@ RunnerConfig.continue_after_failure.
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -68,12 +69,15 @@ class GoalRequest:
     target: str | None = None
     target_w_m: np.ndarray | None = None
     offset_b_m: np.ndarray | None = None
+    target_kind: str | None = None
+    """The World's kind of `target` (object / surface / platform / point); None without one."""
 
     def to_task_goal(self) -> TaskGoal:
         """The goal for the execution layer (types.TaskGoal, g1_control/generator/goals/): same id,
         so GoalGenerator.goal_status[goal_id] answers ProgramProgress.goal_status. Places are
-        passed by name (a table or platform of the launch file's scene is found by it) and by
-        point (for anything else)."""
+        passed by name (a table or platform of the launch file's scene is found by it: a place goes
+        where the execution layer can reach, the middle of the table's near edge) and by point (a
+        named point, the start)."""
         hand = self.hand if self.hand in ("left", "right", "both") else "right"
         if self.kind == "reach":
             return TaskGoal("reach", self.goal_id, hand, pos_w_m=None if self.target_w_m is None else self.target_w_m.copy(),
@@ -82,8 +86,9 @@ class GoalRequest:
         if self.kind == "pick":
             return TaskGoal("pick", self.goal_id, hand, object=self.object)
         if self.kind == "place":
-            return TaskGoal("place", self.goal_id, hand, object=self.object, target=self.target,
-                            pos_w_m=None if self.target_w_m is None else self.target_w_m.copy())
+            on_block = self.target_kind in ("surface", "platform")
+            return TaskGoal("place", self.goal_id, hand, object=self.object, target=self.target if on_block else None,
+                            pos_w_m=None if self.target_w_m is None or on_block else self.target_w_m.copy())
         return TaskGoal(self.kind, self.goal_id, hand, target=self.target)
 
     def to_effector_goals(self) -> list[EffectorGoal]:
@@ -138,7 +143,7 @@ class RunnerConfig:
     yaw_rate_radps: float = 0.6
     min_speed_mps: float = 0.08
     """Walks slow down as they near the end (speed = gain x remaining) but not below this."""
-    slowdown_gain_per_s: float = 1.2
+    slowdown_gain_per_s: float = 0.8
     distance_tolerance_m: float = 0.02
     place_tolerance_m: float = 0.05
     min_yaw_rate_radps: float = 0.12
@@ -150,13 +155,69 @@ class RunnerConfig:
     timeout_margin_s: float = 5.0
     """A step without timeout_s gets factor x the nominal time + margin (walk/turn), or goal_timeout_s."""
     goal_timeout_s: dict[str, float] = field(default_factory=lambda: {
-        "reach": 15.0, "pick": 45.0, "place": 45.0, "step_up": 30.0, "step_down": 30.0})
+        "reach": 30.0, "pick": 60.0, "place": 90.0, "step_up": 45.0, "step_down": 45.0})
+    """Upper bounds on the execution layer's goals, walking to the work included (MuJoCo, tracker.type
+    layer: pick ~16 s, a 3 m carry and place ~45-50 s, step up ~20 s; notes 15_part2.md)."""
     posture_height_m: dict[str, float | None] = field(default_factory=lambda: {
         "crouch": 0.62, "normal": None, "tall": 0.8})
     """None: the generator's own height for the style."""
     height_settle_s: float = 1.5
     """A height step without a duration completes after this (the body gets there)."""
+    walk_settle_max_s: float = 2.0
+    """A walk that reached its end commands zero velocity until the robot is at rest (moved less than
+    still_speed_mps x still_window_s over the last still_window_s), at most this long; its outcome is
+    measured there, so the next step starts from rest and a walk's figures include its run-out
+    (0: complete at once, still moving)."""
+    still_speed_mps: float = 0.05
+    still_window_s: float = 0.3
+    runout_m: float = 0.03
+    """A walk by a distance stops commanding this much early: the walking policy runs on by about
+    that much once its velocity goes to zero (MuJoCo, holosoma ppo: 0-9 cm, mean ~3 cm over 24 walks)."""
+    walk_corrections: int = 2
+    """A walk by a distance that came to rest more than correction_tolerance_m off (by odometry, which
+    reads without sway at rest) walks the rest (or back) at correction_speed_mps, up to this often."""
+    correction_tolerance_m: float = 0.03
+    correction_speed_mps: float = 0.12
+    gait_period_s: float = 1.0
+    """The walking policy's gait period (holosoma: 1 s): walks judge their progress on the position
+    averaged over one period (the pelvis sways +-3-5 cm sideways with each step), brought up to
+    now by half the period's displacement. 0: the raw position."""
     continue_after_failure: bool = False
+
+
+PLACE_WALK_BUDGET_S = 60.0
+"""time_budget_s: a walk to a place, whose length is known only when it starts."""
+
+
+def time_budget_s(program: Program, config: RunnerConfig | None = None) -> float:
+    """An upper bound on how long `program` runs: every step's timeout (or its time), repeats
+    expanded, as the runner would give them (a walk to a place: PLACE_WALK_BUDGET_S unless it has
+    a timeout). Launch files size a program run by it; the run ends early when the program does."""
+    cfg = config or RunnerConfig()
+    leaves: list[_Leaf] = []
+    _flatten(program.steps, "", leaves)
+
+    def budget(step: Step) -> float:
+        if isinstance(step, Parallel):
+            return budget(step.main)
+        timeout = getattr(step, "timeout_s", None)
+        if timeout is not None:
+            return timeout
+        if isinstance(step, Walk):
+            if step.distance_m is None:
+                return step.duration_s if step.duration_s is not None else PLACE_WALK_BUDGET_S
+            speed = step.speed_mps or cfg.walk_speed_mps[step.direction]
+            return cfg.timeout_factor * step.distance_m / speed + cfg.timeout_margin_s
+        if isinstance(step, Turn):
+            rate = step.yaw_rate_radps or cfg.yaw_rate_radps
+            angle = step.angle_rad if step.angle_rad is not None else math.pi
+            return cfg.timeout_factor * angle / rate + cfg.timeout_margin_s
+        if isinstance(step, (Stand, Style, Height)):
+            hold = step.duration_s
+            return hold if hold is not None else cfg.height_settle_s
+        return cfg.goal_timeout_s[step.kind]
+
+    return sum(budget(leaf.step) for leaf in leaves)
 
 
 @dataclass
@@ -192,6 +253,12 @@ class _Active:
         self.stop_m = 0.0
         self.walk_dir_w = np.array([1.0, 0.0])
         self.hold_heading = p.yaw_rad
+        self.reached_xy: tuple[float, float] | None = None
+        self.corrections = 0
+        self.settle_t0: float | None = None
+        """When a walk reached its end and started coming to rest (elapsed s); None while walking."""
+        self.track: deque[tuple[float, float, float]] = deque()
+        """(elapsed, x, y) over the last RunnerConfig.still_window_s, for telling rest."""
 
 
 class ProgramRunner:
@@ -249,6 +316,31 @@ class ProgramRunner:
 
     def summary(self) -> str:
         return "\n".join(o.describe() for o in self.outcomes)
+
+    def step_of(self, label: str) -> Step:
+        """The step an outcome's label names ('3', '2.1#2')."""
+        return next(leaf.step for leaf in self._leaves if leaf.label == label)
+
+    @property
+    def active_is_locomotion(self) -> bool:
+        """The step running now is a walk, turn or stand (alone or as a parallel's main) with no goal."""
+        a = self._active
+        if a is None or a.goals:
+            return False
+        main = a.leaf.step.main if isinstance(a.leaf.step, Parallel) else a.leaf.step
+        return isinstance(main, (Walk, Turn, Stand))
+
+    def restart_active(self, now_s: float, progress: ProgramProgress) -> None:
+        """Start the running locomotion step over from here (its distance, heading and time count
+        from now): the program input does this once the execution layer has handed the robot back
+        to the walking policy after a goal (the hand-over moves the robot; that is not the walk)."""
+        if self.active_is_locomotion:
+            assert self._active is not None
+            self._active = self._begin(self._active.leaf, now_s, progress)
+
+    def hold_command(self) -> Command:
+        """Stand still with the style and height the program has set so far (before it starts, after it ends)."""
+        return self._idle()
 
     # --- step life cycle ---------------------------------------------------------------------
     def _finish(self, a: _Active, status: str, measured: dict[str, float], now_s: float) -> None:
@@ -332,12 +424,13 @@ class ProgramRunner:
                 target_w = target_w + np.array([c * off[0] - s * off[1], s * off[0] + c * off[1], off[2]])
             else:
                 offset_b = off
+        kind = None if name is None else "point" if name == START else self.world.get(name, where).kind
         return GoalRequest(
             gid, step.kind,
             hand=getattr(step, "hand", None) or getattr(step, "hands", None),
             object=step.object if isinstance(step, (Pick, Place)) else None,
             target=name if not isinstance(step, Pick) else None,
-            target_w_m=target_w, offset_b_m=offset_b)
+            target_w_m=target_w, offset_b_m=offset_b, target_kind=kind)
 
     # --- per-tick behaviour ------------------------------------------------------------------
     def _turn_remaining(self, a: _Active, t: Turn, p: ProgramProgress) -> float:
@@ -406,12 +499,50 @@ class ProgramRunner:
         assert isinstance(step, Walk)
         speed = step.speed_mps or cfg.walk_speed_mps[step.direction]
         pos = np.array([p.x_m, p.y_m])
+        a.track.append((elapsed, p.x_m, p.y_m))
+        while a.track and a.track[0][0] < elapsed - max(cfg.still_window_s, cfg.gait_period_s):
+            a.track.popleft()
+        if cfg.gait_period_s > 0 and a.track[-1][0] - a.track[0][0] >= 0.95 * cfg.gait_period_s:
+            # sway-free position: the mean over one gait period is where the robot was half a period
+            # ago; the displacement over the period (also sway-free) brings it up to now
+            track = np.asarray(a.track)
+            pos = track[:, 1:].mean(axis=0) + (track[-1, 1:] - track[0, 1:]) / 2
+        if a.settle_t0 is None:
+            reached = False
+            if step.target is not None:
+                reached = float(np.hypot(*(a.target_xy - pos))) - a.stop_m <= cfg.place_tolerance_m
+            elif step.distance_m is not None:
+                remaining = step.distance_m - float((pos - [a.x0, a.y0]) @ a.walk_dir_w)
+                reached = abs(remaining) <= cfg.distance_tolerance_m if a.corrections else \
+                    remaining <= cfg.distance_tolerance_m + cfg.runout_m
+            elif step.duration_s is not None:
+                reached = elapsed >= step.duration_s
+            if reached:
+                a.settle_t0 = elapsed
+                a.reached_xy = (p.x_m, p.y_m)
+        if a.settle_t0 is not None:  # coming to rest: zero velocity, heading held
+            t0, x0, y0 = next(e for e in a.track if e[0] >= elapsed - cfg.still_window_s - 1e-9)
+            window = elapsed - a.settle_t0 >= cfg.still_window_s and elapsed - t0 >= 0.8 * cfg.still_window_s
+            still = window and math.hypot(p.x_m - x0, p.y_m - y0) <= cfg.still_speed_mps * cfg.still_window_s
+            if still and step.distance_m is not None and a.corrections < cfg.walk_corrections:
+                # at rest, where odometry reads without sway: close the loop on what is left
+                left = step.distance_m - float((np.array([p.x_m, p.y_m]) - [a.x0, a.y0]) @ a.walk_dir_w)
+                if abs(left) > cfg.correction_tolerance_m:
+                    a.corrections += 1
+                    a.settle_t0 = None
+                    return self._tick_main(a, step, cmd, elapsed, p)
+            if still or elapsed - a.settle_t0 >= cfg.walk_settle_max_s:
+                return cmd, (COMPLETED, self._measure(a, step, p))
+            if step.target is None:
+                err = wrap_angle(a.hold_heading - p.yaw_rad)
+                cmd.heading_rad = a.hold_heading
+                cmd.wz_radps = float(np.clip(cfg.heading_hold_gain_per_s * err, -cfg.yaw_rate_radps,
+                                             cfg.yaw_rate_radps))
+            return cmd, None
         if step.target is not None:
             d = a.target_xy - pos
             dist = float(np.hypot(*d))
             remaining = dist - a.stop_m
-            if remaining <= cfg.place_tolerance_m:
-                return cmd, (COMPLETED, self._measure(a, step, p))
             bearing = math.atan2(d[1], d[0])
             err = wrap_angle(bearing - p.yaw_rad)
             v = min(speed, max(cfg.min_speed_mps, cfg.slowdown_gain_per_s * remaining))
@@ -420,15 +551,10 @@ class ProgramRunner:
             cmd.wz_radps = float(np.clip(cfg.heading_hold_gain_per_s * err, -cfg.yaw_rate_radps, cfg.yaw_rate_radps))
             return cmd, None
         if step.distance_m is not None:
-            covered = float((pos - [a.x0, a.y0]) @ a.walk_dir_w)
-            remaining = step.distance_m - covered
-            if remaining <= cfg.distance_tolerance_m:
-                return cmd, (COMPLETED, self._measure(a, step, p))
-            v = min(speed, max(cfg.min_speed_mps, cfg.slowdown_gain_per_s * remaining))
+            remaining = step.distance_m - float((pos - [a.x0, a.y0]) @ a.walk_dir_w)
+            v = math.copysign(min(speed, max(cfg.correction_speed_mps if a.corrections else cfg.min_speed_mps,
+                                             cfg.slowdown_gain_per_s * abs(remaining))), remaining)
         else:
-            assert step.duration_s is not None  # a valid Walk has a target, a distance or a duration
-            if elapsed >= step.duration_s:
-                return cmd, (COMPLETED, self._measure(a, step, p))
             v = speed
         # velocity in the heading frame along the walk's world direction, heading held
         c, s = math.cos(p.yaw_rad), math.sin(p.yaw_rad)
@@ -450,6 +576,10 @@ class ProgramRunner:
             along = float(moved @ a.walk_dir_w)
             side = float(moved[0] * -a.walk_dir_w[1] + moved[1] * a.walk_dir_w[0])
             out = {"distance_m": along, "lateral_m": side}
+            if a.reached_xy is not None:  # how far it ran on after the velocity went to zero
+                out["runout_m"] = float((pos - a.reached_xy) @ a.walk_dir_w)
+            if a.corrections:
+                out["corrections"] = float(a.corrections)
             if step.distance_m is not None:
                 out["error_m"] = along - step.distance_m
             return out
@@ -472,5 +602,6 @@ __all__ = [
     "ProgramRunner",
     "RunnerConfig",
     "StepOutcome",
+    "time_budget_s",
     "wrap_angle",
 ]

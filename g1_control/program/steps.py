@@ -550,3 +550,19 @@ def iter_named_places(step: Step):
     if isinstance(step, Repeat):
         for i, s in enumerate(step.steps):
             yield from ((f"steps[{i}].{p}", n) for p, n in iter_named_places(s))
+
+
+GOAL_STEPS = (Reach, Pick, Place, StepUp, StepDown)
+"""Steps the execution layer carries out (task goals)."""
+
+
+def iter_steps(step: Step):
+    """The step and every step inside it (a parallel's main and alongside, a repeat's steps)."""
+    yield step
+    if isinstance(step, Parallel):
+        yield from iter_steps(step.main)
+        for s in step.alongside:
+            yield from iter_steps(s)
+    if isinstance(step, Repeat):
+        for s in step.steps:
+            yield from iter_steps(s)

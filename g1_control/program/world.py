@@ -9,10 +9,14 @@ from typing import Any
 import numpy as np
 
 from g1_control.program.exceptions import ProgramError
+from g1_control.scene import SceneConfig
 
 PLACE_KINDS = ("object", "surface", "platform", "point")
 START = "start"
 """Reserved place name: where the robot stood when the program started ("walk back to the start")."""
+
+SCENE_CLEARANCE_M = 0.3
+"""World.from_scene: a walk to a table or platform stops this far outside its farthest half-extent."""
 
 DEFAULT_STANDOFF_M = {"object": 0.45, "surface": 0.5, "platform": 0.5, "point": 0.0}
 """Where a walk to a place stops: this far from its centre (an object's is the generator's box standoff)."""
@@ -82,6 +86,29 @@ class World:
                 d["standoff_m"] = float(p.standoff_m)
             out[name] = d
         return out
+
+    @classmethod
+    def from_scene(cls, scene: SceneConfig, extra: World | None = None) -> World:
+        """The scene's tables (surfaces), platforms and boxes (objects) as places, plus `extra`'s
+        (named points of a launch file's input.places). A walk to a table or platform stops
+        SCENE_CLEARANCE_M beyond its farthest half-extent (clear of its edge from any side)."""
+        places: dict[str, Landmark] = {}
+        for kind, blocks in (("surface", scene.tables), ("platform", scene.platforms)):
+            for b in blocks:
+                places[b.name] = Landmark(b.name, np.array([*b.center, b.height_m]), kind,
+                                          float(max(b.half)) + SCENE_CLEARANCE_M)
+        for box in scene.boxes:
+            under = scene.block(box.stands_on)
+            standoff = None  # on the floor: the object default
+            if under is not None:  # on a table: stop as far from its edge as from a box on the floor
+                inside = float(np.min(under.half - np.abs(under.local_xy(np.asarray(box.xy_m, dtype=float)))))
+                standoff = DEFAULT_STANDOFF_M["object"] + max(0.0, inside)
+            places[box.name] = Landmark(box.name, np.asarray(scene.box_center(box), dtype=float), "object", standoff)
+        for name, p in (extra.places if extra is not None else {}).items():
+            if name in places:
+                raise ProgramError(f"world.places.{name}: the scene already has a '{name}'; name it otherwise")
+            places[name] = p
+        return cls(places).validate()
 
     @classmethod
     def from_dict(cls, data: Any) -> World:

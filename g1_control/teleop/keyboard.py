@@ -8,6 +8,12 @@ mode is restored on close() and, should close() never run, at interpreter exit.
 A terminal reports key presses (and auto-repeat) but never releases, so velocity keys step
 virtual axes (mapping `key_axes`) and a key bound to zero_velocity stops. The terminal going
 away (SSH dropped: read returns EOF or EIO) makes the device lost.
+
+Line mode: the key bound to `instruction` ('/' by default) stops the robot and opens a line;
+what is typed next is text (echoed), Backspace edits, Enter submits it (`take_line()`; the
+program input of g1_control/program/instructed.py parses and runs it). In line mode letters
+are text, never actions: only named keys bound to estop or damp (Esc by default) still act,
+and they also drop the line.
 """
 
 from __future__ import annotations
@@ -19,13 +25,14 @@ import select
 import sys
 import termios
 import time
+from collections import deque
 from collections.abc import Callable
 
 from g1_control.errors import InputDeviceError
 from g1_control.teleop.device import DeviceLost, TeleopDevice
-from g1_control.teleop.mapping import MappingConfig
+from g1_control.teleop.mapping import LINE_ACTION, MappingConfig
 from g1_control.teleop.snapshot import InputSnapshot
-from g1_control.types import CommandLimits
+from g1_control.types import Button, CommandLimits
 
 _ESCAPE_KEYS = {  # CSI / SS3 sequences of common terminals (xterm, VT220)
     "[A": "up", "[B": "down", "[C": "right", "[D": "left", "OA": "up", "OB": "down", "OC": "right", "OD": "left",
@@ -77,8 +84,17 @@ class TerminalKeyboard(TeleopDevice):
 
     def __init__(self, mapping: MappingConfig | None = None, limits: CommandLimits | None = None, *,
                  path: str | None = None, fd: int | None = None, where: str = "input",
-                 clock: Callable[[], float] = time.monotonic, name: str | None = None) -> None:
+                 clock: Callable[[], float] = time.monotonic, name: str | None = None,
+                 echo: Callable[[str], None] | None = None) -> None:
         super().__init__(mapping or MappingConfig.default("keyboard"), limits, name=name or "keyboard", clock=clock)
+        buttons = self.mapper.config.buttons
+        self._line_keys = {k for chord, a in buttons.items() if a == LINE_ACTION for k in chord}
+        self._line_stop_keys = {k for chord, a in buttons.items() if a in (Button.ESTOP, Button.DAMP)
+                                for k in chord if len(k) > 1}
+        """Named keys (Esc) that stop the robot even in line mode; letters there are text."""
+        self._line: str | None = None
+        self.lines: deque[str] = deque()
+        self._echo = echo if echo is not None else _stdout_echo
         self._owns_fd = False
         if path is not None:
             try:
@@ -132,7 +148,51 @@ class TerminalKeyboard(TeleopDevice):
         keys, unknown = decode_keys(data.decode("utf-8", errors="replace"))
         self.unknown_keys += unknown
         self.keys_read += len(keys)
+        if self._line_keys or self._line is not None:
+            keys = self._line_mode(keys)
         return InputSnapshot(pressed=tuple(keys))
+
+    # -- line mode ---------------------------------------------------------------------------
+    @property
+    def typing(self) -> bool:
+        """A line is open (keys are text)."""
+        return self._line is not None
+
+    def begin_line(self, prompt: str = "> ") -> None:
+        """Open a line as the `instruction` key does (e.g. to ask for a confirmation)."""
+        self._line = ""
+        self._echo("\r\n" + prompt)
+
+    def take_line(self) -> str | None:
+        """The oldest submitted line, or None."""
+        return self.lines.popleft() if self.lines else None
+
+    def _line_mode(self, keys: list[str]) -> list[str]:
+        """Keys typed into a line are consumed; the rest pass on to the mapping."""
+        out = []
+        for key in keys:
+            if self._line is None:
+                out.append(key)  # the instruction key itself passes: its action stops the robot
+                if key in self._line_keys:
+                    self.begin_line()
+                continue
+            if key in self._line_stop_keys:
+                out.append(key)
+                self._line = None
+                self._echo("  [line dropped]\r\n")
+            elif key == "enter":
+                self.lines.append(self._line)
+                self._line = None
+                self._echo("\r\n")
+            elif key == "backspace":
+                if self._line:
+                    self._line = self._line[:-1]
+                    self._echo("\b \b")
+            elif key == "space" or len(key) == 1:
+                ch = " " if key == "space" else key
+                self._line += ch
+                self._echo(ch)
+        return out
 
     def _restore(self) -> None:
         if self._saved is not None:
@@ -151,3 +211,9 @@ class TerminalKeyboard(TeleopDevice):
     def _release(self) -> None:
         self._restore()
         self._close_fd()
+
+
+def _stdout_echo(text: str) -> None:
+    if sys.stdout.isatty():
+        sys.stdout.write(text)
+        sys.stdout.flush()

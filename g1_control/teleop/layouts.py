@@ -119,6 +119,7 @@ KEYBOARD_DEFAULT_MAPPING: dict[str, Any] = {
         "enter": "start", "r": "run", "o": "stop", "x": "damp", "esc": "estop",
         "space": "zero_velocity", "tab": "policy_switch", "]": "style_next", "[": "style_prev",
         "p": "pick", "l": "place", "u": "step_up", "n": "step_down",
+        "/": "instruction",
     },
     "slew_rate": {"vx": 1.0, "vy": 1.0, "wz": 2.0},
 }

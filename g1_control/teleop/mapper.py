@@ -11,11 +11,12 @@ import math
 from dataclasses import dataclass
 
 from g1_control.teleop.layouts import STICK
-from g1_control.teleop.mapping import GOAL_ACTIONS, MappingConfig
+from g1_control.teleop.mapping import GOAL_ACTIONS, LINE_ACTION, MappingConfig
 from g1_control.teleop.snapshot import InputSnapshot
 from g1_control.types import BUTTONS, Button, Command, CommandLimits, TaskGoal
 
-_STOPPING_ACTIONS = frozenset({Button.ESTOP, Button.DAMP, Button.STOP, "zero_velocity"})
+_STOPPING_ACTIONS = frozenset({Button.ESTOP, Button.DAMP, Button.STOP, "zero_velocity", LINE_ACTION})
+"""Typing a line (LINE_ACTION) stops the robot too: it stands while the operator types."""
 
 
 @dataclass

@@ -34,8 +34,11 @@ GOAL_ACTIONS = {"pick": "pick", "place": "place", "step_up": "step_up", "step_do
 """Actions that start a task goal (types.TaskGoal) against the scene: pick the box in front, set
 the held box down in front (on a table or platform there, else on the floor), step onto the
 platform in front, step back down. Executed by tracker.type layer (g1_control/generator/goals/)."""
-ACTIONS = BUTTONS | {"zero_velocity"} | set(GOAL_ACTIONS)
-"""What a button can do: every Command button, zero_velocity (handled inside the mapping), goals."""
+LINE_ACTION = "instruction"
+"""Keyboard: enter line mode to type an English instruction (teleop/keyboard.py); stops the robot."""
+ACTIONS = BUTTONS | {"zero_velocity", LINE_ACTION} | set(GOAL_ACTIONS)
+"""What a button can do: every Command button, zero_velocity (handled inside the mapping), goals and,
+on a keyboard, instruction (line mode)."""
 YAW_MODES = ("rate", "heading")
 
 
@@ -240,6 +243,8 @@ def _buttons(spec: Mapping[str, Any], where: str, layout: DeviceLayout) -> dict[
             raise LaunchFileError(f"{where}.{name}: two actions bound to one button ({list(action)}); bind one")
         if action not in ACTIONS:
             raise LaunchFileError(f"{where}.{name} is {action!r}, not an action; known: {', '.join(sorted(ACTIONS))}")
+        if action == LINE_ACTION and (layout.kind != "keyboard" or len(chord) != 1):
+            raise LaunchFileError(f"{where}.{name}: '{LINE_ACTION}' (typing a line) is a single keyboard key")
         if chord in buttons:
             raise LaunchFileError(
                 f"{where}.{name}: two actions bound to one button: '{spelled[chord]}' is already "

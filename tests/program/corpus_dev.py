@@ -151,7 +151,7 @@ DEV = [
     ("walk to the other table", [walk(target="other_table")]),
     ("walk slowly to the platform", [walk(target="platform", speed_mps=0.25)]),
     ("walk forward until you reach the table", [walk(target="table")]),
-    ("keep walking until you get to the door", None),  # "keep" is not a word the parser knows
+    ("keep walking until you get to the door", [walk(target="door")]),  # part 2: "keep" became a filler
     ("walk to the box within 30 seconds", [walk(target="box", timeout_s=30.0)]),
     # --- turn -------------------------------------------------------------------------------------------------
     ("turn left", [turn(angle_rad=deg(90))]),
@@ -177,8 +177,8 @@ DEV = [
     ("pivot right 45 degrees", [turn(angle_rad=deg(45), direction="right")]),
     ("turn clockwise 90 degrees", [turn(angle_rad=deg(90), direction="right")]),
     ("turn counterclockwise 30 degrees", [turn(angle_rad=deg(30))]),
-    ("make a quarter turn to the right", None),  # "make" is not a word the parser knows
-    ("do a quarter turn to the right", None),  # "do" only as "do that" (repeat)
+    ("make a quarter turn to the right", [turn(angle_rad=deg(90), direction="right")]),  # part 2: make/do a turn
+    ("do a quarter turn to the right", [turn(angle_rad=deg(90), direction="right")]),
     ("turn a quarter turn to the right", [turn(angle_rad=deg(90), direction="right")]),
     ("turn a half turn", [turn(angle_rad=deg(180))]),
     ("spin a full circle", [turn(angle_rad=deg(360))]),
@@ -203,7 +203,7 @@ DEV = [
     ("wait for three seconds", [stand(3)]),
     ("wait for 5", [stand(5)]),
     ("pause for 1.5 s", [stand(1.5)]),
-    ("stay there for 10 seconds", None),  # "there" is a filler? no: not a known word
+    ("stay there for 10 seconds", [stand(10)]),  # part 2: "there"/"here" after a wait are fillers
     ("stay for 10 seconds", [stand(10)]),
     ("stand still", [stand(2)]),
     ("stand still for 4 seconds", [stand(4)]),
@@ -376,6 +376,53 @@ DEV = [
      [stand(2), reach(target="ball"), pick("ball")]),
     ("walk forward 1 m and turn left 90 degrees, repeat that 4 times, then dance",
      [rep(4, walk(distance_m=1.0), turn(angle_rad=deg(90))), style("dance", 3)]),
+    # --- part 2: constructs from the second held-out set's failures (corpus_phrasing.py), in other sentences ---
+    # distances in steps (0.3 m each; corpus_phrasing.py's conventions)
+    ("take three steps forward", [walk(distance_m=0.9)]),
+    ("take one step to the right", [walk(distance_m=0.3, direction="right")]),
+    ("walk four steps backward", [walk(distance_m=1.2, direction="backward")]),
+    ("take a step forward and wave", [walk(distance_m=0.3), style("wave", 3)]),
+    # back without a distance or a place: back to the start
+    ("walk forward 3 meters and then come back", [walk(distance_m=3.0), walk(target="start")]),
+    ("go to the door and come back", [walk(target="door"), walk(target="start")]),
+    ("turn around and go back", [turn(angle_rad=deg(180)), walk(target="start")]),
+    # make / do a turn
+    ("make a right and walk forward 1 meter", [turn(angle_rad=deg(90), direction="right"), walk(distance_m=1.0)]),
+    ("make a left turn", [turn(angle_rad=deg(90))]),
+    ("do a 90 to the left", [turn(angle_rad=deg(90))]),
+    ("do a 360", [turn(angle_rad=deg(360))]),
+    ("make a u-turn", [turn(angle_rad=deg(180))]),
+    ("walk forward 1 m, then make a half turn", [walk(distance_m=1.0), turn(angle_rad=deg(180))]),
+    # pace, here, me, little
+    ("walk to the door at a brisk pace", [walk(target="door", speed_mps=0.7)]),
+    ("go forward 2 meters at a slow speed", [walk(distance_m=2.0, speed_mps=0.25)]),
+    ("stay here for 4 seconds", [stand(4)]),
+    ("wave to me for 2 seconds", [style("wave", 2)]),
+    ("do a little wave", [style("wave", 3)]),
+    # shapes
+    ("walk a square of 2 meters", [rep(4, walk(distance_m=2.0), turn(angle_rad=deg(90)))]),
+    ("walk in a 1.5 meter square to the right", [rep(4, walk(distance_m=1.5), turn(angle_rad=deg(90), direction="right"))]),
+    # at the same time; keep; spread out; low; back up again
+    ("turn left and look around at the same time", [par(turn(angle_rad=deg(90)), style("look_around"))]),
+    ("walk backward 1 meter and swing your arms simultaneously",
+     [par(walk(distance_m=1.0, direction="backward"), style("arm_swing"))]),
+    ("turn right with your arms spread out", [par(turn(angle_rad=deg(90), direction="right"), style("arms_out"))]),
+    ("keep your hands up while turning left", [par(turn(angle_rad=deg(90)), style("reach_up"))]),
+    ("squat low for 2 seconds", [height(posture="crouch", duration_s=2.0)]),
+    ("crouch for 2 seconds and get back up", [height(posture="crouch", duration_s=2.0), height(posture="normal")]),
+    # places: up to, a second place after "then", sources, back, move/drop as carry and put
+    ("go up to the chair", [walk(target="chair")]),
+    ("go to the door, then to the chair", [walk(target="door"), walk(target="chair")]),
+    ("walk to the box and then the table", [walk(target="box"), walk(target="table")]),
+    ("grab the ball from the chair", [pick("ball")]),
+    ("take the cup off the table and bring it to the shelf", [pick("cup"), place("cup", "shelf")]),
+    ("carry the ball back to the chair", [pick("ball"), place("ball", "chair")]),
+    ("place the cup back on the shelf", [place("cup", "shelf")]),
+    ("move the red box onto the shelf", [pick("red_box"), place("red_box", "shelf")]),
+    ("pick up the ball and drop it", [pick("ball"), place("ball")]),
+    ("turn to face the shelf, walk to it, and set the cup on it",
+     [turn(target="shelf"), walk(target="shelf"), place("cup", "shelf")]),
+    ("wave with your right hand", None),  # the wave is the right hand's; a hand named with a style is refused
     # --- words the parser refuses -----------------------------------------------------------------------
     ("jump forward 1 meter", None),
     ("walk forward 2 parsecs", None),

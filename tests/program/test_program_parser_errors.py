@@ -45,8 +45,10 @@ def test_a_place_the_world_does_not_have_is_an_unknown_word():
     parser = InstructionParser.for_places(["crate", "bench"])
     assert parser.parse("pick up the crate and put it on the bench").to_dict()["steps"] == [
         {"kind": "pick", "object": "crate"}, {"kind": "place", "object": "crate", "target": "bench"}]
-    with pytest.raises(UnknownWordError, match="unknown word 'table'"):
+    with pytest.raises(UnknownWordError, match="'table' in \"walk to the table\" is not a place here; places: "
+                       "bench, crate, start") as err:
         parser.parse("walk to the table")
+    assert err.value.word == "table" and err.value.suggestions == ("bench", "crate", "start")
 
 
 @pytest.mark.parametrize("text,message", [

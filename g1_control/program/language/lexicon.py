@@ -11,7 +11,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-FILLERS = frozenset(["please", "kindly", "the", "your", "you", "yourself", "robot", "now", "just", "ok", "okay", "hey", "also", "again", "carefully", "still", "can", "could", "would", "my", "its"])
+FILLERS = frozenset(["please", "kindly", "the", "your", "you", "yourself", "robot", "now", "just", "ok", "okay", "hey", "also", "again", "carefully", "still", "can", "could", "would", "my", "its",
+                     "here", "there", "me", "us", "little", "some"])
 """Dropped before anything else ("please", "the", "robot", ...)."""
 
 ARTICLES = frozenset({"a", "an"})
@@ -35,11 +36,15 @@ repeat | repeat that | repeat this | repeat it | do that | do this | do it | do 
 until reach | until reaching | until get to | until arrive at | until arriving at | until at => to
 until face | until facing => toward
 # filler phrases
-i want to | i would like to | i need to | go ahead and | make sure to | try to | start by | let us | lets => 
+i want to | i would like to | i need to | go ahead and | make sure to | try to | start by | let us | lets
+    | keep | keep on | with sides of | sides of | sides | side length of | side length | on each side | each side
+    | per side | a bit | bit => 
+at same time | simultaneously | in parallel | at once while | together => SAMETIME
+square => SHAPE:square
 # locomotion
 walk | walking | walks | go | going | goes | move | moving | moves | head | travel | proceed | come | coming
     | step | stepping | stroll | march | sidestep | side step | strafe | shuffle => WALK
-return | returning | go back | come back | head back | walk back to => WALK back
+return | returning | go back | come back | head back | walk back to | get back | move back => WALK back
 approach | approaching => WALK to
 back up | backing up | reverse => WALK backward
 forward | forwards | ahead | straight ahead | straight | onward => forward
@@ -51,7 +56,10 @@ right | rightward | rightwards | to right | towards right | toward right | clock
 sideways => SIDEWAYS
 around | round => around
 up | upward | upwards | above => up
-over to | over towards | over toward => to
+over to | over towards | over toward | up to => to
+left turn => left
+right turn => right
+u turn | uturn => ANGLE:180
 down | downward | downwards | below | under | beneath => down
 turn | turning | turns | spin | spinning | rotate | rotating | pivot | pivoting => TURN
 turn to face | turn and face | face | facing | look at | looking at | look towards | look toward => FACE
@@ -60,8 +68,9 @@ half turn | half circle | half of turn => ANGLE:180
 full turn | full circle | full rotation | complete turn | complete circle | whole turn | full spin | circle
     | full revolution | complete rotation => ANGLE:360
 heading | at heading | to heading | along heading | with heading | heading of => HEADING
-slowly | slow | slower | gently => SPEED:slow
-quickly | quick | fast | faster | rapidly | briskly | swiftly => SPEED:fast
+slowly | slow | slower | gently | slow pace | slow speed | leisurely pace | low speed => SPEED:slow
+quickly | quick | fast | faster | rapidly | briskly | swiftly | fast pace | quick pace | brisk pace | high speed
+    | fast speed => SPEED:fast
 within | in under | in less than | at most | no more than | no longer than => WITHIN
 wait | waiting | pause | pausing | stay | staying | rest | resting | stop | stopping | halt | hold | stand
     | standing | stand still | stay still | hold still | keep still | remain | stay put | freeze | wait there => WAIT
@@ -73,11 +82,12 @@ look around | looking around | looks around => STYLE:look_around
 swing arms | swinging arms | arm swing | arms swinging | swing arm | swinging arm => STYLE:arm_swing
 arms out | arms spread | spread arms | spreading arms | stretch arms out | stretch out arms | hold arms out
     | holding arms out | put arms out | with arms out | arms outstretched | outstretched arms
-    | with arms spread | arms wide | with outstretched arms => STYLE:arms_out
+    | with arms spread | arms wide | with outstretched arms | arms spread out | spread arms out
+    | spread out arms | with arms spread out | arms stretched out | with arms stretched out => STYLE:arms_out
 guard | guard up | put guard up | raise guard | guarding | on guard | with guard up => STYLE:guard
 reach up | reaching up | raise arms | raising arms | raise hands | raising hands | hands up | arms up
     | put hands up | put arms up | lift arms | with hands up | with arms up | arms raised | with arms raised
-    | raised arms | with raised arms => STYLE:reach_up
+    | raised arms | with raised arms | hold arms up | hold hands up | arms in air | hands in air => STYLE:reach_up
 arms down | lower arms | relax arms | put arms down | normal style | default style | default => STYLE:default
 carry | carrying | carries | bring | bringing | deliver | delivering => CARRY
 lift | lifting => LIFT
@@ -87,8 +97,10 @@ use | using style | switch to | change to | switch into | change into | set styl
     | assume | switch | go into | get into => SELECT
 # height
 crouch | crouching | crouched | squat | squatting | duck | ducking | get down | crouch down | squat down
-    | go low | get low | bend knees | bend down => HEIGHT:crouch
-stand up | get up | rise | straighten up | normal height => HEIGHT:normal
+    | go low | get low | bend knees | bend down | crouch low | crouch down low | squat low | squat down low
+    | get down low => HEIGHT:crouch
+stand up | get up | rise | straighten up | normal height | get back up | stand back up | come back up
+    | get up again | stand up again => HEIGHT:normal
 stand tall | stand up tall | stand up straight | stand straight | standing tall | stand at full height
     | stand upright => HEIGHT:tall
 lower | raise | set height | set pelvis height | height | set pelvis | change height => HEIGHTSET
@@ -99,7 +111,7 @@ reach out | reaching out => REACH forward
 pick up | picking up | pick | grab | grabbing | grasp | grasping | take | taking | take hold of
     | get hold of | collect | fetch | lift up => PICK
 put | putting | place | placing | set | set down | put down | drop off | leave | deposit | lay | lay down
-    | place down => PLACE
+    | place down | drop | dropping | drop down => PLACE
 step up onto | step up on | step up to | step up | step onto | step on | climb onto | climb on
     | climb up onto | climb up on | climb up | get on | get onto | get up on | get up onto | go up onto
     | go up on | mount | step on top of | climb on top of => STEPUP
@@ -139,9 +151,12 @@ for _words, _dim, _f in (
     ("s sec secs second seconds", "time", 1.0),
     ("min mins minute minutes", "time", 60.0),
     ("mps", "speed", 1.0),
+    ("step steps", "length", 0.3),
 ):
     for _w in _words.split():
         UNITS[_w] = (_dim, _f)
+STEP_M = 0.3
+"""'N steps' as a distance: this much per step (UNITS['step'])."""
 RATE_OF = {"length": "speed", "angle": "yaw_rate"}
 PER_WORDS = frozenset({"per", "a", "/", "every", "each"})
 

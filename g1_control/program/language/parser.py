@@ -47,6 +47,8 @@ DIRECTIONS = frozenset({"forward", "backward", "left", "right", "up", "down"})
 PREPOSITIONS = frozenset({"to", "toward", "towards", "onto", "on", "into", "in", "at", "from", "off", "of", "for",
                           "by", "with", "near"})
 TARGET_PREPS = frozenset({"to", "toward", "towards", "onto", "on", "into", "in", "at", "near", "by"})
+SOURCE_PREPS = frozenset({"from", "off"})
+"""Where a picked object is ("from the table", "off the shelf"): no step of its own."""
 MAIN_VERBS = frozenset({"WALK", "TURN", "FACE", "WAIT", "REACH", "PICK", "PLACE", "CARRY", "LIFT", "CLIMB",
                         "STEPUP", "STEPDOWN", "SELECT", "HEIGHTSET"})
 _AMBIGUOUS = {"CARRY": "carry", "LIFT": "lift", "CLIMB": "climb"}
@@ -90,6 +92,7 @@ class _Slots:
     numbers: list = field(default_factory=list)
     counts: list = field(default_factory=list)
     body: list = field(default_factory=list)
+    shapes: list = field(default_factory=list)
     other: list = field(default_factory=list)
 
 
@@ -132,6 +135,7 @@ class InstructionParser:
         self._check_words(words)
         toks = self._numbers(words)
         toks = self._rewrite(toks, words)
+        toks = self._idioms(toks, words)
         state = _State(words)
         steps: list[Step] = []
         for sentence in self._sentences(toks):
@@ -161,6 +165,10 @@ class InstructionParser:
             sugg = tuple(s for s, _, _ in found)
             lo, hi = max(0, i - 4), min(len(words), i + 5)
             context = ("... " if lo else "") + _join(words[lo:hi]) + (" ..." if hi < len(words) else "")
+            if any(w in phrase.split() for phrase in L.DEFAULT_PLACES):  # a place word, not a place here
+                places = sorted({n for n in self.places.values()})
+                raise UnknownWordError(f"'{w}' in \"{context}\" is not a place here; places: {', '.join(places)}",
+                                       w, tuple(places))
             hint = f"closest known words: {', '.join(sugg)}" if sugg else "no known word is close"
             raise UnknownWordError(f"unknown word '{w}' in \"{context}\"; {hint}", w, sugg)
 
@@ -232,6 +240,33 @@ class InstructionParser:
                 i += 1
         return out
 
+    @staticmethod
+    def _idioms(toks: list[Tok], words: list[str]) -> list[Tok]:
+        """'take N steps' is a walk; 'make'/'do' + a turn ('make a right', 'do a 180', 'make a quarter
+        turn') is a turn; 'do' + a style ('do a little dance') is the style."""
+        out: list[Tok] = []
+        for i, t in enumerate(toks):
+            nxt = toks[i + 1] if i + 1 < len(toks) else None
+            if t.kind == "w" and t.value == "PICK" and words[t.i0] in ("take", "taking") and nxt is not None \
+                    and nxt.kind == "qty" and words[nxt.i1 - 1] in ("step", "steps"):
+                out.append(Tok("w", "WALK", t.i0, t.i1))
+                continue
+            if t.kind == "w" and t.value in ("make", "do"):
+                if nxt is None:
+                    out.append(t)
+                elif nxt.kind == "num":
+                    out.append(Tok("w", "TURN", t.i0, t.i1))
+                    toks[i + 1] = Tok("qty", (math.radians(nxt.value), "angle"), nxt.i0, nxt.i1)
+                elif (nxt.kind == "qty" and nxt.value[1] == "angle") or (nxt.kind == "w" and nxt.value in ("left", "right")):
+                    out.append(Tok("w", "TURN", t.i0, t.i1))
+                elif nxt.kind == "w" and (nxt.value == "TURN" or nxt.value.startswith(("STYLE:", "HEIGHT:"))):
+                    pass  # "make a turn", "do a little dance": the next word is the action
+                else:
+                    out.append(t)
+                continue
+            out.append(t)
+        return out
+
     # --- stage 5: sentences, clauses, order -----------------------------------------------------------
     @staticmethod
     def _sentences(toks: list[Tok]) -> list[list[Tok]]:
@@ -257,7 +292,17 @@ class InstructionParser:
         for c in raw:
             if not c:
                 continue
+            same = [t for t in c if t.kind == "w" and t.value == "SAMETIME"]
+            if same and out:  # "walk forward and wave at the same time": one clause joined by 'while'
+                out[-1] += [Tok("w", "WHILE", same[0].i0, same[0].i1)] + [t for t in c if t not in same]
+                continue
             has_verb = any(_is_verb(t) for t in c)
+            if not has_verb and out and any(t.kind == "place" for t in c) and all(
+                    t.kind == "place" or (t.kind == "w" and t.value in TARGET_PREPS) for t in c):
+                verb = next((t for t in out[-1] if t.kind == "w" and t.value in MAIN_VERBS), None)
+                if verb is not None and verb.value == "WALK":  # "walk to the table, then (to) the shelf"
+                    out.append([verb] + ([] if c[0].kind == "w" else [Tok("w", "to", c[0].i0, c[0].i0)]) + c)
+                    continue
             if not has_verb and out:
                 out[-1].extend(c)  # "turn left, twice": words without a verb go on with the clause before
             else:
@@ -411,6 +456,8 @@ class InstructionParser:
                 prep = v
             elif v == "BODY":
                 s.body.append((v, t))
+            elif v.startswith("SHAPE:"):
+                s.shapes.append((v[6:], t))
             elif v in ("STYLEWORD", "HEADING", "WITHIN"):
                 pass
             else:
@@ -471,7 +518,12 @@ class InstructionParser:
             s.styles.insert(0, (_AMBIGUOUS[verb], s.verbs[0][1]))
             s.verbs = []
             verb = "STYLE"
-        if verb == "WALK":
+        if verb == "WALK" and any(prep is None for (prep, _), _t in s.places) and \
+                any(prep in TARGET_PREPS for (prep, _), _t in s.places):
+            steps = self._manipulate(s, "CARRY", where, state, one, place, timeout, take)  # "move the box to X"
+        elif verb == "WALK" and s.shapes:
+            steps = [self._shape(s, where, one, take)]
+        elif verb == "WALK":
             steps = [self._walk(s, where, state, one, place, timeout, take)]
         elif verb in ("TURN", "FACE"):
             steps = [self._turn(s, verb, where, state, one, place, timeout, take)]
@@ -481,6 +533,9 @@ class InstructionParser:
                 d = one("numbers", "number")
             steps = [Stand(d if d is not None else c.wait_s)]
         elif verb in ("STYLE", "SELECT"):
+            if s.hands:
+                raise InstructionError(f"\"{where}\": a style is a whole upper-body pose; \"{state.text(s.hands[0][1])}\" "
+                                       "cannot be chosen for a style (styles have no hand; the wave waves the right one)")
             name = one("styles", "style")
             if name is None:
                 raise InstructionError(f"\"{where}\": which style? known: wave, dance, look around, arms out, "
@@ -547,7 +602,8 @@ class InstructionParser:
             side = [Style(n) for n, _ in s.styles] + [Height(None, p) for p, _ in s.heights]
             take("styles", "heights")
         for name in ("select", "directions", "back", "around", "sideways", "places", "hands", "speed_words",
-                     "lengths", "angles", "headings", "durations", "timeouts", "speeds", "rates", "numbers", "body"):
+                     "lengths", "angles", "headings", "durations", "timeouts", "speeds", "rates", "numbers", "body",
+                     "shapes"):
             items = getattr(s, name)
             if items and name not in used:
                 raise InstructionError(f"could not use \"{state.text(items[0][1])}\" in \"{where}\"")
@@ -580,6 +636,8 @@ class InstructionParser:
         heading = one("headings", "heading")
         if distance is None and duration is None and target is None:
             distance = one("numbers", "number")  # "walk forward 2": meters
+        if s.back and target is None and distance is None and duration is None:
+            target, direction = "start", None  # "come back", "walk back": to where the program started
         if [distance, duration, target].count(None) < 2:
             raise InstructionError(f"\"{where}\": a walk goes a distance, for a time or to a place, not two of them")
         if distance is None and duration is None and target is None:
@@ -592,6 +650,23 @@ class InstructionParser:
         if speed is None and word is not None:
             speed = c.slow_mps if word == "slow" else c.fast_mps
         return Walk(distance, duration, target, direction or "forward", heading, speed, timeout())
+
+    def _shape(self, s: _Slots, where, one, take) -> Repeat:
+        """'walk a square of 2 meters (to the right)': 4 x (walk the side, turn 90 degrees that way)."""
+        one("shapes", "shape")
+        side = one("lengths", "side length")
+        if side is None:
+            side = one("numbers", "number")
+        if side is None:
+            raise InstructionError(f"\"{where}\": how long are the sides? e.g. \"walk a square of 1 meter\"")
+        turn = one("directions", "direction") or "left"
+        if turn not in ("left", "right"):
+            raise InstructionError(f"\"{where}\": a square turns left or right, not {turn}")
+        speed = one("speeds", "speed")
+        word = one("speed_words", "speed")
+        if speed is None and word is not None:
+            speed = self.conv.slow_mps if word == "slow" else self.conv.fast_mps
+        return Repeat(4, [Walk(side, speed_mps=speed), Turn(math.pi / 2, turn)])
 
     def _turn(self, s: _Slots, verb, where, state, one, place, timeout, take) -> Turn:
         c = self.conv
@@ -630,11 +705,22 @@ class InstructionParser:
         return Turn(angle, direction or "left", heading, target, rate, timeout())
 
     def _manipulate(self, s: _Slots, verb, where, state, one, place, timeout, take) -> list[Step]:
-        take("places")
+        take("places", "back")  # "put it back on the table": back adds nothing to a place
         objects: list[str] = []
         targets: list[str] = []
         down = False
+        before = state.last_place  # "it" means what was named before this clause ("set the cup on it")
         for (prep, name), t in s.places:
+            if prep in SOURCE_PREPS and verb in ("PICK", "LIFT", "CARRY"):
+                continue  # "pick up the cup from the table": where it is; the execution layer finds it
+            if name == "IT":
+                if prep not in TARGET_PREPS and verb in ("PLACE", "CARRY") and state.held is not None:
+                    objects.append(state.held)  # "put it down": the object in hand
+                    continue
+                if before is None:
+                    raise InstructionError(f"\"{state.text(t)}\" does not refer to anything yet; name the object")
+                (targets if prep in TARGET_PREPS else objects).append(before)
+                continue
             (targets if prep in TARGET_PREPS else objects).append(state.resolve(name, t))
         if s.directions:
             d = one("directions", "direction")
