@@ -50,9 +50,10 @@ def main(argv: list[str] | None = None) -> int:
     except G1ControlError as exc:
         print(f"g1 {args.command}: error: {exc}", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        print(f"g1 {args.command}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        signum = getattr(exc, "signum", 2)
+        print(f"g1 {args.command}: interrupted ({exc or 'SIGINT received'})", file=sys.stderr)
+        return 128 + signum
 
 
 if __name__ == "__main__":

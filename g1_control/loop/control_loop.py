@@ -4,6 +4,7 @@ guard -> low-level stream, as scheduler stages at their own rates (see scheduler
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,10 +29,16 @@ class LoopEvent:
 
 @dataclass
 class RunLog:
-    """Per-tracker-tick records, preallocated for the whole run (no allocation in the loop)."""
+    """Per-tracker-tick records, preallocated (no allocation in the loop). Without a sink it holds the
+    whole run (capacity rows; later ticks are dropped). With a sink (a run folder, g1_control/launch/
+    run_folder.py) it is one chunk: when full, a copy goes to sink() and the chunk starts over, so
+    memory stays bounded however long the run."""
 
     capacity: int
+    sink: Callable[[dict[str, np.ndarray]], None] | None = None
     n: int = 0
+    total: int = 0
+    """Rows logged so far, over every chunk."""
     t_s: np.ndarray = field(init=False)
     command: np.ndarray = field(init=False)          # operator (vx, vy, wz)
     policy_command: np.ndarray = field(init=False)   # after velocity correction
@@ -54,10 +61,17 @@ class RunLog:
         self.yaw_rad = np.full(c, np.nan)
         self.tilt_rad = np.full(c, np.nan)
 
+    NAMES = ("t_s", "command", "policy_command", "velocity_est", "velocity_true", "base_pos_m", "base_quat_wxyz",
+             "yaw_rad", "tilt_rad", "q_rad", "q_target_rad", "tau_nm")
+
     def arrays(self) -> dict[str, np.ndarray]:
-        names = ("t_s", "command", "policy_command", "velocity_est", "velocity_true", "base_pos_m", "base_quat_wxyz", "yaw_rad",
-                 "tilt_rad", "q_rad", "q_target_rad", "tau_nm")
-        return {name: getattr(self, name)[: self.n] for name in names}
+        return {name: getattr(self, name)[: self.n] for name in self.NAMES}
+
+    def flush(self) -> None:
+        """Hand the rows so far to the sink (a copy) and start a new chunk."""
+        if self.sink is not None and self.n:
+            self.sink({name: getattr(self, name)[: self.n].copy() for name in self.NAMES})
+            self.n = 0
 
 
 class ControlLoop:
@@ -84,6 +98,8 @@ class ControlLoop:
         self._tracker_command = self.motor_command
         self.invalid_commands = 0
         self.events: list[LoopEvent] = []
+        self.on_record: Callable[[dict], None] | None = None
+        """Called with each event as a JSON-able dict (a run folder's events.jsonl)."""
         self.chain: dict[str, str] = {}
         """What each stage is (set by g1_control/launch/builder.py): the same in a deploy's dry run and on the robot."""
         self.log = RunLog(max(1, log_capacity))
@@ -121,8 +137,10 @@ class ControlLoop:
     def time_s(self) -> float:
         return self.scheduler.time_s
 
-    def _event(self, kind: str, detail: str) -> None:
+    def _event(self, kind: str, detail: str, record: dict | None = None) -> None:
         self.events.append(LoopEvent(self.time_s, kind, detail))
+        if self.on_record is not None:
+            self.on_record(record or {"type": "loop", "t_s": self.time_s, "kind": kind, "detail": detail})
 
     def now_s(self) -> float:
         return self.time_s if self.backend.lockstep else time.monotonic()
@@ -137,7 +155,9 @@ class ControlLoop:
         return trip is not None and trip.kind == SafetyEventKind.TILT
 
     def _on_safety_event(self, event) -> None:
-        self._event(event.kind.value, event.detail + ("; damping" if event.trips else ""))
+        self._event(event.kind.value, event.detail + ("; damping" if event.trips else ""),
+                    {"type": "safety", "t_s": event.t_s, "loop_t_s": self.time_s, "kind": event.kind.value,
+                     "detail": event.detail, "trips": event.trips, "planned": event.planned})
 
     # -- stages --------------------------------------------------------------------------------------
     def _input(self) -> None:
@@ -194,11 +214,16 @@ class ControlLoop:
         self._tracker_command = self.tracker.act(self._joint_ref, state)
 
     def _safety(self) -> None:
-        # Robot links count states dropped for a bad CRC; a burst of them trips the filter.
+        # Robot links count states dropped for a bad CRC; a burst of them trips the filter. A second
+        # publisher of the robot's state (or another writer of its commands) trips it at once.
         self.safety.report_crc_errors(self.backend.bad_crc, self.now_s())
+        self.safety.report_peers(self.backend.peer_fault, self.now_s())
         # Missed deadlines endanger a robot that runs on its own; a simulator we step just slows down.
+        # A tick counts as an overrun when it finished more than safety.overrun_lateness_s late.
         if self.scheduler.wallclock and not self.backend.lockstep:
-            self.safety.report_deadline(self.scheduler.deadline_misses > self._misses_seen, self.now_s())
+            late = self.scheduler.take_lateness()
+            self.safety.report_deadline(late > self.safety.config.overrun_lateness_s, self.now_s(),
+                                        f"{late * 1000:.0f} ms late" if late > 0 else "")
             self._misses_seen = self.scheduler.deadline_misses
         self.motor_command = self.safety.filter(self._tracker_command, self.state, self.now_s())
 
@@ -215,7 +240,10 @@ class ControlLoop:
         log = self.log
         i = log.n
         if i >= log.capacity:
-            return
+            if log.sink is None:
+                return
+            log.flush()
+            i = 0
         s, est = self.state, self.estimator.estimate
         log.t_s[i] = self.time_s
         log.command[i] = (self.command.vx_mps, self.command.vy_mps, self.command.wz_radps)
@@ -236,3 +264,4 @@ class ControlLoop:
         log.q_target_rad[i] = self.motor_command.q_rad
         log.tau_nm[i] = s.tau_nm
         log.n = i + 1
+        log.total += 1
