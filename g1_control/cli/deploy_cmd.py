@@ -65,6 +65,8 @@ def register(subparsers) -> None:
     parser.add_argument("--duration", type=float, help="length of the control phase in seconds, then damping "
                         "(default: the launch file's duration_s, or until stopped)")
     parser.add_argument("--preflight-only", action="store_true", help="run the checklist and exit; nothing is sent")
+    parser.add_argument("--out", type=Path, help="run folder root (default: the launch file's output.dir); the run "
+                        "folder (per-tick log, transitions, safety events, summary) is written as the deploy goes")
     parser.add_argument("--json", type=Path, help="write the deploy report (preflight, states, link stats) as JSON")
     parser.set_defaults(func=_run)
 
@@ -76,7 +78,7 @@ def _run(args) -> int:
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     options = DeployOptions(yes=args.yes, overrides=frozenset(args.override), release_motion_service=args.release,
                             interface=args.interface, domain=args.domain, partition=args.partition,
-                            duration_s=args.duration, preflight_only=args.preflight_only)
+                            duration_s=args.duration, preflight_only=args.preflight_only, out_root=args.out)
     try:
         report = deploy(args.file, options)
     except PreflightRefused as exc:

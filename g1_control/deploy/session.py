@@ -24,12 +24,14 @@ from g1_control.deploy.preflight import CHECKS, FAIL, Preflight
 from g1_control.deploy.state_machine import DeployState, DeployTracker, OperatorButtons, Transition
 from g1_control.errors import G1ControlError, LaunchFileError
 from g1_control.hardware.links.network import LOOPBACK
+from g1_control.launch.run_folder import RunFolder
 from g1_control.launch.schema import LaunchFile
+from g1_control.loop.priority import get_nice, set_nice
 from g1_control.robot import g1
 
 log = logging.getLogger("g1_control.deploy")
 
-ROBOT_CHECKS = ("variant", "state_stream", "imu_upright", "joint_limits", "temperatures", "battery")
+ROBOT_CHECKS = ("variant", "state_stream", "peers", "imu_upright", "joint_limits", "temperatures", "battery")
 CLEAN_ENDINGS = ("operator stop", "control time over", "SIGINT received", "SIGTERM received")
 """Trip details that end a deploy as planned (exit code 0); any other trip is a fault (exit code 3)."""
 
@@ -47,6 +49,8 @@ class DeployOptions:
     duration_s: float | None = None
     """Length of the control phase (None: the launch file's duration_s, or until stopped)."""
     preflight_only: bool = False
+    out_root: Path | None = None
+    """Where the run folder goes (None: the launch file's output.dir)."""
 
 
 @dataclass
@@ -66,6 +70,8 @@ class DeployReport:
     loop: dict = field(default_factory=dict)
     chain: dict = field(default_factory=dict)
     """The loop's stages (g1_control/launch/builder.py), the same the preflight's dry run ran."""
+    run_dir: str | None = None
+    """The run folder (per-tick log, events, summary), written as the deploy went."""
 
     def to_json(self) -> str:
         return json.dumps(dataclasses.asdict(self), indent=2, default=float)
@@ -132,6 +138,8 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
 
     spec, policy_variant = pf.check_policy(launch)
     backend = device = None
+    previous_nice = get_nice()
+    say(f"scheduling priority: {set_nice(launch.deploy.nice)}")
     try:
         if pf.check_interface(launch):
             from g1_control.deploy.backends import open_robot_backend
@@ -173,6 +181,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             device.close()
         if backend is not None:
             backend.close()
+        set_nice(previous_nice)
 
 
 def _refuse(pf: Preflight, report: DeployReport, say) -> DeployReport:
@@ -191,8 +200,13 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
     buttons = OperatorButtons(device)
     t_start = time.monotonic()
 
+    folder: RunFolder | None = None
+
     def on_transition(t: Transition) -> None:
         say(f"[{t.t_s - t_start:7.2f} s] {t}")
+        if folder is not None:
+            folder.event({"type": "transition", "t_s": t.t_s, "from": t.source.value, "to": t.target.value,
+                          "reason": t.reason})
         if t.target == DeployState.HOLD and not options.yes:
             say(f"holding the default pose: press {_keys_for(device, 'run') or 'run'} to start the policy")
 
@@ -209,11 +223,13 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
         wrapped.append(tracker)
         return tracker
 
-    r = launch.rates
-    expected_s = (control_s or 600.0) + launch.deploy.ramp_s + 60.0
+    # The per-tick log streams into the run folder (attached below): the loop keeps one chunk only.
     loop = build_loop(launch, backend=backend, input_device=buttons, wrap_tracker=deploy_state_machine,
-                      wallclock=True, log_capacity=int(expected_s * r.tracker_hz))
+                      wallclock=True, log_capacity=1)
     tracker, safety = wrapped[0], loop.safety
+    # The variant the preflight accepted: a state reporting another mode_machine trips, and is never echoed.
+    if getattr(backend, "expected_mode_machine", None) is not None:
+        safety.expect_mode_machine(backend.expected_mode_machine)
     # A scripted timeline starts when control starts.
     buttons.timeline_clock = tracker.control_elapsed_s
     report.chain = dict(loop.chain)
@@ -222,11 +238,15 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
     if dry and differs:
         raise G1ControlError("the robot's loop differs from the one the dry run checked: " + "; ".join(
             f"{k}: dry run {dry.get(k)!r}, robot {loop.chain.get(k)!r}" for k in differs))
+    folder = RunFolder.create(Path(options.out_root or launch.output.dir), launch)
+    folder.attach(loop)
+    report.run_dir = str(folder.run_dir)
+    say(f"run folder: {folder.run_dir} (log, events and summary written as the deploy goes)")
     say("control chain (as checked by the dry run): " + " -> ".join(loop.chain[k] for k in ("generator", "retargeter",
                                                                                             "tracker")))
 
     def on_signal(signum, frame):
-        safety.estop(f"{signal.Signals(signum).name} received", time.monotonic())
+        safety.estop(f"{signal.Signals(signum).name} received", time.monotonic(), planned=True)
         backend.damp()  # damping on the wire now, not at the next tick
         raise KeyboardInterrupt
 
@@ -264,13 +284,19 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
             time.sleep(launch.deploy.exit_damping_s)  # damping keeps streaming before the link closes
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-    _fill_report(report, loop, tracker, backend, safety, t_loop0)
+    log = folder.close_log(loop)
+    _fill_report(report, log, loop, tracker, backend, safety, t_loop0)
+    folder.write_npz(log)
+    status = ("error" if error is not None else "fault" if report.fault
+              else "interrupted" if report.end_reason.startswith("SIG") else "completed")
+    folder.finish(status, report.end_reason, dataclasses.asdict(report))
     _print_summary(report, say)
     if error is not None:
         raise error
 
 
-def _fill_report(report: DeployReport, loop, tracker: DeployTracker, backend, safety, t_loop0: float) -> None:
+def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTracker, backend, safety,
+                 t_loop0: float) -> None:
     report.sequence = tracker.sequence
     report.transitions = [{"t_s": t.t_s, "from": t.source.value, "to": t.target.value, "reason": t.reason}
                           for t in tracker.transitions]
@@ -280,7 +306,6 @@ def _fill_report(report: DeployReport, loop, tracker: DeployTracker, backend, sa
     report.safety_events = [{"t_s": e.t_s, "kind": e.kind.value, "detail": e.detail, "trips": e.trips}
                             for e in safety.events]
     report.link = dataclasses.asdict(backend.stats())
-    log_arrays = loop.log.arrays()
     control = [t for t in tracker.transitions if t.target == DeployState.CONTROL]
     if control:
         start = control[0].t_s
@@ -294,14 +319,18 @@ def _fill_report(report: DeployReport, loop, tracker: DeployTracker, backend, sa
         report.control = {"duration_s": end - start, "steady_window_s": max(0.0, end - steady_from),
                           "velocity_est_mean": est.mean(axis=0).tolist() if len(est) else None,
                           "command_mean": cmd.mean(axis=0).tolist() if len(cmd) else None}
+    late = loop.scheduler.lateness.summary()
     report.loop = {"deadline_misses": loop.scheduler.deadline_misses, "ticks": loop.scheduler.tick_index,
                    "tick_p99_us": loop.scheduler.report()["tick"]["p99_us"],
+                   "lateness_p99_ms": late["p99_us"] / 1000, "lateness_max_ms": loop.scheduler.max_lateness_s * 1000,
                    "clamped_commands": safety.clamps.commands}
 
 
 def _print_summary(report: DeployReport, say) -> None:
     link = report.link
     say(f"deploy ended in damping: {report.end_reason}" + (" (FAULT)" if report.fault else ""))
+    if report.run_dir:
+        say(f"run folder: {report.run_dir}")
     say(f"states: {' -> '.join(report.sequence)}")
     say(f"lowcmd sent {link['commands_sent']} ({link['command_rate_hz']:.0f} Hz, p99 period "
         f"{link['command_period_p99_s'] * 1000:.2f} ms at the sender); lowstate received {link['states_received']}, "
@@ -311,7 +340,8 @@ def _print_summary(report: DeployReport, say) -> None:
         c = report.control["command_mean"]
         say(f"control {report.control['duration_s']:.1f} s: estimated velocity vx {v[0]:+.2f} m/s, vy {v[1]:+.2f}, "
             f"wz {v[2]:+.2f} (commanded {c[0]:+.2f}, {c[1]:+.2f}, {c[2]:+.2f})")
-    say(f"loop: {report.loop['ticks']} ticks, {report.loop['deadline_misses']} deadline misses, "
+    say(f"loop: {report.loop['ticks']} ticks, {report.loop['deadline_misses']} deadline misses (worst "
+        f"{report.loop['lateness_max_ms']:.1f} ms late, p99 {report.loop['lateness_p99_ms']:.1f} ms), "
         f"{report.loop['clamped_commands']} commands clamped by the safety layer")
 
 

@@ -98,7 +98,7 @@ def test_sim2sim_walks_forward_and_ends_in_damping(tmp_path, partition, processe
     processes.append(robot)
     report_path = tmp_path / "deploy.json"
     host = Proc("deploy", "launch/sim2sim.yaml", "--yes", "--partition", partition, "--duration", "5",
-                "--json", str(report_path))
+                "--json", str(report_path), "--out", str(tmp_path))
     processes.append(host)
     host.wait_for(r"zero torque: the robot is limp", 90)
     host.wait_for(r"control -> damping: control time over", 60)
@@ -138,7 +138,8 @@ def test_operator_drives_with_the_unitree_remote_and_stops_with_b(tmp_path, part
                                                                     "device": {"stale_after_s": 0.5}}})
     robot = Emulator(partition, "--lower-gantry-on-policy")
     processes.append(robot)
-    host = Proc("deploy", str(launch), "--partition", partition, "--json", str(tmp_path / "deploy.json"))
+    host = Proc("deploy", str(launch), "--partition", partition, "--json", str(tmp_path / "deploy.json"),
+                "--out", str(tmp_path))
     processes.append(host)
     line = host.wait_for(r"zero torque: the robot is limp", 90)
     assert "Press start to ramp" in line and "e-stop: L1+R1" in line and "stop (damping): B" in line
@@ -169,7 +170,7 @@ def test_a_signal_during_control_puts_damping_on_the_wire(tmp_path, partition, p
     robot = Emulator(partition, "--physics", "mock")
     processes.append(robot)
     launch = write_launch(tmp_path, {"deploy": {"state_window_s": 0.3}})
-    host = Proc("deploy", str(launch), "--yes", "--partition", partition, "--duration", "60")
+    host = Proc("deploy", str(launch), "--yes", "--partition", partition, "--duration", "60", "--out", str(tmp_path))
     processes.append(host)
     host.wait_for(r"hold -> control: run \(--yes\)", 90)
     time.sleep(0.5)
@@ -192,7 +193,7 @@ def test_a_fault_during_control_damps_and_exits_3_in_debug_mode(tmp_path, partit
     processes.append(robot)
     launch = write_launch(tmp_path, {"deploy": {"state_window_s": 0.3}})
     host = Proc("deploy", str(launch), "--yes", "--no-release-motion-service", "--partition", partition,
-                "--duration", "60")
+                "--duration", "60", "--out", str(tmp_path))
     processes.append(host)
     line = host.wait_for(r"zero torque: the robot is limp", 90)
     assert not any("releasing the robot's built-in motion service" in s for s in host.seen), line
