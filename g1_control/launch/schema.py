@@ -9,9 +9,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
-import yaml
-
-from g1_control.config import from_dict
+from g1_control.config import from_dict, read_yaml
 from g1_control.errors import LaunchFileError, SafetyConfigError
 from g1_control.loop.rates import LoopRates
 from g1_control.safety.config import SafetyConfig
@@ -111,6 +109,9 @@ class DeployConfig:
     """Lockstep MuJoCo run of the same launch file before the robot moves; it must not fall."""
     input_check_s: float = 0.3
     """The operator input is polled this long and must not be lost."""
+    nice: int = -10
+    """Scheduling priority of the deploy process (-20..19; lower runs first): a control loop must not wait
+    behind ordinary work on the host. Lowering it needs root or CAP_SYS_NICE (else a warning)."""
 
     def validate(self, where: str) -> None:
         if self.ramp_s < 2.0:
@@ -121,6 +122,8 @@ class DeployConfig:
         for name in ("auto_start_s", "auto_run_s", "min_hold_s", "exit_damping_s", "state_window_s", "input_check_s"):
             if getattr(self, name) < 0 or (name in ("state_window_s", "input_check_s") and getattr(self, name) == 0):
                 raise LaunchFileError(f"{where}.{name}: must be positive, got {getattr(self, name)}")
+        if not -20 <= self.nice <= 19:
+            raise LaunchFileError(f"{where}.nice: {self.nice} is not a nice value (-20..19)")
         if self.min_state_rate_hz <= 0 or self.max_start_tilt_rad <= 0 or self.joint_limit_tolerance_rad < 0:
             raise LaunchFileError(f"{where}: min_state_rate_hz and max_start_tilt_rad must be positive, "
                                   "joint_limit_tolerance_rad not negative")
@@ -209,6 +212,13 @@ class LimitsConfig:
     max_tilt_rad: float = 1.0
     """Beyond this pelvis tilt the robot counts as fallen and the loop damps it."""
 
+    def validate(self, where: str) -> None:
+        for name in ("max_vx_mps", "max_vy_mps", "max_wz_radps", "max_tilt_rad"):
+            value = getattr(self, name)
+            if not value > 0:
+                raise LaunchFileError(f"{where}.{name}: {value} must be > 0 (a limit on the magnitude, both "
+                                      "directions)")
+
 
 @dataclass
 class OutputConfig:
@@ -265,6 +275,13 @@ class LaunchFile:
         if self.tracker.type == "wbt" and self.rates.tracker_hz != 50.0:
             raise LaunchFileError(f"rates.tracker_hz: tracker.type wbt runs at the policy's 50 Hz, got "
                                   f"{self.rates.tracker_hz:g}")
+        from g1_control.generator.styles import STYLES
+
+        styles = [(f"input.timeline[{i}].style", seg.style) for i, seg in enumerate(self.input.timeline)]
+        styles.append(("input.random.style", self.input.random.style))
+        for key, style in styles:
+            if style not in STYLES:
+                raise LaunchFileError(f"{key}: unknown style '{style}'; known: {', '.join(STYLES)}")
         lim = self.limits
         for i, seg in enumerate(self.input.timeline):
             for name, limit in (("vx_mps", lim.max_vx_mps), ("vy_mps", lim.max_vy_mps), ("wz_radps", lim.max_wz_radps)):
@@ -297,11 +314,7 @@ def load_launch(path: str | Path) -> LaunchFile:
     path = Path(path)
     if not path.is_file():
         raise LaunchFileError(f"{path}: no such launch file")
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise LaunchFileError(f"{path}: not valid YAML: {exc}") from None
-    launch = parse_launch(data, str(path))
+    launch = parse_launch(read_yaml(path), str(path))
     # The tracker's policy must resolve and fit the robot before anything runs.
     from g1_control.trackers.policy_spec import resolve_spec_path
 
