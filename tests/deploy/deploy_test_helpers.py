@@ -44,14 +44,13 @@ FAST = {"deploy": {"state_window_s": 0.3, "input_check_s": 0.1}, "backend": {"co
 
 class SecondPublisher:
     """Another writer on rt/lowstate in the same domain and partition (lo, domain 1): valid CRCs, as a
-    second robot or a spoofing program would send. `source()` gives the RobotState to report."""
+    second robot or a spoofing program would send. `source()` gives the RobotState to report. The
+    writer exists (and DDS discovery sees it) from start() + delay_s on."""
 
     def __init__(self, partition: str, source, mode_machine: int = 5, rate_hz: float = 500.0):
         import threading
 
-        from g1_control.hardware.links.dds import DdsLink
-
-        self.link = DdsLink("robot", "lo", 1, partition=partition)
+        self.partition, self.link = partition, None
         self.source, self.mode_machine, self.period_s = source, mode_machine, 1.0 / rate_hz
         self.sent = 0
         self._stop = threading.Event()
@@ -67,10 +66,12 @@ class SecondPublisher:
     def _run(self, seconds: float, delay_s: float) -> None:
         import time
 
+        from g1_control.hardware.links.dds import DdsLink
         from g1_control.hardware.unitree.conversions import robot_state_to_lowstate
 
         if self._stop.wait(delay_s):
             return
+        self.link = DdsLink("robot", "lo", 1, partition=self.partition)
         end = time.monotonic() + seconds
         tick = 10_000_000
         while not self._stop.is_set() and time.monotonic() < end:
@@ -88,4 +89,5 @@ class SecondPublisher:
     def close(self) -> None:
         self._stop.set()
         self.join()
-        self.link.close()
+        if self.link is not None:
+            self.link.close()
