@@ -15,9 +15,9 @@ from importlib import resources
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from g1_control import assets
+from g1_control.config import read_yaml
 from g1_control.errors import PolicyMismatchError
 from g1_control.robot import g1
 from g1_control.trackers.observation import ObservationSpec
@@ -98,7 +98,9 @@ def load_spec(name_or_path: str | Path, *, fetch: bool = True) -> PolicySpec:
     import onnxruntime as ort
 
     spec_file = resolve_spec_path(name_or_path)
-    d = yaml.safe_load(spec_file.read_text()) or {}
+    d = read_yaml(spec_file, PolicyMismatchError) or {}
+    if not isinstance(d, dict):
+        raise PolicyMismatchError(f"{spec_file}: expected a mapping of spec keys, got {type(d).__name__}")
     unknown = set(d) - _SPEC_KEYS
     if unknown:
         raise PolicyMismatchError(f"{spec_file}: unknown keys {sorted(unknown)}; known: {sorted(_SPEC_KEYS)}")
@@ -107,7 +109,13 @@ def load_spec(name_or_path: str | Path, *, fetch: bool = True) -> PolicySpec:
         raise PolicyMismatchError(f"{spec_file}: ONNX file {onnx_path} does not exist")
     meta = dict(ort.InferenceSession(str(onnx_path), providers=["CPUExecutionProvider"])
                 .get_modelmeta().custom_metadata_map)
-    spec = _build(d, spec_file, onnx_path, meta)
+    try:
+        spec = _build(d, spec_file, onnx_path, meta)
+    except KeyError as exc:
+        raise PolicyMismatchError(f"{spec_file}: missing key {exc}") from None
+    except (TypeError, ValueError) as exc:
+        raise PolicyMismatchError(f"{spec_file}: {' '.join(str(exc).split())} (check the spec's values: numbers "
+                                  "where numbers are expected)") from None
     check_against_robot(spec)
     check_against_onnx(spec)
     return spec
@@ -169,8 +177,12 @@ def check_against_robot(spec: PolicySpec) -> None:
             f"({len(names)} policy joints, {g1.NUM_JOINTS} robot joints)"
         )
     for label, arr in (("kp", spec.kp), ("kd", spec.kd), ("default_q", spec.default_q_rad)):
-        if arr.shape != (g1.NUM_JOINTS,) or not np.all(np.isfinite(arr)):
+        if arr.shape != (g1.NUM_JOINTS,):
             raise PolicyMismatchError(f"policy '{spec.name}' {label} must be {g1.NUM_JOINTS} finite numbers, got shape {arr.shape}")
+        if not np.all(np.isfinite(arr)):
+            j = int(np.argmax(~np.isfinite(arr)))
+            raise PolicyMismatchError(f"policy '{spec.name}' {label} must be {g1.NUM_JOINTS} finite numbers; "
+                                      f"{g1.JOINT_NAMES[j]} is {arr[j]}")
     if np.any(spec.kp < 0) or np.any(spec.kd < 0):
         raise PolicyMismatchError(f"policy '{spec.name}' has negative gains")
     outside = np.nonzero((spec.default_q_rad < g1.Q_MIN_RAD) | (spec.default_q_rad > g1.Q_MAX_RAD))[0]
