@@ -37,9 +37,9 @@ def register(subparsers) -> None:
     parser.add_argument("--mode-machine", type=int, default=5, help="variant to report with --physics mock (4/5/6)")
     parser.add_argument("--no-builtin", action="store_true",
                         help="start with no built-in controller (as after debug mode on the remote)")
-    parser.add_argument("--nice", type=int, default=-10,
-                        help="scheduling priority (default -10: the emulated robot keeps its 500 Hz on a busy host, as "
-                        "the robot's own computer would; needs root, else it warns and runs at its current one)")
+    parser.add_argument("--rt-priority", type=int, default=30, metavar="N",
+                        help="SCHED_RR priority (default 30; 0: normal scheduling): the emulated robot keeps its 500 Hz "
+                        "on a busy host, as the robot's own computer would (needs root, else nice -10 with a warning)")
     parser.add_argument("--seconds", type=float, help="stop after this long (default: until Ctrl-C)")
     parser.add_argument("--control-stdin", action="store_true",
                         help="read fault names and remote commands ('press start', 'press A', 'stick ly 0.5', "
@@ -48,10 +48,10 @@ def register(subparsers) -> None:
 
 
 def _run(args) -> int:
-    from g1_control.loop.priority import set_nice
+    from g1_control.loop.priority import realtime
     from g1_control.sim.emulator import RobotEmulator
 
-    set_nice(args.nice)
+    realtime(args.rt_priority)
     if args.physics == "mujoco":
         from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
 

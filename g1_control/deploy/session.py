@@ -26,7 +26,7 @@ from g1_control.errors import G1ControlError, LaunchFileError
 from g1_control.hardware.links.network import LOOPBACK
 from g1_control.launch.run_folder import RunFolder
 from g1_control.launch.schema import LaunchFile
-from g1_control.loop.priority import get_nice, set_nice
+from g1_control.loop.priority import realtime
 from g1_control.robot import g1
 
 log = logging.getLogger("g1_control.deploy")
@@ -138,8 +138,8 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
 
     spec, policy_variant = pf.check_policy(launch)
     backend = device = None
-    previous_nice = get_nice()
-    say(f"scheduling priority: {set_nice(launch.deploy.nice)}")
+    normal, scheduling = realtime(launch.deploy.realtime_priority)
+    say(f"scheduling: {scheduling}")
     try:
         if pf.check_interface(launch):
             from g1_control.deploy.backends import open_robot_backend
@@ -160,7 +160,11 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             pf.check_input(device, launch, open_error)
         if spec is not None:
             say(f"simulated dry run ({launch.deploy.dry_run_s:.0f} s lockstep MuJoCo) ...")
-            pf.check_dry_run(launch)
+            normal.restore()  # as fast as it can, but never ahead of the host's other work
+            try:
+                pf.check_dry_run(launch)
+            finally:
+                realtime(launch.deploy.realtime_priority)
         else:
             pf.not_run(["dry_run"], "no valid policy")
         report.preflight = pf.as_dict()
@@ -181,7 +185,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             device.close()
         if backend is not None:
             backend.close()
-        set_nice(previous_nice)
+        normal.restore()
 
 
 def _refuse(pf: Preflight, report: DeployReport, say) -> DeployReport:

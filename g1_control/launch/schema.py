@@ -109,9 +109,10 @@ class DeployConfig:
     """Lockstep MuJoCo run of the same launch file before the robot moves; it must not fall."""
     input_check_s: float = 0.3
     """The operator input is polled this long and must not be lost."""
-    nice: int = -10
-    """Scheduling priority of the deploy process (-20..19; lower runs first): a control loop must not wait
-    behind ordinary work on the host. Lowering it needs root or CAP_SYS_NICE (else a warning)."""
+    realtime_priority: int = 20
+    """SCHED_RR priority of the deploy process (1..99; 0: normal scheduling): ordinary work on the host
+    cannot delay a real-time loop (g1_control/loop/priority.py). Needs root or CAP_SYS_NICE; without,
+    it falls back to nice -10 with a warning. The simulated dry run runs at normal priority."""
 
     def validate(self, where: str) -> None:
         if self.ramp_s < 2.0:
@@ -122,8 +123,9 @@ class DeployConfig:
         for name in ("auto_start_s", "auto_run_s", "min_hold_s", "exit_damping_s", "state_window_s", "input_check_s"):
             if getattr(self, name) < 0 or (name in ("state_window_s", "input_check_s") and getattr(self, name) == 0):
                 raise LaunchFileError(f"{where}.{name}: must be positive, got {getattr(self, name)}")
-        if not -20 <= self.nice <= 19:
-            raise LaunchFileError(f"{where}.nice: {self.nice} is not a nice value (-20..19)")
+        if not 0 <= self.realtime_priority <= 99:
+            raise LaunchFileError(f"{where}.realtime_priority: {self.realtime_priority} is not a real-time priority "
+                                  "(1..99, or 0 for normal scheduling)")
         if self.min_state_rate_hz <= 0 or self.max_start_tilt_rad <= 0 or self.joint_limit_tolerance_rad < 0:
             raise LaunchFileError(f"{where}: min_state_rate_hz and max_start_tilt_rad must be positive, "
                                   "joint_limit_tolerance_rad not negative")

@@ -189,19 +189,18 @@ def run_signal_fault(sig: str, emulator: _Emulator, partition: str) -> FaultResu
                        (t_wire - t_inject) * 1000, trip.get("detail", err.strip()[-200:]))
 
 
-HOST_NICE = -10
-"""The host controller's scheduling priority during the suite (as g1 deploy's deploy.nice)."""
+HOST_RT_PRIORITY = 20
+"""The host controller's real-time priority during the suite (as g1 deploy's deploy.realtime_priority)."""
 
 
 def run_suite(faults=ALL_FAULTS, progress: bool = True) -> list[FaultResult]:
-    from g1_control.loop.priority import get_nice, set_nice
+    from g1_control.loop.priority import realtime
 
-    previous = get_nice()
-    set_nice(HOST_NICE)
+    normal, _ = realtime(HOST_RT_PRIORITY)
     try:
         return _run_suite(faults, progress)
     finally:
-        set_nice(previous)
+        normal.restore()
 
 
 SETUP_ATTEMPTS = 3
@@ -252,10 +251,10 @@ def format_table(results: list[FaultResult]) -> str:
 
 def _host_main(partition: str) -> int:
     """Subprocess host for the signal faults: hold until a signal, then report the trip as JSON."""
-    from g1_control.loop.priority import set_nice
+    from g1_control.loop.priority import realtime
     from g1_control.safety import install_signal_damping
 
-    set_nice(HOST_NICE)
+    realtime(HOST_RT_PRIORITY)
     robot = _open_robot(partition)
     install_signal_damping(robot)
     controller = HoldController(robot).start()

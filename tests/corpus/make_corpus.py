@@ -60,7 +60,7 @@ def launch_cases() -> dict[str, str | bytes]:
         "gain_cap_too_high.yaml": b + "safety: {max_kp: 5000}\n",
         "damping_kd_over_cap.yaml": b + "safety: {max_kd: 1.0, damping_kd: 2.0}\n",
         "ramp_too_fast.yaml": b + "deploy: {ramp_s: 0.5}\n",
-        "nice_out_of_range.yaml": b + "deploy: {nice: 40}\n",
+        "realtime_priority_out_of_range.yaml": b + "deploy: {realtime_priority: 150}\n",
         "top_level_list.yaml": "- name: corpus\n- duration_s: 2\n",
         "empty_file.yaml": "",
         "invalid_yaml_syntax.yaml": b + "rates: {tracker_hz: 50\n",
