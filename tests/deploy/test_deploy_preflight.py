@@ -19,6 +19,8 @@ from g1_control.deploy.preflight import PreflightRefused
 from g1_control.deploy.session import DeployOptions, deploy
 from g1_control.robot import g1
 
+pytestmark = pytest.mark.timing
+
 
 def _preflight(path: Path, partition: str, **options):
     lines: list[str] = []

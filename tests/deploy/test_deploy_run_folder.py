@@ -7,9 +7,12 @@ import json
 import logging
 
 import numpy as np
+import pytest
 from deploy_test_helpers import write_launch
 
 from g1_control.deploy.session import DeployOptions, deploy
+
+pytestmark = pytest.mark.timing
 
 
 def test_deploy_writes_a_run_folder_and_a_normal_end_is_not_an_error(tmp_path, partition, mock_robot, caplog):

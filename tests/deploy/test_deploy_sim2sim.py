@@ -19,6 +19,8 @@ import time
 import pytest
 from deploy_test_helpers import ROOT, write_launch
 
+pytestmark = pytest.mark.timing
+
 ENV = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
 
 

@@ -14,11 +14,14 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
 from deploy_test_helpers import FAST, SecondPublisher, write_launch
 
 from g1_control.deploy.preflight import PreflightRefused
 from g1_control.deploy.session import DeployOptions, deploy
 from g1_control.robot import g1
+
+pytestmark = pytest.mark.timing
 
 
 def _preflight(path: Path, partition: str, **options):

@@ -22,6 +22,8 @@ from g1_control.sim.mock_robot import MockG1
 from g1_control.sim.robot_endpoint import RobotEndpoint
 from g1_control.types import MotorCommand
 
+pytestmark = pytest.mark.timing
+
 RATE_HZ = 200.0  # byte links run at bench rates; the stream logic is the DDS one
 CLASSIC_CAN_RATE_HZ = 50.0
 """Classic CAN (8-byte frames) needs ~390 frames per state+command pair: a bench rate of 50 Hz (see

@@ -31,6 +31,8 @@ from g1_control.sim.mock_robot import MockG1
 from g1_control.sim.robot_endpoint import RobotEndpoint
 from g1_control.types import MotorCommand
 
+pytestmark = pytest.mark.timing
+
 INTERFACE, DOMAIN = "lo", 1
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -15,6 +15,8 @@ import pytest
 
 from tests.paths import LAUNCH_DIR, REPO
 
+pytestmark = pytest.mark.timing
+
 ENV = {**os.environ, "PYTHONPATH": str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", "")}
 
 
