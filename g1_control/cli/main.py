@@ -24,6 +24,7 @@ SUBCOMMAND_MODULES = (
     "g1_control.cli.deploy_cmd",
     "g1_control.cli.library_cmd",
     "g1_control.cli.train_cmd",
+    "g1_control.cli.soak_cmd",
 )
 
 

@@ -307,8 +307,8 @@ def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTr
     trip = safety.trip_event
     report.end_reason = trip.detail if trip else "exit"
     report.fault = trip is None or not any(trip.detail.startswith(c) for c in CLEAN_ENDINGS)
-    report.safety_events = [{"t_s": e.t_s, "kind": e.kind.value, "detail": e.detail, "trips": e.trips}
-                            for e in safety.events]
+    report.safety_events = [{"t_s": e.t_s, "kind": e.kind.value, "detail": e.detail, "trips": e.trips,
+                             "planned": e.planned} for e in safety.events]
     report.link = dataclasses.asdict(backend.stats())
     control = [t for t in tracker.transitions if t.target == DeployState.CONTROL]
     if control:
@@ -327,6 +327,7 @@ def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTr
     report.loop = {"deadline_misses": loop.scheduler.deadline_misses, "ticks": loop.scheduler.tick_index,
                    "tick_p99_us": loop.scheduler.report()["tick"]["p99_us"],
                    "lateness_p99_ms": late["p99_us"] / 1000, "lateness_max_ms": loop.scheduler.max_lateness_s * 1000,
+                   "misses_over_period": loop.scheduler.misses_over_period,
                    "clamped_commands": safety.clamps.commands}
 
 

@@ -74,6 +74,8 @@ class Scheduler:
         self.lateness = StageTimes(capacity=1 << 14)
         """How late each wall-clock tick finished past its deadline (0 when on time), seconds."""
         self.max_lateness_s = 0.0
+        self.misses_over_period = 0
+        """Ticks that finished more than a whole tick period late (the next tick's deadline passed too)."""
         self._late_since_take = 0.0
         self._t0: float | None = None
 
@@ -105,6 +107,8 @@ class Scheduler:
             if late > 0:
                 self.deadline_misses += 1
                 self.max_lateness_s = max(self.max_lateness_s, late)
+                if late > self.dt_s:
+                    self.misses_over_period += 1
                 self._late_since_take = max(self._late_since_take, late)
             else:
                 self.sleep(-late)
