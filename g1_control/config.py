@@ -20,9 +20,34 @@ T = TypeVar("T")
 
 
 def _type_name(tp) -> str:
-    if typing.get_origin(tp) is Literal:
+    origin = typing.get_origin(tp)
+    if origin is Literal:
         return "one of " + ", ".join(repr(a) for a in typing.get_args(tp))
-    return getattr(tp, "__name__", str(tp))
+    if origin in (list, tuple):
+        return "a list"
+    if origin is dict:
+        return "a mapping"
+    if dataclasses.is_dataclass(tp):
+        return f"a mapping of {tp.__name__} fields"
+    return {bool: "true or false", int: "an integer", float: "a number", str: "a string"}.get(tp, getattr(tp, "__name__", str(tp)))
+
+
+def _shape_matches(tp, value) -> bool:
+    """Whether `value` has the outer shape of type `tp` (so an error inside it is the one to report)."""
+    origin = typing.get_origin(tp)
+    if origin is Literal:
+        return any(type(value) is type(a) for a in typing.get_args(tp))
+    if origin in (list, tuple):
+        return isinstance(value, (list, tuple))
+    if origin is dict or dataclasses.is_dataclass(tp):
+        return isinstance(value, dict)
+    if tp is bool:
+        return isinstance(value, bool)
+    if tp in (int, float):
+        return isinstance(value, (int, float)) and not isinstance(value, bool)
+    if tp is str:
+        return isinstance(value, str)
+    return False
 
 
 def _convert(tp, value: Any, path: str, error: type[Exception]):
@@ -31,13 +56,19 @@ def _convert(tp, value: Any, path: str, error: type[Exception]):
         if value is None and type(None) in args:
             return None
         inner = [a for a in args if a is not type(None)]
-        last: Exception | None = None
+        failures: list[tuple[object, Exception]] = []
         for a in inner:
             try:
                 return _convert(a, value, path, error)
             except error as exc:
-                last = exc
-        raise last  # type: ignore[misc]
+                failures.append((a, exc))
+        # Report the alternative the value was shaped for (a mapping for a dataclass, a list for a
+        # list...): its own message names the inner key that is wrong.
+        shaped = [exc for a, exc in failures if _shape_matches(a, value)]
+        if len(shaped) == 1:
+            raise shaped[0]
+        names = " or ".join(_type_name(a) for a, _ in failures) + (" or null" if type(None) in args else "")
+        raise error(f"{path}: expected {names}, got {value!r}")
     if origin is Literal:
         if value not in args:
             raise error(f"{path}: expected {_type_name(tp)}, got {value!r}")

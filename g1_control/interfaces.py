@@ -18,6 +18,7 @@ import numpy as np
 
 from g1_control.types import (
     Command,
+    CommandLimits,
     EstimatedState,
     JointReference,
     KinematicReference,
@@ -112,6 +113,12 @@ class Tracker(ABC):
     def observe(self, estimate: EstimatedState) -> None:
         """The state estimator's latest output (at the estimator's rate); trackers that close
         loops on the base's velocity keep it."""
+
+    @property
+    def command_limits(self) -> CommandLimits | None:
+        """The operator command range this tracker can follow (None: no range of its own). The
+        loop builder intersects it with the launch file's limits; teleop sticks scale to it."""
+        return None
 
     @property
     def policy_command(self) -> np.ndarray | None:

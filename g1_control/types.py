@@ -8,22 +8,135 @@ the ground, y left, z up). Nothing here does I/O or math beyond validation.
 
 from __future__ import annotations
 
+import json
+import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any
 
 import numpy as np
 
-from g1_control.errors import InvalidCommandError, InvalidStateError
-from g1_control.robot.g1 import NUM_JOINTS
+from g1_control.errors import InvalidCommandError, InvalidStateError, LaunchFileError
+from g1_control.robot.g1 import DEFAULT_PELVIS_HEIGHT_M, NUM_JOINTS
 
 
 def _zeros() -> np.ndarray:
     return np.zeros(NUM_JOINTS)
 
 
-BUTTONS = frozenset(
-    {"start", "stop", "estop", "run", "style_next", "style_prev", "policy_switch", "damp"}
-)
-"""Operator buttons a Command may carry (edges: present on the tick they were pressed)."""
+class Button(str, Enum):
+    """Operator buttons a Command may carry (edges: present on the tick they were pressed). A str
+    enum: `"stop" in command.buttons` and `Button.STOP in command.buttons` are the same test."""
+
+    START = "start"
+    """Ramp to the default pose (g1 deploy)."""
+    STOP = "stop"
+    """Stop: damping, for good (g1 deploy)."""
+    ESTOP = "estop"
+    """Emergency stop: damping at once, from any state."""
+    RUN = "run"
+    """Hand the robot to the tracker (g1 deploy)."""
+    STYLE_NEXT = "style_next"
+    STYLE_PREV = "style_prev"
+    POLICY_SWITCH = "policy_switch"
+    DAMP = "damp"
+    """Damping now (the remote's select)."""
+
+
+BUTTONS = frozenset(b.value for b in Button)
+"""Every button name a Command may carry."""
+
+
+# -- command limits -------------------------------------------------------------------------------------
+# A 15 cm crouch is what the whole-body tracker was measured to follow (11 of 15 cm, FACTS.md);
+# deeper crouches are untested, so the default range stops there.
+DEFAULT_CROUCH_M = 0.15
+
+
+def _range(value: Any, where: str) -> tuple[float, float]:
+    if (
+        not isinstance(value, (list, tuple))
+        or len(value) != 2
+        or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+    ):
+        raise LaunchFileError(f"{where} is {value!r}; expected [low, high], two numbers")
+    low, high = float(value[0]), float(value[1])
+    if not (math.isfinite(low) and math.isfinite(high)) or low > high:
+        raise LaunchFileError(f"{where} is {value!r}; expected finite low <= high")
+    return low, high
+
+
+@dataclass(frozen=True)
+class CommandLimits:
+    """Inclusive [low, high] ranges of the command fields the mapping produces."""
+
+    vx_mps: tuple[float, float] = (-1.0, 1.0)
+    vy_mps: tuple[float, float] = (-1.0, 1.0)
+    wz_radps: tuple[float, float] = (-1.0, 1.0)
+    pelvis_height_m: tuple[float, float] = (DEFAULT_PELVIS_HEIGHT_M - DEFAULT_CROUCH_M, DEFAULT_PELVIS_HEIGHT_M)
+
+    def __post_init__(self) -> None:
+        for name in ("vx_mps", "vy_mps", "wz_radps", "pelvis_height_m"):
+            object.__setattr__(self, name, _range(getattr(self, name), f"CommandLimits.{name}"))
+        for name in ("vx_mps", "vy_mps", "wz_radps"):
+            low, high = getattr(self, name)
+            # Zero must be reachable: releasing the sticks has to stop the robot.
+            if not low <= 0.0 <= high:
+                raise LaunchFileError(f"CommandLimits.{name} is {(low, high)}; the range must contain 0")
+
+    @classmethod
+    def from_tracker_metadata(cls, metadata: Mapping[str, Any], where: str = "tracker metadata") -> CommandLimits:
+        """Read holosoma-style `command_ranges` (a dict, or the JSON string ONNX metadata stores).
+
+        Fields the metadata does not name keep their defaults.
+        """
+        ranges = metadata.get("command_ranges")
+        if ranges is None:
+            raise LaunchFileError(f"{where} has no 'command_ranges'; cannot derive command limits")
+        if isinstance(ranges, str):
+            try:
+                ranges = json.loads(ranges)
+            except json.JSONDecodeError as exc:
+                raise LaunchFileError(f"{where}.command_ranges is not valid JSON: {exc}") from None
+        if not isinstance(ranges, Mapping):
+            raise LaunchFileError(f"{where}.command_ranges is {type(ranges).__name__}; expected a mapping")
+        kwargs = {}
+        for key, field_name in (("lin_vel_x", "vx_mps"), ("lin_vel_y", "vy_mps"), ("ang_vel_yaw", "wz_radps")):
+            if key in ranges:
+                kwargs[field_name] = _range(ranges[key], f"{where}.command_ranges.{key}")
+        return cls(**kwargs)
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any] | None, where: str) -> CommandLimits:
+        """Limits written in a launch file: {vx_mps: [lo, hi], ...}; absent fields keep defaults."""
+        if d is None:
+            return cls()
+        if not isinstance(d, Mapping):
+            raise LaunchFileError(f"{where} is {type(d).__name__}; expected a mapping")
+        known = ("vx_mps", "vy_mps", "wz_radps", "pelvis_height_m")
+        kwargs = {}
+        for key, value in d.items():
+            if key not in known:
+                raise LaunchFileError(f"{where}.{key} is not a command limit; known: {', '.join(known)}")
+            kwargs[key] = _range(value, f"{where}.{key}")
+        return cls(**kwargs)
+
+    def intersect(self, other: CommandLimits) -> CommandLimits:
+        """The ranges both allow."""
+        def both(a: tuple[float, float], b: tuple[float, float]) -> tuple[float, float]:
+            return max(a[0], b[0]), min(a[1], b[1])
+
+        return CommandLimits(both(self.vx_mps, other.vx_mps), both(self.vy_mps, other.vy_mps),
+                             both(self.wz_radps, other.wz_radps), both(self.pelvis_height_m, other.pelvis_height_m))
+
+    @classmethod
+    def symmetric(cls, vx_mps: float, vy_mps: float, wz_radps: float) -> CommandLimits:
+        return cls((-vx_mps, vx_mps), (-vy_mps, vy_mps), (-wz_radps, wz_radps))
+
+    def clamp_velocity(self, vx: float, vy: float, wz: float) -> tuple[float, float, float]:
+        return (min(max(vx, self.vx_mps[0]), self.vx_mps[1]), min(max(vy, self.vy_mps[0]), self.vy_mps[1]),
+                min(max(wz, self.wz_radps[0]), self.wz_radps[1]))
 
 
 @dataclass

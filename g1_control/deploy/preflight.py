@@ -17,7 +17,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from g1_control.errors import G1ControlError, RobotNotConnectedError, VariantMismatchError
 from g1_control.launch.schema import InputConfig, LaunchFile, Segment
@@ -122,11 +121,11 @@ class Preflight:
         return launch
 
     def check_policy(self, launch: LaunchFile):
-        from g1_control.trackers.policy_spec import load_spec, resolve_spec_path
+        from g1_control.trackers.policy_spec import load_spec, read_spec_file, resolve_spec_path
 
         try:
             spec = load_spec(launch.tracker.policy)
-            variant = (yaml.safe_load(resolve_spec_path(launch.tracker.policy).read_text()) or {}).get("variant")
+            variant = read_spec_file(resolve_spec_path(launch.tracker.policy)).variant
         except G1ControlError as exc:
             self.record("policy", FAIL, str(exc), overridable=False)
             return None, None

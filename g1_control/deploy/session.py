@@ -70,6 +70,7 @@ class DeployReport:
     loop: dict = field(default_factory=dict)
     chain: dict = field(default_factory=dict)
     """The loop's stages (g1_control/launch/builder.py), the same the preflight's dry run ran."""
+    dry_run_chain: dict = field(default_factory=dict)
     run_dir: str | None = None
     """The run folder (per-tick log, events, summary), written as the deploy went."""
 
@@ -105,14 +106,15 @@ def _apply_cli(launch: LaunchFile, options: DeployOptions) -> None:
                               f"'{LOOPBACK}' (or a virtual CAN bus). On a robot the operator presses start and run")
 
 
-def _open_input(launch: LaunchFile, backend, command_ranges):
+def _open_input(launch: LaunchFile, backend, spec):
     """(device, None) or (None, why it cannot be opened)."""
-    from g1_control.launch.builder import timeline_of
+    from g1_control.launch.builder import command_limits, timeline_of
     from g1_control.launch.inputs import make_input
 
     kind = launch.input.type
+    limits = command_limits(launch, spec.command_limits if spec is not None else None)
     try:
-        device = make_input(launch, timeline_of(launch), command_ranges=command_ranges,
+        device = make_input(launch, timeline_of(launch), limits=limits,
                             state_source=backend.read_state if backend is not None else None)
     except G1ControlError as exc:
         return None, f"{kind} cannot be opened: {exc}"
@@ -153,7 +155,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             pf.check_robot(backend, launch, policy_variant)
         else:
             pf.not_run(ROBOT_CHECKS, "no link to the robot")
-        device, open_error = _open_input(launch, backend, spec.command_ranges if spec else None)
+        device, open_error = _open_input(launch, backend, spec)
         if launch.input.type == "unitree_remote" and pf.results["variant"].status == "not run":
             pf.not_run(["estop_input"], "the remote's bytes ride in the robot's LowState_, and none arrived")
         else:
@@ -238,6 +240,7 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
     buttons.timeline_clock = tracker.control_elapsed_s
     report.chain = dict(loop.chain)
     dry = pf.dry_run.chain if pf.dry_run is not None else {}
+    report.dry_run_chain = dict(dry)
     differs = [k for k in CHAIN_STAGES if dry.get(k) != loop.chain.get(k)]
     if dry and differs:
         raise G1ControlError("the robot's loop differs from the one the dry run checked: " + "; ".join(
@@ -301,6 +304,8 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
 
 def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTracker, backend, safety,
                  t_loop0: float) -> None:
+    from g1_control.launch.runner import upper_body_rms_by_style
+
     report.sequence = tracker.sequence
     report.transitions = [{"t_s": t.t_s, "from": t.source.value, "to": t.target.value, "reason": t.reason}
                           for t in tracker.transitions]
@@ -322,7 +327,8 @@ def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTr
         cmd = log_arrays["command"][window]
         report.control = {"duration_s": end - start, "steady_window_s": max(0.0, end - steady_from),
                           "velocity_est_mean": est.mean(axis=0).tolist() if len(est) else None,
-                          "command_mean": cmd.mean(axis=0).tolist() if len(cmd) else None}
+                          "command_mean": cmd.mean(axis=0).tolist() if len(cmd) else None,
+                          "upper_body_vs_plan": upper_body_rms_by_style(log_arrays, (t_mono >= start) & (t_mono < end))}
     late = loop.scheduler.lateness.summary()
     report.loop = {"deadline_misses": loop.scheduler.deadline_misses, "ticks": loop.scheduler.tick_index,
                    "tick_p99_us": loop.scheduler.report()["tick"]["p99_us"],
@@ -345,6 +351,8 @@ def _print_summary(report: DeployReport, say) -> None:
         c = report.control["command_mean"]
         say(f"control {report.control['duration_s']:.1f} s: estimated velocity vx {v[0]:+.2f} m/s, vy {v[1]:+.2f}, "
             f"wz {v[2]:+.2f} (commanded {c[0]:+.2f}, {c[1]:+.2f}, {c[2]:+.2f})")
+    for style, fig in (report.control.get("upper_body_vs_plan") or {}).items():
+        say(f"upper body vs plan, style {style}: RMS {fig['rms_rad']:.3f} rad over {fig['seconds']:.1f} s")
     say(f"loop: {report.loop['ticks']} ticks, {report.loop['deadline_misses']} deadline misses (worst "
         f"{report.loop['lateness_max_ms']:.1f} ms late, p99 {report.loop['lateness_p99_ms']:.1f} ms), "
         f"{report.loop['clamped_commands']} commands clamped by the safety layer")

@@ -24,7 +24,7 @@ from g1_control.launch.schema import DeployConfig
 from g1_control.safety import SafetyFilter
 from g1_control.teleop.gamepad_script import ScriptedGamepad
 from g1_control.teleop.scripted import ScriptedInput
-from g1_control.types import Command, EstimatedState, JointReference, MotorCommand, RobotState
+from g1_control.types import Button, Command, CommandLimits, EstimatedState, JointReference, MotorCommand, RobotState
 
 log = logging.getLogger("g1_control.deploy")
 
@@ -119,6 +119,10 @@ class DeployTracker(Tracker):
     def policy_command(self) -> np.ndarray | None:
         return self.policy.policy_command
 
+    @property
+    def command_limits(self) -> CommandLimits | None:
+        return self.policy.command_limits
+
     def reset(self, state: RobotState | None = None) -> None:
         """Start over in zero torque (a deploy runs the machine once; reset is for the loop's reset)."""
         self.state = DeployState.ZERO_TORQUE
@@ -152,23 +156,23 @@ class DeployTracker(Tracker):
         pressed = self.buttons.take() if self.buttons is not None else frozenset()
         in_state = now - self.entered_s
         cfg = self.config
-        if "stop" in pressed:
+        if Button.STOP in pressed:
             self.safety.estop("operator stop", now, planned=True)
             self._go(DeployState.DAMPING, "operator stop", now)
         elif self.state == DeployState.ZERO_TORQUE:
-            if "start" in pressed or (self.auto and in_state >= cfg.auto_start_s):
+            if Button.START in pressed or (self.auto and in_state >= cfg.auto_start_s):
                 self._ramp_from = state.q_rad.copy()
-                self._go(DeployState.RAMP, "operator start" if "start" in pressed else "start (--yes)", now)
-            elif "run" in pressed:
+                self._go(DeployState.RAMP, "operator start" if Button.START in pressed else "start (--yes)", now)
+            elif Button.RUN in pressed:
                 self.ignored.append("run ignored in zero_torque: press start first")
         elif self.state == DeployState.RAMP:
             if in_state >= cfg.ramp_s:
                 self._go(DeployState.HOLD, f"default pose reached ({cfg.ramp_s:.1f} s ramp)", now)
-            elif "run" in pressed:
+            elif Button.RUN in pressed:
                 self.ignored.append("run ignored during the ramp: wait for hold")
         elif self.state == DeployState.HOLD:
             # A run pressed early waits for min_hold_s: the robot settles on the pose before the policy.
-            self._run_requested |= "run" in pressed
+            self._run_requested |= Button.RUN in pressed
             if in_state >= cfg.min_hold_s and (self._run_requested or (self.auto and in_state >= cfg.auto_run_s)):
                 self.policy.reset(state)
                 self.control_started_s = now

@@ -10,16 +10,18 @@ from __future__ import annotations
 from pathlib import Path
 
 from g1_control.errors import G1ControlError
+from g1_control.types import CommandLimits
 
 GENERATORS = ("velocity", "backbone", "interpolation", "motion_matching")
 
 
-def make_generator(kind: str, *, model: str | Path | None = None, limits=None):
+def make_generator(kind: str, *, model: str | Path | None = None, limits: CommandLimits | None = None):
+    """The generator and its retargeter; `limits`: the operator command range (the loop builder's
+    one source of velocity limits, g1_control/launch/builder.py)."""
     from g1_control.generator.velocity import CopyRetargeter, VelocityReferenceGenerator
 
     if kind == "velocity":
-        args = (limits.max_vx_mps, limits.max_vy_mps, limits.max_wz_radps) if limits is not None else ()
-        return VelocityReferenceGenerator(*args), CopyRetargeter()
+        return VelocityReferenceGenerator(limits), CopyRetargeter()
     if kind not in GENERATORS:
         raise G1ControlError(f"unknown generator '{kind}'; known: {', '.join(GENERATORS)}")
     from g1_control.generator.learned import SHIPPED_DIR, OnnxInbetweener
@@ -42,7 +44,7 @@ def make_generator(kind: str, *, model: str | Path | None = None, limits=None):
         inbetweener = MotionMatchingInbetweener(load_split(None, "train")[0])
     config = RuntimeConfig()
     if limits is not None:
-        config.spring.max_vx_mps = min(config.spring.max_vx_mps, limits.max_vx_mps)
-        config.spring.max_vy_mps = min(config.spring.max_vy_mps, limits.max_vy_mps)
-        config.spring.max_wz_radps = min(config.spring.max_wz_radps, limits.max_wz_radps)
+        config.spring.max_vx_mps = min(config.spring.max_vx_mps, max(-limits.vx_mps[0], limits.vx_mps[1]))
+        config.spring.max_vy_mps = min(config.spring.max_vy_mps, max(-limits.vy_mps[0], limits.vy_mps[1]))
+        config.spring.max_wz_radps = min(config.spring.max_wz_radps, max(-limits.wz_radps[0], limits.wz_radps[1]))
     return InbetweeningGenerator(inbetweener, styles, config), GeneratorRetargeter()

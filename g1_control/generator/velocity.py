@@ -14,16 +14,16 @@ import numpy as np
 from g1_control.generator.styles import ROLLOUT_STYLES
 from g1_control.interfaces import Generator, Retargeter
 from g1_control.robot import g1
-from g1_control.types import Command, JointReference, KinematicReference, RobotState
+from g1_control.types import Command, CommandLimits, JointReference, KinematicReference, RobotState
 
 
 class VelocityReferenceGenerator(Generator):
-    def __init__(self, max_vx_mps: float = 1.0, max_vy_mps: float = 0.6, max_wz_radps: float = 1.0):
-        self._limits = np.array([max_vx_mps, max_vy_mps, max_wz_radps])
+    def __init__(self, limits: CommandLimits | None = None):
+        self.limits = limits or CommandLimits()
         self._ref = KinematicReference(q_rad=g1.DEFAULT_Q_RAD.copy())
 
     def update(self, command: Command, state: RobotState) -> KinematicReference:
-        v = np.clip([command.vx_mps, command.vy_mps, command.wz_radps], -self._limits, self._limits)
+        v = self.limits.clamp_velocity(command.vx_mps, command.vy_mps, command.wz_radps)
         ref = self._ref
         ref.t_s = state.t_s
         ref.root_linvel_h_mps[:2] = v[:2]

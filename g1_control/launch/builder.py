@@ -24,6 +24,7 @@ from g1_control.launch.schema import LaunchFile
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.safety import SafetyConfig, SafetyFilter
 from g1_control.teleop.scripted import Segment, random_timeline
+from g1_control.types import CommandLimits
 
 CHAIN_STAGES = ("generator", "retargeter", "tracker", "rates", "safety")
 """The parts of `loop.chain` that must be the same in a deploy's dry run and on the robot."""
@@ -62,7 +63,15 @@ def make_tracker(launch: LaunchFile) -> Tracker:
     raise LaunchFileError(f"tracker.type: unknown tracker '{cfg.type}'")
 
 
-def make_generator(launch: LaunchFile) -> tuple[Generator, Retargeter]:
+def command_limits(launch: LaunchFile, tracker_limits: CommandLimits | None) -> CommandLimits:
+    """The one source of operator velocity limits: the launch file's `limits` within the range the
+    tracker can follow (Tracker.command_limits). Teleop sticks scale to it; the generator clamps to it."""
+    lim = launch.limits
+    limits = CommandLimits.symmetric(lim.max_vx_mps, lim.max_vy_mps, lim.max_wz_radps)
+    return limits if tracker_limits is None else limits.intersect(tracker_limits)
+
+
+def make_generator(launch: LaunchFile, limits: CommandLimits | None = None) -> tuple[Generator, Retargeter]:
     cfg = launch.generator
     if cfg.type == "scripted":
         from g1_control.generator.scripted import TrajectoryGenerator, TrajectoryRetargeter, build_reference
@@ -71,13 +80,7 @@ def make_generator(launch: LaunchFile) -> tuple[Generator, Retargeter]:
         return TrajectoryGenerator(trajectory), TrajectoryRetargeter(trajectory)
     from g1_control.generator.factory import make_generator as make_named
 
-    return make_named(cfg.type, model=cfg.model or None, limits=launch.limits)
-
-
-def command_ranges(tracker: Tracker) -> dict | None:
-    """The walking policy's command ranges (what teleop sticks scale to), when the tracker has them."""
-    spec = getattr(tracker, "spec", None)
-    return spec.command_ranges if spec is not None else None
+    return make_named(cfg.type, model=cfg.model or None, limits=limits)
 
 
 def make_sim_backend(launch: LaunchFile) -> Backend:
@@ -119,13 +122,13 @@ def build_loop(launch: LaunchFile, *, backend: Backend | None = None, input_devi
     from g1_control.launch.inputs import make_input
 
     tracker = make_tracker(launch)
-    generator, retargeter = make_generator(launch)
+    limits = command_limits(launch, tracker.command_limits)
+    generator, retargeter = make_generator(launch, limits)
     chain = describe_chain(launch, generator, retargeter, tracker)
     if backend is None:
         backend = make_sim_backend(launch)
     if input_device is None:
-        input_device = make_input(launch, timeline_of(launch), command_ranges=command_ranges(tracker),
-                                  state_source=backend.read_state)
+        input_device = make_input(launch, timeline_of(launch), limits=limits, state_source=backend.read_state)
     safety = SafetyFilter(safety_config(launch))
     if wrap_tracker is not None:
         tracker = wrap_tracker(tracker, safety)

@@ -6,20 +6,19 @@ from g1_control.errors import InputDeviceError
 from g1_control.interfaces import InputDevice
 from g1_control.launch.schema import TELEOP_DEVICES, LaunchFile
 from g1_control.teleop.scripted import ScriptedInput, Segment
+from g1_control.types import CommandLimits
 
 
-def make_input(launch: LaunchFile, segments: list[Segment], command_ranges: dict | None = None,
+def make_input(launch: LaunchFile, segments: list[Segment], limits: CommandLimits | None = None,
                state_source=None) -> InputDevice:
-    """Open the device `launch.input` names. Teleop devices get the tracker's command ranges as
-    limits; every device is timed by the loop's clock (poll(now_s)), so slew rates follow
-    simulated time in lockstep."""
+    """Open the device `launch.input` names. Teleop devices scale their sticks to `limits` (the
+    loop builder's command limits); every device is timed by the loop's clock (poll(now_s)), so
+    slew rates follow simulated time in lockstep."""
     cfg = launch.input
     if cfg.type in ("scripted", "random"):
         return ScriptedInput(segments)
-    from g1_control.teleop.command_limits import CommandLimits
     from g1_control.teleop.factory import make_input_device
 
-    limits = CommandLimits.from_tracker_metadata({"command_ranges": command_ranges}) if command_ranges else None
     if cfg.type == "gamepad_script":
         from g1_control.teleop.gamepad_script import ScriptedGamepad, parse_gamepad_script
 

@@ -14,7 +14,7 @@ Layout (documented for users in the README, "The run folder"):
       events.jsonl    one JSON object per line, flushed as it happens: safety events, loop
                       events, the deploy state machine's transitions
       log/            the per-tick log while the run goes: fields.json (names, dtypes, widths,
-                      units, rate, joint names) and one raw little-endian float64 file per field,
+                      units, rate, joint and style names) and one raw little-endian file per field,
                       appended and flushed every `flush_every_s`; `read_log(run_dir)` reads it
                       back (whole rows only, so a killed run's log still reads)
       log.npz         the same log assembled at close (what the plot and video readers take),
@@ -54,7 +54,9 @@ LOG_FIELDS: dict[str, tuple[str, str]] = {
     "tilt_rad": ("rad", "angle between the pelvis z axis and vertical"),
     "q_rad": ("rad", "measured joint positions, G1 joint order (joint_names)"),
     "q_target_rad": ("rad", "joint position targets sent (after the safety filter), joint order"),
+    "q_ref_rad": ("rad", "the tracker's reference posture (the plan after the IK), joint order"),
     "tau_nm": ("N m", "measured (estimated) joint torques, joint order"),
+    "style_id": ("1", "index into style_names of the operator's style (-1 before the first tick)"),
 }
 """Per-tick log fields: unit and meaning (one row per tracker tick, at rates.tracker_hz)."""
 
@@ -80,6 +82,8 @@ class RunFolder:
         self.rows = 0
         self.closed = False
         self._files: dict[str, object] = {}
+        self._dtypes: dict[str, str] = {}
+        self._meta: dict = {}
         self._events = open(self.run_dir / "events.jsonl", "a", buffering=1)
         self._queue: queue.Queue = queue.Queue()
         self._error: BaseException | None = None
@@ -126,19 +130,21 @@ class RunFolder:
         n = len(chunk["t_s"])
         for name, arr in chunk.items():
             f = self._files[name]
-            f.write(np.ascontiguousarray(arr, dtype="<f8").tobytes())
+            f.write(np.ascontiguousarray(arr, dtype=self._dtypes[name]).tobytes())
             f.flush()
         self.rows += n
 
     def _write_fields(self, chunk: dict[str, np.ndarray]) -> None:
-        fields = {name: {"dtype": "<f8", "shape": list(arr.shape[1:]), "unit": LOG_FIELDS.get(name, ("", ""))[0],
-                         "doc": LOG_FIELDS.get(name, ("", ""))[1], "file": f"{name}.f64"}
+        self._dtypes = {name: np.dtype(arr.dtype).newbyteorder("<").str for name, arr in chunk.items()}
+        fields = {name: {"dtype": self._dtypes[name], "shape": list(arr.shape[1:]),
+                         "unit": LOG_FIELDS.get(name, ("", ""))[0], "doc": LOG_FIELDS.get(name, ("", ""))[1],
+                         "file": f"{name}.bin"}
                   for name, arr in chunk.items()}
-        meta = {"rate_hz": self.rate_hz, "rows_per_flush": self.chunk_rows, "joint_names": list(g1.JOINT_NAMES),
-                "fields": fields}
-        (self.log_dir / "fields.json").write_text(json.dumps(meta, indent=2))
+        self._meta = {"rate_hz": self.rate_hz, "rows_per_flush": self.chunk_rows, "joint_names": list(g1.JOINT_NAMES),
+                      "style_names": [], "fields": fields}
+        (self.log_dir / "fields.json").write_text(json.dumps(self._meta, indent=2))
         for name in chunk:
-            self._files[name] = open(self.log_dir / f"{name}.f64", "ab")
+            self._files[name] = open(self.log_dir / f"{name}.bin", "ab")
 
     # -- the end -------------------------------------------------------------------------------------
     def close_log(self, loop=None) -> dict[str, np.ndarray]:
@@ -153,6 +159,9 @@ class RunFolder:
             f.close()
         if self._error is not None:
             raise self._error
+        if loop is not None and self._files:
+            self._meta["style_names"] = list(loop.log.style_names)
+            (self.log_dir / "fields.json").write_text(json.dumps(self._meta, indent=2))
         return read_log(self.run_dir)
 
     def write_npz(self, log: dict[str, np.ndarray]) -> Path:
@@ -226,13 +235,15 @@ def read_log(run_dir: str | Path) -> dict[str, np.ndarray]:
         if npz.is_file():
             with np.load(npz) as data:
                 return {k: data[k] for k in data.files if k != "joint_names"}
-        return {name: np.zeros((0,)) for name in LOG_FIELDS}
+        return {name: np.zeros((0,)) for name in LOG_FIELDS} | {"style_names": np.array([], dtype=str)}
     meta = json.loads(meta_path.read_text())
-    arrays = {}
+    arrays: dict[str, np.ndarray] = {}
     for name, spec in meta["fields"].items():
         width = int(np.prod(spec["shape"])) if spec["shape"] else 1
         flat = np.fromfile(run_dir / "log" / spec["file"], dtype=spec["dtype"])
         rows = flat.size // width
         arrays[name] = flat[: rows * width].reshape((rows, *spec["shape"]))
     n = min(len(a) for a in arrays.values())
-    return {name: a[:n] for name, a in arrays.items()}
+    out = {name: a[:n] for name, a in arrays.items()}
+    out["style_names"] = np.array(meta.get("style_names", []), dtype=str)
+    return out

@@ -89,6 +89,34 @@ def segments_from_log(log: dict[str, np.ndarray], min_s: float = 1.0) -> list[tu
     return out
 
 
+def upper_body_rms_by_style(log: dict[str, np.ndarray], window: np.ndarray | None = None,
+                            settle_s: float = 1.0) -> dict[str, dict[str, float]]:
+    """Waist and arm joints as measured vs the tracker's reference posture (the plan after the IK),
+    per operator style: RMS (rad) over the ticks in `window`, skipping the first `settle_s` after each
+    style change (the arms are still moving to the new pose)."""
+    from g1_control.robot import g1
+
+    ids, t = log["style_id"], log["t_s"]
+    if window is None:
+        window = np.ones(len(t), dtype=bool)
+    change_t = np.full(len(t), -np.inf)
+    last = -np.inf
+    for k in range(len(t)):
+        if k == 0 or ids[k] != ids[k - 1]:
+            last = t[k]
+        change_t[k] = last
+    settled = window & (t - change_t >= settle_s) & ~np.isnan(log["q_ref_rad"][:, 0])
+    ub = list(g1.UPPER_BODY_JOINTS)
+    out = {}
+    for i, name in enumerate(log["style_names"]):
+        rows = settled & (ids == i)
+        if rows.sum() < 5:
+            continue
+        err = log["q_rad"][rows][:, ub] - log["q_ref_rad"][rows][:, ub]
+        out[str(name)] = {"rms_rad": float(np.sqrt(np.mean(err**2))), "seconds": float(rows.sum() * np.median(np.diff(t)))}
+    return out
+
+
 def segment_results(log: dict[str, np.ndarray], segments: list[Segment]) -> list[SegmentResult]:
     t = log["t_s"]
     achieved = log["velocity_true"] if not np.isnan(log["velocity_true"]).all() else log["velocity_est"]

@@ -17,7 +17,7 @@ from g1_control.loop.scheduler import Scheduler, Stage
 from g1_control.robot import g1
 from g1_control.rotations import quat_to_rot, tilt_rad, yaw_of
 from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter
-from g1_control.types import Command, RobotState
+from g1_control.types import Button, Command, RobotState
 
 
 @dataclass
@@ -49,29 +49,42 @@ class RunLog:
     yaw_rad: np.ndarray = field(init=False)
     tilt_rad: np.ndarray = field(init=False)
     q_rad: np.ndarray = field(init=False)
-    q_target_rad: np.ndarray = field(init=False)
+    q_target_rad: np.ndarray = field(init=False)     # what the motors were sent (after the safety filter)
+    q_ref_rad: np.ndarray = field(init=False)        # the tracker's reference posture (the plan after the IK)
     tau_nm: np.ndarray = field(init=False)
+    style_id: np.ndarray = field(init=False)         # index into style_names of the operator's style
+    style_names: list[str] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         c, j = self.capacity, g1.NUM_JOINTS
         self.t_s = np.zeros(c)
         for name, width in (("command", 3), ("policy_command", 3), ("velocity_est", 3), ("velocity_true", 3),
-                            ("base_pos_m", 3), ("base_quat_wxyz", 4), ("q_rad", j), ("q_target_rad", j), ("tau_nm", j)):
+                            ("base_pos_m", 3), ("base_quat_wxyz", 4), ("q_rad", j), ("q_target_rad", j),
+                            ("q_ref_rad", j), ("tau_nm", j)):
             setattr(self, name, np.full((c, width), np.nan))
+        self.style_id = np.full(c, -1, dtype=np.int16)
         self.yaw_rad = np.full(c, np.nan)
         self.tilt_rad = np.full(c, np.nan)
 
     NAMES = ("t_s", "command", "policy_command", "velocity_est", "velocity_true", "base_pos_m", "base_quat_wxyz",
-             "yaw_rad", "tilt_rad", "q_rad", "q_target_rad", "tau_nm")
+             "yaw_rad", "tilt_rad", "q_rad", "q_target_rad", "q_ref_rad", "tau_nm", "style_id")
+    """The per-tick arrays (style_names, the names behind style_id, is not per tick)."""
 
     def arrays(self) -> dict[str, np.ndarray]:
-        return {name: getattr(self, name)[: self.n] for name in self.NAMES}
+        out = {name: getattr(self, name)[: self.n] for name in self.NAMES}
+        out["style_names"] = np.array(self.style_names, dtype=str)
+        return out
 
     def flush(self) -> None:
-        """Hand the rows so far to the sink (a copy) and start a new chunk."""
+        """Hand the rows so far to the sink (a copy) and start a new chunk (style_names stay)."""
         if self.sink is not None and self.n:
             self.sink({name: getattr(self, name)[: self.n].copy() for name in self.NAMES})
             self.n = 0
+
+    def style_index(self, name: str) -> int:
+        if name not in self.style_names:
+            self.style_names.append(name)
+        return self.style_names.index(name)
 
 
 class ControlLoop:
@@ -176,7 +189,7 @@ class ControlLoop:
                 self._event("invalid_command", str(exc))
             self.command = self.safety.vet_input(None, now)
             return
-        if "damp" in command.buttons:
+        if Button.DAMP in command.buttons:
             self.safety.estop("damp pressed on the operator input", now)
         self.command = self.safety.vet_input(command, now)
 
@@ -262,6 +275,9 @@ class ControlLoop:
             log.base_pos_m[i] = s.base_pos_w_m
         log.q_rad[i] = s.q_rad
         log.q_target_rad[i] = self.motor_command.q_rad
+        if self._joint_ref is not None:
+            log.q_ref_rad[i] = self._joint_ref.q_rad
+        log.style_id[i] = log.style_index(self.command.style)
         log.tau_nm[i] = s.tau_nm
         log.n = i + 1
         log.total += 1

@@ -27,7 +27,7 @@ from g1_control.robot import g1
 from g1_control.rotations import tilt_rad
 from g1_control.safety.config import SafetyConfig
 from g1_control.safety.events import SafetyEvent, SafetyEventKind
-from g1_control.types import Command, MotorCommand, RobotState
+from g1_control.types import Button, Command, MotorCommand, RobotState
 
 log = logging.getLogger("g1_control.safety")
 
@@ -217,7 +217,7 @@ class SafetyFilter:
         the last one with zero velocity once input is late; an e-stop button trips."""
         c = self.config
         if command is not None:
-            if "estop" in command.buttons:
+            if Button.ESTOP in command.buttons:
                 self.estop("e-stop pressed on the operator input", now_s)
             self._last_input_s, self._last_input = now_s, command
             if self._input_stale:

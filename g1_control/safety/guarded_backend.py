@@ -64,11 +64,9 @@ class GuardedBackend(Backend):
         self._damp_now()
 
     def _damp_now(self) -> None:
-        damp = getattr(self.inner, "damp", None)
-        if damp is not None:
-            damp()
-        else:
-            self.inner.write_command(self.safety.damping())
+        # The link's own damping first (on the wire at once), then the filter's, with its kd.
+        self.inner.damp()
+        self.inner.write_command(self.safety.damping())
 
     def step(self, dt_s: float) -> None:
         self.inner.step(dt_s)

@@ -5,8 +5,8 @@ MappingConfig validated from the launch file (make_input_device builds one from 
 See README.md here for the default button mappings.
 """
 
-from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.factory import make_input_device
 from g1_control.teleop.mapping import MappingConfig
+from g1_control.types import CommandLimits
 
 __all__ = ["CommandLimits", "MappingConfig", "make_input_device"]

@@ -15,11 +15,10 @@ from collections.abc import Callable
 
 from g1_control.errors import LaunchFileError
 from g1_control.interfaces import InputDevice
-from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.mapper import CommandMapper
 from g1_control.teleop.mapping import MappingConfig
 from g1_control.teleop.snapshot import InputSnapshot
-from g1_control.types import Command
+from g1_control.types import Command, CommandLimits
 
 log = logging.getLogger(__name__)
 

@@ -19,11 +19,10 @@ from collections.abc import Callable, Mapping
 from typing import Any
 
 from g1_control.errors import InputDeviceError, LaunchFileError
-from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.device import TeleopDevice
 from g1_control.teleop.layouts import LAYOUTS
 from g1_control.teleop.mapping import MappingConfig
-from g1_control.types import RobotState
+from g1_control.types import CommandLimits, RobotState
 
 DEVICE_TYPES = tuple(LAYOUTS)
 _KEYS = {

@@ -23,11 +23,11 @@ from typing import Any
 
 from g1_control.errors import InputDeviceError, LaunchFileError
 from g1_control.teleop import evdev_protocol as ev
-from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.device import DeviceLost, TeleopDevice
 from g1_control.teleop.layouts import GAMEPAD_AXES, GAMEPAD_BUTTONS, STICK
 from g1_control.teleop.mapping import MappingConfig
 from g1_control.teleop.snapshot import InputSnapshot
+from g1_control.types import CommandLimits
 
 # Codes the Linux xpad driver (Xbox 360 / One pads) reports; other pads differ and are set in
 # the launch file with `button_codes` / `axis_codes`. xpad reports the Xbox "X" as BTN_X (0x133,

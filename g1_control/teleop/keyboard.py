@@ -22,10 +22,10 @@ import time
 from collections.abc import Callable
 
 from g1_control.errors import InputDeviceError
-from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.device import DeviceLost, TeleopDevice
 from g1_control.teleop.mapping import MappingConfig
 from g1_control.teleop.snapshot import InputSnapshot
+from g1_control.types import CommandLimits
 
 _ESCAPE_KEYS = {  # CSI / SS3 sequences of common terminals (xterm, VT220)
     "[A": "up", "[B": "down", "[C": "right", "[D": "left", "OA": "up", "OB": "down", "OC": "right", "OD": "left",

@@ -10,13 +10,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.layouts import STICK
 from g1_control.teleop.mapping import MappingConfig
 from g1_control.teleop.snapshot import InputSnapshot
-from g1_control.types import BUTTONS, Command
+from g1_control.types import BUTTONS, Button, Command, CommandLimits
 
-_STOPPING_ACTIONS = frozenset({"estop", "damp", "stop", "zero_velocity"})
+_STOPPING_ACTIONS = frozenset({Button.ESTOP, Button.DAMP, Button.STOP, "zero_velocity"})
 
 
 @dataclass
@@ -60,7 +59,7 @@ class CommandMapper:
         for name in self._virtual:
             self._virtual[name] = 0.0
         heading = self._heading_rad if self.config.yaw_mode == "heading" else None
-        return Command(heading_rad=heading, style=self.style, buttons=frozenset({"damp"}))
+        return Command(heading_rad=heading, style=self.style, buttons=frozenset({Button.DAMP}))
 
     # -- one poll ---------------------------------------------------------------------------
     def update(self, snapshot: InputSnapshot, t_s: float) -> Command:
@@ -74,9 +73,9 @@ class CommandMapper:
             for name in self._virtual:
                 if self.config.layout.axes[name] == STICK:
                     self._virtual[name] = 0.0
-        if "style_next" in actions:
+        if Button.STYLE_NEXT in actions:
             self._style_index = (self._style_index + 1) % len(self.config.styles)
-        if "style_prev" in actions:
+        if Button.STYLE_PREV in actions:
             self._style_index = (self._style_index - 1) % len(self.config.styles)
 
         scale = 1.0

@@ -22,11 +22,10 @@ from g1_control.hardware.unitree.remote import (  # noqa: F401  (the wire format
     decode_wireless_remote,
     encode_wireless_remote,
 )
-from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.device import DeviceLost, TeleopDevice
 from g1_control.teleop.mapping import MappingConfig
 from g1_control.teleop.snapshot import InputSnapshot
-from g1_control.types import RobotState
+from g1_control.types import CommandLimits, RobotState
 
 
 class UnitreeRemote(TeleopDevice):

@@ -1,11 +1,17 @@
 """Measure sim2sim: `g1 sim-robot --lower-gantry-on-policy` and `g1 deploy launch/sim2sim.yaml --yes`
 as two processes on lo/domain 1 (a private partition), the emulator sampled for ground truth.
 
-    python -m g1_control.tools.measure_sim2sim        # prints one JSON object
+    python -m g1_control.tools.measure_sim2sim                 # prints one JSON object
+    python -m g1_control.tools.measure_sim2sim --generator     # launch/sim2sim_generator.yaml, styles on the d-pad
 
 Reports the LowCmd_ stream as the robot took it off the wire (rate, period p50/p99/max), the
 walking velocity from the simulator's base position over the steady part of the forward segment
 (from 3 s after control began to its end), the host's own estimate, and the state sequence.
+
+With --generator: the generator -> IK -> policy chain over DDS; once control began, the emulated
+remote walks the robot (left stick) and presses d-pad right every STYLE_S seconds to step through the
+launch file's styles. Reports, per style, the upper-body joints the emulator reported vs the plan the
+host tracked (RMS), and the chains of the robot loop and of the preflight's dry run.
 """
 
 from __future__ import annotations
@@ -28,7 +34,11 @@ def _g1(*args: str, **kwargs) -> subprocess.Popen:
                             bufsize=1, **kwargs)
 
 
-def measure(launch: str = "launch/sim2sim.yaml") -> dict:
+STYLE_S = 3.5
+"""Seconds per style in --generator mode."""
+
+
+def measure(launch: str = "launch/sim2sim.yaml", generator: bool = False) -> dict:
     partition = f"g1measure-{os.getpid()}-{uuid.uuid4().hex[:6]}"
     robot = _g1("sim-robot", "--lower-gantry-on-policy", "--partition", partition, "--control-stdin",
                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
@@ -47,10 +57,21 @@ def measure(launch: str = "launch/sim2sim.yaml") -> dict:
             host = _g1("deploy", launch, "--yes", "--partition", partition, "--json", str(report_path),
                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
             samples = []
+            next_style_s, walking = None, False
             while host.poll() is None:
                 r = ask("report")
                 if r.get("gantry_lowered_at_s") == r.get("gantry_lowered_at_s"):  # not NaN: control began
-                    samples.append((time.monotonic(), r["base_pos_w_m"], r["gantry_lowered_at_s"]))
+                    now = time.monotonic()
+                    samples.append((now, r["base_pos_w_m"], r["gantry_lowered_at_s"]))
+                    if generator:
+                        if next_style_s is None:
+                            next_style_s = now + STYLE_S
+                        if not walking and now > r["gantry_lowered_at_s"] + 2.0:
+                            ask("stick ly 0.5")
+                            walking = True
+                        if now >= next_style_s:
+                            ask("press right")
+                            next_style_s = now + STYLE_S
                 time.sleep(0.25)
             report = json.loads(report_path.read_text())
         wire = ask("report")
@@ -66,6 +87,8 @@ def measure(launch: str = "launch/sim2sim.yaml") -> dict:
             "walk_window_s": t2 - t1, "walk_vx_host_estimate_mps": report["control"]["velocity_est_mean"][0],
             "pelvis_height_at_damping_m": wire["first_damping_base_pos_w_m"][2],
             "deadline_misses": report["loop"]["deadline_misses"],
+            "upper_body_vs_plan": report["control"].get("upper_body_vs_plan"),
+            "chain": report.get("chain"), "dry_run_chain": report.get("dry_run_chain"),
         }
     finally:
         if host is not None and host.poll() is None:
@@ -79,4 +102,7 @@ def measure(launch: str = "launch/sim2sim.yaml") -> dict:
 
 
 if __name__ == "__main__":
-    print(json.dumps(measure(*sys.argv[1:]), indent=2))
+    if "--generator" in sys.argv[1:]:
+        print(json.dumps(measure("launch/sim2sim_generator.yaml", generator=True), indent=2))
+    else:
+        print(json.dumps(measure(*sys.argv[1:]), indent=2))

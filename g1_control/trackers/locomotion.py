@@ -19,7 +19,7 @@ from g1_control.rotations import projected_gravity
 from g1_control.trackers.observation import ObservationBuilder
 from g1_control.trackers.onnx_runner import OnnxRunner
 from g1_control.trackers.policy_spec import PolicySpec
-from g1_control.types import EstimatedState, JointReference, MotorCommand, RobotState
+from g1_control.types import CommandLimits, EstimatedState, JointReference, MotorCommand, RobotState
 
 
 @dataclass
@@ -95,6 +95,10 @@ class LocomotionPolicyTracker(Tracker):
     @property
     def policy_command(self) -> np.ndarray:
         return self.last_policy_command
+
+    @property
+    def command_limits(self) -> CommandLimits:
+        return self.spec.command_limits
 
     def reset(self, state: RobotState | None = None) -> None:
         self.last_action[:] = 0.0

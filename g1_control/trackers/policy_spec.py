@@ -10,23 +10,91 @@ policy travels with its own robot configuration.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 
 from g1_control import assets
-from g1_control.config import read_yaml
+from g1_control.config import from_dict, read_yaml
 from g1_control.errors import PolicyMismatchError
 from g1_control.robot import g1
 from g1_control.trackers.observation import ObservationSpec
+from g1_control.types import CommandLimits
 
 GAIN_RTOL = 0.02
 """Gains in a policy's metadata may differ from the robot's by this fraction (rounding)."""
 
-_SPEC_KEYS = {"name", "kind", "onnx", "rate_hz", "variant", "joint_names", "gains", "default_q",
-              "action", "observation", "phase", "command_ranges"}
+
+# -- the spec file's schema (read by g1_control/config.py, the launch files' typed loader) -------------------
+@dataclass
+class OnnxAssetSection:
+    path: str
+    """Path of the ONNX file inside the asset (or, without an asset, relative to the spec file)."""
+    asset: str | None = None
+    """A registry asset fetched by `g1 policies fetch` (g1_control/assets.py)."""
+
+
+@dataclass
+class GainsSection:
+    kp: list[float]
+    kd: list[float]
+
+
+@dataclass
+class ActionSection:
+    scale: float | list[float] = 1.0
+    """q* = default_q + scale * action (one number, or one per joint)."""
+    clip: float = 100.0
+
+
+@dataclass
+class ObsTermSection:
+    name: str
+    scale: float = 1.0
+
+
+@dataclass
+class ObservationSection:
+    terms: list[str | ObsTermSection] = field(default_factory=list)
+    """In the order the network expects them (holosoma: alphabetical by name)."""
+    input: str = "obs"
+    """Name of the ONNX input the observation feeds."""
+    history: int = 1
+
+
+@dataclass
+class PhaseSection:
+    period_s: float
+    offsets_rad: tuple[float, float]
+    stand_threshold: float = 0.01
+
+
+@dataclass
+class PolicySpecFile:
+    """A policy spec YAML. `metadata` reads a value from the ONNX file's own metadata; `robot` takes
+    the G1's (g1_control/robot/g1.py)."""
+
+    onnx: str | OnnxAssetSection
+    name: str = ""
+    kind: Literal["locomotion", "tracking"] = "locomotion"
+    rate_hz: float = 50.0
+    variant: Literal["g1_23dof", "g1_29dof", "g1_29dof_locked_waist"] = "g1_29dof"
+    joint_names: Literal["metadata", "robot"] | list[str] = "robot"
+    gains: Literal["metadata", "robot"] | GainsSection = "robot"
+    default_q: Literal["robot"] | list[float] = "robot"
+    action: ActionSection = field(default_factory=ActionSection)
+    observation: ObservationSection = field(default_factory=ObservationSection)
+    phase: PhaseSection | None = None
+    command_ranges: Literal["metadata"] | dict[str, tuple[float, float]] = field(default_factory=dict)
+
+    def validate(self, where: str) -> None:
+        if not self.rate_hz > 0:
+            raise PolicyMismatchError(f"{where}.rate_hz: must be > 0, got {self.rate_hz}")
+        if self.observation.history < 1:
+            raise PolicyMismatchError(f"{where}.observation.history must be >= 1, got {self.observation.history}")
 
 
 def builtin_specs() -> dict[str, Path]:
@@ -60,6 +128,13 @@ class PolicySpec:
     metadata: dict[str, str]
 
     @property
+    def command_limits(self) -> CommandLimits:
+        """The command range the policy was trained on (holosoma: lin_vel_x, lin_vel_y, ang_vel_yaw)."""
+        r = self.command_ranges
+        return CommandLimits(r.get("lin_vel_x", (-1.0, 1.0)), r.get("lin_vel_y", (-1.0, 1.0)),
+                             r.get("ang_vel_yaw", (-1.0, 1.0)))
+
+    @property
     def joint_index(self) -> np.ndarray:
         """For each policy joint, its index in the robot's joint order."""
         return np.array([g1.JOINT_INDEX[n] for n in self.joint_names])
@@ -79,18 +154,21 @@ def resolve_spec_path(name_or_path: str | Path) -> Path:
     return specs[str(name_or_path)]
 
 
-def _onnx_path(d: dict, spec_file: Path, fetch: bool) -> Path:
-    onnx = d.get("onnx")
+def _onnx_path(onnx: str | OnnxAssetSection, spec_file: Path, fetch: bool) -> Path:
     if isinstance(onnx, str):
         path = Path(onnx)
         return path if path.is_absolute() else (spec_file.parent / path)
-    if not isinstance(onnx, dict) or "path" not in onnx:
-        raise PolicyMismatchError(f"{spec_file}: 'onnx' must be a file path or {{asset: NAME, path: IN_ASSET}}")
-    if "asset" in onnx:
-        if not assets.is_fetched(onnx["asset"]) and not fetch:
-            raise PolicyMismatchError(f"{spec_file}: asset '{onnx['asset']}' is not fetched; run `g1 policies fetch`")
-        return assets.fetch(onnx["asset"]) / onnx["path"]
-    return spec_file.parent / onnx["path"]
+    if onnx.asset is not None:
+        if not assets.is_fetched(onnx.asset) and not fetch:
+            raise PolicyMismatchError(f"{spec_file}: asset '{onnx.asset}' is not fetched; run `g1 policies fetch`")
+        return assets.fetch(onnx.asset) / onnx.path
+    return spec_file.parent / onnx.path
+
+
+def read_spec_file(spec_file: Path) -> PolicySpecFile:
+    """The spec file, validated by the typed loader (unknown keys, types, ranges named by key)."""
+    data = read_yaml(spec_file, PolicyMismatchError)  # duplicate keys and binary files refused too
+    return from_dict(PolicySpecFile, data, spec_file.name, error=PolicyMismatchError)
 
 
 def load_spec(name_or_path: str | Path, *, fetch: bool = True) -> PolicySpec:
@@ -98,13 +176,8 @@ def load_spec(name_or_path: str | Path, *, fetch: bool = True) -> PolicySpec:
     import onnxruntime as ort
 
     spec_file = resolve_spec_path(name_or_path)
-    d = read_yaml(spec_file, PolicyMismatchError) or {}
-    if not isinstance(d, dict):
-        raise PolicyMismatchError(f"{spec_file}: expected a mapping of spec keys, got {type(d).__name__}")
-    unknown = set(d) - _SPEC_KEYS
-    if unknown:
-        raise PolicyMismatchError(f"{spec_file}: unknown keys {sorted(unknown)}; known: {sorted(_SPEC_KEYS)}")
-    onnx_path = _onnx_path(d, spec_file, fetch)
+    d = read_spec_file(spec_file)
+    onnx_path = _onnx_path(d.onnx, spec_file, fetch)
     if not onnx_path.is_file():
         raise PolicyMismatchError(f"{spec_file}: ONNX file {onnx_path} does not exist")
     meta = dict(ort.InferenceSession(str(onnx_path), providers=["CPUExecutionProvider"])
@@ -114,8 +187,7 @@ def load_spec(name_or_path: str | Path, *, fetch: bool = True) -> PolicySpec:
     except KeyError as exc:
         raise PolicyMismatchError(f"{spec_file}: missing key {exc}") from None
     except (TypeError, ValueError) as exc:
-        raise PolicyMismatchError(f"{spec_file}: {' '.join(str(exc).split())} (check the spec's values: numbers "
-                                  "where numbers are expected)") from None
+        raise PolicyMismatchError(f"{spec_file}: {' '.join(str(exc).split())}") from None
     check_against_robot(spec)
     check_against_onnx(spec)
     return spec
@@ -129,36 +201,40 @@ def _from_meta(value, key: str, meta: dict, spec_file: Path):
     return json.loads(meta[key])
 
 
-def _build(d: dict, spec_file: Path, onnx_path: Path, meta: dict) -> PolicySpec:
-    joint_names = tuple(_from_meta(d.get("joint_names", list(g1.JOINT_NAMES)), "dof_names", meta, spec_file))
-    gains = d.get("gains", "robot")
-    if gains == "metadata":
+def _build(d: PolicySpecFile, spec_file: Path, onnx_path: Path, meta: dict) -> PolicySpec:
+    if d.joint_names == "robot":
+        joint_names = g1.JOINT_NAMES
+    elif d.joint_names == "metadata":
+        joint_names = tuple(_from_meta("metadata", "dof_names", meta, spec_file))
+    else:
+        joint_names = tuple(d.joint_names)
+    if d.gains == "metadata":
         kp, kd = (np.asarray(_from_meta("metadata", k, meta, spec_file), dtype=float) for k in ("kp", "kd"))
-    elif gains == "robot":
+    elif d.gains == "robot":
         idx = [g1.JOINT_INDEX.get(n, 0) for n in joint_names]
         kp, kd = g1.KP_DEFAULT[idx].copy(), g1.KD_DEFAULT[idx].copy()
     else:
-        kp, kd = np.asarray(gains["kp"], dtype=float), np.asarray(gains["kd"], dtype=float)
-    default_q = d.get("default_q", "robot")
-    default_q = g1.DEFAULT_Q_RAD.copy() if default_q == "robot" else np.asarray(default_q, dtype=float)
-    action = d.get("action", {})
-    scale = np.broadcast_to(np.asarray(action.get("scale", 1.0), dtype=float), (len(joint_names),)).copy()
-    obs_d = d.get("observation") or {}
-    phase_d = d.get("phase")
+        kp, kd = np.asarray(d.gains.kp, dtype=float), np.asarray(d.gains.kd, dtype=float)
+    default_q = g1.DEFAULT_Q_RAD.copy() if d.default_q == "robot" else np.asarray(d.default_q, dtype=float)
+    scale = np.asarray(d.action.scale, dtype=float)
+    if scale.ndim and scale.shape != (len(joint_names),):
+        raise PolicyMismatchError(f"{spec_file.name}.action.scale: {scale.size} values for {len(joint_names)} joints")
+    scale = np.broadcast_to(scale, (len(joint_names),)).copy()
     phase = None
-    if phase_d:
-        phase = PhaseSpec(float(phase_d["period_s"]), np.asarray(phase_d["offsets_rad"], dtype=float),
-                          float(phase_d.get("stand_threshold", 0.01)))
-    ranges = d.get("command_ranges") or {}
+    if d.phase is not None:
+        phase = PhaseSpec(d.phase.period_s, np.asarray(d.phase.offsets_rad, dtype=float), d.phase.stand_threshold)
+    ranges = d.command_ranges
     if ranges == "metadata":
         ranges = _from_meta("metadata", "command_ranges", meta, spec_file) or {}
     ranges = {k: (float(v[0]), float(v[1])) for k, v in ranges.items()}
+    obs = d.observation
+    terms = [t if isinstance(t, str) else {"name": t.name, "scale": t.scale} for t in obs.terms]
     return PolicySpec(
-        name=d.get("name", spec_file.stem), kind=d.get("kind", "locomotion"), onnx_path=onnx_path,
-        rate_hz=float(d.get("rate_hz", 50)), joint_names=joint_names, kp=kp, kd=kd,
-        default_q_rad=default_q, action_scale=scale, action_clip=float(action.get("clip", 100.0)),
-        observation=ObservationSpec.from_dict(obs_d, f"{spec_file.name}: observation"),
-        input_name=obs_d.get("input", "obs"), phase=phase, command_ranges=ranges, metadata=meta,
+        name=d.name or spec_file.stem, kind=d.kind, onnx_path=onnx_path, rate_hz=d.rate_hz, joint_names=joint_names,
+        kp=kp, kd=kd, default_q_rad=default_q, action_scale=scale, action_clip=d.action.clip,
+        observation=ObservationSpec.from_dict({"terms": terms, "history": obs.history},
+                                              f"{spec_file.name}: observation"),
+        input_name=obs.input, phase=phase, command_ranges=ranges, metadata=meta,
     )
 
 

@@ -11,6 +11,7 @@ import yaml
 
 ROOT = Path(__file__).resolve().parents[2]
 SIM2SIM = ROOT / "launch" / "sim2sim.yaml"
+SIM2SIM_GENERATOR = ROOT / "launch" / "sim2sim_generator.yaml"
 
 
 def new_partition() -> str:

@@ -209,3 +209,35 @@ def test_a_fault_during_control_damps_and_exits_3_in_debug_mode(tmp_path, partit
     print(f"\ntilt injected -> first damping LowCmd_ at the robot: {to_wire_ms:.1f} ms")
     assert 0 < to_wire_ms < 200, "tilt seen within a few 50 Hz ticks, damping on the wire right after"
     assert wire["last_command_is_damping"] is True and wire["ignored_while_builtin_active"] == 0
+
+
+def test_the_launch_files_generator_chain_runs_on_the_robot_path_and_styles_follow_the_dpad(tmp_path, partition,
+                                                                                          processes):
+    """launch/sim2sim_generator.yaml: the generator -> IK -> policy chain over DDS, the same chain the
+    preflight's MuJoCo dry run ran, and the emulator's upper-body joints following the plan as the
+    remote's d-pad switches styles."""
+    from deploy_test_helpers import SIM2SIM_GENERATOR
+
+    robot = Emulator(partition, "--lower-gantry-on-policy")
+    processes.append(robot)
+    report_path = tmp_path / "deploy.json"
+    host = Proc("deploy", str(SIM2SIM_GENERATOR), "--yes", "--partition", partition, "--duration", "9",
+                "--json", str(report_path))
+    processes.append(host)
+    chain_line = host.wait_for(r"control chain \(as checked by the dry run\)", 120)
+    assert "InbetweeningGenerator [backbone] -> GeneratorRetargeter -> LocomotionPolicyTracker" in chain_line
+    host.wait_for(r"hold -> control: run \(--yes\)", 60)
+    time.sleep(3.0)
+    robot.ask("press right")  # default -> wave
+    host.wait_for(r"control -> damping: control time over", 60)
+    assert host.proc.wait(timeout=30) == 0, host.stderr
+    report = json.loads(report_path.read_text())
+    for stage in ("generator", "retargeter", "tracker", "rates", "safety"):
+        assert report["chain"][stage] == report["dry_run_chain"][stage]
+    assert report["chain"]["backend"] == "UnitreeDDSBackend" and report["dry_run_chain"]["backend"] == "MujocoBackend"
+    styles = report["control"]["upper_body_vs_plan"]
+    print(f"\nsim2sim generator: upper body vs plan {styles}")
+    assert set(styles) == {"default", "wave"}
+    assert all(s["rms_rad"] < 0.2 for s in styles.values())
+    wire = robot.ask("report")
+    assert wire["first_damping_base_pos_w_m"][2] > 0.6 and wire["last_command_is_damping"] is True

@@ -7,12 +7,11 @@ import pytest
 
 from g1_control.errors import InputDeviceError, LaunchFileError
 from g1_control.teleop import evdev_protocol as ev
-from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.factory import make_input_device
 from g1_control.teleop.gamepad import EvdevGamepad
 from g1_control.teleop.keyboard import TerminalKeyboard
 from g1_control.teleop.unitree_remote import UnitreeRemote, encode_wireless_remote
-from g1_control.types import RobotState
+from g1_control.types import CommandLimits, RobotState
 
 
 @pytest.mark.parametrize(

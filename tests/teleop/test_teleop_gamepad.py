@@ -7,10 +7,10 @@ import pytest
 
 from g1_control.errors import InputDeviceError, LaunchFileError
 from g1_control.teleop import evdev_protocol as ev
-from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.gamepad import EvdevGamepad, find_gamepads
 from g1_control.teleop.layouts import LAYOUTS
 from g1_control.teleop.mapping import MappingConfig
+from g1_control.types import CommandLimits
 
 
 class Clock:

@@ -3,9 +3,9 @@
 import pytest
 
 from g1_control.errors import LaunchFileError
-from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.gamepad import EvdevGamepad
 from g1_control.teleop.gamepad_script import GamepadScriptFeeder, parse_gamepad_script
+from g1_control.types import CommandLimits
 
 SCRIPT = [
     {"t_s": 0.5, "press": ["start"]},

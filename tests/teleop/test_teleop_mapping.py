@@ -5,11 +5,11 @@ import math
 import pytest
 
 from g1_control.errors import LaunchFileError
-from g1_control.teleop.command_limits import CommandLimits
 from g1_control.teleop.layouts import LAYOUTS
 from g1_control.teleop.mapper import CommandMapper
 from g1_control.teleop.mapping import AxisBinding, MappingConfig
 from g1_control.teleop.snapshot import InputSnapshot
+from g1_control.types import CommandLimits
 
 GAMEPAD = LAYOUTS["gamepad"]
 REMOTE = LAYOUTS["unitree_remote"]

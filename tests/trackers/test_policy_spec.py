@@ -55,7 +55,23 @@ def test_gains_that_differ_from_training_are_refused(tmp_path):
 
 
 def test_unknown_spec_key_and_unknown_name(tmp_path):
-    with pytest.raises(PolicyMismatchError, match="unknown keys \\['gain'\\]"):
+    with pytest.raises(PolicyMismatchError, match="spec.yaml: unknown key 'gain'; allowed: onnx, name, kind"):
         load_spec(variant(tmp_path, gain=1))
     with pytest.raises(PolicyMismatchError, match="unknown policy 'nope'"):
         load_spec("nope")
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    ({"rate_hz": "fast"}, "spec.yaml.rate_hz: expected a number, got 'fast'"),
+    ({"rate_hz": 0}, "spec.yaml.rate_hz: must be > 0, got 0.0"),
+    ({"gains": "metadta"}, "spec.yaml.gains: expected one of 'metadata', 'robot'"),
+    ({"gains": {"kp": [1.0]}}, "spec.yaml.gains.kd: required field is missing"),
+    ({"phase": {"period_s": 1.0, "offsets_rad": [0.0]}}, "spec.yaml.phase.offsets_rad: expected 2 items, got 1"),
+    ({"action": {"scale": [0.25, 0.25]}}, "spec.yaml.action.scale: 2 values for 29 joints"),
+    ({"observation": {"terms": ["dof_pos"], "history": 0}}, "spec.yaml.observation.history must be >= 1, got 0"),
+    ({"variant": "g1_31dof"}, "spec.yaml.variant: expected one of 'g1_23dof', 'g1_29dof'"),
+])
+def test_spec_files_are_read_by_the_typed_loader(tmp_path, change, message):
+    """The same loader as launch files: every key's type and range checked, the key path named."""
+    with pytest.raises(PolicyMismatchError, match=message.replace(".", "\\.").replace("(", "\\(").replace("[", "\\[")):
+        load_spec(variant(tmp_path, **change))
