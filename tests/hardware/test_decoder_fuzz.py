@@ -3,11 +3,12 @@ flipped bits and random contents never crash a decoder (only its own MalformedMe
 CrcMismatchError or RemoteDecodeError) and never pass as valid; a CRC-valid LowState_ carrying any
 values never becomes a state the safety layer acts on unless every value is finite and in range.
 
-The example counts are the `settings(max_examples=...)` below; the run prints them."""
+Each test runs EXAMPLES examples (300; G1_FUZZ_EXAMPLES overrides)."""
 
 from __future__ import annotations
 
 import math
+import os
 import struct
 
 import numpy as np
@@ -24,7 +25,9 @@ from g1_control.robot import g1
 from g1_control.safety import SafetyFilter
 
 DECODE_ERRORS = (MalformedMessageError, CrcMismatchError)
-FUZZ = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+EXAMPLES = int(os.environ.get("G1_FUZZ_EXAMPLES", "300"))
+"""Examples per fuzz test (scripts/mutation.py lowers it: each mutant runs these tests again)."""
+FUZZ = settings(max_examples=EXAMPLES, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 MESSAGES = {"LowState_": LowState, "LowCmd_": LowCmd}
 
 
