@@ -21,6 +21,7 @@ import sys
 import threading
 import time
 import uuid
+from collections import deque
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -110,13 +111,28 @@ class _Emulator:
             [sys.executable, "-m", "g1_control.cli.main", "sim-robot", "--physics", "mock", "--partition", partition,
              "--control-stdin"], cwd=_ROOT, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
             stderr=subprocess.PIPE, text=True, bufsize=1)
+        # stderr is drained on a thread: a full pipe would block the emulator on its next log line.
+        self.errors: deque[str] = deque(maxlen=50)
+        threading.Thread(target=lambda: self.errors.extend(self.proc.stderr), daemon=True).start()
         if self.proc.stdout.readline().strip() != "ready":
-            raise RuntimeError(f"emulator did not start: {self.proc.stderr.read()}")
+            self.proc.wait(timeout=10)
+            raise RuntimeError(f"emulator did not start: {''.join(self.errors)}")
+
+    @property
+    def alive(self) -> bool:
+        return self.proc.poll() is None
 
     def ask(self, word: str) -> dict:
-        self.proc.stdin.write(word + "\n")
-        self.proc.stdin.flush()
-        return json.loads(self.proc.stdout.readline())
+        try:
+            self.proc.stdin.write(word + "\n")
+            self.proc.stdin.flush()
+            line = self.proc.stdout.readline()
+        except OSError as exc:
+            line = ""
+            self.errors.append(str(exc))
+        if not line:
+            raise RuntimeError(f"the emulator exited (status {self.proc.poll()}): {''.join(self.errors)[-600:]}")
+        return json.loads(line)
 
     def close(self) -> None:
         try:
@@ -216,6 +232,8 @@ def _run_suite(faults, progress: bool) -> list[FaultResult]:
     results = []
     try:
         for fault in tqdm(faults, desc="fault injection", unit="fault", disable=not progress):
+            if not emulator.alive:  # a dead robot must not fail every later trial too
+                emulator = _Emulator(partition)
             results.append(_trial(fault, emulator, partition))
     finally:
         emulator.close()
@@ -235,8 +253,10 @@ def _trial(fault: str, emulator: _Emulator, partition: str) -> FaultResult:
                 return run_in_process_fault(fault, emulator, robot)
             finally:
                 robot.close()
-        except (RuntimeError, G1ControlError) as exc:
+        except (RuntimeError, G1ControlError, ValueError) as exc:
             problems.append(str(exc))
+            if not emulator.alive:
+                break
     return FaultResult(fault, "(setup failed)", math.nan, math.nan, math.nan,
                        f"{SETUP_ATTEMPTS} attempts: " + " | ".join(problems))
 

@@ -12,6 +12,8 @@ from g1_control.tools.fault_suite import FaultResult
 
 
 class _FakeEmulator:
+    alive = True
+
     def __init__(self, partition: str):
         self.partition = partition
 
