@@ -73,7 +73,7 @@ def configure(dest: Path, group: dict) -> None:
     text = re.sub(r"\n\[tool\.mutmut\][^\[]*", "\n", text)
     listed = ", ".join(f'"{p}"' for p in group["mutate"])
     tests = ", ".join(f'"{p}"' for p in group["tests"])
-    text += (f"\n[tool.mutmut]\npaths_to_mutate = [{listed}]\nsource_paths = [\"g1_control\"]\n"
+    text += (f"\n[tool.mutmut]\nsource_paths = [\"g1_control\"]\nonly_mutate = [{listed}]\n"
              f"tests_dir = [{tests}]\npytest_add_cli_args = [\"-p\", \"no:cacheprovider\", \"-q\"]\n"
              "also_copy = [\"g1_control\", \"launch\", \"tests\"]\n")
     toml.write_text(text)
