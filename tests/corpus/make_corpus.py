@@ -70,6 +70,40 @@ def launch_cases() -> dict[str, str | bytes]:
         "timeline_not_a_list.yaml": b.replace(
             "  timeline:\n    - {duration_s: 2.0, vx_mps: 0.3, label: walk}\n", "  timeline: walk\n"),
         "bool_as_rate.yaml": b + "rates: {tracker_hz: true}\n",
+        # every branch of the schema's own checks (scripts/mutation.py group "schema")
+        "physics_dt_too_small.yaml": b + "backend: {physics_dt_s: 0.0001}\n",
+        "dds_domain_negative.yaml": b + "backend: {type: unitree_dds, interface: lo, domain: -1}\n",
+        "can_without_channel.yaml": b + "backend: {type: can, can_interface: virtual}\n",
+        "can_without_interface.yaml": b + "backend: {type: can, channel: can0}\n",
+        "serial_without_port.yaml": b + "backend: {type: serial}\n",
+        "mode_pr_two.yaml": b + "backend: {type: unitree_dds, interface: lo, mode_pr: 2}\n",
+        "command_rate_too_low.yaml": b + "backend: {type: unitree_dds, interface: lo, command_rate_hz: 49.9}\n",
+        "command_rate_too_high.yaml": b + "backend: {type: serial, port: /dev/ttyUSB0, command_rate_hz: 1000.5}\n",
+        "connect_timeout_zero.yaml": b + "backend: {type: unitree_dds, interface: lo, connect_timeout_s: 0}\n",
+        "dry_run_too_short.yaml": b + "deploy: {dry_run_s: 9.9}\n",
+        "auto_start_negative.yaml": b + "deploy: {auto_start_s: -0.1}\n",
+        "auto_run_negative.yaml": b + "deploy: {auto_run_s: -0.1}\n",
+        "min_hold_negative.yaml": b + "deploy: {min_hold_s: -0.1}\n",
+        "exit_damping_negative.yaml": b + "deploy: {exit_damping_s: -1}\n",
+        "state_window_zero.yaml": b + "deploy: {state_window_s: 0}\n",
+        "input_check_zero.yaml": b + "deploy: {input_check_s: 0}\n",
+        "min_state_rate_zero.yaml": b + "deploy: {min_state_rate_hz: 0}\n",
+        "max_start_tilt_zero.yaml": b + "deploy: {max_start_tilt_rad: 0}\n",
+        "joint_tolerance_negative.yaml": b + "deploy: {joint_limit_tolerance_rad: -0.01}\n",
+        "realtime_priority_negative.yaml": b + "deploy: {realtime_priority: -1}\n",
+        "device_type_given.yaml": b.replace("type: scripted", "type: gamepad").replace(
+            "  timeline:\n    - {duration_s: 2.0, vx_mps: 0.3, label: walk}\n", "  device: {type: keyboard}\n"),
+        "gamepad_script_empty_step.yaml": b.replace("type: scripted", "type: gamepad_script").replace(
+            "  timeline:\n    - {duration_s: 2.0, vx_mps: 0.3, label: walk}\n", "  gamepad_script: [{}]\n"),
+        "unknown_reference_param.yaml": b + "rates: {tracker_hz: 250}\ntracker: {type: wbc}\n"
+                                            "generator: {type: scripted, reference: walk, reference_params: {pace: 2}}\n",
+        "wbc_without_scripted.yaml": b + "rates: {tracker_hz: 250}\ntracker: {type: wbc}\n",
+        "wbt_wrong_rate.yaml": b + "rates: {tracker_hz: 25}\ntracker: {type: wbt}\n",
+        "vy_over_limit.yaml": b.replace("vx_mps: 0.3", "vy_mps: 0.61"),
+        "negative_duration.yaml": b.replace("duration_s: 2.0", "duration_s: -1", 1),
+        "lowlevel_hz_too_high.yaml": b + "rates: {lowlevel_hz: 20000, tracker_hz: 50}\n",
+        "input_rate_not_dividing.yaml": b + "rates: {input_hz: 30}\n",
+        "estimator_rate_zero.yaml": b + "rates: {estimator_hz: 0}\n",
     }
 
 
