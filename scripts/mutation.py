@@ -90,7 +90,7 @@ def parse_results(text: str) -> dict[str, str]:
     return out
 
 
-def run_group(name: str, group: dict, rev: str, workdir: Path) -> dict:
+def run_group(name: str, group: dict, rev: str, workdir: Path, diffs_wanted: bool = True) -> dict:
     dest = workdir / name
     dest.mkdir(parents=True)
     export(rev, dest)
@@ -105,14 +105,14 @@ def run_group(name: str, group: dict, rev: str, workdir: Path) -> dict:
         statuses = {k: v for k, v in statuses.items() if any(o in k for o in only)}
     survivors = sorted(k for k, v in statuses.items() if v == "survived")
     diffs = {}
-    for mutant in survivors:
+    for mutant in survivors if diffs_wanted else ():
         shown = subprocess.run(["mutmut", "show", mutant], check=False, cwd=dest, env=env, capture_output=True, text=True)
         diffs[mutant] = shown.stdout.strip()
     count = {s: sum(1 for v in statuses.values() if v == s) for s in sorted(set(statuses.values()))}
     killed, survived = count.get("killed", 0), count.get("survived", 0)
     return {"group": name, "files": group["mutate"], "tests": group["tests"], "seconds": time.monotonic() - t0,
             "counts": count, "score": killed / (killed + survived) if killed + survived else None,
-            "survivors": diffs, "mutmut_exit": run.returncode, "mutmut_tail": run.stdout[-1500:] + run.stderr[-1500:]}
+            "survivors": diffs or dict.fromkeys(survivors, ""), "mutmut_exit": run.returncode, "mutmut_tail": run.stdout[-1500:] + run.stderr[-1500:]}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -120,6 +120,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("groups", nargs="*", default=[], help=f"groups (default: all): {', '.join(GROUPS)}")
     parser.add_argument("--rev", default="HEAD", help="the commit whose code and tests are mutated (default HEAD)")
     parser.add_argument("--keep", action="store_true", help="keep the scratch folders")
+    parser.add_argument("--no-diffs", action="store_true", help="list survivors by name only (mutmut show is slow)")
     args = parser.parse_args(argv)
     if shutil.which("mutmut") is None:
         print("mutmut is not installed: pip install 'mutmut>=3.8'", file=sys.stderr)
@@ -130,7 +131,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"unknown group(s) {unknown}; groups: {', '.join(GROUPS)}")
     sha = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", args.rev], check=True, capture_output=True,
                          text=True).stdout.strip()
-    out_dir = REPO / "runs" / f"mutation-{sha}"
+    out_dir = REPO / "runs" / f"mutation-{sha}-{'-'.join(names)}"
     out_dir.mkdir(parents=True, exist_ok=True)
     workdir = Path(tempfile.mkdtemp(prefix=f"g1-mutation-{sha}-"))
     reports = []
@@ -138,7 +139,7 @@ def main(argv: list[str] | None = None) -> int:
         for name in names:
             print(f"== {name}: mutating {', '.join(GROUPS[name]['mutate'])} against {', '.join(GROUPS[name]['tests'])}",
                   flush=True)
-            report = run_group(name, GROUPS[name], args.rev, workdir)
+            report = run_group(name, GROUPS[name], args.rev, workdir, not args.no_diffs)
             reports.append(report)
             score = "n/a" if report["score"] is None else f"{100 * report['score']:.1f}%"
             print(f"   {report['counts']}  score {score}  ({report['seconds']:.0f} s)", flush=True)
