@@ -39,10 +39,11 @@ STICKS = {"ly": (-0.3, 0.7), "lx": (-0.3, 0.3), "rx": (-0.5, 0.5)}
 """Random stick ranges (the remote's own scale, [-1, 1]): forward, sideways, turning."""
 
 
-class _Proc:
-    """A `g1` subprocess whose stdout lines are read on a thread, so waits can time out."""
+class G1Process:
+    """A `g1 ...` subprocess (this checkout first on PYTHONPATH) whose stdout lines are read on a
+    thread, so waits can time out; stderr is drained too (a full pipe would block the process)."""
 
-    def __init__(self, args: list[str], stdin: bool = False):
+    def __init__(self, *args: str, stdin: bool = False):
         env = {**os.environ, "PYTHONPATH": str(_ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
         self.proc = subprocess.Popen([sys.executable, "-m", "g1_control.cli.main", *args], cwd=_ROOT, env=env,
                                      stdin=subprocess.PIPE if stdin else subprocess.DEVNULL, stdout=subprocess.PIPE,
@@ -57,6 +58,10 @@ class _Proc:
         for line in self.proc.stdout:
             self.lines.put(line.rstrip("\n"))
 
+    @property
+    def stderr(self) -> str:
+        return "".join(self.errors)
+
     def wait_for(self, pattern: str, timeout_s: float) -> str:
         deadline = time.monotonic() + timeout_s
         while time.monotonic() < deadline:
@@ -69,10 +74,11 @@ class _Proc:
             self.seen.append(line)
             if re.search(pattern, line):
                 return line
-        raise RuntimeError(f"no line matching {pattern!r} within {timeout_s} s:\n" + "\n".join(self.seen[-30:])
-                           + "\n" + "".join(self.errors[-30:]))
+        raise AssertionError(f"no line matching {pattern!r} within {timeout_s} s; got:\n" + "\n".join(self.seen)
+                             + "\nstderr:\n" + self.stderr)
 
     def ask(self, line: str) -> dict:
+        """One line to stdin (`g1 sim-robot --control-stdin`), its JSON reply."""
         self.proc.stdin.write(line + "\n")
         self.proc.stdin.flush()
         return json.loads(self.wait_for(r"^\{", 10))
@@ -84,7 +90,7 @@ class _Proc:
             return float("nan")
         return int(re.search(r"VmRSS:\s+(\d+) kB", text).group(1)) / 1024
 
-    def stop(self) -> None:
+    def kill(self) -> None:
         if self.proc.poll() is None:
             self.proc.kill()
             self.proc.wait(timeout=10)
@@ -107,14 +113,14 @@ def run_soak(minutes: float, seed: int = 0, out: Path | None = None, progress=pr
     out.mkdir(parents=True, exist_ok=True)
     work = out / f"soak-{time.strftime('%Y%m%d-%H%M%S')}"
     work.mkdir()
-    robot = _Proc(["sim-robot", "--partition", partition, "--control-stdin", "--lower-gantry-on-policy"], stdin=True)
+    robot = G1Process("sim-robot", "--partition", partition, "--control-stdin", "--lower-gantry-on-policy", stdin=True)
     host = None
     memory: list[dict] = []
     changes = 0
     try:
         robot.wait_for("^ready$", 120)
-        host = _Proc(["deploy", str(soak_launch(work)), "--partition", partition, "--json", str(work / "deploy.json"),
-                      "--out", str(work)])
+        host = G1Process("deploy", str(soak_launch(work)), "--partition", partition, "--json",
+                         str(work / "deploy.json"), "--out", str(work))
         host.wait_for(r"zero torque: the robot is limp", 180)
         robot.ask("press start")
         host.wait_for(r"ramp -> hold", 30)
@@ -153,12 +159,12 @@ def run_soak(minutes: float, seed: int = 0, out: Path | None = None, progress=pr
         wire = robot.ask("report")
     finally:
         if host is not None:
-            host.stop()
+            host.kill()
         try:
             robot.ask("quit")
-        except (OSError, RuntimeError, ValueError):
+        except (OSError, AssertionError, ValueError):
             pass
-        robot.stop()
+        robot.kill()
     report = json.loads((work / "deploy.json").read_text())
     trips = [e for e in report["safety_events"] if e["trips"] and not e.get("planned")]
     first_minute = next((m for m in memory if m["t_s"] >= 60.0), memory[0])

@@ -37,6 +37,19 @@ def write_launch(folder: Path, changes: dict | None = None, name: str = "launch.
     return path
 
 
+def preflight_only(path: Path, partition: str, **options):
+    """g1 deploy --preflight-only in this process: (report, PreflightRefused or None, printed text)."""
+    from g1_control.deploy.preflight import PreflightRefused
+    from g1_control.deploy.session import DeployOptions, deploy
+
+    lines: list[str] = []
+    try:
+        report = deploy(path, DeployOptions(preflight_only=True, partition=partition, **options), say=lines.append)
+        return report, None, "\n".join(lines)
+    except PreflightRefused as exc:
+        return exc.report, exc, "\n".join(lines)
+
+
 FAST = {"deploy": {"state_window_s": 0.3, "input_check_s": 0.1}, "backend": {"connect_timeout_s": 2.0}}
 """Shorter listening windows for tests that only need the checklist's verdict."""
 

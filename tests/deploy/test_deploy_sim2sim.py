@@ -7,75 +7,22 @@ Thresholds are loose (shared 2-core host): the figures themselves are printed fo
 from __future__ import annotations
 
 import json
-import os
-import queue
-import re
 import signal
 import subprocess
-import sys
-import threading
 import time
 
 import pytest
-from deploy_test_helpers import ROOT, write_launch
+from deploy_test_helpers import write_launch
+
+from g1_control.tools.soak import G1Process as Proc
 
 pytestmark = pytest.mark.timing
-
-ENV = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
-
-
-class Proc:
-    """A `g1` subprocess whose stdout lines are read on a thread (so waits can time out)."""
-
-    def __init__(self, *args: str, stdin: bool = False):
-        self.proc = subprocess.Popen([sys.executable, "-m", "g1_control.cli.main", *args], cwd=ROOT, env=ENV,
-                                     stdin=subprocess.PIPE if stdin else subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                     stderr=subprocess.PIPE, text=True, bufsize=1)
-        self.lines: queue.Queue[str] = queue.Queue()
-        self.seen: list[str] = []
-        self.errors: list[str] = []
-        threading.Thread(target=self._pump, daemon=True).start()
-        # stderr is drained too: a full pipe would block the process on its next log line.
-        threading.Thread(target=lambda: self.errors.extend(self.proc.stderr), daemon=True).start()
-
-    def _pump(self) -> None:
-        for line in self.proc.stdout:
-            self.lines.put(line.rstrip("\n"))
-
-    @property
-    def stderr(self) -> str:
-        return "".join(self.errors)
-
-    def wait_for(self, pattern: str, timeout_s: float) -> str:
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
-            try:
-                line = self.lines.get(timeout=0.1)
-            except queue.Empty:
-                if self.proc.poll() is not None and self.lines.empty():
-                    break
-                continue
-            self.seen.append(line)
-            if re.search(pattern, line):
-                return line
-        raise AssertionError(f"no line matching {pattern!r} within {timeout_s} s; got:\n" + "\n".join(self.seen)
-                             + "\nstderr:\n" + self.stderr)
-
-    def kill(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.kill()
-            self.proc.wait(timeout=10)
 
 
 class Emulator(Proc):
     def __init__(self, partition: str, *flags: str):
         super().__init__("sim-robot", "--partition", partition, "--control-stdin", *flags, stdin=True)
         self.wait_for("^ready$", 60)
-
-    def ask(self, line: str) -> dict:
-        self.proc.stdin.write(line + "\n")
-        self.proc.stdin.flush()
-        return json.loads(self.wait_for(r"^\{", 10))
 
     def close(self) -> None:
         try:

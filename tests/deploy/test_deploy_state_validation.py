@@ -11,11 +11,10 @@ from __future__ import annotations
 
 import threading
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
-from deploy_test_helpers import FAST, SecondPublisher, write_launch
+from deploy_test_helpers import FAST, SecondPublisher, preflight_only, write_launch
 
 from g1_control.deploy.preflight import PreflightRefused
 from g1_control.deploy.session import DeployOptions, deploy
@@ -24,13 +23,6 @@ from g1_control.robot import g1
 pytestmark = pytest.mark.timing
 
 
-def _preflight(path: Path, partition: str, **options):
-    lines: list[str] = []
-    try:
-        report = deploy(path, DeployOptions(preflight_only=True, partition=partition, **options), say=lines.append)
-        return report, None, "\n".join(lines)
-    except PreflightRefused as exc:
-        return exc.report, exc, "\n".join(lines)
 
 
 def _row(report, name: str) -> dict:
@@ -43,7 +35,7 @@ def test_a_nan_joint_fails_the_preflight_and_nothing_is_released(tmp_path, parti
     robot.physics.inner._q[knee] = np.nan
     robot.start()
     path = write_launch(tmp_path, FAST)
-    report, refused, text = _preflight(path, partition)
+    report, refused, text = preflight_only(path, partition)
     print("\n" + text)
     assert refused is not None, text
     row = _row(report, "joint_limits")
@@ -61,11 +53,11 @@ def test_a_nan_joint_fails_the_preflight_and_nothing_is_released(tmp_path, parti
     assert robot.endpoint.counters.commands_applied == 0
 
 
-def test_a_second_lowstate_publisher_is_refused_at_the_preflight(tmp_path, partition, mock_robot):
+def test_a_second_lowstate_publisher_is_refused_at_thepreflight_only(tmp_path, partition, mock_robot):
     robot = mock_robot().start()
     spoof = SecondPublisher(partition, robot.physics.read_state).start(seconds=30.0)
     try:
-        report, refused, text = _preflight(write_launch(tmp_path, FAST), partition)
+        report, refused, text = preflight_only(write_launch(tmp_path, FAST), partition)
     finally:
         spoof.close()
     print("\n" + text)
