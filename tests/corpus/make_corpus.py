@@ -95,8 +95,17 @@ def launch_cases() -> dict[str, str | bytes]:
             "  timeline:\n    - {duration_s: 2.0, vx_mps: 0.3, label: walk}\n", "  device: {type: keyboard}\n"),
         "gamepad_script_empty_step.yaml": b.replace("type: scripted", "type: gamepad_script").replace(
             "  timeline:\n    - {duration_s: 2.0, vx_mps: 0.3, label: walk}\n", "  gamepad_script: [{}]\n"),
-        "unknown_reference_param.yaml": b + "rates: {tracker_hz: 250}\ntracker: {type: wbc}\n"
-                                            "generator: {type: scripted, reference: walk, reference_params: {pace: 2}}\n",
+        "unknown_reference_param.yaml": b + "rates: {tracker_hz: 250}\ntracker: {type: wbc}\ngenerator: {type: scripted, "
+                                            "reference: walk, reference_params: {pace: 2, gait: 1}}\n",
+        "gamepad_bad_mapping.yaml": b.replace("type: scripted", "type: gamepad").replace(
+            "  timeline:\n    - {duration_s: 2.0, vx_mps: 0.3, label: walk}\n",
+            "  device: {mapping: {axes: {vx: {axis: wheel}}}}\n"),
+        "remote_gamepad_button.yaml": b.replace("type: scripted", "type: unitree_remote").replace(
+            "  timeline:\n    - {duration_s: 2.0, vx_mps: 0.3, label: walk}\n",
+            "  device: {mapping: {buttons: {LB+RB: estop}}}\n"),
+        "gamepad_script_bad_mapping.yaml": b.replace("type: scripted", "type: gamepad_script").replace(
+            "  timeline:\n    - {duration_s: 2.0, vx_mps: 0.3, label: walk}\n",
+            "  gamepad_script: [{t_s: 0.0, press: A}]\n  device: {mapping: {buttons: {L1+R1: estop}}}\n"),
         "wbc_without_scripted.yaml": b + "rates: {tracker_hz: 250}\ntracker: {type: wbc}\n",
         "wbt_wrong_rate.yaml": b + "rates: {tracker_hz: 25}\ntracker: {type: wbt}\n",
         "vy_over_limit.yaml": b.replace("vx_mps: 0.3", "vy_mps: 0.61"),

@@ -36,6 +36,13 @@ def _with(**sections) -> dict:
     {"rates": {"tracker_hz": 250}, "tracker": {"type": "wbc"},
      "generator": {"type": "scripted", "reference": "walk", "reference_params": {"speed_mps": 0.3}}},
     {"tracker": {"type": "wbt"}},
+    {"rates": {"tracker_hz": 250}, "tracker": {"type": "wbc"}, "generator": {"type": "scripted"}},
+    {"rates": {"lowlevel_hz": 1000, "tracker_hz": 200}, "tracker": {"type": "wbc"}, "generator": {"type": "scripted"}},
+    # robot-link settings are not checked for the simulator, which does not use them
+    {"backend": {"type": "mujoco", "command_rate_hz": 10.0, "mode_pr": 7, "connect_timeout_s": 0.0}},
+    # each device's mapping is checked against its own layout
+    {"input": {"type": "unitree_remote", "device": {"mapping": {"buttons": {"L1+R1": "estop", "B": "stop"}}}}},
+    {"input": {"type": "gamepad", "device": {"mapping": {"buttons": {"LB+RB": "estop"}}}}},
     {"input": {"type": "random", "random": {"style": "wave"}}},
     {"duration_s": 0.001},
 ])
@@ -50,3 +57,12 @@ def test_total_duration_follows_the_input():
     script = {"type": "gamepad_script", "gamepad_script": [{"t_s": 0.0, "press": "A"}, {"t_s": 4.0, "release": "A"}]}
     assert parse_launch(_with(input=script)).total_duration_s == 7.0
     assert parse_launch(_with(input={"type": "random"})).total_duration_s == 60.0
+
+
+def test_a_missing_launch_file_is_named(tmp_path):
+    from g1_control.errors import LaunchFileError
+    from g1_control.launch.schema import load_launch
+
+    with pytest.raises(LaunchFileError) as info:
+        load_launch(tmp_path / "nope.yaml")
+    assert str(info.value) == f"{tmp_path / 'nope.yaml'}: no such launch file"
