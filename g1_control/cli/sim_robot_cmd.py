@@ -67,6 +67,10 @@ def _run(args) -> int:
         physics = MockG1(mode_machine=args.mode_machine)
     emulator = RobotEmulator(physics, args.interface, args.domain, partition=args.partition,
                              builtin_mode="" if args.no_builtin else "ai").start()
+    import gc
+
+    gc.collect()
+    gc.freeze()  # the 500 Hz robot loop never waits for a full collection of the startup heap
     stop = {"now": False}
 
     def _stop(signum, frame):

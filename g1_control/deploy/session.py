@@ -26,7 +26,7 @@ from g1_control.errors import G1ControlError, LaunchFileError
 from g1_control.hardware.links.network import LOOPBACK
 from g1_control.launch.run_folder import RunFolder
 from g1_control.launch.schema import LaunchFile
-from g1_control.loop.priority import realtime
+from g1_control.loop.priority import frozen_heap, realtime
 from g1_control.robot import g1
 
 log = logging.getLogger("g1_control.deploy")
@@ -277,7 +277,8 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
             return tracker.observe_safety(now) and now - tracker.entered_s >= exit_s
 
         t_loop0 = time.monotonic()
-        loop.scheduler.run(1 << 40, stop=finished)
+        with frozen_heap():  # no full garbage collection of the whole heap inside the loop
+            loop.scheduler.run(1 << 40, stop=finished)
     except KeyboardInterrupt:
         pass
     except G1ControlError as exc:

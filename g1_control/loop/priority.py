@@ -80,3 +80,20 @@ def realtime(priority: int) -> tuple[Priority, str]:
         log.warning("real-time scheduling not permitted (%s; needs root or CAP_SYS_NICE): %s; deadlines may be "
                     "missed on a busy host", exc, done)
         return before, f"{done} (real-time not permitted)"
+
+
+@contextlib.contextmanager
+def frozen_heap():
+    """Inside: the objects alive at entry are moved out of the garbage collector's reach (gc.freeze),
+    so a collection during a real-time loop scans only what the loop itself allocated. A full
+    collection of a deploy process's heap takes 20-80 ms (its modules, the policy, MuJoCo's dry
+    run): measured as ticks more than a period late, and LowCmd_ gaps of ~100 ms, in a 30-minute
+    soak before this. Outside: the heap as it was (gc.unfreeze)."""
+    import gc
+
+    gc.collect()
+    gc.freeze()
+    try:
+        yield
+    finally:
+        gc.unfreeze()
