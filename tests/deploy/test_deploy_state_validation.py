@@ -117,3 +117,37 @@ def test_a_second_publisher_appearing_mid_run_trips(tmp_path, partition, mock_ro
     assert report.fault, f"the deploy ended as planned ({report.end_reason}) with a second publisher"
     assert "publisher" in report.end_reason or "tick" in report.end_reason, report.end_reason
     assert robot.report()["last_command_is_damping"] is True
+
+
+def test_the_robot_changing_its_mode_machine_mid_run_trips_naming_it(tmp_path, partition, mock_robot):
+    """No second publisher: the robot itself reports mode_machine 4 for 1 s during control. The deploy
+    trips naming the field and keeps streaming the accepted mode_machine (5), which a robot of another
+    variant drops; once it reports 5 again, it takes the damping."""
+    robot = mock_robot().start()
+    mock = robot.physics.inner
+    control = threading.Event()
+    lines: list[str] = []
+
+    def flip() -> None:
+        time.sleep(0.5)
+        mock.mode_machine = 4
+        time.sleep(1.0)
+        mock.mode_machine = 5
+
+    def say(line: str) -> None:
+        lines.append(line)
+        if "hold -> control" in line and not control.is_set():
+            control.set()
+            threading.Thread(target=flip, daemon=True).start()
+
+    launch = write_launch(tmp_path, {"deploy": {"state_window_s": 0.3, "input_check_s": 0.1,
+                                                "exit_damping_s": 2.0}})
+    report = deploy(launch, DeployOptions(yes=True, partition=partition, duration_s=3.0, out_root=tmp_path),
+                    say=say)
+    print("\n" + "\n".join(lines))
+    time.sleep(0.2)
+    wire = robot.report()
+    assert report.fault and report.end_reason == "RobotState.mode_machine changed from 5 to 4 (another DoF " \
+        "variant, or a second publisher)", report.end_reason
+    assert wire["wrong_mode_machine"] > 0, "the host kept the accepted mode_machine while the robot reported 4"
+    assert wire["last_command_is_damping"] is True and wire["damping_commands"] > 0
