@@ -4,6 +4,7 @@ non-finite joints, temperatures and battery, the peer check. Fast, so a mutation
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -146,3 +147,107 @@ def test_the_peer_check(launch, peers, status, text):
     assert pf.results["peers"].status == status and text in pf.results["peers"].reason
     if status == FAIL:
         assert not pf.results["peers"].overridable
+
+
+# -- every branch's exact words (the operator reads them), against a golden file ----------------------
+
+GOLDEN = Path(__file__).with_name("preflight_golden.yaml")
+
+
+class _CountingStats(FakeBackend):
+    """A stream that is slow, corrupted or framed badly, as `rate`, `bad` etc. say."""
+
+    def __init__(self, state, rate_ok=True, bad_crc=0, malformed=0, bad_frames=0, **kw):
+        super().__init__(state, **kw)
+        self.rate_ok, self.bad = rate_ok, (bad_crc, malformed, bad_frames)
+
+    def stats(self):
+        self._calls += 1
+        if self._calls == 1:
+            return _Stats()
+        return _Stats(states_received=10_000_000 if self.rate_ok else 1, bad_crc=self.bad[0], malformed=self.bad[1],
+                      bad_frames=self.bad[2])
+
+
+class _Silent(FakeBackend):
+    def wait_for_state(self, timeout_s):
+        from g1_control.errors import RobotNotConnectedError
+
+        raise RobotNotConnectedError("no valid LowState from the robot within 3.0 s on stand-in link")
+
+
+def _scenarios():
+    q5 = g1.DEFAULT_Q_RAD.copy()
+    q5[:5] = g1.Q_MAX_RAD[:5] + 0.5
+    nan5 = g1.DEFAULT_Q_RAD.copy()
+    nan5[:5] = np.nan
+    hot = np.full(29, 40.0)
+    hot[12] = 75.0
+    tilted = np.array([np.cos(0.25), np.sin(0.25), 0.0, 0.0])
+    return {
+        "healthy": (FakeBackend(_state()), None),
+        "other_variant_with_policy": (FakeBackend(_state(mode_machine=4)), "g1_29dof"),
+        "other_variant": (FakeBackend(_state(mode_machine=6)), None),
+        "unknown_variant": (FakeBackend(_state(mode_machine=9)), None),
+        "slow_stream": (_CountingStats(_state(), rate_ok=False), None),
+        "bad_crc": (_CountingStats(_state(), bad_crc=2), None),
+        "malformed": (_CountingStats(_state(), malformed=1), None),
+        "bad_frames": (_CountingStats(_state(), bad_frames=3), None),
+        "five_joints_out": (FakeBackend(_state(q_rad=q5)), None),
+        "five_joints_nan": (FakeBackend(_state(q_rad=nan5)), None),
+        "hot_motor": (FakeBackend(_state(motor_temperature_c=hot)), None),
+        "tilted": (FakeBackend(_state(imu_quat_wxyz=tilted)), None),
+        "battery_low": (FakeBackend(_state(), battery_v=30.0), None),
+        "battery_ok": (FakeBackend(_state(), battery_v=48.0), None),
+        "no_state": (_Silent(_state()), None),
+        "two_publishers": (FakeBackend(_state(), peers=(2, 2, 1)), None),
+        "other_commander": (FakeBackend(_state(), peers=(1, 1, 2)), None),
+    }
+
+
+def _normalized(pf: Preflight) -> dict:
+    import re
+
+    rows = {}
+    for r in pf.as_dict():
+        reason = re.sub(r"^\d+ Hz over \d+\.\d s", "<rate> Hz over <window> s", r["reason"])
+        rows[r["name"]] = {"status": r["status"], "reason": reason, "overridable": r["overridable"]}
+    return {"checks": rows, "refusal": str(pf.refusal()) if not pf.passed else None}
+
+
+def test_every_robot_check_says_exactly_what_the_golden_file_says(launch):
+    import os
+
+    import yaml
+
+    got = {}
+    for name, (backend, policy_variant) in _scenarios().items():
+        pf = Preflight()
+        pf.check_robot(backend, launch, policy_variant)
+        got[name] = _normalized(pf)
+    if os.environ.get("G1_UPDATE_GOLDEN"):
+        GOLDEN.write_text(yaml.safe_dump(got, sort_keys=True, width=300, allow_unicode=True))
+    expected = yaml.safe_load(GOLDEN.read_text())
+    for name in got:
+        assert got[name] == expected[name], name
+
+
+def test_overrides_are_recorded_loudly_and_refused_where_not_allowed(caplog):
+    import logging
+
+    caplog.set_level(logging.ERROR, logger="g1_control.deploy")
+    pf = Preflight(frozenset({"temperatures", "variant"}))
+    assert not pf.record("temperatures", FAIL, "hot")
+    assert pf.results["temperatures"].overridden and not pf.results["temperatures"].blocks
+    assert not pf.record("variant", FAIL, "other robot", overridable=False)
+    assert not pf.results["variant"].overridden and pf.results["variant"].blocks
+    assert pf.results["variant"].reason == "other robot (--override variant refused: this failure cannot be overridden)"
+    assert pf.record("battery", SKIP, "n/a") and pf.record("imu_upright", PASS, "ok")
+    assert [r.getMessage() for r in caplog.records] == [
+        "PREFLIGHT OVERRIDE: check 'temperatures' failed (hot) and is overridden by --override temperatures"]
+    with pytest.raises(Exception, match="--override temp, warp: no such check; checks: launch_file, policy"):
+        Preflight(frozenset({"warp", "temp"}))
+    fresh = Preflight()
+    assert all(r.status == "not run" and r.reason == "not run" for r in fresh.results.values())
+    fresh.not_run(["dry_run"], "no policy")
+    assert fresh.results["dry_run"].reason == "not run: no policy"
