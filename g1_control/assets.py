@@ -109,6 +109,22 @@ def extract(asset: WheelAsset, wheel: Path, dest: Path) -> list[Path]:
     return written
 
 
+def pip_command() -> list[str] | None:
+    """How to run pip here: this interpreter's own pip; else a pip on PATH (any pip downloads a
+    pure-Python wheel); else uv's `uvx pip`; None when there is none (a uv venv on a machine without pip)."""
+    import importlib.util
+    import shutil
+
+    if importlib.util.find_spec("pip") is not None:
+        return [sys.executable, "-m", "pip"]
+    for name in ("pip3", "pip"):
+        found = shutil.which(name)
+        if found:
+            return [found]
+    uv = shutil.which("uv")
+    return [uv, "tool", "run", "pip"] if uv else None
+
+
 def fetch(name: str, *, force: bool = False, quiet: bool = False, wheel: Path | None = None) -> Path:
     """Folder holding the asset's files, downloading the pinned wheel on first use.
 
@@ -124,21 +140,28 @@ def fetch(name: str, *, force: bool = False, quiet: bool = False, wheel: Path | 
         extract(asset, Path(wheel), dest)
         return dest
     with tempfile.TemporaryDirectory(prefix="g1-fetch-") as tmp:
+        pip = pip_command()
+        if pip is None:
+            raise PolicyFetchError(
+                f"this Python environment has no pip to download {asset.package}=={asset.version} with (uv makes "
+                f"virtual environments without it). Either add pip (`uv pip install pip`, or `python -m ensurepip`) "
+                f"and run again, or download the wheel with any pip or uv (`pip download --no-deps "
+                f"{asset.package}=={asset.version} -d DIR`, or `uvx pip download ...`) and run "
+                f"`g1 policies fetch --asset {asset.name} --wheel DIR/{asset.wheel_name}`"
+            )
         if not quiet:
             print(f"Fetching {asset.package}=={asset.version} ({asset.description}) from the package registry ...",
                   file=sys.stderr)
-        cmd = [sys.executable, "-m", "pip", "download", "--no-deps", "--only-binary=:all:",
-               "--disable-pip-version-check", "-d", tmp, f"{asset.package}=={asset.version}"]
-        if quiet:
-            cmd.insert(4, "-q")
+        cmd = [*pip, "download", "--no-deps", "--only-binary=:all:", "--disable-pip-version-check", "-d", tmp,
+               f"{asset.package}=={asset.version}"] + (["-q"] if quiet else [])
         proc = subprocess.run(cmd, capture_output=quiet, text=True, check=False)
         found = list(Path(tmp).glob("*.whl"))
         if proc.returncode != 0 or not found:
             detail = (proc.stderr or "").strip().splitlines()[-1:] if quiet else []
             raise PolicyFetchError(
                 f"could not download {asset.package}=={asset.version} from the package registry "
-                f"(pip exit {proc.returncode}{': ' + detail[0] if detail else ''}). Check the network or "
-                f"pip's index settings, or pass a wheel you already have with --wheel FILE"
+                f"({' '.join(pip)} exit {proc.returncode}{': ' + detail[0] if detail else ''}). Check the network "
+                f"or pip's index settings, or pass a wheel you already have with --wheel FILE"
             )
         extract(asset, found[0], dest)
     return dest

@@ -9,14 +9,18 @@ tuple[X, ...], dict[str, X] and nested dataclasses.
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 import types
 import typing
-from typing import Any, Literal, TypeVar
+from typing import TYPE_CHECKING, Any, Literal, TypeVar
 
 from g1_control.errors import LaunchFileError
 
-T = TypeVar("T")
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
+T = TypeVar("T", bound="DataclassInstance")
 
 
 def _type_name(tp) -> str:
@@ -27,7 +31,7 @@ def _type_name(tp) -> str:
         return "a list"
     if origin is dict:
         return "a mapping"
-    if dataclasses.is_dataclass(tp):
+    if isinstance(tp, type) and dataclasses.is_dataclass(tp):
         return f"a mapping of {tp.__name__} fields"
     return {bool: "true or false", int: "an integer", float: "a number", str: "a string"}.get(tp, getattr(tp, "__name__", str(tp)))
 
@@ -87,7 +91,7 @@ def _convert(tp, value: Any, path: str, error: type[Exception]):
         if not isinstance(value, dict):
             raise error(f"{path}: expected a mapping, got {type(value).__name__}")
         return {str(k): _convert(args[1], v, f"{path}.{k}", error) for k, v in value.items()}
-    if dataclasses.is_dataclass(tp):
+    if isinstance(tp, type) and dataclasses.is_dataclass(tp):
         return from_dict(tp, value, path, error)
     if tp is Any:
         return value
@@ -195,3 +199,67 @@ _StrictLoader = _strict_loader()
 
 def to_dict(obj) -> dict:
     return dataclasses.asdict(obj)
+
+
+def apply_overrides(data: Any, overrides: typing.Iterable[str], error: type[Exception] = LaunchFileError) -> dict:
+    """`data` (a YAML mapping) with dotted `KEY=VALUE` overrides applied, for `--set` on the command line.
+
+    KEY is a dotted path (`tracker.policy`, `safety.max_tilt_rad`, `input.timeline[2].vx_mps`);
+    missing mappings on the way are made, so any field of the schema can be set. VALUE is read as
+    YAML (`0.5`, `true`, `[480, 360]`, `holosoma_loco_fastsac`). The result still goes through
+    `from_dict`, so an unknown key or a wrong type fails there with the key named.
+    """
+    import copy
+    import re
+
+    import yaml
+
+    data = copy.deepcopy(data) if data is not None else {}
+    if not isinstance(data, dict):
+        raise error(f"expected a mapping at the top, got {type(data).__name__}")
+    for item in overrides:
+        key, sep, raw = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise error(f"--set {item!r}: expected KEY=VALUE, e.g. tracker.policy=holosoma_loco_fastsac")
+        try:
+            value = yaml.safe_load(raw) if raw.strip() else ""
+        except yaml.YAMLError as exc:
+            raise error(f"--set {key}: value {raw!r} is not valid YAML ({exc})") from None
+        steps: list[str | int] = []
+        for part in key.split("."):
+            m = re.fullmatch(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)", part)
+            if not m:
+                raise error(f"--set {key}: '{part}' is not a key name (letters, digits, _; [N] for a list item)")
+            steps.append(m.group(1))
+            steps.extend(int(i) for i in re.findall(r"\[(\d+)\]", m.group(2)))
+        node: Any = data
+        where = ""
+        for step, nxt in itertools.pairwise(steps):
+            where = f"{where}[{step}]" if isinstance(step, int) else (f"{where}.{step}" if where else step)
+            node = _child(node, step, nxt, where, key, error)
+        last = steps[-1]
+        if isinstance(last, int):
+            if not isinstance(node, list) or last >= len(node):
+                raise error(f"--set {key}: no item [{last}] (the list has {len(node) if isinstance(node, list) else 0})")
+            node[last] = value
+        else:
+            if not isinstance(node, dict):
+                raise error(f"--set {key}: '{last}' is set on a {type(node).__name__}, not a mapping")
+            node[last] = value
+    return data
+
+
+def _child(node: Any, step: str | int, nxt: str | int, where: str, key: str, error: type[Exception]) -> Any:
+    if isinstance(step, int):
+        if not isinstance(node, list) or step >= len(node):
+            raise error(f"--set {key}: {where}: no such list item (the list has "
+                        f"{len(node) if isinstance(node, list) else 0})")
+        return node[step]
+    if not isinstance(node, dict):
+        raise error(f"--set {key}: {where} is inside a {type(node).__name__}, not a mapping")
+    if node.get(step) is None:
+        if isinstance(nxt, int):
+            raise error(f"--set {key}: {where} has no list to index")
+        node[step] = {}
+    return node[step]

@@ -34,7 +34,7 @@ class InputDeviceError(G1ControlError, RuntimeError):
 
 
 class RemoteDecodeError(G1ControlError, ValueError):
-    """Wireless-remote bytes that do not have the layout the G1 reports (40 bytes, see FACTS.md)."""
+    """Wireless-remote bytes that do not have the layout the G1 reports (40 bytes, see docs/robot_facts.md)."""
 
 
 class MalformedMessageError(G1ControlError, ValueError):

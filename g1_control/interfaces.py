@@ -45,6 +45,14 @@ class Backend(ABC):
     def step(self, dt_s: float) -> None:
         """Advance `dt_s` seconds (lockstep only; a no-op on wall-clock backends)."""
 
+    def step_ticks(self, command: MotorCommand, dt_s: float, n: int) -> None:
+        """`n` low-level ticks of `command` in a row: write_command(command) then step(dt_s), n times
+        (lockstep). A backend that only stores the command may advance all n at once. The caller
+        does not modify `command` in place once written (a new command is a new object)."""
+        for _ in range(n):
+            self.write_command(command)
+            self.step(dt_s)
+
     def damp(self) -> None:
         """Put damping on the motors now, not at the next tick (signal handlers, faults)."""
         self.write_command(MotorCommand.damping())

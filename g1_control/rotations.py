@@ -3,7 +3,8 @@ matrices, roll-pitch-yaw, the heading (yaw) frame.
 
 The array functions take (..., 4) quaternions or (..., 3, 3) matrices. The scalar ones
 (`quat_to_rot`, `yaw_of`, `tilt_rad`, `projected_gravity`) take one quaternion and run every
-control tick, so they are written out instead of broadcast. The IK's compiled per-tick copies
+control tick, so they are written out instead of broadcast, on Python floats (a numpy scalar
+operation costs ~20 times a float one; tests/test_rotations.py holds them to the array versions). The IK's compiled per-tick copies
 (g1_control/ik/kernels.py) are tested against pinocchio.
 
 Frames: "_w" world; "_b" base (pelvis); "_h" heading: the world frame turned by the base's yaw,
@@ -11,6 +12,8 @@ so x points forward along the ground, y left, z up.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -95,33 +98,48 @@ def angular_velocity_w(quats: np.ndarray, fps: float) -> np.ndarray:
 
 
 # -- single rotations, per control tick ---------------------------------------------------------------------
-def quat_to_rot(quat_wxyz: np.ndarray) -> np.ndarray:
-    """(3, 3) rotation matrix (body -> world) of one unit quaternion."""
-    w, x, y, z = quat_wxyz
-    return np.array([
+def _floats(quat_wxyz) -> list[float]:
+    return np.asarray(quat_wxyz, dtype=float).tolist()
+
+
+def quat_to_rot_rows(quat_wxyz) -> list[list[float]]:
+    """quat_to_rot as three rows of Python floats (for per-tick arithmetic on 3-vectors)."""
+    w, x, y, z = _floats(quat_wxyz)
+    return [
         [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
         [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-    ])
+    ]
+
+
+def quat_to_rot(quat_wxyz: np.ndarray) -> np.ndarray:
+    """(3, 3) rotation matrix (body -> world) of one unit quaternion."""
+    return np.array(quat_to_rot_rows(quat_wxyz))
 
 
 def yaw_of(quat_wxyz: np.ndarray) -> float:
     """Heading (rad): the yaw of the ZYX roll-pitch-yaw decomposition."""
-    w, x, y, z = quat_wxyz
-    return float(np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
+    w, x, y, z = _floats(quat_wxyz)
+    return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
 
 def tilt_rad(quat_wxyz: np.ndarray) -> float:
     """Angle between the body z axis and world up."""
-    _, x, y, _ = np.asarray(quat_wxyz, dtype=float) / np.linalg.norm(quat_wxyz)
-    return float(np.arccos(np.clip(1.0 - 2.0 * (x * x + y * y), -1.0, 1.0)))
+    w, x, y, z = _floats(quat_wxyz)
+    norm = math.sqrt(w * w + x * x + y * y + z * z)
+    if norm == 0.0:
+        return math.nan
+    x, y = x / norm, y / norm
+    cos = 1.0 - 2.0 * (x * x + y * y)
+    cos = 1.0 if cos > 1.0 else -1.0 if cos < -1.0 else cos  # NaN stays NaN
+    return math.acos(cos)
 
 
 def projected_gravity(quat_wxyz: np.ndarray) -> np.ndarray:
     """World gravity direction (0, 0, -1) expressed in the body frame of `quat_wxyz`."""
-    w, x, y, z = quat_wxyz
+    w, x, y, z = _floats(quat_wxyz)
     # Third row of R (body->world), negated: R^T @ (0, 0, -1).
-    return -np.array([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)])
+    return np.array([-(2 * (x * z - w * y)), -(2 * (y * z + w * x)), -(1 - 2 * (x * x + y * y))])
 
 
 def rotation_error(rot_ref: np.ndarray, rot: np.ndarray) -> np.ndarray:

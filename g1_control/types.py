@@ -20,6 +20,9 @@ import numpy as np
 from g1_control.errors import InvalidCommandError, InvalidStateError, LaunchFileError
 from g1_control.robot.g1 import DEFAULT_PELVIS_HEIGHT_M, NUM_JOINTS
 
+_sum = np.add.reduce
+"""ndarray.sum without its Python wrapper (the per-tick finite checks sum small arrays)."""
+
 
 def _zeros() -> np.ndarray:
     return np.zeros(NUM_JOINTS)
@@ -49,7 +52,7 @@ BUTTONS = frozenset(b.value for b in Button)
 
 
 # -- command limits -------------------------------------------------------------------------------------
-# A 15 cm crouch is what the whole-body tracker was measured to follow (11 of 15 cm, FACTS.md);
+# A 15 cm crouch is what the whole-body tracker was measured to follow (11 of 15 cm, docs/robot_facts.md);
 # deeper crouches are untested, so the default range stops there.
 DEFAULT_CROUCH_M = 0.15
 
@@ -165,7 +168,7 @@ class Command:
         """Raise InvalidCommandError naming the first bad field; return self when fine."""
         for name in ("vx_mps", "vy_mps", "wz_radps", "heading_rad", "pelvis_height_m"):
             value = getattr(self, name)
-            if value is not None and not np.isfinite(value):
+            if value is not None and not math.isfinite(value):
                 raise InvalidCommandError(f"Command.{name} is {value}; it must be a finite number")
         for goal in self.goals:
             pos = np.asarray(goal.pos_w_m, dtype=float)
@@ -174,8 +177,8 @@ class Command:
                     f"Command goal for frame '{goal.frame}' has position {goal.pos_w_m!r}; "
                     "it must be 3 finite numbers"
                 )
-        unknown = set(self.buttons) - BUTTONS
-        if unknown:
+        if not BUTTONS.issuperset(self.buttons):
+            unknown = set(self.buttons) - BUTTONS
             raise InvalidCommandError(
                 f"Command has unknown buttons {sorted(unknown)}; known: {sorted(BUTTONS)}"
             )
@@ -207,14 +210,14 @@ class RobotState:
             arr = getattr(self, name)
             if arr.shape != (NUM_JOINTS,):
                 raise InvalidStateError(f"RobotState.{name} has shape {arr.shape}; expected ({NUM_JOINTS},)")
-        quat = self.imu_quat_wxyz
+        quat = self.imu_quat_wxyz.tolist()  # small vectors as Python floats: cheaper than a numpy call each
         # One finite check over everything the controllers read (this runs every tick).
-        if not np.isfinite(self.q_rad.sum() + self.dq_radps.sum() + quat.sum() + self.imu_gyro_radps.sum()
-                           + self.imu_acc_mps2.sum()):
+        if not math.isfinite(_sum(self.q_rad) + _sum(self.dq_radps) + sum(quat) + sum(self.imu_gyro_radps.tolist())
+                             + sum(self.imu_acc_mps2.tolist())):
             bad = [n for n in ("q_rad", "dq_radps", "imu_quat_wxyz", "imu_gyro_radps", "imu_acc_mps2")
                    if not np.all(np.isfinite(getattr(self, n)))]
             raise InvalidStateError(f"RobotState.{', '.join(bad) or 'values'} contains NaN or inf")
-        norm_sq = float(quat @ quat)
+        norm_sq = sum(c * c for c in quat)
         if abs(norm_sq - 1.0) > 2e-2:
             raise InvalidStateError(f"RobotState.imu_quat_wxyz has norm {norm_sq ** 0.5:.4f}; expected 1")
         return self

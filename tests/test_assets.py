@@ -54,3 +54,32 @@ def test_unknown_asset():
 def test_empty_cache_variable_means_the_default(monkeypatch):
     monkeypatch.setenv("G1_CONTROL_CACHE", "")
     assert assets.cache_dir().is_absolute()
+
+
+def test_without_pip_says_what_to_do(tmp_path, monkeypatch):
+    """A uv-made venv has no pip: the error names the fixes instead of blaming the network."""
+    import importlib.util
+    import shutil
+
+    real_find_spec = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "pip" else real_find_spec(name, *a))
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    monkeypatch.setenv("G1_CONTROL_CACHE", str(tmp_path))
+    assert assets.pip_command() is None
+    with pytest.raises(PolicyFetchError) as exc:
+        assets.fetch("holosoma-policies", quiet=True)
+    message = str(exc.value)
+    assert "no pip" in message and "uv pip install pip" in message and "--wheel" in message
+    assert "network" not in message
+
+
+def test_pip_fallbacks(monkeypatch):
+    import importlib.util
+    import shutil
+
+    real_find_spec = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "pip" else real_find_spec(name, *a))
+    monkeypatch.setattr(shutil, "which", lambda name: {"uv": "/opt/uv"}.get(name))
+    assert assets.pip_command() == ["/opt/uv", "tool", "run", "pip"]
+    monkeypatch.setattr(shutil, "which", lambda name: {"pip3": "/usr/bin/pip3", "uv": "/opt/uv"}.get(name))
+    assert assets.pip_command() == ["/usr/bin/pip3"]

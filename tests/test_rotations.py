@@ -30,3 +30,21 @@ def test_rotvec_and_angular_velocity():
     angles = np.linspace(0, 1, 11)
     seq = np.stack([np.cos(angles / 2), 0 * angles, 0 * angles, np.sin(angles / 2)], axis=1)
     np.testing.assert_allclose(quat.angular_velocity_w(seq, 10.0), np.tile([0, 0, 1.0], (11, 1)), atol=1e-9)
+
+
+def test_per_tick_scalar_functions_equal_the_array_forms():
+    qs = np.vstack([_random(500, 5), [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]]])
+    for q in qs:
+        rot = quat.to_matrix(q)
+        np.testing.assert_allclose(quat.quat_to_rot(q), rot, atol=1e-15)
+        assert abs(quat.yaw_of(q) - quat.yaw_of_matrix(rot)) < 1e-12 or abs(abs(quat.yaw_of(q)) - np.pi) < 1e-9
+        np.testing.assert_allclose(quat.projected_gravity(q), rot.T @ [0.0, 0.0, -1.0], atol=1e-15)
+        tilt = np.arccos(np.clip(rot[2, 2], -1.0, 1.0))
+        assert abs(quat.tilt_rad(q) - tilt) < 1e-7
+        assert isinstance(quat.yaw_of(q), float) and isinstance(quat.tilt_rad(q), float)
+    # Unnormalised and non-finite inputs: the tilt normalises; NaN in, NaN out; zero is NaN.
+    assert abs(quat.tilt_rad(np.array([2.0, 0.0, 0.0, 0.0]))) < 1e-12
+    assert np.isnan(quat.tilt_rad(np.array([np.nan, 0.0, 0.0, 1.0])))
+    assert np.isnan(quat.tilt_rad(np.zeros(4)))
+    np.testing.assert_allclose(quat.quat_to_rot([1, 0, 0, 0]), np.eye(3))  # lists and float32 arrays too
+    np.testing.assert_allclose(quat.quat_to_rot(np.array([1, 0, 0, 0], dtype=np.float32)), np.eye(3))

@@ -82,7 +82,7 @@ def _run(args) -> int:
     try:
         report = deploy(args.file, options)
     except PreflightRefused as exc:
-        if args.json and getattr(exc, "report", None) is not None:
+        if args.json and exc.report is not None:
             write_report(exc.report, args.json)
         raise
     if args.json:

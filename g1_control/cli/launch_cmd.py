@@ -13,13 +13,23 @@ def register(subparsers) -> None:
         help="validate and run a launch file (sim)",
         description="Validate a launch file, then run it: progress while it runs, a summary at the end "
         "(fall, commanded vs achieved velocity per segment, stage timings, real-time factor), and a run "
-        "folder with log.npz, velocity.png and, where headless rendering works, video.mp4.",
-        epilog="examples:\n  g1 launch launch/sim_walk.yaml\n  g1 launch launch/sim_walk.yaml --check\n"
-        "  g1 launch launch/sim_random.yaml --seed 3 --no-video",
+        "folder with log.npz, velocity.png and, where headless rendering works, video.mp4 (with an overlay "
+        "of command, achieved velocity and safety state). FILE is a path or the name of a launch file "
+        "that comes with g1-control (g1 launch --list; g1 init DIR copies them for editing).",
+        epilog="examples:\n  g1 launch sim_walk\n  g1 launch launch/sim_walk.yaml --check\n"
+        "  g1 launch sim_random --seed 3 --no-video\n"
+        "  g1 launch sim_walk --set tracker.policy=holosoma_loco_fastsac --set output.video_fps=20\n"
+        "  g1 launch sim_walk --web        # watch it in the browser (http://127.0.0.1:8080)\n"
+        "then: g1 replay runs/sim_walk-*   # look at the run again",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("file", type=Path, help="launch file (YAML)")
+    parser.add_argument("file", nargs="?", help="launch file (YAML path) or a shipped launch file's name")
+    parser.add_argument("--list", action="store_true", help="list the launch files that come with g1-control")
     parser.add_argument("--check", action="store_true", help="validate the file (and its policy) and exit")
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                        help="override any launch-file key, dotted (tracker.policy=holosoma_loco_fastsac, "
+                        "safety.max_tilt_rad=0.8, input.timeline[1].vx_mps=0.3); VALUE is YAML; validated by "
+                        "the same schema; repeatable")
     parser.add_argument("--out", type=Path, help="run folder root (default: the file's output.dir)")
     parser.add_argument("--seed", type=int, help="seed for a random command timeline (input.type: random)")
     parser.add_argument("--duration", type=float, help="override the run length in seconds")
@@ -28,14 +38,43 @@ def register(subparsers) -> None:
     video.add_argument("--no-video", dest="video", action="store_false", help="skip the video")
     parser.add_argument("--viewer", choices=("auto", "on", "off"), help="MuJoCo viewer (default: the file's "
                         "viewer setting; auto opens it when a display exists)")
+    parser.add_argument("--web", nargs="?", const=8080, type=int, metavar="PORT",
+                        help="show the robot live in the browser (viser) at http://127.0.0.1:PORT (default 8080); "
+                        "runs on the wall clock")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.set_defaults(func=_run)
 
 
-def _run(args) -> int:
-    from g1_control.launch.schema import load_launch
+def _list() -> int:
+    import yaml
 
-    launch = load_launch(args.file)
+    from g1_control.resources import launch_dir, launch_files
+
+    print(f"launch files in {launch_dir()}:")
+    for name, path in launch_files().items():
+        try:
+            about = (yaml.safe_load(path.read_text()) or {}).get("description", "")
+        except yaml.YAMLError:
+            about = "(not valid YAML)"
+        print(f"  {name:20s} {' '.join(str(about).split())[:100]}")
+    print("run one with `g1 launch NAME`; copy them for editing with `g1 init DIR`")
+    return 0
+
+
+def _run(args) -> int:
+    if args.list:
+        return _list()
+    if not args.file:
+        from g1_control.errors import LaunchFileError
+
+        raise LaunchFileError("name a launch file (a path or a name from g1 launch --list), e.g. g1 launch sim_walk")
+    from g1_control.launch.schema import load_launch
+    from g1_control.resources import resolve_launch
+
+    path, shipped = resolve_launch(args.file)
+    if shipped and not args.quiet:
+        print(f"launch file: {path}")
+    launch = load_launch(path, overrides=args.overrides)
     if args.seed is not None:
         launch.input.random.seed = args.seed
     if args.duration is not None:
@@ -51,9 +90,11 @@ def _run(args) -> int:
 
     setting = {"on": True, "off": False, "auto": "auto"}[args.viewer] if args.viewer else launch.viewer
     viewer = setting is True or (setting == "auto" and bool(os.environ.get("DISPLAY")))
-    if viewer:
+    if viewer or args.web is not None:
         launch.backend.mode = "wallclock"
     result = run(launch, out_root=args.out or Path(launch.output.dir), video=args.video,
-                 progress=not args.quiet, viewer=viewer)
+                 progress=not args.quiet, viewer=viewer, web_port=args.web)
     print(format_summary(result))
+    if result.run_dir is not None:
+        print(f"look again: g1 replay {result.run_dir}")
     return 1 if result.fell else 0

@@ -31,13 +31,16 @@ def register(subparsers) -> None:
     build.add_argument("--no-demo", action="store_true", help="leave out the retargeted demo mocap")
     build.add_argument("--jobs", type=int, default=2, help="rollout worker processes (default 2)")
     build.set_defaults(func=_build)
-    show = sub.add_parser("show", help="print styles, clips and frames per split")
+    show = sub.add_parser("show", help="print styles, clips and frames per split",
+                          description="Print the built library's styles, clips and frame counts per split "
+                          "(train / held-out). Look at a clip with g1 view CLIP.npz.")
     show.add_argument("path", nargs="?", help="library folder (default: the user cache)")
     show.set_defaults(func=_show)
 
 
 def _build(args) -> int:
-    from g1_control.library.builder import LibraryConfig, build_library, default_library_dir
+    from g1_control.library.builder import LibraryConfig, build_library
+    from g1_control.motion.library import default_library_dir
 
     config = LibraryConfig(rollout_seconds=args.rollout_seconds, rollouts_per_style=args.rollouts_per_style,
                            dance=not args.no_dance, demo=not args.no_demo)
@@ -49,8 +52,7 @@ def _build(args) -> int:
 
 
 def _show(args) -> int:
-    from g1_control.library.builder import default_library_dir
-    from g1_control.motion.library import MotionLibrary
+    from g1_control.motion.library import MotionLibrary, default_library_dir
 
     lib = MotionLibrary(args.path or default_library_dir())
     print(lib.summary())

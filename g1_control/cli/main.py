@@ -11,11 +11,16 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+from pathlib import Path
 
 from g1_control.errors import G1ControlError
 
 SUBCOMMAND_MODULES = (
     "g1_control.cli.launch_cmd",
+    "g1_control.cli.replay_cmd",
+    "g1_control.cli.view_cmd",
+    "g1_control.cli.init_cmd",
+    "g1_control.cli.docs_cmd",
     "g1_control.cli.policies_cmd",
     "g1_control.cli.bench_cmd",
     "g1_control.cli.input_cmd",
@@ -28,12 +33,29 @@ SUBCOMMAND_MODULES = (
 )
 
 
+def version() -> str:
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as dist_version
+
+    import g1_control
+
+    try:
+        installed = dist_version("g1-control")
+    except PackageNotFoundError:
+        installed = None
+    where = Path(g1_control.__file__).resolve().parent
+    return f"g1-control {installed or g1_control.__version__} ({where})"
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="g1",
         description="g1-control: real-time whole-body control for the Unitree G1, in simulation and on the robot.",
-        epilog="Start with: g1 launch launch/sim_walk.yaml",
+        epilog="Start with: g1 launch sim_walk   (g1 launch --list: the launch files; g1 init DIR: copies to edit;\n"
+        "g1 docs: the README, architecture, API and package docs; every command has --help)",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    parser.add_argument("--version", action="version", version=version())
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     for module_name in SUBCOMMAND_MODULES:
         importlib.import_module(module_name).register(subparsers)

@@ -14,12 +14,18 @@ def register(subparsers) -> None:
         "the user cache ($G1_CONTROL_CACHE or ~/.cache/g1-control). First use of a policy fetches it too.",
     )
     sub = parser.add_subparsers(dest="action", metavar="ACTION", required=True)
-    fetch = sub.add_parser("fetch", help="download and verify the policy files")
+    fetch = sub.add_parser("fetch", help="download and verify the policy files",
+                           description="Download the pinned wheel of an asset (holosoma-policies by default; "
+                           "holosoma-demo-mocap for the demo motion capture) with pip, check its SHA-256 and "
+                           "extract the listed files into the cache. Offline, or without pip in this "
+                           "environment: download the wheel elsewhere and pass --wheel FILE.")
     fetch.add_argument("--force", action="store_true", help="download again even if cached")
     fetch.add_argument("--wheel", type=Path, help="use this already-downloaded wheel instead of the registry")
     fetch.add_argument("--asset", default="holosoma-policies", help="asset name (default holosoma-policies)")
     fetch.set_defaults(func=_fetch)
-    lst = sub.add_parser("list", help="list built-in policy specs and whether their files are cached")
+    lst = sub.add_parser("list", help="list built-in policy specs and whether their files are cached",
+                         description="List the built-in policy specs (names usable as tracker.policy), their "
+                         "kind, and whether their ONNX files are in the cache.")
     lst.set_defaults(func=_list)
 
 

@@ -89,9 +89,8 @@ def process_one(path: str, out_path: str, options: dict, show_frames: bool = Fal
         from g1_control.motion.clip import MotionClip
         from g1_control.motion.formats.dispatch import load_motion, save_clip
         from g1_control.motion.resample import resample
-        from g1_control.motion.skeletons import load_joint_map
         from g1_control.retarget.metrics import compute_metrics, plot_metrics
-        from g1_control.retarget.mocap import MocapRetargetConfig, MocapRetargeter
+        from g1_control.retarget.mocap import MocapRetargetConfig, MocapRetargeter, load_joint_map
 
         skeleton = load_joint_map(options["joint_map"]) if options.get("joint_map") else None
         motion = load_motion(path, joint_names=skeleton.joints if skeleton else None,

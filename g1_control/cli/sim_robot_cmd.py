@@ -6,6 +6,10 @@ import argparse
 import signal
 import sys
 import time
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from g1_control.interfaces import Backend
 
 
 def register(subparsers) -> None:
@@ -52,14 +56,15 @@ def _run(args) -> int:
     from g1_control.sim.emulator import RobotEmulator
 
     realtime(args.rt_priority)
+    physics: Backend
     if args.physics == "mujoco":
         from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
 
-        physics = MujocoBackend(MujocoConfig(lockstep=True))
+        physics = mujoco = MujocoBackend(MujocoConfig(lockstep=True))
         if args.gantry or args.lower_gantry_on_policy:
             from g1_control.sim.emulator import Gantry
 
-            physics = Gantry(physics, physics_dt_s=physics.config.physics_dt_s,
+            physics = Gantry(mujoco, physics_dt_s=mujoco.config.physics_dt_s,
                              lower_on_policy=args.lower_gantry_on_policy)
     else:
         from g1_control.sim.mock_robot import MockG1

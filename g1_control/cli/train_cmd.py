@@ -39,7 +39,8 @@ def register(subparsers) -> None:
 
 def _generator(args) -> int:
     from g1_control.generator.learned import SHIPPED_DIR
-    from g1_control.library.builder import build_library, default_library_dir
+    from g1_control.library.builder import build_library
+    from g1_control.motion.library import default_library_dir
     from g1_control.training.train import TrainConfig, train
 
     library = args.library or default_library_dir()

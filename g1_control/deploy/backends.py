@@ -11,11 +11,22 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import TypedDict
 
 from g1_control.errors import NetworkInterfaceError, TransportError
 from g1_control.hardware.links.network import LOOPBACK, check_interface
 from g1_control.launch.schema import BackendConfig
 from g1_control.robot import g1
+
+
+class _HostOptions(TypedDict):
+    """The LinkBackend keywords every robot link shares."""
+
+    command_rate_hz: float
+    mode_pr: int
+    expected_mode_machine: int
+    connect_timeout_s: float
+    damping_kd: float
 
 
 def expected_mode_machine(config: BackendConfig) -> int:
@@ -56,12 +67,15 @@ def _serial_ports() -> list[str]:
 
 def open_robot_backend(config: BackendConfig, *, damping_kd: float = 2.0, release_motion_service: bool | None = None):
     """The host side of the robot link `config` describes (a LinkBackend; threads running, silent)."""
-    common = {"command_rate_hz": config.command_rate_hz, "mode_pr": config.mode_pr,
-              "expected_mode_machine": expected_mode_machine(config), "connect_timeout_s": config.connect_timeout_s,
-              "damping_kd": damping_kd}
+    common: _HostOptions = {
+        "command_rate_hz": config.command_rate_hz, "mode_pr": config.mode_pr,
+        "expected_mode_machine": expected_mode_machine(config), "connect_timeout_s": config.connect_timeout_s,
+        "damping_kd": damping_kd}
     if config.type == "unitree_dds":
         from g1_control.hardware.dds_backend import UnitreeDDSBackend
 
+        if not config.interface:  # BackendConfig.validate refuses this in a launch file
+            raise TransportError("backend.interface: a unitree_dds backend must name its network interface")
         release = config.release_motion_service if release_motion_service is None else release_motion_service
         return UnitreeDDSBackend(config.interface, config.domain, partition=config.partition,
                                  release_motion_service=release, **common)

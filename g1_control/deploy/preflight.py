@@ -15,6 +15,7 @@ import logging
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -22,6 +23,9 @@ from g1_control.errors import G1ControlError, RobotNotConnectedError, VariantMis
 from g1_control.launch.schema import InputConfig, LaunchFile, Segment
 from g1_control.robot import g1
 from g1_control.rotations import tilt_rad
+
+if TYPE_CHECKING:
+    from g1_control.launch.runner import RunResult
 
 log = logging.getLogger("g1_control.deploy")
 
@@ -59,6 +63,9 @@ def nonfinite_fields(state) -> list[str]:
 class PreflightRefused(G1ControlError):
     """A preflight check failed and was not overridden: nothing was sent to the robot."""
 
+    report: Any = None
+    """The refused deploy's DeployReport (g1_control.deploy.session sets it, for --json)."""
+
 
 @dataclass
 class CheckResult:
@@ -77,8 +84,8 @@ class CheckResult:
 class Preflight:
     overrides: frozenset[str] = frozenset()
     results: dict[str, CheckResult] = field(default_factory=dict)
-    dry_run: object | None = None
-    """The dry run's RunResult (g1_control.launch.runner), when it ran."""
+    dry_run: RunResult | None = None
+    """The dry run's result, when it ran."""
 
     def __post_init__(self) -> None:
         unknown = set(self.overrides) - set(CHECKS)

@@ -195,7 +195,7 @@ def _refuse(pf: Preflight, report: DeployReport, say) -> DeployReport:
     report.preflight = pf.as_dict()
     say("\npreflight\n" + pf.table())
     refusal = pf.refusal()
-    refusal.report = report  # type: ignore[attr-defined]  # for --json
+    refusal.report = report  # for --json
     raise refusal
 
 
@@ -274,7 +274,7 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
 
         def finished() -> bool:
             now = time.monotonic()
-            return tracker.observe_safety(now) and now - tracker.entered_s >= exit_s
+            return tracker.observe_safety(now) and tracker.time_in_state_s(now) >= exit_s
 
         t_loop0 = time.monotonic()
         with frozen_heap():  # no full garbage collection of the whole heap inside the loop

@@ -132,6 +132,10 @@ class DeployTracker(Tracker):
         """Seconds since control began (0 before): the clock of a scripted command timeline."""
         return 0.0 if self.control_started_s is None else max(0.0, self.clock() - self.control_started_s)
 
+    def time_in_state_s(self, now: float) -> float:
+        """Seconds since the current state was entered (0 before the machine's first tick)."""
+        return 0.0 if self.entered_s is None else now - self.entered_s
+
     def _go(self, target: DeployState, reason: str, now: float) -> None:
         transition = Transition(now, self.state, target, reason)
         self.transitions.append(transition)
@@ -143,8 +147,8 @@ class DeployTracker(Tracker):
     def observe_safety(self, now: float) -> bool:
         """Enter damping if the safety layer tripped; True once in damping. The loop stops calling
         act() after a trip (it sends damping itself), so its driver calls this every tick."""
-        if self.state != DeployState.DAMPING and self.safety.tripped:
-            trip = self.safety.trip_event
+        trip = self.safety.trip_event
+        if self.state != DeployState.DAMPING and trip is not None:  # i.e. self.safety.tripped
             self._go(DeployState.DAMPING, f"{trip.kind.value}: {trip.detail}", now)
         return self.state == DeployState.DAMPING
 
@@ -188,7 +192,7 @@ class DeployTracker(Tracker):
         if s == DeployState.CONTROL:
             return self.policy.act(reference, state)
         if s == DeployState.RAMP:
-            alpha = smooth_step((now - self.entered_s) / self.config.ramp_s)
+            alpha = smooth_step(self.time_in_state_s(now) / self.config.ramp_s)
             self._pose.q_rad[:] = self._ramp_from + alpha * (self.default_q_rad - self._ramp_from)
             return self._pose
         if s == DeployState.HOLD:

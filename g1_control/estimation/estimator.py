@@ -8,21 +8,18 @@ between kinematic corrections (a complementary filter), which smooths the switch
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from g1_control.robot import description, g1
-from g1_control.rotations import quat_to_rot, yaw_of
+from g1_control.rotations import quat_to_rot_rows, yaw_of
 from g1_control.types import EstimatedState, RobotState
 
 GRAVITY_W = np.array([0.0, 0.0, -9.81])
 SOLE_OFFSET_M = np.array([0.035, 0.0, -0.035])
 """Sole centre in the ankle-roll link frame (middle of the URDF's four foot contact spheres)."""
-
-
-
-
 
 
 @dataclass
@@ -39,7 +36,21 @@ class StateEstimator:
 
         self._pin = pin
         self.config = config or EstimatorConfig()
-        self.model = pin.Model(description.pinocchio_model())
+        # Only the legs matter (base -> sole chains): the other joints are locked out of the model,
+        # which leaves the legs' kinematics as they are and halves the forward kinematics.
+        full = description.pinocchio_model()
+        keep: set[int] = set()
+        for body in g1.FOOT_BODIES:
+            joint = full.frames[full.getFrameId(body)].parentJoint
+            while joint > 0:
+                keep.add(joint)
+                joint = full.parents[joint]
+        locked = [j for j in range(1, full.njoints) if j not in keep]
+        self.model = pin.buildReducedModel(full, locked, pin.neutral(full))
+        self._n_legs = self.model.nq - 7
+        names = tuple(self.model.names[2:])  # after "universe" and the floating base
+        if names != g1.JOINT_NAMES[: self._n_legs]:
+            raise ValueError(f"estimator: leg joints {names} are not the robot's first joints in order")
         self._soles = []
         for body in g1.FOOT_BODIES:
             parent = self.model.getFrameId(body)
@@ -59,42 +70,52 @@ class StateEstimator:
         self._last_t = None
 
     def update(self, state: RobotState) -> EstimatedState:
-        pin = self._pin
+        # Small vectors are handled as Python floats: this runs at 100 Hz and numpy's per-call cost
+        # dominates 3-vector arithmetic.
+        pin, model, data = self._pin, self.model, self.data
         est = self.estimate
         quat = state.imu_quat_wxyz
-        rot = quat_to_rot(quat)
+        w, x, y, z = quat.tolist()
         # Base at the origin with the IMU's orientation and zero linear velocity: foot velocities
         # are then relative to the base, expressed in world axes.
-        self._q[3:7] = (quat[1], quat[2], quat[3], quat[0])
-        self._q[7:] = state.q_rad
-        self._v[3:6] = state.imu_gyro_radps
-        self._v[6:] = state.dq_radps
-        pin.forwardKinematics(self.model, self.data, self._q, self._v)
-        heights, velocities = np.zeros(2), np.zeros((2, 3))
-        for i, fid in enumerate(self._soles):
-            heights[i] = pin.updateFramePlacement(self.model, self.data, fid).translation[2]
-            velocities[i] = pin.getFrameVelocity(self.model, self.data, fid, pin.LOCAL_WORLD_ALIGNED).linear
+        q, v = self._q, self._v
+        q[3:7] = (x, y, z, w)
+        n = self._n_legs
+        q[7:] = state.q_rad[:n]
+        v[3:6] = state.imu_gyro_radps
+        v[6:] = state.dq_radps[:n]
+        pin.forwardKinematics(model, data, q, v)
+        left, right = self._soles
+        height_left = pin.updateFramePlacement(model, data, left).translation[2]
+        height_right = pin.updateFramePlacement(model, data, right).translation[2]
+        vel_left = pin.getFrameVelocity(model, data, left, pin.LOCAL_WORLD_ALIGNED).linear.tolist()
+        vel_right = pin.getFrameVelocity(model, data, right, pin.LOCAL_WORLD_ALIGNED).linear.tolist()
         # Soft stance: the lower foot carries the weight.
-        d = (heights[1] - heights[0]) / self.config.stance_height_scale_m
-        w_left = 1.0 / (1.0 + np.exp(-np.clip(d, -50, 50)))
-        weights = np.array([w_left, 1.0 - w_left])
-        v_kin = -(weights @ velocities)
+        d = float(height_right - height_left) / self.config.stance_height_scale_m
+        w_left = 1.0 / (1.0 + math.exp(-min(50.0, max(-50.0, d))))
+        w_right = 1.0 - w_left
+        v_kin = [-(w_left * a + w_right * b) for a, b in zip(vel_left, vel_right)]
 
+        rot = quat_to_rot_rows(quat)
         dt = 0.0 if self._last_t is None else max(0.0, state.t_s - self._last_t)
         self._last_t = state.t_s
         if dt == 0.0:
-            est.base_linvel_w_mps = v_kin
+            linvel = v_kin
         else:
-            acc_w = rot @ state.imu_acc_mps2 + GRAVITY_W
-            predicted = est.base_linvel_w_mps + acc_w * dt
+            acc = state.imu_acc_mps2.tolist()
+            acc_w = [r[0] * acc[0] + r[1] * acc[1] + r[2] * acc[2] + g for r, g in zip(rot, GRAVITY_W.tolist())]
             gain = dt / (self.config.kinematic_gain_tau_s + dt)
-            est.base_linvel_w_mps = predicted + gain * (v_kin - predicted)
+            predicted = [p + a * dt for p, a in zip(est.base_linvel_w_mps.tolist(), acc_w)]
+            linvel = [p + gain * (k - p) for p, k in zip(predicted, v_kin)]
+        est.base_linvel_w_mps = np.array(linvel)
         est.t_s = state.t_s
         est.base_quat_wxyz = quat.copy()
         est.base_angvel_b_radps = state.imu_gyro_radps.copy()
-        est.stance_weight = weights
+        est.stance_weight = np.array((w_left, w_right))
         yaw = est.yaw_rad = yaw_of(quat)
-        c, s = np.cos(yaw), np.sin(yaw)
-        v = est.base_linvel_w_mps
-        est.heading_velocity = np.array([c * v[0] + s * v[1], -s * v[0] + c * v[1], (rot @ state.imu_gyro_radps)[2]])
+        c, s = math.cos(yaw), math.sin(yaw)
+        vx, vy, _ = linvel
+        gx, gy, gz = state.imu_gyro_radps.tolist()
+        r2 = rot[2]
+        est.heading_velocity = np.array((c * vx + s * vy, -s * vx + c * vy, r2[0] * gx + r2[1] * gy + r2[2] * gz))
         return est

@@ -56,7 +56,8 @@ class MotionMatchingInbetweener(Inbetweener):
             return self._db[gap]
         from scipy.spatial import cKDTree
 
-        keys, feats = [], []
+        keys: list[np.ndarray] = []
+        feat_rows: list[np.ndarray] = []
         for c, clip in enumerate(self.clips):
             n = clip.shape[0] - (gap + 2)
             if n <= 0:
@@ -64,9 +65,9 @@ class MotionMatchingInbetweener(Inbetweener):
             starts = np.arange(n)
             # prev, start, end frames only, canonical w.r.t. the start (it plays the last context frame)
             three = F.canonicalize(clip[starts[:, None] + np.array([0, 1, gap + 2])[None, :]], 1)
-            feats.append(_match_features(three[:, 1], three[:, 0], three[:, 2]))
+            feat_rows.append(_match_features(three[:, 1], three[:, 0], three[:, 2]))
             keys.append(np.stack([np.full(n, c), starts], axis=1))
-        feats = np.concatenate(feats)
+        feats = np.concatenate(feat_rows)
         scale = feats.std(axis=0) + 1e-3
         self._db[gap] = (cKDTree(feats / scale), scale, np.concatenate(keys), feats.mean(axis=0))
         return self._db[gap]

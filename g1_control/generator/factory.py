@@ -24,6 +24,7 @@ def make_generator(kind: str, *, model: str | Path | None = None, limits: Comman
         return VelocityReferenceGenerator(limits), CopyRetargeter()
     if kind not in GENERATORS:
         raise G1ControlError(f"unknown generator '{kind}'; known: {', '.join(GENERATORS)}")
+    from g1_control.generator.inbetween import Inbetweener
     from g1_control.generator.learned import SHIPPED_DIR, OnnxInbetweener
     from g1_control.generator.retarget import GeneratorRetargeter
     from g1_control.generator.runtime import InbetweeningGenerator, RuntimeConfig
@@ -31,6 +32,7 @@ def make_generator(kind: str, *, model: str | Path | None = None, limits: Comman
 
     model_path = Path(model) if model else SHIPPED_DIR / "backbone.onnx"
     styles = load_style_stats(model_path.parent / "style_stats.json")
+    inbetweener: Inbetweener
     if kind == "backbone":
         inbetweener = OnnxInbetweener(model_path)
     elif kind == "interpolation":
@@ -39,7 +41,7 @@ def make_generator(kind: str, *, model: str | Path | None = None, limits: Comman
         inbetweener = InterpolationInbetweener()
     else:
         from g1_control.generator.baselines import MotionMatchingInbetweener
-        from g1_control.training.train import load_split
+        from g1_control.generator.features import load_split
 
         inbetweener = MotionMatchingInbetweener(load_split(None, "train")[0])
     config = RuntimeConfig()

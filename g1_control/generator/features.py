@@ -15,6 +15,8 @@ Frame feature vector (D = 50), all in the canonical frame:
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from g1_control.robot import g1
@@ -126,6 +128,17 @@ def fix_effectors(features: np.ndarray) -> np.ndarray:
     idx = effector_indices(default_body_names())
     out[..., EFFECTORS] = pos[..., idx, :].reshape(features.shape[:-1] + (12,))
     return out
+
+
+def load_split(library_root: str | Path | None, split: str) -> tuple[list[np.ndarray], list[int]]:
+    """Features (clip_features) and style ids of the clips of one split ("train", "test") of a
+    built motion library (default: the library's default folder)."""
+    from g1_control.generator.styles import style_id
+    from g1_control.motion.library import MotionLibrary, default_library_dir
+
+    lib = MotionLibrary(library_root or default_library_dir())
+    clips = lib.clips(split)
+    return [clip_features(c) for c in clips], [style_id(c.style) for c in clips]
 
 
 def matrix_to_quat(rot: np.ndarray) -> np.ndarray:

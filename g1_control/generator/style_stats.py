@@ -46,6 +46,7 @@ def compute_style_stats(clips) -> dict:
             k = int(np.argmin(h))
             if best is None or h[k] < best[0]:
                 best = (h[k], c, k)
+        assert best is not None  # lift has at least one clip
         _, c, k = best
         out["lift"]["grasp_pose_rad"] = c.joint_pos_rad[k].tolist()
         out["lift"]["grasp_pelvis_height_m"] = float(c.root_pos_w_m[k, 2])

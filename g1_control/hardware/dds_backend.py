@@ -25,11 +25,12 @@ class UnitreeDDSBackend(LinkBackend):
         self.release_motion_service = release_motion_service
         self.motion_service_timeout_s = motion_service_timeout_s
         self.released_modes: list[str] = []
-        super().__init__(DdsLink("host", interface, domain_id, partition=partition), **kwargs)
+        self._dds = DdsLink("host", interface, domain_id, partition=partition)
+        super().__init__(self._dds, **kwargs)
 
     def reset(self) -> RobotState:
         if self.release_motion_service:
-            link: DdsLink = self.link  # type: ignore[assignment]
+            link = self._dds  # self.link, typed as the DDS link it is
             self.released_modes = release_motion_service(link._participant, link.partition,
                                                          timeout_s=self.motion_service_timeout_s)
         return super().reset()

@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 import math
 import xml.etree.ElementTree as ET
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -40,9 +41,13 @@ def foot_contact_points() -> dict[str, list[tuple[np.ndarray, float]]]:
             if sphere is None:
                 continue
             origin = col.find("origin")
-            xyz = np.array([float(v) for v in (origin.get("xyz") if origin is not None else "0 0 0").split()])
+            radius = sphere.get("radius")
+            if radius is None:
+                raise InvalidFrameError(f"the G1 URDF has a collision sphere without a radius on {name}")
+            # URDF: an <origin> without xyz is at the link origin.
+            xyz = np.array([float(v) for v in (origin.get("xyz", "0 0 0") if origin is not None else "0 0 0").split()])
             xyz.setflags(write=False)  # shared by every caller (cached)
-            points.setdefault(name, []).append((xyz, float(sphere.get("radius"))))
+            points.setdefault(name, []).append((xyz, float(radius)))
     missing = [b for b in g1.FOOT_BODIES if b not in points]
     if missing:
         raise InvalidFrameError(f"the G1 URDF has no collision spheres on {missing}; expected four per foot")
@@ -93,8 +98,9 @@ class Configuration:
         self.nq, self.nv = self.model.nq, self.model.nv
         self._frame_ids: dict[str, int] = {}
         self._support_masks: dict[tuple[int, ...], np.ndarray] = {}
-        self.layout_cache: dict[tuple, object] = {}
-        """Per-task-set data (row layouts) that tasks keep between ticks; keyed by the tasks."""
+        self.layout_cache: dict[tuple, Any] = {}
+        """Per-task-set data (row layouts) that tasks keep between ticks; keyed by the tasks. The values
+        are the tasks' own (g1_control/ik/tasks/frame_task.py: _Layout)."""
         self._com_w_m = np.zeros(3)
         self._com_jacobian = np.zeros((3, self.nv))
         self._com_valid = False

@@ -18,11 +18,12 @@ compare the two, and both against finite differences.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numba
 import numpy as np
 
-_NJIT = {"cache": True, "nogil": True, "error_model": "numpy"}
+_NJIT: dict[str, Any] = {"cache": True, "nogil": True, "error_model": "numpy"}
 
 
 @numba.njit(**_NJIT)

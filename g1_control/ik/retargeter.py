@@ -183,6 +183,7 @@ class IKRetargeter(Retargeter):
                     raise InvalidReferenceError(f"KinematicReference.{name} has shape {arr.shape}; expected {expected}")
                 if not np.all(np.isfinite(arr)):
                     raise InvalidReferenceError(f"KinematicReference.{name} contains NaN or inf (t = {ref.t_s} s)")
+        assert flat is not None  # a field that does not concatenate has the wrong shape: raised above
         if not flat[3:7].any():
             raise InvalidReferenceError(f"KinematicReference.root_quat_wxyz is zero at t = {ref.t_s} s; "
                                         "expected a unit quaternion (qw qx qy qz)")
@@ -317,7 +318,7 @@ class IKRetargeter(Retargeter):
         return limits
 
     def _soft_contact_tasks(self) -> list[Task]:
-        tasks = []
+        tasks: list[Task] = []
         for contact in self.contacts:
             if contact.active:
                 task = FrameTask(contact.frame, self.config.soft_contact_cost, self.config.soft_contact_cost)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from g1_control.errors import LaunchFileError
 from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, Tracker
@@ -25,6 +26,9 @@ from g1_control.loop.control_loop import ControlLoop
 from g1_control.safety import SafetyConfig, SafetyFilter
 from g1_control.teleop.scripted import Segment, random_timeline
 from g1_control.types import CommandLimits
+
+if TYPE_CHECKING:
+    from g1_control.sim.mujoco_backend import MujocoBackend
 
 CHAIN_STAGES = ("generator", "retargeter", "tracker", "rates", "safety")
 """The parts of `loop.chain` that must be the same in a deploy's dry run and on the robot."""
@@ -83,7 +87,7 @@ def make_generator(launch: LaunchFile, limits: CommandLimits | None = None) -> t
     return make_named(cfg.type, model=cfg.model or None, limits=limits)
 
 
-def make_sim_backend(launch: LaunchFile) -> Backend:
+def make_sim_backend(launch: LaunchFile) -> MujocoBackend:
     if launch.backend.type != "mujoco":
         raise LaunchFileError(f"launch file '{launch.name}' drives a robot (backend.type {launch.backend.type}); "
                               "run it with `g1 deploy`, which checks the robot before anything moves")

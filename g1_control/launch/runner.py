@@ -20,15 +20,20 @@ import signal
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from g1_control.errors import Interrupted
 from g1_control.launch.builder import build_loop, make_sim_backend, timeline_of
+from g1_control.launch.overlay import overlay_lines
 from g1_control.launch.run_folder import RunFolder, interrupt_on_signals
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.teleop.scripted import Segment
+
+if TYPE_CHECKING:
+    from g1_control.sim.mujoco_backend import MujocoBackend
 
 STEADY_STATE_SKIP_S = 2.0
 """Time after a segment starts before its velocity counts as steady state."""
@@ -44,9 +49,12 @@ class SegmentResult:
 
     def error_pct(self) -> tuple[float | None, float | None, float | None]:
         """Relative error per axis where the command is meaningfully non-zero."""
-        return tuple(
-            (100.0 * (a - c) / c) if abs(c) >= 0.1 else None for c, a in zip(self.commanded, self.achieved)
-        )  # type: ignore[return-value]
+
+        def pct(c: float, a: float) -> float | None:
+            return (100.0 * (a - c) / c) if abs(c) >= 0.1 else None
+
+        (c0, c1, c2), (a0, a1, a2) = self.commanded, self.achieved
+        return pct(c0, a0), pct(c1, a1), pct(c2, a2)
 
 
 @dataclass
@@ -131,21 +139,26 @@ def segment_results(log: dict[str, np.ndarray], segments: list[Segment]) -> list
         window = (t >= start + min(STEADY_STATE_SKIP_S, seg.duration_s / 2)) & (t < end)
         mean = achieved[window].mean(axis=0) if window.any() else np.full(3, np.nan)
         out.append(SegmentResult(seg.label or "segment", start, end, (seg.vx_mps, seg.vy_mps, seg.wz_radps),
-                                 tuple(float(x) for x in mean)))
+                                 (float(mean[0]), float(mean[1]), float(mean[2]))))
     return out
 
 
 def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None = None,
-        progress: bool = True, viewer: bool = False) -> RunResult:
-    """Run `launch` to the end (or a fall); write the run folder when `out_root` is given."""
+        progress: bool = True, viewer: bool = False, web_port: int | None = None) -> RunResult:
+    """Run `launch` to the end (or a fall); write the run folder when `out_root` is given, as the run
+    goes (g1_control/launch/run_folder.py), closed on the end, a fall, SIGINT or SIGTERM.
+
+    viewer: the MuJoCo viewer; web_port: the browser view (g1_control/sim/web.py) on that port.
+    """
     segments = timeline_of(launch)
-    loop = build_loop(launch, backend=make_sim_backend(launch))
+    sim = make_sim_backend(launch)
+    loop = build_loop(launch, backend=sim)
     folder = RunFolder.create(Path(out_root), launch) if out_root is not None else None
     if folder is None:
-        return _run_loop(launch, loop, segments, None, progress, viewer)
+        return _run_loop(launch, sim, loop, segments, None, progress, viewer, web_port)
     try:
         with interrupt_on_signals():
-            return _run_loop(launch, loop, segments, folder, progress, viewer, video)
+            return _run_loop(launch, sim, loop, segments, folder, progress, viewer, web_port, video)
     except BaseException as exc:
         if not folder.closed:  # an error before the loop ran, or while closing: say so
             folder.finish("error" if not isinstance(exc, KeyboardInterrupt) else "interrupted",
@@ -153,8 +166,9 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
         raise
 
 
-def _run_loop(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], folder: RunFolder | None,
-              progress: bool, viewer: bool, video: bool | None = None) -> RunResult:
+def _run_loop(launch: LaunchFile, sim: MujocoBackend, loop: ControlLoop, segments: list[Segment],
+              folder: RunFolder | None, progress: bool, viewer: bool, web_port: int | None,
+              video: bool | None = None) -> RunResult:
     if folder is not None:
         folder.attach(loop)
     loop.reset()
@@ -165,7 +179,8 @@ def _run_loop(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], fo
 
         bar = tqdm(total=round(duration, 1), unit="sim s", desc=launch.name, bar_format="{l_bar}{bar}| {n:.1f}/{total} sim s [{elapsed}<{remaining}]")
     ticks_per_update = int(loop.rates.lowlevel_hz)
-    view = _open_viewer(loop) if viewer else None
+    view = _open_viewer(sim) if viewer else None
+    web = _open_web(sim, web_port, launch.name) if web_port is not None else None
 
     def on_tick(i: int) -> None:
         if bar is not None and (i + 1) % ticks_per_update == 0:
@@ -175,8 +190,13 @@ def _run_loop(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], fo
         if view is not None and (i + 1) % 10 == 0 and time.perf_counter() - last_sync[0] > 1 / 30:
             _update_viewer(view, loop)  # at most 30 Hz: sync() waits for the viewer's render
             last_sync[0] = time.perf_counter()
+        if web is not None and (i + 1) % 10 == 0 and time.perf_counter() - last_web[0] > 1 / 25:
+            web.show(sim.data.qpos, "\n".join(": ".join(kv) for kv in zip(*map(str.splitlines,
+                                                                                    overlay_lines(loop)))))
+            last_web[0] = time.perf_counter()
 
     last_sync = [0.0]
+    last_web = [0.0]
     t0 = time.perf_counter()
     stop = (lambda: not view.is_running()) if view is not None else None
     interrupted: KeyboardInterrupt | None = None
@@ -192,6 +212,8 @@ def _run_loop(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], fo
             bar.close()
         if view is not None:
             view.close()
+        if web is not None:
+            web.close()
         loop.input.close()
         loop.backend.close()
     log = folder.close_log(loop) if folder is not None else loop.log.arrays()
@@ -203,14 +225,21 @@ def _run_loop(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], fo
     return result
 
 
-def _open_viewer(loop: ControlLoop):
+def _open_viewer(sim: MujocoBackend):
     from g1_control.sim.viewer import open_viewer
 
-    return open_viewer(loop.backend.model, loop.backend.data)
+    return open_viewer(sim.model, sim.data)
+
+
+def _open_web(sim: MujocoBackend, port: int, title: str):
+    from g1_control.sim.web import WebView
+
+    web = WebView(sim.model, port=port, title=title)
+    print(f"browser view: {web.url}", flush=True)
+    return web
 
 
 def _update_viewer(view, loop: ControlLoop) -> None:
-    from g1_control.launch.overlay import overlay_lines
     from g1_control.sim.viewer import update_viewer
 
     update_viewer(view, *overlay_lines(loop))
@@ -243,10 +272,12 @@ def write_run_folder(result: RunResult, launch: LaunchFile, folder: RunFolder, l
         plot_run(log, result, run_dir / "velocity.png")
     want_video = video if video is not None else (launch.output.video in (True, "auto") and interrupted is None)
     if want_video:
+        from g1_control.launch.overlay import run_overlay_rows
         from g1_control.sim.render import render_video
 
+        overlay = run_overlay_rows(log, result.events, [dataclasses.asdict(s) for s in result.segments])
         backend = render_video(run_dir / "log.npz", run_dir / "video.mp4", launch.output.video_fps,
-                               launch.output.video_size)
+                               launch.output.video_size, overlay=overlay)
         result.video = str(run_dir / "video.mp4") if backend else None
         result.extra["render_backend"] = backend
     if interrupted is not None:

@@ -5,11 +5,12 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
-from g1_control.config import from_dict, read_yaml
+from g1_control.config import apply_overrides, from_dict, read_yaml
 from g1_control.errors import LaunchFileError, SafetyConfigError
 from g1_control.loop.rates import LoopRates
 from g1_control.safety.config import SafetyConfig
@@ -311,12 +312,22 @@ def parse_launch(data, source: str = "<launch>") -> LaunchFile:
         raise LaunchFileError(f"{source}: safety: {exc}") from None
 
 
-def load_launch(path: str | Path) -> LaunchFile:
-    """Read and validate a launch file; raise LaunchFileError naming the file and key on any problem."""
+def load_launch(path: str | Path, overrides: Iterable[str] = ()) -> LaunchFile:
+    """Read and validate a launch file; raise LaunchFileError naming the file and key on any problem.
+
+    `overrides`: dotted `KEY=VALUE` settings (`g1 launch FILE --set tracker.policy=...`), applied
+    before validation, so they pass the same schema (g1_control/config.py:apply_overrides).
+    """
     path = Path(path)
     if not path.is_file():
         raise LaunchFileError(f"{path}: no such launch file")
-    launch = parse_launch(read_yaml(path), str(path))
+    data = read_yaml(path)
+    if overrides:
+        try:
+            data = apply_overrides(data, overrides)
+        except LaunchFileError as exc:
+            raise LaunchFileError(f"{path}: {exc}") from None
+    launch = parse_launch(data, str(path))
     # The tracker's policy must resolve and fit the robot before anything runs.
     from g1_control.trackers.policy_spec import resolve_spec_path
 

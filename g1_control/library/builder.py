@@ -45,12 +45,6 @@ class LibraryConfig:
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
-def default_library_dir() -> Path:
-    from g1_control.assets import cache_dir
-
-    return cache_dir() / "library"
-
-
 def _rollout_job(args) -> tuple[MotionClip | None, dict]:
     from g1_control.generator.styles import ROLLOUT_STYLES
     from g1_control.library.rollouts import RolloutConfig, record_rollout
@@ -61,13 +55,13 @@ def _rollout_job(args) -> tuple[MotionClip | None, dict]:
 
 def _demo_clips(fps: float) -> list[MotionClip]:
     from g1_control.assets import fetch
-    from g1_control.motion.formats.dispatch import load_motion
+    from g1_control.motion.formats.dispatch import load_human_motion
     from g1_control.retarget.mocap import MocapRetargetConfig, MocapRetargeter
 
     root = fetch("holosoma-demo-mocap") / "holosoma_retargeting" / "demo_data"
     out = []
     for path in sorted(root.glob("climb/*/*.npy")) + sorted(root.glob("OMOMO_new/*.pt")):
-        clip = MocapRetargeter(MocapRetargetConfig(fps=fps)).retarget(load_motion(str(path)))
+        clip = MocapRetargeter(MocapRetargetConfig(fps=fps)).retarget(load_human_motion(str(path)))
         clip.style = "climb" if "climb" in str(path) else "lift"
         clip.source = path.stem
         clip.tags = ("demo", "retargeted")

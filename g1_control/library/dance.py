@@ -1,4 +1,4 @@
-"""The 131 s dance clip stored inside holosoma's WBT policy (FACTS.md), as a MotionClip.
+"""The 131 s dance clip stored inside holosoma's WBT policy (docs/robot_facts.md), as a MotionClip.
 
 The ONNX graph holds the reference motion as constants indexed by its `time_step` input
 (policy steps at 50 Hz); its outputs joint_pos, ref_pos_xyz and ref_quat_xyzw are the
@@ -14,7 +14,7 @@ import numpy as np
 
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.exceptions import MotionFormatError
-from g1_control.motion.resample import interpolate_positions, interpolate_quaternions
+from g1_control.motion.interpolation import interpolate_positions, interpolate_quaternions
 from g1_control.robot import g1
 
 POLICY_RATE_HZ = 50.0
@@ -43,7 +43,9 @@ def extract_dance(onnx_path: str | Path | None = None, fps: float = 30.0) -> Mot
                                 f"outputs {sorted(needed)}; has {sorted(names)})")
     obs_in = sess.get_inputs()[0]
     obs = np.zeros((1, int(obs_in.shape[1])), np.float32)
-    joints, pos, quat_xyzw = [], [], []
+    joints: list[np.ndarray] = []
+    pos: list[np.ndarray] = []
+    quat_xyzw: list[np.ndarray] = []
     for step in range(MAX_STEPS):
         j, p, q = sess.run(["joint_pos", "ref_pos_xyz", "ref_quat_xyzw"],
                            {obs_in.name: obs, "time_step": np.array([[step]], np.float32)})

@@ -3,7 +3,7 @@ per rollout, recorded as MotionClips.
 
 The loop is the project's own, built from a launch file like every other (MuJoCo in lockstep,
 the velocity generator with the style's pose, holosoma's loco policy, the safety filter), so the recorded motion is what the robot's physics and policy produce: real gait
-timing, foot contacts and the ~80 % speed response (FACTS.md), not an idealized gait. Frames
+timing, foot contacts and the ~80 % speed response (docs/robot_facts.md), not an idealized gait. Frames
 after a fall are dropped.
 """
 
@@ -17,7 +17,7 @@ from g1_control.generator.styles import ROLLOUT_STYLES, UpperBodyStyle
 from g1_control.launch.builder import build_loop, timeline_of
 from g1_control.launch.schema import LaunchFile
 from g1_control.motion.clip import MotionClip
-from g1_control.motion.resample import interpolate_positions, interpolate_quaternions
+from g1_control.motion.interpolation import interpolate_positions, interpolate_quaternions
 from g1_control.teleop.scripted import RandomTimelineConfig
 
 
@@ -69,13 +69,14 @@ def record_rollout(style: UpperBodyStyle, config: RolloutConfig) -> tuple[Motion
     log = loop.log.arrays()
     loop.backend.close()
     valid = ~np.isnan(log["base_pos_m"][:, 0])
-    if loop.faulted:
+    trip = loop.safety.trip_event  # not None exactly when loop.faulted
+    if trip is not None:
         # Damped frames are not motion anyone commanded; before a fall, the last 2 s were
         # already a loss of balance.
-        valid &= log["t_s"] < loop.safety.trip_event.t_s - (2.0 if loop.fell else 0.0)
+        valid &= log["t_s"] < trip.t_s - (2.0 if loop.fell else 0.0)
     n = int(np.argmin(valid)) if not valid.all() else len(valid)
     info = {"style": style.name, "seed": config.seed, "fell": bool(loop.fell),
-            "fault": loop.safety.trip_event.kind.value if loop.faulted else None, "recorded_s": float(n / 50.0),
+            "fault": trip.kind.value if trip is not None else None, "recorded_s": float(n / 50.0),
             "commands": segments}
     if n < 60:
         return None, info

@@ -3,6 +3,7 @@ guard -> low-level stream, as scheduler stages at their own rates (see scheduler
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -15,9 +16,9 @@ from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, T
 from g1_control.loop.rates import LoopRates
 from g1_control.loop.scheduler import Scheduler, Stage
 from g1_control.robot import g1
-from g1_control.rotations import quat_to_rot, tilt_rad, yaw_of
+from g1_control.rotations import quat_to_rot_rows, tilt_rad, yaw_of
 from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter
-from g1_control.types import Button, Command, RobotState
+from g1_control.types import Button, Command, JointReference, KinematicReference, RobotState
 
 
 @dataclass
@@ -124,12 +125,14 @@ class ControlLoop:
             Stage("retargeter", r.tracker_hz, self._retarget),
             Stage("tracker", r.tracker_hz, self._track),
             Stage("safety", r.tracker_hz, self._safety),
-            Stage("lowlevel", r.lowlevel_hz, self._lowlevel),
+            Stage("lowlevel", r.lowlevel_hz, self._lowlevel, batch=self._lowlevel_ticks if backend.lockstep else None),
             Stage("log", r.tracker_hz, self._log),
         ]
         self.scheduler = Scheduler(r.lowlevel_hz, stages, wallclock=wallclock)
-        self._kin_ref = None
-        self._joint_ref = None
+        # The latest generator and retargeter outputs (None before their first tick: within a tick the
+        # stages run in the order listed above, so each is set before the next stage reads it).
+        self._kin_ref: KinematicReference | None = None
+        self._joint_ref: JointReference | None = None
         self._state_tick = -1
         self._misses_seen = 0
         self.safety.on_event = self._on_safety_event
@@ -216,6 +219,7 @@ class ControlLoop:
         self._kin_ref = self.generator.update(self.command, self.state)
 
     def _retarget(self) -> None:
+        assert self._kin_ref is not None  # the generator stage ran first
         self._joint_ref = self.retargeter.solve(self._kin_ref, self.state.q_rad)
 
     def _track(self) -> None:
@@ -224,6 +228,7 @@ class ControlLoop:
         state = self._read_state()
         if state is None:
             return
+        assert self._joint_ref is not None  # the retargeter stage ran first
         self._tracker_command = self.tracker.act(self._joint_ref, state)
 
     def _safety(self) -> None:
@@ -245,9 +250,14 @@ class ControlLoop:
         self.motor_command = self.safety.damping()
 
     def _lowlevel(self) -> None:
-        self.backend.write_command(self.motor_command)
         if self.backend.lockstep:
-            self.backend.step(self.scheduler.dt_s)
+            self.backend.step_ticks(self.motor_command, self.scheduler.dt_s, 1)  # write_command, then step
+        else:
+            self.backend.write_command(self.motor_command)
+
+    def _lowlevel_ticks(self, n: int) -> None:
+        """n low-level ticks in a row with nothing else due (lockstep; see loop/scheduler.py)."""
+        self.backend.step_ticks(self.motor_command, self.scheduler.dt_s, n)
 
     def _log(self) -> None:
         log = self.log
@@ -258,20 +268,23 @@ class ControlLoop:
             log.flush()
             i = 0
         s, est = self.state, self.estimator.estimate
+        quat = s.imu_quat_wxyz
         log.t_s[i] = self.time_s
-        log.command[i] = (self.command.vx_mps, self.command.vy_mps, self.command.wz_radps)
+        command = log.command[i]
+        command[:] = (self.command.vx_mps, self.command.vy_mps, self.command.wz_radps)
         policy_command = self.tracker.policy_command
-        log.policy_command[i] = log.command[i] if policy_command is None else policy_command
+        log.policy_command[i] = command if policy_command is None else policy_command
         log.velocity_est[i] = est.heading_velocity
-        yaw = yaw_of(s.imu_quat_wxyz)
+        yaw = yaw_of(quat)
         log.yaw_rad[i] = yaw
-        log.base_quat_wxyz[i] = s.imu_quat_wxyz
-        log.tilt_rad[i] = tilt_rad(s.imu_quat_wxyz)
+        log.base_quat_wxyz[i] = quat
+        log.tilt_rad[i] = tilt_rad(quat)
         if s.base_linvel_w_mps is not None:
-            c, sn = np.cos(yaw), np.sin(yaw)
-            v = s.base_linvel_w_mps
-            wz = (quat_to_rot(s.imu_quat_wxyz) @ s.imu_gyro_radps)[2]
-            log.velocity_true[i] = (c * v[0] + sn * v[1], -sn * v[0] + c * v[1], wz)
+            c, sn = math.cos(yaw), math.sin(yaw)
+            vx, vy, _ = s.base_linvel_w_mps.tolist()
+            r2, (gx, gy, gz) = quat_to_rot_rows(quat)[2], s.imu_gyro_radps.tolist()
+            wz = r2[0] * gx + r2[1] * gy + r2[2] * gz  # world yaw rate
+            log.velocity_true[i] = (c * vx + sn * vy, -sn * vx + c * vy, wz)
             log.base_pos_m[i] = s.base_pos_w_m
         log.q_rad[i] = s.q_rad
         log.q_target_rad[i] = self.motor_command.q_rad

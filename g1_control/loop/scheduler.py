@@ -5,10 +5,15 @@ ticks that are a multiple of its period, in the order the stages were given, so 
 "input, estimator, generator, tracker, safety, low-level" when all are due. The same code runs
 in lockstep (as fast as possible; the backend advances simulated time) and in wall-clock mode
 (each tick waits for its deadline). A tick that ends after its deadline is a deadline miss.
+
+In lockstep, ticks on which only the one every-tick stage is due (the low-level stream between
+tracker ticks) run as one call of that stage's `batch(n)` when it has one: n ticks of the stage
+with nothing in between, so the result is the same (a simulator steps its physics n times at once).
 """
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -22,6 +27,8 @@ class Stage:
     rate_hz: float
     fn: Callable[[], None]
     period_ticks: int = 0
+    batch: Callable[[int], None] | None = None
+    """Optional: run the stage for n consecutive ticks in one call (lockstep only; see the module doc)."""
 
 
 @dataclass
@@ -38,6 +45,15 @@ class StageTimes:
     def add(self, seconds: float) -> None:
         self.samples[self.count % self.capacity] = seconds
         self.count += 1
+
+    def add_repeated(self, seconds: float, n: int) -> None:
+        """`n` calls of `seconds` each (a batch of ticks, timed as a whole)."""
+        start = self.count % self.capacity
+        stop = min(start + n, self.capacity)
+        self.samples[start:stop] = seconds
+        if start + n > stop:
+            self.samples[: min(start + n - stop, self.capacity)] = seconds
+        self.count += n
 
     def summary(self) -> dict[str, float]:
         data = self.samples[: min(self.count, self.capacity)]
@@ -78,6 +94,20 @@ class Scheduler:
         """Ticks that finished more than a whole tick period late (the next tick's deadline passed too)."""
         self._late_since_take = 0.0
         self._t0: float | None = None
+        self._timed = [(s.period_ticks, s.fn, self.times[s.name]) for s in stages]
+        every_tick = [s for s in stages if s.period_ticks == 1]
+        self._batched = every_tick[0] if len(every_tick) == 1 and every_tick[0].batch is not None else None
+        self._others = [s.period_ticks for s in stages if s.period_ticks > 1]
+        # Per phase of the stages' common cycle: how many ticks from it on only the batched stage is due.
+        self._cycle = math.lcm(*self._others) if self._others else 1
+        self._runs: list[int] | None = None
+        if self._others and self._cycle <= 1 << 16:
+            self._runs = [0] * self._cycle
+            due_next = self._cycle  # phase 0 of the next cycle: every stage is due
+            for k in reversed(range(self._cycle)):
+                if any(k % period == 0 for period in self._others):
+                    due_next = k
+                self._runs[k] = due_next - k
 
     @property
     def time_s(self) -> float:
@@ -90,11 +120,11 @@ class Scheduler:
             self._t0 = clock()
         start = clock()
         k = self.tick_index
-        for stage in self.stages:
-            if k % stage.period_ticks == 0:
+        for period, fn, times in self._timed:
+            if k % period == 0:
                 s0 = clock()
-                stage.fn()
-                self.times[stage.name].add(clock() - s0)
+                fn()
+                times.add(clock() - s0)
         end = clock()
         self.tick_times.add(end - start)
         if end - start > self.dt_s:
@@ -118,15 +148,51 @@ class Scheduler:
         late, self._late_since_take = self._late_since_take, 0.0
         return late
 
+    def _batchable(self, limit: int) -> int:
+        """How many ticks from now (at most `limit`) only the batched stage is due on."""
+        if self._batched is None or self.wallclock:
+            return 0
+        k = self.tick_index
+        if self._runs is not None:
+            return min(self._runs[k % self._cycle], limit)
+        n = limit
+        for period in self._others:
+            n = min(n, -k % period)
+        return n
+
+    def _run_batch(self, n: int) -> None:
+        stage = self._batched
+        assert stage is not None and stage.batch is not None  # _batchable() said so
+        clock = self.clock
+        if self._t0 is None:
+            self._t0 = clock()
+        start = clock()
+        stage.batch(n)
+        end = clock()
+        each = (end - start) / n
+        self.times[stage.name].add_repeated(each, n)
+        self.tick_times.add_repeated(each, n)
+        if each > self.dt_s:
+            self.overruns += n
+        self.tick_index += n
+
     def run(self, n_ticks: int, stop: Callable[[], bool] | None = None,
             progress: Callable[[int], None] | None = None) -> int:
         """Run up to `n_ticks` ticks; returns how many ran (fewer when `stop()` turns true)."""
-        for i in range(n_ticks):
+        i = 0
+        while i < n_ticks:
             if stop is not None and stop():
                 return i
-            self.tick()
+            n = self._batchable(n_ticks - i)
+            if n > 1:
+                self._run_batch(n)
+            else:
+                n = 1
+                self.tick()
             if progress is not None:
-                progress(i)
+                for j in range(i, i + n):
+                    progress(j)
+            i += n
         return n_ticks
 
     def report(self) -> dict[str, dict[str, float]]:

@@ -73,11 +73,11 @@ def concatenate(clips: Sequence[MotionClip], align_root: bool = True) -> MotionC
         setattr(out, name, np.concatenate([getattr(p, name) for p in parts], axis=0))
     # One object track only when every part handles the same object; otherwise the result has none
     # (a clip has at most one object).
-    objects = [p.object for p in parts]
-    if all(o is not None and o.shape.equals(objects[0].shape) for o in objects):
-        out.object = ObjectTrack(objects[0].shape, np.concatenate([o.pos_w_m for o in objects]),
-                                 np.concatenate([o.quat_wxyz for o in objects]),
-                                 np.concatenate([o.hand_contacts for o in objects]))
+    tracks = [p.object for p in parts if p.object is not None]
+    if len(tracks) == len(parts) and all(o.shape.equals(tracks[0].shape) for o in tracks):
+        out.object = ObjectTrack(tracks[0].shape, np.concatenate([o.pos_w_m for o in tracks]),
+                                 np.concatenate([o.quat_wxyz for o in tracks]),
+                                 np.concatenate([o.hand_contacts for o in tracks]))
     else:
         out.object = None
     scene: list = []  # every part's shapes where that part put them (shared ones once)

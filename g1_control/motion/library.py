@@ -18,6 +18,13 @@ INDEX_NAME = "index.json"
 SPLITS = ("train", "test")
 
 
+def default_library_dir() -> Path:
+    """Where `g1 library build` writes the library and its readers look by default."""
+    from g1_control.assets import cache_dir
+
+    return cache_dir() / "library"
+
+
 class LibraryError(G1ControlError):
     """A motion library that is missing, stale or malformed."""
 
@@ -68,7 +75,7 @@ class MotionLibrary:
         return sorted({e.style for e in self.entries})
 
     def summary(self) -> str:
-        rows = {}
+        rows: dict[str, dict[str, list[int]]] = {}
         for e in self.entries:
             r = rows.setdefault(e.style, {"train": [0, 0], "test": [0, 0]})
             r[e.split][0] += 1

@@ -99,6 +99,10 @@ class ObjectShape:
             self.planes, other.planes)
 
 
+_NO_CONTACTS = np.zeros((0, 2), dtype=bool)
+"""ObjectTrack.hand_contacts not given (the default): no hand at the object in any frame."""
+
+
 @dataclass(eq=False)
 class ObjectTrack:
     shape: ObjectShape
@@ -106,13 +110,13 @@ class ObjectTrack:
     """(T, 3) object origin in the world."""
     quat_wxyz: np.ndarray
     """(T, 4) object orientation in the world."""
-    hand_contacts: np.ndarray = field(default=None)  # type: ignore[assignment]
-    """(T, 2) bool (left, right hand): the source motion's hand is at the object."""
+    hand_contacts: np.ndarray = field(default_factory=lambda: _NO_CONTACTS)
+    """(T, 2) bool (left, right hand): the source motion's hand is at the object (default: never)."""
 
     def __post_init__(self) -> None:
         self.pos_w_m = np.asarray(self.pos_w_m, dtype=float)
         self.quat_wxyz = np.asarray(self.quat_wxyz, dtype=float)
-        if self.hand_contacts is None:
+        if self.hand_contacts is _NO_CONTACTS or self.hand_contacts is None:
             self.hand_contacts = np.zeros((self.pos_w_m.shape[0], 2), dtype=bool)
         self.hand_contacts = np.asarray(self.hand_contacts, dtype=bool)
 
@@ -162,7 +166,7 @@ class ObjectTrack:
                            self.hand_contacts.copy())
 
     def resampled(self, fps: float, times_s: np.ndarray) -> ObjectTrack:
-        from g1_control.motion.resample import interpolate_positions, interpolate_quaternions
+        from g1_control.motion.interpolation import interpolate_positions, interpolate_quaternions
 
         nearest = np.clip(np.rint(times_s * fps).astype(int), 0, self.num_frames - 1)
         return ObjectTrack(self.shape, interpolate_positions(self.pos_w_m, fps, times_s),

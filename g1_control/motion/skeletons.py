@@ -146,9 +146,10 @@ def skeleton_for_count(count: int) -> Skeleton | None:
     return None
 
 
-def load_joint_map(path: str | Path) -> Skeleton:
+def read_joint_map(path: str | Path) -> Skeleton:
     """A skeleton from a JSON joint map: {"joints": [...], "frame_map": {human: g1_frame}, "pelvis": ...,
-    "left_hip": ..., ... (every Skeleton field)}. Unknown joints or G1 frames are refused."""
+    "left_hip": ..., ... (every Skeleton field)}. Unknown joints are refused; whether the G1 frames
+    exist is checked by the retargeter's loader (g1_control/retarget/mocap.py: load_joint_map)."""
     path = Path(path)
     try:
         raw = json.loads(path.read_text())
@@ -161,10 +162,4 @@ def load_joint_map(path: str | Path) -> Skeleton:
     skeleton = Skeleton(name=raw.get("name", path.stem), joints=tuple(raw["joints"]), frame_map=dict(raw["frame_map"]),
                         **{f: raw[f] for f in fields if f not in ("joints", "frame_map")},
                         default_height_m=raw.get("default_height_m"))
-    from g1_control.ik.configuration import Configuration
-
-    conf = Configuration()
-    bad = [f for f in skeleton.frame_map.values() if not conf.model.existFrame(f)]
-    if bad:
-        raise UnknownJointError(f"{path}: joint map targets G1 frames that do not exist: {bad}")
     return skeleton.validate(str(path))

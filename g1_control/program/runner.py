@@ -251,7 +251,8 @@ class ProgramRunner:
     def _height(self, step: Height) -> float | None:
         if step.pelvis_height_m is not None:
             return step.pelvis_height_m
-        return self.config.posture_height_m[step.posture]  # type: ignore[index]
+        assert step.posture is not None  # a valid Height has exactly one of the two
+        return self.config.posture_height_m[step.posture]
 
     def _begin(self, leaf: _Leaf, now_s: float, p: ProgramProgress) -> _Active:
         a = _Active(leaf, now_s, p)
@@ -288,7 +289,8 @@ class ProgramRunner:
 
     def _place_xy(self, name: str, where: str) -> tuple[np.ndarray, float]:
         if name == START:
-            return self._start_xy.copy(), 0.0  # type: ignore[union-attr]
+            assert self._start_xy is not None  # set on the first tick, before any step begins
+            return self._start_xy.copy(), 0.0
         lm = self.world.get(name, where)
         return lm.pos_w_m[:2].copy(), lm.stop_distance_m()
 
@@ -300,7 +302,8 @@ class ProgramRunner:
         target_w = None
         if name is not None:
             if name == START:
-                target_w = np.array([*self._start_xy, 0.0])  # type: ignore[misc]
+                assert self._start_xy is not None  # set on the first tick, before any step begins
+                target_w = np.array([*self._start_xy, 0.0])
             else:
                 target_w = self.world.get(name, where).pos_w_m.copy()
         offset_b = None
@@ -325,7 +328,8 @@ class ProgramRunner:
             return sign * t.angle_rad - a.turned
         if t.heading_rad is not None:
             return wrap_angle(t.heading_rad - p.yaw_rad)
-        tx, ty = self._place_xy(t.target, f"step {a.leaf.label} (turn)")[0]  # type: ignore[arg-type]
+        assert t.target is not None  # a valid Turn has an angle, a heading or a target
+        tx, ty = self._place_xy(t.target, f"step {a.leaf.label} (turn)")[0]
         return wrap_angle(math.atan2(ty - p.y_m, tx - p.x_m) - p.yaw_rad)
 
     def _tick(self, a: _Active, step: Step, now_s: float, p: ProgramProgress):
@@ -383,7 +387,7 @@ class ProgramRunner:
         speed = step.speed_mps or cfg.walk_speed_mps[step.direction]
         pos = np.array([p.x_m, p.y_m])
         if step.target is not None:
-            d = a.target_xy - pos  # type: ignore[operator]
+            d = a.target_xy - pos
             dist = float(np.hypot(*d))
             remaining = dist - a.stop_m
             if remaining <= cfg.place_tolerance_m:
@@ -402,7 +406,8 @@ class ProgramRunner:
                 return cmd, (COMPLETED, self._measure(a, step, p))
             v = min(speed, max(cfg.min_speed_mps, cfg.slowdown_gain_per_s * remaining))
         else:
-            if elapsed >= step.duration_s:  # type: ignore[operator]
+            assert step.duration_s is not None  # a valid Walk has a target, a distance or a duration
+            if elapsed >= step.duration_s:
                 return cmd, (COMPLETED, self._measure(a, step, p))
             v = speed
         # velocity in the heading frame along the walk's world direction, heading held

@@ -30,14 +30,15 @@ MAX_REACH_OFFSET_M = 1.0
 MAX_REPEAT = 100
 
 
-def _fmt(x: float) -> str:
-    return f"{x:.3g}"
+def _fmt(x: float | None) -> str:
+    return "?" if x is None else f"{x:.3g}"  # None only on a step that fails validation
 
 
 def _deg(x: float) -> str:
     return f"{math.degrees(x):.3g} deg"
 
 
+@dataclass  # no fields of its own; makes `fields()` of any Step well-typed
 class Step:
     """Base of every step. Subclasses are dataclasses with a class-level `kind`."""
 
@@ -63,7 +64,7 @@ class Step:
     # --- serialisation ----------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {"kind": self.kind}
-        for f in fields(self):  # type: ignore[arg-type]
+        for f in fields(self):
             value = getattr(self, f.name)
             if value is None or (f.default is not MISSING and value == f.default):
                 continue
@@ -104,7 +105,7 @@ class Step:
 
 
 def _required(f) -> bool:
-    return f.default is MISSING and f.default_factory is MISSING  # type: ignore[misc]
+    return f.default is MISSING and f.default_factory is MISSING
 
 
 _STEP_FIELDS = {"main"}

@@ -14,20 +14,22 @@ import dataclasses
 import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 
 from g1_control import rotations as quat
-from g1_control.ik.configuration import sole_depth_m
+from g1_control.ik.configuration import Configuration, sole_depth_m
 from g1_control.ik.exceptions import IKError
 from g1_control.ik.retargeter import IKConfig, IKRetargeter
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.contacts import stance_from_trajectory
+from g1_control.motion.exceptions import UnknownJointError
 from g1_control.motion.human import HumanMotion
+from g1_control.motion.interpolation import interpolate_positions, resample_times
 from g1_control.motion.objects import ObjectShape, ObjectTrack
-from g1_control.motion.resample import interpolate_positions, resample_times
-from g1_control.motion.skeletons import Skeleton, detect_skeleton
+from g1_control.motion.skeletons import Skeleton, detect_skeleton, read_joint_map
 from g1_control.robot import description, g1
 from g1_control.types import KinematicReference
 
@@ -36,6 +38,17 @@ G1_HEIGHT_M = 1.32
 FALLBACK_HUMAN_HEIGHT_M = 1.75
 LIMBS = ("left_arm", "right_arm", "left_leg", "right_leg")
 HAND_FRAMES = ("left_rubber_hand", "right_rubber_hand")
+
+
+def load_joint_map(path: str | Path) -> Skeleton:
+    """A skeleton from a JSON joint map (g1_control/motion/skeletons.py: read_joint_map) whose G1
+    frames all exist in the IK's model. Unknown joints or G1 frames are refused."""
+    skeleton = read_joint_map(path)
+    conf = Configuration()
+    bad = [f for f in skeleton.frame_map.values() if not conf.model.existFrame(f)]
+    if bad:
+        raise UnknownJointError(f"{path}: joint map targets G1 frames that do not exist: {bad}")
+    return skeleton
 
 
 @dataclass
@@ -178,8 +191,9 @@ def prepare_targets(motion: HumanMotion, skeleton: Skeleton, config: MocapRetarg
     if motion.object is not None:
         track = motion.object.resampled(motion.fps, times).scaled(scale)
         hands = [next((h for h, f in skeleton.frame_map.items() if f == frame), None) for frame in HAND_FRAMES]
-        if None not in hands:
-            track.hand_contacts = track.distance(np.stack([p(h) for h in hands], axis=1)) < config.object_contact_m
+        found = [h for h in hands if h is not None]
+        if len(found) == len(hands):
+            track.hand_contacts = track.distance(np.stack([p(h) for h in found], axis=1)) < config.object_contact_m
     scene = tuple(shape.scaled(scale) for shape in motion.scene)
     return PreparedTargets(config.fps, keypoints, root, pelvis_rot, torso_rot, foot_rot, contacts, scale, track,
                            scene)
@@ -224,7 +238,7 @@ class MocapRetargeter:
         )
 
     def retarget(self, motion: HumanMotion, skeleton: Skeleton | None = None,
-                 progress: Callable[[int], None] | None = None) -> MotionClip:
+                 progress: Callable[[int], object] | None = None) -> MotionClip:
         motion.validate()
         skeleton = skeleton or detect_skeleton(motion.joint_names, motion.source)
         skeleton = skeleton.validate(motion.source)

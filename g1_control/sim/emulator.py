@@ -101,7 +101,7 @@ class Gantry(Backend):
         """lower_on_policy: take the gantry away when the policy takes over, as the operator lowers
         the robot onto its feet: when stiff leg targets that were held still for at least
         `held_before_policy_s` (the deploy's hold) start to move (the policy's first actions). A
-        plain PD hold on the floor falls (FACTS.md), so the gantry must carry the robot until then."""
+        plain PD hold on the floor falls (docs/robot_facts.md), so the gantry must carry the robot until then."""
         from g1_control.sim.mujoco_backend import MujocoBackend
 
         if not isinstance(inner, MujocoBackend):
@@ -123,6 +123,7 @@ class Gantry(Backend):
 
     def reset(self) -> RobotState:
         state = self.inner.reset()
+        assert state.base_pos_w_m is not None  # MuJoCo states carry the ground-truth base pose
         self.anchor = state.base_pos_w_m.copy()
         return state
 

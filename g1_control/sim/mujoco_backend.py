@@ -1,7 +1,17 @@
 """MuJoCo backend: the G1 scene under the robot's own motor law.
 
 The latest MotorCommand is applied through the driver law (g1_control.sim.motor_law) at every
-physics step, as the robot's drivers do between host commands. State comes out as the robot
+physics step, as the robot's drivers do between host commands. MuJoCo evaluates the law itself:
+each joint's actuator is a general actuator with an affine bias,
+
+    force = b0 + b1 * q + b2 * dq,   b0 = tau_ff + kp * q* + kd * dq*,  b1 = -kp,  b2 = -kd,
+
+clamped to the joint's effort limit (forcerange), so a physics step is one mj_step and writing a
+command only rewrites the bias parameters. A disabled motor gets zero parameters (no torque).
+The integrator is semi-implicit Euler: implicitfast would integrate the actuators' kd term
+implicitly, which the drivers (and motor_law.py, evaluated once per physics step) do not; the
+scene has no joint damping, so Euler is what implicitfast computed when the law ran in Python.
+tests/sim/test_mujoco_motor_law.py holds both to motor_law.py. State comes out as the robot
 reports it (IMU quaternion/gyro/accelerometer at the pelvis, joint q/dq/tau), plus ground truth
 that only a simulator has (base position and velocity), for tests and logs.
 
@@ -18,8 +28,23 @@ import numpy as np
 
 from g1_control.interfaces import Backend
 from g1_control.robot import description, g1
-from g1_control.sim.motor_law import motor_torque
 from g1_control.types import MotorCommand, RobotState
+
+
+def motor_law_scene(physics_dt_s: float) -> mujoco.MjSpec:
+    """The G1 scene (robot/description.py) with the drivers' motor law in its actuators (see above)."""
+    spec = description.mujoco_spec(timestep_s=physics_dt_s)
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    for i, name in enumerate(g1.JOINT_NAMES):
+        actuator = spec.actuator(name.removesuffix("_joint"))
+        actuator.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+        actuator.gainprm[0] = 0.0  # ctrl unused: the whole law sits in the bias
+        actuator.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+        actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+        actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        limit = float(g1.EFFORT_LIMIT_NM[i])
+        actuator.forcerange = [-limit, limit]
+    return spec
 
 
 @dataclass
@@ -36,19 +61,31 @@ class MujocoBackend(Backend):
     def __init__(self, config: MujocoConfig | None = None):
         self.config = config or MujocoConfig()
         self.lockstep = self.config.lockstep
-        self.model = description.mujoco_spec(timestep_s=self.config.physics_dt_s).compile()
+        self.model = self._compile()
         self.data = mujoco.MjData(self.model)
+        self._bias = self.model.actuator_biasprm[:, :3]
+        """(b0, b1, b2) per joint: a view into the model, rewritten by write_command."""
+        self._law = np.zeros((3, g1.NUM_JOINTS))
         self._command = MotorCommand.damping(g1.KD_DEFAULT)
-        self._tau = np.zeros(g1.NUM_JOINTS)
+        self.write_command(self._command)
         self._tick = 0
         adr = self.model.sensor_adr
         self._gyro = slice(adr[self.model.sensor("imu_gyro").id], adr[self.model.sensor("imu_gyro").id] + 3)
         self._acc = slice(adr[self.model.sensor("imu_acc").id], adr[self.model.sensor("imu_acc").id] + 3)
         self._quat = slice(adr[self.model.sensor("imu_quat").id], adr[self.model.sensor("imu_quat").id] + 4)
+        # What read_state reports, as views into MjData's arrays (MuJoCo keeps them in place).
+        d = self.data
+        self._views = (d.qpos[7:], d.qvel[6:], d.actuator_force, d.sensordata[self._quat], d.sensordata[self._gyro],
+                       d.sensordata[self._acc], d.qpos[0:3], d.qvel[0:3])
+        self._temperature = np.full(g1.NUM_JOINTS, float(self.config.motor_temperature_c))
         self._push_force_w = np.zeros(3)
         self._push_until_s = -1.0
+        self._pushing = False
         self._push_body = self.model.body(g1.BASE_BODY).id
         self.closed = False
+
+    def _compile(self) -> mujoco.MjModel:
+        return motor_law_scene(self.config.physics_dt_s).compile()
 
     # -- Backend ---------------------------------------------------------------------------------
     def reset(self, q_rad: np.ndarray | None = None, base_pos_xy_m=(0.0, 0.0), yaw_rad: float = 0.0) -> RobotState:
@@ -66,48 +103,71 @@ class MujocoBackend(Backend):
             if self.model.geom_conaffinity[i] and self.model.geom_bodyid[i] != 0
         )
         self.data.qpos[2] += -lowest + self.config.init_height_clearance_m
-        self._command = MotorCommand(q_rad=q.copy(), kp=g1.KP_DEFAULT.copy(), kd=g1.KD_DEFAULT.copy())
+        self.write_command(MotorCommand(q_rad=q.copy(), kp=g1.KP_DEFAULT.copy(), kd=g1.KD_DEFAULT.copy()))
         self._tick = 0
         self._push_until_s = -1.0
+        self._pushing = False
         mujoco.mj_forward(self.model, self.data)
         return self.read_state()
 
     def read_state(self) -> RobotState:
-        d = self.data
+        q, dq, tau, quat, gyro, acc, pos, vel = self._views
         return RobotState(
-            t_s=float(d.time),
-            q_rad=d.qpos[7:].copy(),
-            dq_radps=d.qvel[6:].copy(),
-            tau_nm=self._tau.copy(),
-            imu_quat_wxyz=d.sensordata[self._quat].copy(),
-            imu_gyro_radps=d.sensordata[self._gyro].copy(),
-            imu_acc_mps2=d.sensordata[self._acc].copy(),
-            motor_temperature_c=np.full(g1.NUM_JOINTS, self.config.motor_temperature_c),
+            t_s=float(self.data.time),
+            q_rad=q.copy(),
+            dq_radps=dq.copy(),
+            tau_nm=tau.copy(),
+            imu_quat_wxyz=quat.copy(),
+            imu_gyro_radps=gyro.copy(),
+            imu_acc_mps2=acc.copy(),
+            motor_temperature_c=self._temperature.copy(),
             mode_machine=g1.G1_29DOF.mode_machine,
             tick=self._tick,
-            base_pos_w_m=d.qpos[0:3].copy(),
-            base_linvel_w_mps=d.qvel[0:3].copy(),
+            base_pos_w_m=pos.copy(),
+            base_linvel_w_mps=vel.copy(),
         )
 
     def write_command(self, command: MotorCommand) -> None:
+        """Hand `command` to the simulated drivers (taken by value, as the robot's link encodes it)."""
         self._command = command
+        law = self._law
+        np.multiply(command.kp, command.q_rad, out=law[0])
+        law[0] += command.kd * command.dq_radps
+        law[0] += command.tau_nm
+        np.negative(command.kp, out=law[1])
+        np.negative(command.kd, out=law[2])
+        if not command.enable.all():
+            law[:, ~command.enable] = 0.0
+        self._bias[:] = law.T
 
     def step(self, dt_s: float) -> None:
-        n = max(1, round(dt_s / self.model.opt.timestep))
-        d = self.data
-        for _ in range(n):
-            motor_torque(self._command, d.qpos[7:], d.qvel[6:], out=self._tau)
-            d.ctrl[:] = self._tau
-            if d.time < self._push_until_s:
-                d.xfrc_applied[self._push_body, :3] = self._push_force_w
-            else:
-                d.xfrc_applied[self._push_body, :3] = 0.0
-            mujoco.mj_step(self.model, d)
+        self._physics_steps(max(1, round(dt_s / self.model.opt.timestep)))
+
+    def step_ticks(self, command: MotorCommand, dt_s: float, n: int) -> None:
+        # Writing the same command again changes nothing here: n ticks are one run of physics steps.
+        # The command last written is not written again: the loop hands on the command it wrote
+        # on the tick before, unchanged (see Backend.step_ticks).
+        if command is not self._command:
+            self.write_command(command)
+        self._physics_steps(n * max(1, round(dt_s / self.model.opt.timestep)))
+
+    def _physics_steps(self, n: int) -> None:
+        m, d = self.model, self.data
         self._tick += n
+        # A push acts on every physics step that starts before it ends.
+        while n > 0 and d.time < self._push_until_s:
+            d.xfrc_applied[self._push_body, :3] = self._push_force_w
+            mujoco.mj_step(m, d)
+            n -= 1
+        if n > 0:
+            if self._pushing:
+                d.xfrc_applied[self._push_body, :3] = 0.0
+                self._pushing = False
+            mujoco.mj_step(m, d, n)
 
     def close(self) -> None:
         # A simulated robot left alone is damped, like the real one after close().
-        self._command = MotorCommand.damping(g1.KD_DEFAULT)
+        self.write_command(MotorCommand.damping(g1.KD_DEFAULT))
         self.closed = True
 
     # -- simulation only ----------------------------------------------------------------------------
@@ -115,6 +175,7 @@ class MujocoBackend(Backend):
         """Apply a force (N, world frame) to the pelvis for `duration_s` from now."""
         self._push_force_w = np.asarray(force_w_n, dtype=float)
         self._push_until_s = self.data.time + duration_s
+        self._pushing = True
 
     @property
     def time_s(self) -> float:

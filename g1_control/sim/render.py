@@ -1,9 +1,13 @@
-"""Headless video of a run: replays logged base pose and joints through MuJoCo's renderer.
+"""Headless video of a run or a clip: replays base pose and joints through MuJoCo's renderer.
 
-Runs in its own process (`python -m g1_control.sim.render LOG.npz OUT.mp4`) because MuJoCo picks
-its OpenGL backend once per process: `render_video` tries EGL, then OSMesa (Debian's
-libosmesa6), and reports which one worked. Without a GPU both render in software; without
-multisampling, shadows and reflections that costs ~0.04 s per 480x360 frame instead of ~1 s.
+Runs in its own process (`python -m g1_control.sim.render TRAJ.npz OUT.mp4`; users call it through
+`g1 launch`, `g1 replay` and `g1 view`) because MuJoCo picks its OpenGL backend once per process:
+`render_video` tries EGL, then OSMesa (Debian's libosmesa6), and reports which one worked.
+Without a GPU both render in software; without multisampling, shadows and reflections that costs
+~0.04 s per 480x360 frame instead of ~1 s.
+
+The trajectory file holds t_s, base_pos_m, base_quat_wxyz and q_rad per row (a run's log.npz is
+one) and optionally `overlay`: one text per row, drawn in the frame's top-left corner.
 """
 
 from __future__ import annotations
@@ -12,15 +16,30 @@ import argparse
 import os
 import subprocess
 import sys
+import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 GL_BACKENDS = ("egl", "osmesa")
+TRAJECTORY_KEYS = ("t_s", "base_pos_m", "base_quat_wxyz", "q_rad")
 
 
-def render_video(log_path: Path, out_path: Path, fps: float = 10.0, size=(480, 360), quiet: bool = False) -> str | None:
-    """Render `log_path` to `out_path`; returns the GL backend used, or None if none works."""
+def render_video(log_path: Path, out_path: Path, fps: float = 10.0, size=(480, 360), quiet: bool = False,
+                 overlay: Sequence[str] | None = None, frame_at_s: float | None = None) -> str | None:
+    """Render the trajectory in `log_path` to `out_path` (MP4); returns the GL backend used, or None
+    if none works. `overlay`: one text per row of the log, drawn on each frame. `frame_at_s`: write
+    only the frame at that time, as a PNG."""
+    if overlay is not None:
+        import numpy as np
+
+        with np.load(log_path) as log, tempfile.TemporaryDirectory(prefix="g1-render-") as tmp:
+            traj = Path(tmp) / "trajectory.npz"
+            np.savez(traj, overlay=np.asarray(list(overlay), dtype=str), **{k: log[k] for k in TRAJECTORY_KEYS})
+            return render_video(traj, out_path, fps, size, quiet, None, frame_at_s)
     cmd = [sys.executable, "-m", "g1_control.sim.render", str(log_path), str(out_path),
            "--fps", str(fps), "--size", str(size[0]), str(size[1])]
+    if frame_at_s is not None:
+        cmd += ["--frame-at", str(frame_at_s)]
     for backend in GL_BACKENDS:
         env = dict(os.environ, MUJOCO_GL=backend, PYOPENGL_PLATFORM=backend)
         # Probe quietly (a missing GL stack fails with a long traceback), then render with progress.
@@ -70,7 +89,27 @@ def _probe(size: tuple[int, int]) -> None:
         renderer.close()
 
 
-def _render(log_path: Path, out_path: Path, fps: float, size: tuple[int, int], quiet: bool) -> None:
+def draw_overlay(frame, text: str):
+    """`frame` (H, W, 3 uint8) with `text` in a dark box in its top-left corner."""
+    import numpy as np
+    from PIL import Image, ImageDraw, ImageFont
+
+    if not text:
+        return frame
+    image = Image.fromarray(frame)
+    draw = ImageDraw.Draw(image, "RGBA")
+    try:
+        font = ImageFont.load_default(size=max(10, frame.shape[0] // 30))
+    except TypeError:  # Pillow < 10.1: one fixed bitmap font
+        font = ImageFont.load_default()
+    _, _, right, bottom = draw.multiline_textbbox((8, 6), text, font=font, spacing=3)
+    draw.rectangle((2, 2, right + 6, bottom + 6), fill=(0, 0, 0, 150))
+    draw.multiline_text((8, 6), text, font=font, fill=(255, 255, 255, 255), spacing=3)
+    return np.asarray(image)
+
+
+def _render(log_path: Path, out_path: Path, fps: float, size: tuple[int, int], quiet: bool,
+            frame_at_s: float | None = None) -> None:
     import imageio.v2 as imageio
     import mujoco
     import numpy as np
@@ -78,6 +117,7 @@ def _render(log_path: Path, out_path: Path, fps: float, size: tuple[int, int], q
 
     log = np.load(log_path)
     t, pos, quat, q = log["t_s"], log["base_pos_m"], log["base_quat_wxyz"], log["q_rad"]
+    overlay = log["overlay"] if "overlay" in log.files else None
     if len(t) == 0 or np.isnan(pos).all():
         raise SystemExit("log has no ground-truth base pose to replay")
     model = _video_model()
@@ -87,33 +127,46 @@ def _render(log_path: Path, out_path: Path, fps: float, size: tuple[int, int], q
     camera.type = mujoco.mjtCamera.mjCAMERA_TRACKING
     camera.trackbodyid = model.body("pelvis").id
     camera.distance, camera.elevation, camera.azimuth = 3.0, -15.0, 135.0
-    frame_times = np.arange(t[0], t[-1], 1.0 / fps)
-    idx = np.searchsorted(t, frame_times).clip(0, len(t) - 1)
+
+    def frame(i: int):
+        data.qpos[:3], data.qpos[3:7], data.qpos[7:] = pos[i], quat[i], q[i]
+        mujoco.mj_forward(model, data)  # also the subtree CoM the tracking camera follows
+        renderer.update_scene(data, camera)
+        _cheap_scene(renderer)
+        image = renderer.render()
+        return draw_overlay(image, str(overlay[i])) if overlay is not None else image
+
     try:
-        with imageio.get_writer(out_path, fps=fps, codec="libx264", quality=7, macro_block_size=8) as writer:
+        if frame_at_s is not None:
+            i = int(np.searchsorted(t, frame_at_s).clip(0, len(t) - 1))
+            imageio.imwrite(out_path, frame(i))
+            return
+        frame_times = np.arange(t[0], t[-1], 1.0 / fps) if len(t) > 1 else t[:1]
+        idx = np.searchsorted(t, frame_times).clip(0, len(t) - 1)
+        # Not `with ... as writer`: imageio's stub types __enter__ as its base class, which has no append_data.
+        writer = imageio.get_writer(out_path, fps=fps, codec="libx264", quality=7, macro_block_size=8)
+        with writer:
             for i in tqdm(idx, desc="render", unit="frame", disable=quiet):
-                data.qpos[:3], data.qpos[3:7], data.qpos[7:] = pos[i], quat[i], q[i]
-                mujoco.mj_forward(model, data)  # also the subtree CoM the tracking camera follows
-                renderer.update_scene(data, camera)
-                _cheap_scene(renderer)
-                writer.append_data(renderer.render())
+                writer.append_data(frame(int(i)))
     finally:
         renderer.close()  # before interpreter exit, or its destructor complains noisily
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description="Render a g1-control run log (log.npz) to MP4, headless.")
+    parser = argparse.ArgumentParser(description="Render a trajectory (a run's log.npz) to MP4, headless "
+                                     "(users: g1 replay RUN, g1 view CLIP).")
     parser.add_argument("log", type=Path)
     parser.add_argument("out", type=Path)
     parser.add_argument("--fps", type=float, default=10.0)
     parser.add_argument("--size", type=int, nargs=2, default=(480, 360), metavar=("W", "H"))
     parser.add_argument("--quiet", action="store_true")
     parser.add_argument("--probe", action="store_true", help="only check that rendering works here")
+    parser.add_argument("--frame-at", type=float, help="write only the frame at this time (s) as an image")
     args = parser.parse_args(argv)
     if args.probe:
         _probe(tuple(args.size))
         return 0
-    _render(args.log, args.out, args.fps, tuple(args.size), args.quiet)
+    _render(args.log, args.out, args.fps, tuple(args.size), args.quiet, args.frame_at)
     return 0
 
 

@@ -200,7 +200,7 @@ class EvdevGamepad(TeleopDevice):
             except InterruptedError:
                 continue
             except OSError as exc:
-                name = errno.errorcode.get(exc.errno, str(exc.errno))
+                name = errno.errorcode.get(exc.errno or 0, str(exc.errno))
                 raise DeviceLost(f"{self.path}: read failed with {name} ({exc.strerror}): unplugged?") from None
             if not chunk:
                 if self._eof_is_loss:
@@ -234,11 +234,11 @@ class EvdevGamepad(TeleopDevice):
         elif self._dropping:
             return
         elif ev_type == ev.EV_KEY:
-            button = self._button_by_code.get(code)
-            if button is not None and value != ev.KEY_REPEAT:
-                self._pending_keys[button] = value == ev.KEY_PRESS
+            mapped = self._button_by_code.get(code)
+            if mapped is not None and value != ev.KEY_REPEAT:
+                self._pending_keys[mapped] = value == ev.KEY_PRESS
                 if value == ev.KEY_PRESS:
-                    self._pending_presses.append(button)
+                    self._pending_presses.append(mapped)
         elif ev_type == ev.EV_ABS:
             if code in HAT_BUTTONS:
                 negative, positive = HAT_BUTTONS[code]

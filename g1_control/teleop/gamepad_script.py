@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from g1_control.errors import LaunchFileError
+from g1_control.interfaces import InputDevice
 from g1_control.teleop import evdev_protocol as ev
 from g1_control.teleop.gamepad import HAT_BUTTONS, XPAD_AXIS_CODES, XPAD_AXIS_RANGES, XPAD_BUTTON_CODES
 from g1_control.teleop.layouts import GAMEPAD_AXES, GAMEPAD_BUTTONS, STICK
@@ -153,7 +154,7 @@ class GamepadScriptFeeder:
         self.close()
 
 
-class ScriptedGamepad:
+class ScriptedGamepad(InputDevice):
     """A gamepad script played through the real evdev reader: an InputDevice whose poll() first
     writes the steps due by `clock()` into the FIFO, then reads them back as a pad would."""
 

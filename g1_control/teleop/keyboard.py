@@ -97,7 +97,8 @@ class TerminalKeyboard(TeleopDevice):
             raise InputDeviceError(
                 f"{where}: keyboard input needs a terminal, but {self.path} is not one "
                 "(run in an interactive shell or ssh -t; pipes and files cannot drive the keyboard device)")
-        self._saved = termios.tcgetattr(fd)
+        self._saved: list | None = termios.tcgetattr(fd)
+        """The terminal's attributes to restore (None once restored)."""
         mode = termios.tcgetattr(fd)
         mode[0] &= ~(termios.IXON | termios.IXOFF | termios.ICRNL | termios.INLCR | termios.IGNCR | termios.ISTRIP)
         mode[3] &= ~(termios.ICANON | termios.ECHO | termios.IEXTEN)
@@ -121,7 +122,7 @@ class TerminalKeyboard(TeleopDevice):
             except InterruptedError:
                 continue
             except OSError as exc:
-                name = errno.errorcode.get(exc.errno, str(exc.errno))
+                name = errno.errorcode.get(exc.errno or 0, str(exc.errno))
                 raise DeviceLost(f"{self.path}: read failed with {name} ({exc.strerror}): terminal closed?") from None
             if not chunk:
                 raise DeviceLost(f"{self.path}: end of input (terminal hung up)")

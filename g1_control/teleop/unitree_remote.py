@@ -67,9 +67,9 @@ class UnitreeRemote(TeleopDevice):
             self._fresh_samples += 1
             self.samples += 1
 
-    def _pull(self) -> None:
+    def _pull(self, source: Callable[[], RobotState | bytes | None]) -> None:
         try:
-            sample = self._source()
+            sample = source()
         except Exception as exc:
             raise DeviceLost(f"state source failed: {type(exc).__name__}: {exc}") from None
         if sample is None:
@@ -89,7 +89,7 @@ class UnitreeRemote(TeleopDevice):
 
     def _read(self) -> InputSnapshot:
         if self._source is not None:
-            self._pull()
+            self._pull(self._source)
         now = self._now_s
         with self._lock:
             # Freshness is judged on the poll's clock, whichever thread fed the sample.

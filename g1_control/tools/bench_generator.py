@@ -97,7 +97,7 @@ def _codebook_floor(train_feats, windows: E.Windows, stats: E.PositionStats, cod
     return E.score_predictions(f"codebook{codes}", F.fix_effectors(truth), windows, stats, 30.0)
 
 
-def _latency(gen_factory, n: int = 300) -> np.ndarray:
+def _latency(gen_factory, n: int = 300) -> tuple[np.ndarray, np.ndarray]:
     from g1_control.types import Command
 
     gen = gen_factory()
@@ -198,15 +198,16 @@ def main(args) -> int:
             print(f"{r.method:<16} {gap:>3} {r.l2p:>7.3f} {r.l2q:>7.3f} {r.npss:>8.5f} {r.skate_mps:>9.3f} {r.penetration:>8.3f}")
             figures["quality"].append(r.__dict__)
         print(f"{'(ground truth)':<16} {gap:>3} {'':>7} {'':>7} {'':>8} {truth[0]:>9.3f} {truth[1]:>8.3f}")
-        b, i, m = rows[2], rows[0], rows[1]
+        b, i, mr = rows[2], rows[0], rows[1]
         print(f"  backbone / interpolation: L2P {b.l2p / i.l2p:.2f}x, L2Q {b.l2q / i.l2q:.2f}x;  "
-              f"backbone / motion matching: L2P {b.l2p / m.l2p:.2f}x, L2Q {b.l2q / m.l2q:.2f}x "
-              f"({'beats both' if b.l2p < min(i.l2p, m.l2p) and b.l2q < min(i.l2q, m.l2q) else 'DOES NOT beat both'})\n")
+              f"backbone / motion matching: L2P {b.l2p / mr.l2p:.2f}x, L2Q {b.l2q / mr.l2q:.2f}x "
+              f"({'beats both' if b.l2p < min(i.l2p, mr.l2p) and b.l2q < min(i.l2q, mr.l2q) else 'DOES NOT beat both'})\n")
     # the root module's duration head: how many frames a transition to this keyframe takes
     errs = []
     for gap, w in windows.items():
         n = min(256, len(w.frames))
         backbone.infill(w.context[:n], w.target[:n], np.ones((n, F.DIM), bool), gap, w.style[:n])
+        assert backbone.last_duration is not None  # infill just set it
         errs.append(np.abs(backbone.last_duration - gap))
     mae = float(np.concatenate(errs).mean())
     figures["duration_mae_frames"] = mae

@@ -124,7 +124,7 @@ def _time_parts(refs) -> dict:
 
 def _time_offline(max_frames: int) -> dict:
     from g1_control.assets import fetch
-    from g1_control.motion.formats.dispatch import load_motion
+    from g1_control.motion.formats.dispatch import load_human_motion
     from g1_control.motion.human import HumanMotion
     from g1_control.retarget.mocap import MocapRetargeter
 
@@ -132,7 +132,7 @@ def _time_offline(max_frames: int) -> dict:
     files = [root / "OMOMO_new/sub3_largebox_003.pt", next(iter(sorted(root.glob("climb/*_0/*.npy"))))]
     frames, ik_s, total_s, cpu_s = 0, 0.0, 0.0, 0.0
     for f in files:
-        motion = load_motion(f)
+        motion = load_human_motion(f)
         keep = int(max_frames * motion.fps / 30.0)
         motion = HumanMotion(motion.positions_w_m[:keep], motion.joint_names, motion.fps, motion.height_m,
                              motion.source)

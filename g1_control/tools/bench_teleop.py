@@ -117,6 +117,7 @@ def _waiters(device, tick_s: float | None):
             select.select([fd], [], [], 5.0)
 
     def tick() -> None:
+        assert tick_s is not None  # called only when ticking
         now = time.monotonic()
         time.sleep(tick_s - now % tick_s)
 

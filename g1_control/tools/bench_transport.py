@@ -36,7 +36,7 @@ def _time_us(fn, budget_s: float, min_runs: int = 3) -> float:
     fn()
     one = max(time.perf_counter() - start, 1e-7)
     batch = max(1, int(0.02 / one))
-    samples = []
+    samples: list[float] = []
     end = time.perf_counter() + budget_s
     while len(samples) < min_runs or time.perf_counter() < end:
         t0 = time.perf_counter()

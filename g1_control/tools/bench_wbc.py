@@ -18,6 +18,8 @@ import json
 import os
 import time
 from pathlib import Path
+from typing import Any
+from unittest import mock
 
 import numpy as np
 
@@ -39,7 +41,7 @@ def main(args) -> int:
     from g1_control.trackers.wbc import tracker as tracker_module
 
     seconds = float(args.seconds)
-    params = {"speed_mps": 0.3, "n_steps": max(2, int((seconds - 2.6) / 0.55))}
+    params: dict[str, Any] = {"speed_mps": 0.3, "n_steps": max(2, int((seconds - 2.6) / 0.55))}
     duration = min(seconds, R.walk(**params).duration_s)
 
     records, problems = [], []
@@ -48,6 +50,7 @@ def main(args) -> int:
         def act(self, reference, state):
             out = super().act(reference, state)
             sol = self.diagnostics.solution
+            assert sol is not None  # None only before the first solved QP
             records.append((self._q.copy(), self._v.copy(), sol.solve_time_s, reference.contacts.copy(),
                             sol.iterations))
             if len(records) % PROBLEM_STRIDE == 0:
@@ -55,12 +58,9 @@ def main(args) -> int:
                 problems.append(tuple(m.copy() for m in (qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u)))
             return out
 
-    original = tracker_module.WholeBodyTracker
-    tracker_module.WholeBodyTracker = Recording
-    try:
+    # build_loop makes the WBC tracker by its name in tracker_module: record through a subclass.
+    with mock.patch.object(tracker_module, "WholeBodyTracker", Recording):
         figures, loop = run_wbc("walk", params, duration_s=duration)
-    finally:
-        tracker_module.WholeBodyTracker = original
     tracker = loop.tracker
     act_times = loop.scheduler.times["tracker"]
     act_samples = act_times.samples[: min(act_times.count, act_times.capacity)]

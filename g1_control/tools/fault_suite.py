@@ -111,10 +111,13 @@ class _Emulator:
             [sys.executable, "-m", "g1_control.cli.main", "sim-robot", "--physics", "mock", "--partition", partition,
              "--control-stdin"], cwd=_ROOT, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
             stderr=subprocess.PIPE, text=True, bufsize=1)
+        stdin, stdout, stderr = self.proc.stdin, self.proc.stdout, self.proc.stderr
+        assert stdin is not None and stdout is not None and stderr is not None  # all three are pipes
+        self._stdin, self._stdout = stdin, stdout
         # stderr is drained on a thread: a full pipe would block the emulator on its next log line.
         self.errors: deque[str] = deque(maxlen=50)
-        threading.Thread(target=lambda: self.errors.extend(self.proc.stderr), daemon=True).start()
-        if self.proc.stdout.readline().strip() != "ready":
+        threading.Thread(target=lambda: self.errors.extend(stderr), daemon=True).start()
+        if stdout.readline().strip() != "ready":
             self.proc.wait(timeout=10)
             raise RuntimeError(f"emulator did not start: {''.join(self.errors)}")
 
@@ -124,9 +127,9 @@ class _Emulator:
 
     def ask(self, word: str) -> dict:
         try:
-            self.proc.stdin.write(word + "\n")
-            self.proc.stdin.flush()
-            line = self.proc.stdout.readline()
+            self._stdin.write(word + "\n")
+            self._stdin.flush()
+            line = self._stdout.readline()
         except OSError as exc:
             line = ""
             self.errors.append(str(exc))
@@ -136,8 +139,8 @@ class _Emulator:
 
     def close(self) -> None:
         try:
-            self.proc.stdin.write("quit\n")
-            self.proc.stdin.flush()
+            self._stdin.write("quit\n")
+            self._stdin.flush()
             self.proc.wait(timeout=10)
         except (OSError, subprocess.TimeoutExpired):
             self.proc.kill()
@@ -188,6 +191,7 @@ def run_signal_fault(sig: str, emulator: _Emulator, partition: str) -> FaultResu
     env = {**os.environ, "PYTHONPATH": str(_ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
     host = subprocess.Popen([sys.executable, "-m", "g1_control.tools.fault_suite", "--host", partition],
                             cwd=_ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert host.stdout is not None and host.stderr is not None  # both opened as pipes just above
     try:
         if host.stdout.readline().strip() != "holding":
             raise RuntimeError(f"host did not start: {host.stderr.read()}")

@@ -42,15 +42,17 @@ def measure(launch: str = "launch/sim2sim.yaml", generator: bool = False) -> dic
     partition = f"g1measure-{os.getpid()}-{uuid.uuid4().hex[:6]}"
     robot = _g1("sim-robot", "--lower-gantry-on-policy", "--partition", partition, "--control-stdin",
                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+    to_robot, from_robot = robot.stdin, robot.stdout
+    assert to_robot is not None and from_robot is not None  # both opened as pipes just above
     host = None
 
     def ask(word: str) -> dict:
-        robot.stdin.write(word + "\n")
-        robot.stdin.flush()
-        return json.loads(robot.stdout.readline())
+        to_robot.write(word + "\n")
+        to_robot.flush()
+        return json.loads(from_robot.readline())
 
     try:
-        if robot.stdout.readline().strip() != "ready":
+        if from_robot.readline().strip() != "ready":
             raise RuntimeError("the emulator did not start")
         with tempfile.TemporaryDirectory() as tmp:
             report_path = Path(tmp) / "deploy.json"
@@ -94,8 +96,8 @@ def measure(launch: str = "launch/sim2sim.yaml", generator: bool = False) -> dic
         if host is not None and host.poll() is None:
             host.kill()
         try:
-            robot.stdin.write("quit\n")
-            robot.stdin.flush()
+            to_robot.write("quit\n")
+            to_robot.flush()
             robot.wait(timeout=10)
         except (OSError, subprocess.TimeoutExpired):
             robot.kill()
@@ -105,4 +107,4 @@ if __name__ == "__main__":
     if "--generator" in sys.argv[1:]:
         print(json.dumps(measure("launch/sim2sim_generator.yaml", generator=True), indent=2))
     else:
-        print(json.dumps(measure(*sys.argv[1:]), indent=2))
+        print(json.dumps(measure(sys.argv[1]) if len(sys.argv) > 1 else measure(), indent=2))

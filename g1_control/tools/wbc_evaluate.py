@@ -18,8 +18,12 @@ import json
 import sys
 import time
 from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING, Literal, cast
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from g1_control.trackers.wbc.tracker import WholeBodyTracker
 
 DEFAULT_TRACKER_HZ = 250.0
 
@@ -54,7 +58,10 @@ HEADER = (f"{'reference':<14} {'ctrl':<6} {'fall':<5} {'sim s':>6} {'joint rms':
           f"{'drift end':>9} {'drift max':>9} {'p50 us':>8} {'p99 us':>8} {'wall s':>7} relaxed/unsolved QPs")
 
 
-def evaluation_launch(reference: str, params: dict | None = None, *, controller: str = "wbc",
+Controller = Literal["wbc", "wbt"]
+
+
+def evaluation_launch(reference: str, params: dict | None = None, *, controller: Controller = "wbc",
                       tracker_hz: float = DEFAULT_TRACKER_HZ, duration_s: float | None = None):
     """The evaluation as a launch file: a scripted reference tracked by the WBC (or the WBT policy
     at its 50 Hz), an idle operator, MuJoCo in lockstep. duration_s: default, the reference's."""
@@ -82,29 +89,35 @@ def evaluation_launch(reference: str, params: dict | None = None, *, controller:
 
 def run_wbc(reference: str, params: dict | None = None, *, tracker_hz: float = DEFAULT_TRACKER_HZ,
             push_n: float = 0.0, push_at_s: float = 2.0, push_s: float = 0.2, duration_s: float | None = None,
-            controller: str = "wbc"):
+            controller: Controller = "wbc"):
     """Run the scripted `reference` (with `params`) with the WholeBodyTracker (or, controller="wbt",
     holosoma's WBT policy at 50 Hz); returns (TrackingFigures, loop)."""
+    from g1_control.generator.scripted import TrajectoryGenerator
     from g1_control.launch.builder import build_loop
+    from g1_control.sim.mujoco_backend import MujocoBackend
 
     loop = build_loop(evaluation_launch(reference, params, controller=controller, tracker_hz=tracker_hz,
                                         duration_s=duration_s))
-    tracker = loop.tracker
+    tracker, generator, sim = loop.tracker, loop.generator, loop.backend
+    # What evaluation_launch asks for: a scripted reference on MuJoCo (build_loop's default backend).
+    assert isinstance(generator, TrajectoryGenerator) and isinstance(sim, MujocoBackend)
     loop.reset()
     push_tick = round(push_at_s * loop.rates.lowlevel_hz)
 
     def on_tick(i: int) -> None:
         if push_n and i == push_tick:
-            loop.backend.push([push_n, 0.0, 0.0], push_s)
+            sim.push([push_n, 0.0, 0.0], push_s)
 
-    duration = loop.generator.trajectory.duration_s if duration_s is None else duration_s
+    duration = generator.trajectory.duration_s if duration_s is None else duration_s
     t0 = time.perf_counter()
     loop.scheduler.run(round(duration * loop.rates.lowlevel_hz), stop=lambda: loop.fell, progress=on_tick)
     wall = time.perf_counter() - t0
-    figures = figures_of(loop.generator.trajectory, loop, controller, wall)
+    figures = figures_of(generator.trajectory, loop, controller, wall)
     if controller == "wbc":
-        figures.qp_failures = tracker.diagnostics.solve_failures
-        figures.qp_unsolved = tracker.diagnostics.unsolved_ticks
+        # What build_loop makes for tracker.type "wbc" (by name at run time: tests and the WBC bench swap it).
+        wbc = cast("WholeBodyTracker", tracker)
+        figures.qp_failures = wbc.diagnostics.solve_failures
+        figures.qp_unsolved = wbc.diagnostics.unsolved_ticks
     return figures, loop
 
 
@@ -167,7 +180,8 @@ def main(argv: list[str] | None = None) -> int:
     print(HEADER)
     for name in args.references:
         params = {"duration_s": args.stand_seconds} if name == "stand" else {}
-        for controller in ("wbc", "wbt") if args.compare_wbt else ("wbc",):
+        controllers: tuple[Controller, ...] = ("wbc", "wbt") if args.compare_wbt else ("wbc",)
+        for controller in controllers:
             figures, _ = run_wbc(name, params, tracker_hz=args.tracker_hz, push_n=50.0 if args.push else 0.0,
                                  controller=controller)
             if args.push:

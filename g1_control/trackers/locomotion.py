@@ -4,11 +4,12 @@ velocity correction.
 The reference's root velocity (heading frame) is the command. When the reference sets
 `upper_body_override`, waist and arm targets come from the reference while the policy keeps
 balancing with the legs. The correction closes the loop on the estimated base velocity, because
-the bare holosoma policies reach only ~80 % of the commanded speed (FACTS.md).
+the bare holosoma policies reach only ~80 % of the commanded speed (docs/robot_facts.md).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,9 +43,10 @@ class VelocityCorrector:
     def __init__(self, config: VelocityCorrectionConfig, dt_s: float):
         self.config = config
         self.dt_s = dt_s
-        self._ff = np.array(config.feedforward)
-        self._ki = np.array(config.ki)
-        self._limit = np.array(config.integral_limit)
+        self._ff = tuple(float(v) for v in config.feedforward)
+        self._ki = tuple(float(v) for v in config.ki)
+        self._limit = tuple(float(v) for v in config.integral_limit)
+        self._alpha = dt_s / (config.velocity_filter_tau_s + dt_s)
         self.integral = np.zeros(3)
         self.v_filtered = np.zeros(3)
 
@@ -56,12 +58,21 @@ class VelocityCorrector:
         """cmd and v_est are (vx, vy, wz) in the heading frame."""
         if not self.config.enabled or v_est is None:
             return cmd
-        alpha = self.dt_s / (self.config.velocity_filter_tau_s + self.dt_s)
-        self.v_filtered += alpha * (v_est - self.v_filtered)
-        moving = np.abs(cmd) > 0.05
-        self.integral = np.where(moving, self.integral + (cmd - self.v_filtered) * self.dt_s * self._ki, 0.0)
-        np.clip(self.integral, -self._limit, self._limit, out=self.integral)
-        return np.where(moving, self._ff * cmd + self.integral, cmd)
+        # Per axis on Python floats (three values; numpy's per-call cost would dominate).
+        alpha, dt = self._alpha, self.dt_s
+        out = cmd.tolist()
+        integral, v_filtered = self.integral.tolist(), self.v_filtered.tolist()
+        for i, (c, v) in enumerate(zip(out, v_est.tolist())):
+            vf = v_filtered[i] = v_filtered[i] + alpha * (v - v_filtered[i])
+            if abs(c) > 0.05:  # moving on this axis
+                limit = self._limit[i]
+                integral[i] = min(max(integral[i] + (c - vf) * dt * self._ki[i], -limit), limit)
+                out[i] = self._ff[i] * c + integral[i]
+            else:
+                integral[i] = 0.0
+        self.integral[:] = integral
+        self.v_filtered[:] = v_filtered
+        return np.array(out)
 
 
 class LocomotionPolicyTracker(Tracker):
@@ -82,12 +93,19 @@ class LocomotionPolicyTracker(Tracker):
             spec.command_ranges.get("lin_vel_y", (-1.0, 1.0)),
             spec.command_ranges.get("ang_vel_yaw", (-1.0, 1.0)),
         ])
+        self._lower = tuple(float(v) for v in self._ranges[:, 0])
+        self._upper = tuple(float(v) for v in self._ranges[:, 1])
         self.last_action = np.zeros(g1.NUM_JOINTS)
         self.last_policy_command = np.zeros(3)
         self._phase = np.zeros(2)
         self._standing = True
         self._command = MotorCommand(q_rad=spec.default_q_rad.copy(), kp=spec.kp.copy(), kd=spec.kd.copy())
-        self._values: dict[str, np.ndarray] = {}
+        self._upper_body = np.array(g1.UPPER_BODY_JOINTS)
+        # Observation inputs, reused every tick (the builder copies them into its own vector).
+        self._cos_phase, self._sin_phase = np.zeros(2), np.zeros(2)
+        self._dof_pos = np.zeros(g1.NUM_JOINTS)
+        self._values: dict[str, np.ndarray] = {"actions": self.last_action, "cos_phase": self._cos_phase,
+                                               "sin_phase": self._sin_phase, "dof_pos": self._dof_pos}
 
     def observe(self, estimate: EstimatedState) -> None:
         self.velocity_estimate = estimate.heading_velocity
@@ -112,36 +130,39 @@ class LocomotionPolicyTracker(Tracker):
         phase = self.spec.phase
         if phase is None:
             return
-        self._phase = np.fmod(self._phase + 2 * np.pi * self.dt_s / phase.period_s + np.pi, 2 * np.pi) - np.pi
-        if np.linalg.norm(cmd[:2]) < phase.stand_threshold and abs(cmd[2]) < phase.stand_threshold:
-            self._phase[:] = np.pi  # both feet in the same phase: stand
+        step = 2 * np.pi * self.dt_s / phase.period_s
+        p = self._phase
+        p[:] = [math.fmod(a + step + np.pi, 2 * np.pi) - np.pi for a in p.tolist()]
+        vx, vy, wz = cmd.tolist()
+        if math.sqrt(vx * vx + vy * vy) < phase.stand_threshold and abs(wz) < phase.stand_threshold:
+            p[:] = np.pi  # both feet in the same phase: stand
             self._standing = True
         elif self._standing:
-            self._phase = phase.offsets_rad.copy()  # start the gait from its initial phase
+            p[:] = phase.offsets_rad  # start the gait from its initial phase
             self._standing = False
 
     def act(self, reference: JointReference, state: RobotState) -> MotorCommand:
-        cmd = np.array([reference.root_linvel_h_mps[0], reference.root_linvel_h_mps[1], reference.root_angvel_h_radps[2]])
-        cmd = self.corrector(cmd, self.velocity_estimate)
-        cmd = np.clip(cmd, self._ranges[:, 0], self._ranges[:, 1])
+        lin, ang = reference.root_linvel_h_mps, reference.root_angvel_h_radps
+        cmd = self.corrector(np.array((float(lin[0]), float(lin[1]), float(ang[2]))), self.velocity_estimate)
+        cmd = np.array([min(max(c, lo), hi) for c, lo, hi in zip(cmd.tolist(), self._lower, self._upper)])
         self.last_policy_command = cmd
         self._advance_phase(cmd)
         v = self._values
-        v["actions"] = self.last_action
         v["base_ang_vel"] = state.imu_gyro_radps
         v["command_ang_vel"] = cmd[2:3]
         v["command_lin_vel"] = cmd[0:2]
-        v["cos_phase"] = np.cos(self._phase)
-        v["sin_phase"] = np.sin(self._phase)
-        v["dof_pos"] = state.q_rad - self.spec.default_q_rad
+        np.cos(self._phase, out=self._cos_phase)
+        np.sin(self._phase, out=self._sin_phase)
+        np.subtract(state.q_rad, self.spec.default_q_rad, out=self._dof_pos)
         v["dof_vel"] = state.dq_radps
         v["projected_gravity"] = projected_gravity(state.imu_quat_wxyz)
         action = self.runner(self.obs.build(v))
-        np.clip(action, -self.spec.action_clip, self.spec.action_clip, out=action)
-        self.last_action = action.astype(float)
+        clip = self.spec.action_clip
+        np.minimum(np.maximum(action, -clip, out=action), clip, out=action)  # np.clip's result, cheaper
+        np.copyto(self.last_action, action)
         out = self._command
-        out.q_rad[:] = self.spec.default_q_rad + self.spec.action_scale * self.last_action
+        np.multiply(self.last_action, self.spec.action_scale, out=out.q_rad)
+        out.q_rad += self.spec.default_q_rad
         if reference.upper_body_override:
-            ub = list(g1.UPPER_BODY_JOINTS)
-            out.q_rad[ub] = reference.q_rad[ub]
+            out.q_rad[self._upper_body] = reference.q_rad[self._upper_body]
         return out

@@ -84,12 +84,16 @@ class ObservationBuilder:
     _slices: list[tuple[str, slice, float]] = field(init=False)
 
     def __post_init__(self) -> None:
-        self._frame = np.zeros(self.spec.frame_dim, dtype=np.float32)
         self._stack = np.zeros((1, self.spec.dim), dtype=np.float32)
+        # With no history the frame is the observation itself (no copy per call).
+        self._frame = self._stack[0] if self.spec.history == 1 else np.zeros(self.spec.frame_dim, dtype=np.float32)
         self._slices, start = [], 0
         for term in self.spec.terms:
             self._slices.append((term.name, slice(start, start + term.dim), term.scale))
             start += term.dim
+        # Per term: its slice of the frame (a view), expected shape, and scale (None for 1: no multiply).
+        self._views = [(name, self._frame[sl], (sl.stop - sl.start,), None if scale == 1.0 else np.float32(scale))
+                       for name, sl, scale in self._slices]
         self._filled = False
 
     def reset(self) -> None:
@@ -97,17 +101,17 @@ class ObservationBuilder:
 
     def build(self, values: dict[str, np.ndarray]) -> np.ndarray:
         """Observation (1, dim) from raw term values (unscaled), history per term, oldest first."""
-        for name, sl, scale in self._slices:
+        for name, view, shape, scale in self._views:
             value = values[name]
-            if np.shape(value) != (sl.stop - sl.start,):
+            if (value.shape if isinstance(value, np.ndarray) else np.shape(value)) != shape:
                 raise PolicyMismatchError(
-                    f"observation term '{name}' has shape {np.shape(value)}; expected ({sl.stop - sl.start},)"
+                    f"observation term '{name}' has shape {np.shape(value)}; expected {shape}"
                 )
-            self._frame[sl] = value
-            self._frame[sl] *= scale
+            view[:] = value
+            if scale is not None:
+                view *= scale
         h = self.spec.history
         if h == 1:
-            self._stack[0] = self._frame
             return self._stack
         # Per-term history: [term_a(t-h+1..t), term_b(t-h+1..t), ...]
         flat = self._stack[0]

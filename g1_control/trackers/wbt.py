@@ -2,7 +2,7 @@
 fed our references, as a Tracker.
 
 The policy was trained on one dance clip; its observation still carries the reference it should
-follow, so new references go in through the same terms (FACTS.md). Actor observation, the terms
+follow, so new references go in through the same terms (docs/robot_facts.md). Actor observation, the terms
 concatenated in alphabetical order of their names (154 values):
   actions (29, last action), base_ang_vel (3, pelvis gyro), dof_pos (29, q - default),
   dof_vel (29), motion_command (58: reference joint positions then velocities),

@@ -100,6 +100,9 @@ class _TokenModule(nn.Module):
 
 
 class Backbone(nn.Module):
+    feat_mean: torch.Tensor  # buffers (register_buffer below): feature normalisation
+    feat_std: torch.Tensor
+
     def __init__(self, config: BackboneConfig):
         super().__init__()
         self.config = config

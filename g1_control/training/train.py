@@ -18,7 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
+from g1_control.errors import G1ControlError
 from g1_control.generator import features as F
+from g1_control.generator.features import load_split
 
 
 @dataclass
@@ -99,16 +101,6 @@ def _to_torch(batch: dict):
     return out
 
 
-def load_split(library_root: str | Path | None, split: str):
-    from g1_control.generator.styles import style_id
-    from g1_control.library.builder import default_library_dir
-    from g1_control.motion.library import MotionLibrary
-
-    lib = MotionLibrary(library_root or default_library_dir())
-    clips = lib.clips(split)
-    return [F.clip_features(c) for c in clips], [style_id(c.style) for c in clips]
-
-
 def check_splits(library_root: str | Path | None) -> None:
     """Refuse a library whose train or held-out ('test') split has no clip long enough for a window."""
     from g1_control.library.builder import default_library_dir
@@ -164,7 +156,7 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | N
     vfeats, vstyles = load_split(library_root, "test")
     vsampler = WindowSampler(vfeats, vstyles, len(STYLES), seed=12345, style_dropout=0.0)
     history: list[dict] = []
-    best = (float("inf"), None)
+    best: tuple[float, dict[str, torch.Tensor] | None] = (float("inf"), None)
 
     val_batches = [_to_torch(vsampler.sample(128, gap=g)) for g in (15, 30)]
 
@@ -211,6 +203,8 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | N
     result = {"steps": step + 1, "wall_s": wall, "initial_val_loss": initial_val, "best_val_loss": best[0],
               "world_size": world}
     if rank == 0:
+        if best[1] is None:  # every validation loss was NaN
+            raise G1ControlError(f"training gave no finite validation loss in {step + 1} steps; nothing saved")
         model.load_state_dict(best[1])
         save_checkpoint(model, out / "backbone.pt", config)
         (out / "train_config.json").write_text(json.dumps({"train": asdict(config), "model": model_cfg.to_dict(),
@@ -219,7 +213,7 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | N
         plot_losses(history, out / "loss.png")
         export_onnx(model, out / "backbone.onnx")
         from g1_control.generator.style_stats import write_style_stats
-        from g1_control.library.builder import default_library_dir
+        from g1_control.motion.library import default_library_dir
 
         write_style_stats(library_root or default_library_dir(), out / "style_stats.json")
     if world > 1:

@@ -1,6 +1,6 @@
-"""The DDS transport over real Cyclone DDS 0.10.2 on loopback (interface lo, domain 1).
+"""The DDS transport over real Cyclone DDS 0.10.x on loopback (interface lo, domain 1).
 
-Thresholds are loose on purpose: the host is shared and DDS rates sag under load (FACTS.md).
+Thresholds are loose on purpose: the host is shared and DDS rates sag under load (docs/robot_facts.md).
 Each test uses its own DDS partition so that concurrent runs on this host never see each other.
 """
 

@@ -36,7 +36,10 @@ def test_generator_session_in_physics_follows_styles_and_directions_without_a_fa
     assert not result.fell and not result.events
     stand, fast = result.segments[0], result.segments[2]
     assert np.abs(stand.achieved).max() < 0.05
-    assert fast.achieved[0] > 0.35  # walks forward with the arms out
+    # Walks forward with the arms out. After 25 s of walking, float rounding alone moves this speed
+    # within about 0.35-0.40 m/s (1e-12 rad/s nudges to the start state, on the same code), so the
+    # bound sits below that spread.
+    assert fast.achieved[0] > 0.3
     # (the carry sidestep is not checked: the loco policy walks backwards with the arms held
     # forward, with or without the generator - measured, see the issue notes)
     assert result.timings["generator"]["p50_us"] < 5000

@@ -1,6 +1,7 @@
+import numpy as np
 import pytest
 
-from g1_control.loop.scheduler import Scheduler, Stage
+from g1_control.loop.scheduler import Scheduler, Stage, StageTimes
 
 
 class FakeClock:
@@ -71,3 +72,107 @@ def test_timing_percentiles():
     r = sched.report()["s"]
     assert r["p50_us"] == pytest.approx(1000.0)
     assert 1000.0 < r["p99_us"] <= 10000.0 and r["max_us"] == pytest.approx(10000.0)
+
+
+def _recording_stages(calls, batch_every_tick=True):
+    def every_tick():
+        calls.append("low")
+
+    def batch(n):
+        calls.extend(["low"] * n)
+        calls.append(f"batch{n}")
+
+    return [Stage("tracker", 50, lambda: calls.append("tracker")), Stage("input", 100, lambda: calls.append("input")),
+            Stage("low", 500, every_tick, batch=batch if batch_every_tick else None)]
+
+
+def test_lockstep_runs_low_level_only_ticks_as_one_batch():
+    calls = []
+    sched = Scheduler(500, _recording_stages(calls))
+    seen = []
+    assert sched.run(20, progress=seen.append) == 20
+    plain = [c for c in calls if not c.startswith("batch")]
+    # The same calls in the same order as tick by tick: every tick's stages, then the next tick's.
+    expected = (["tracker", "input", "low"] + ["low"] * 4 + ["input", "low"] + ["low"] * 4) * 2
+    assert plain == expected
+    assert [c for c in calls if c.startswith("batch")] == ["batch4"] * 4
+    assert seen == list(range(20))  # progress still hears of every tick
+    assert sched.tick_index == 20 and sched.time_s == pytest.approx(0.04)
+    report = sched.report()
+    assert report["low"]["calls"] == 20 and report["tick"]["calls"] == 20 and report["tracker"]["calls"] == 2
+
+
+def test_stop_is_asked_before_every_batch_and_every_tick():
+    calls = []
+    sched = Scheduler(500, _recording_stages(calls))
+    asked = []
+
+    def stop():
+        asked.append(sched.tick_index)
+        return sched.tick_index >= 5
+
+    assert sched.run(20, stop=stop) == 5
+    assert asked == [0, 1, 5]
+
+
+def test_no_batch_on_the_wall_clock_or_without_a_batch_function():
+    for kwargs, batch in (({"wallclock": True, "clock": FakeClock(), "sleep": lambda s: None}, True), ({}, False)):
+        calls = []
+        Scheduler(500, _recording_stages(calls, batch_every_tick=batch), **kwargs).run(10)
+        assert not [c for c in calls if c.startswith("batch")]
+        assert calls.count("low") == 10
+
+
+def test_two_stages_due_every_tick_are_never_batched():
+    calls = []
+    stages = [Stage("a", 500, lambda: calls.append("a"), batch=lambda n: calls.append("batch")),
+              Stage("b", 500, lambda: calls.append("b"), batch=lambda n: calls.append("batch"))]
+    Scheduler(500, stages).run(3)
+    assert calls == ["a", "b"] * 3
+
+
+def test_batched_ticks_are_timed_per_tick():
+    clock = FakeClock()
+
+    def batch(n):
+        clock.t += 0.001 * n  # 1 ms per tick of work
+
+    sched = Scheduler(500, [Stage("slow", 50, lambda: None), Stage("low", 500, lambda: None, batch=batch)], clock=clock)
+    sched.run(10)
+    low = sched.times["low"]
+    assert low.count == 10
+    np.testing.assert_allclose(low.samples[1:10], 0.001)
+    assert sched.overruns == 0
+
+
+def test_time_ring_buffer_wraps_for_batches():
+    times = StageTimes(capacity=8)
+    times.add_repeated(1.0, 6)
+    times.add_repeated(2.0, 5)
+    assert times.count == 11
+    np.testing.assert_array_equal(times.samples, [2.0, 2.0, 2.0, 1.0, 1.0, 1.0, 2.0, 2.0])
+
+
+def test_batch_lengths_follow_every_stage_s_period():
+    calls = []
+    stages = [Stage("a", 100, lambda: calls.append("a")), Stage("b", 125, lambda: calls.append("b")),
+              Stage("low", 500, lambda: calls.append("low"), batch=lambda n: calls.append(n))]
+    Scheduler(500, stages).run(40)  # a every 5 ticks, b every 4: batches between their ticks
+    due = [k for k in range(40) if k % 5 == 0 or k % 4 == 0]
+    expected_batches = [b - a - 1 for a, b in zip(due, due[1:] + [40]) if b - a - 1 > 1]
+    assert [c for c in calls if isinstance(c, int)] == expected_batches
+    assert calls.count("low") + sum(expected_batches) == 40
+
+
+def test_batches_without_the_phase_table_are_the_same():
+    def run(table):
+        calls = []
+        stages = [Stage("a", 100, lambda: calls.append("a")), Stage("b", 125, lambda: calls.append("b")),
+                  Stage("low", 500, lambda: calls.append("low"), batch=lambda n: calls.append(n))]
+        sched = Scheduler(500, stages)
+        if not table:
+            sched._runs = None  # as for stage periods whose common cycle is too long to tabulate
+        sched.run(97)
+        return calls
+
+    assert run(True) == run(False)

@@ -3,7 +3,8 @@ import pytest
 from test_motion_clip import make_clip
 
 from g1_control.motion.exceptions import InvalidClipError
-from g1_control.motion.resample import resample, resample_times
+from g1_control.motion.interpolation import resample_times
+from g1_control.motion.resample import resample
 
 
 def test_double_rate_keeps_original_frames_and_interpolates_between():

@@ -1,3 +1,4 @@
+import json
 from pathlib import Path
 
 import numpy as np
@@ -12,8 +13,10 @@ from g1_control.retarget.mocap import (
     MocapRetargetConfig,
     MocapRetargeter,
     frame_from_left_up,
+    load_joint_map,
     prepare_targets,
 )
+from tests.motion.test_motion_skeletons import lafan1_joint_map
 
 
 def demo_root(monkeypatch) -> Path:
@@ -129,3 +132,12 @@ def test_climbing_feet_stay_on_and_out_of_the_boxes(monkeypatch):
     m = compute_metrics(clip)
     assert m.penetration_fraction <= 0.01 and m.max_penetration_m < 0.02, m
     assert m.passes()
+
+
+def test_joint_map_with_unknown_g1_frames_names_them(tmp_path):
+    bad, good = tmp_path / "map.json", tmp_path / "good.json"
+    bad.write_text(json.dumps(lafan1_joint_map({"LeftHand": "left_claw"})))
+    with pytest.raises(UnknownJointError, match=r"map.json: joint map targets G1 frames that do not exist: \['left_claw'\]"):
+        load_joint_map(bad)
+    good.write_text(json.dumps(lafan1_joint_map()))
+    assert load_joint_map(good).frame_map == LAFAN1.frame_map

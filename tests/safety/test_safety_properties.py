@@ -12,7 +12,7 @@ from hypothesis.extra.numpy import arrays
 from g1_control.hardware.unitree.conversions import motor_command_to_lowcmd
 from g1_control.hardware.unitree.messages import LowCmd, verify_crc
 from g1_control.robot import g1
-from g1_control.safety import SafetyFilter
+from g1_control.safety import SafetyConfig, SafetyFilter
 from g1_control.types import MotorCommand, RobotState
 
 N = g1.NUM_JOINTS
@@ -72,3 +72,31 @@ def test_no_unsafe_command_ever_leaves_the_filter(steps):
         if tripped_before:
             assert np.all(out.kp == 0) and np.all(out.kd > 0) and np.all(out.tau_nm == 0)
         tripped_before = f.tripped
+
+
+finite_vec = arrays(np.float64, N, elements=st.one_of(st.floats(-50, 50), st.floats(-1e6, 1e6)))
+
+
+@settings(max_examples=120, deadline=None)
+@given(q=finite_vec, dq=finite_vec, kp=finite_vec, kd=finite_vec, tau=finite_vec, enable=arrays(np.bool_, N))
+def test_each_field_is_clamped_to_its_own_limits_and_counted(q, dq, kp, kd, tau, enable):
+    config = SafetyConfig(max_kp=400.0, max_kd=20.0)
+    f = SafetyFilter(config)
+    cmd = MotorCommand(q_rad=q, dq_radps=dq, kp=kp, kd=kd, tau_nm=tau, enable=enable)
+    upright = RobotState(q_rad=g1.DEFAULT_Q_RAD.copy(), motor_temperature_c=np.full(N, 40.0))
+    out = f.filter(cmd, upright, 0.0)
+    assert not f.tripped
+    limits = {"q_rad": (g1.Q_MIN_RAD, g1.Q_MAX_RAD), "dq_radps": (-g1.VELOCITY_LIMIT_RADPS, g1.VELOCITY_LIMIT_RADPS),
+              "tau_nm": (-g1.EFFORT_LIMIT_NM, g1.EFFORT_LIMIT_NM), "kp": (0.0, 400.0), "kd": (0.0, 20.0)}
+    for name, (lo, hi) in limits.items():
+        given_, sent = getattr(cmd, name), getattr(out, name)
+        inside = (given_ >= lo) & (given_ <= hi)
+        # In-limit values pass unchanged (bar the float32-safe margin at the very edge of a limit).
+        np.testing.assert_allclose(sent[inside], given_[inside], rtol=0, atol=1e-5, err_msg=name)
+        assert np.all(sent >= lo) and np.all(sent <= hi), name
+        # Out-of-limit values land on the nearer limit.
+        np.testing.assert_allclose(sent[~inside], np.clip(given_, lo, hi)[~inside], rtol=0, atol=1e-5, err_msg=name)
+        assert np.array_equal(f.clamps.per_joint[name], (sent != given_).astype(int)), name
+    assert f.clamps.commands == int(any(np.any(getattr(out, n) != getattr(cmd, n)) for n in limits))
+    np.testing.assert_array_equal(out.enable, enable)
+    assert out.enable is not cmd.enable and out.q_rad is not cmd.q_rad  # the caller's arrays stay the caller's

@@ -13,7 +13,7 @@ from g1_control.types import RobotState
 
 
 def remote_bytes(bits=0, lx=0.0, rx=0.0, ry=0.0, l2=0.0, ly=0.0, head=b"\xa5\x5a"):
-    """40 bytes laid out as FACTS.md states, field by field (independent of the module's encoder)."""
+    """40 bytes laid out as docs/robot_facts.md states, field by field (independent of the module's encoder)."""
     data = bytearray(40)
     data[0:2] = head
     data[2:4] = struct.pack("<H", bits)
@@ -22,7 +22,7 @@ def remote_bytes(bits=0, lx=0.0, rx=0.0, ry=0.0, l2=0.0, ly=0.0, head=b"\xa5\x5a
     return bytes(data)
 
 
-# bit positions per FACTS.md: 0 R1, 1 L1, 2 start, 3 select, 4 R2, 5 L2, 6 F1, 7 F2,
+# bit positions per docs/robot_facts.md: 0 R1, 1 L1, 2 start, 3 select, 4 R2, 5 L2, 6 F1, 7 F2,
 # 8 A, 9 B, 10 X, 11 Y, 12 up, 13 right, 14 down, 15 left
 R1, L1, START, SELECT, A, B, X, RIGHT, LEFT = 1, 2, 4, 8, 1 << 8, 1 << 9, 1 << 10, 1 << 13, 1 << 15
 

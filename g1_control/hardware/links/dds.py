@@ -1,4 +1,4 @@
-"""The G1's DDS link on Cyclone DDS 0.10.2: rt/lowcmd (host -> robot), rt/lowstate (robot -> host).
+"""The G1's DDS link on Cyclone DDS 0.10.x: rt/lowcmd (host -> robot), rt/lowstate (robot -> host).
 
 Samples are encoded by the numpy codecs in unitree_hg.py (~10 us) and handed to Cyclone as bytes
 through the binding's C layer, instead of through IdlStruct.serialize (~170 us per LowCmd, ~370 us
@@ -13,6 +13,7 @@ participant indices (ports 7400 + 250 * domain + 10 + 2 * index).
 from __future__ import annotations
 
 import threading
+from typing import Any
 from xml.sax.saxutils import quoteattr
 
 from g1_control.errors import TransportError
@@ -34,7 +35,7 @@ def import_cyclonedds():
         from cyclonedds.domain import Domain  # noqa: F401
     except ImportError as exc:
         raise TransportError(
-            f"the DDS transport needs the cyclonedds 0.10.2 Python binding ({exc}); "
+            f"the DDS transport needs the cyclonedds 0.10.x Python binding ({exc}); "
             "install it with scripts/install_cyclonedds.sh"
         ) from None
 
@@ -103,8 +104,9 @@ class DdsLink(Link):
         # the robot itself publishes in the default partition, so real use passes None.
         group_qos = Qos(Policy.Partition([partition])) if partition else None
         self._participant = participant
-        self._writer = DataWriter(Publisher(participant, qos=group_qos), out_topic)
-        self._reader = DataReader(
+        # LowCmd_ out and LowState_ in on the host side, the reverse on the robot side.
+        self._writer: DataWriter[Any] = DataWriter(Publisher(participant, qos=group_qos), out_topic)
+        self._reader: DataReader[Any] = DataReader(
             Subscriber(participant, qos=group_qos), in_topic,
             qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(history_depth)),
         )

@@ -2,7 +2,7 @@
 
 The byte layout of LowCmd_/LowState_ lives in unitree_hg.py (numpy codecs, what is actually sent);
 these classes give Cyclone the type names and member structure the robot announces, so that
-discovery matches. Member names and order follow the protocol (shared FACTS.md); tests check that
+discovery matches. Member names and order follow the protocol (docs/robot_facts.md); tests check that
 they serialise to the same bytes as the numpy codecs and as Unitree's own definitions.
 Importing this module needs cyclonedds (scripts/install_cyclonedds.sh).
 """

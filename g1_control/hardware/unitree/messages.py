@@ -1,5 +1,5 @@
 """The G1's low-level messages (`unitree_hg.msg.dds_.LowCmd_` / `LowState_`), defined by this
-project from the protocol (see shared FACTS.md), with fast numpy codecs for both byte forms:
+project from the protocol (see docs/robot_facts.md), with fast numpy codecs for both byte forms:
 
 - `to_dds` / `from_dds`: the XCDR1 little-endian sample DDS carries (4-byte encapsulation header
   + payload), byte-identical to what Unitree's own type definitions serialise to;
@@ -12,7 +12,7 @@ The CRC is the last 32-bit word of the C image, computed over every word before 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -272,7 +272,7 @@ def _fill(msg, codec: FieldCodec, buf: np.ndarray, header: bytes = b"") -> None:
 
 
 def _unpack(cls, codec: FieldCodec, buf: np.ndarray):
-    kwargs = {}
+    kwargs: dict[str, Any] = {}
     scalar_types = {f.name: f.type for f in fields(cls)}
     for attr, path in cls._PATHS.items():
         value = codec.get(buf, path)

@@ -16,6 +16,7 @@ import json
 import logging
 import threading
 import time
+from typing import Any
 
 from g1_control.errors import MotionServiceError
 
@@ -45,8 +46,10 @@ def _endpoints(participant, partition: str | None, serving: bool):
     group = Qos(Policy.Partition([partition])) if partition else None
     reliable = Qos(Policy.Reliability.Reliable(1_000_000_000), Policy.History.KeepLast(16))
     out_topic, in_topic = (responses, requests) if serving else (requests, responses)
-    return (DataWriter(Publisher(participant, qos=group), out_topic, qos=reliable),
-            DataReader(Subscriber(participant, qos=group), in_topic, qos=reliable))
+    # The sample type depends on the side (requests out and responses in, or the reverse).
+    writer: DataWriter[Any] = DataWriter(Publisher(participant, qos=group), out_topic, qos=reliable)
+    reader: DataReader[Any] = DataReader(Subscriber(participant, qos=group), in_topic, qos=reliable)
+    return writer, reader
 
 
 class MotionServiceClient:

@@ -123,7 +123,7 @@ def stack_frame_tasks(configuration: Configuration, tasks: list[FrameTask]) -> t
             task._check_target()
     key = tuple((t.frame, t.gain, t._w2.tobytes()) for t in tasks)
     cache = configuration.layout_cache
-    layout = cache.get(key)
+    layout: _Layout | None = cache.get(key)
     if layout is None:
         if len(cache) > 256:
             cache.clear()

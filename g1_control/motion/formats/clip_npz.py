@@ -27,7 +27,7 @@ BODY_MATCH_TOLERANCE_M = 0.01
 
 
 def write_clip_npz(clip: MotionClip, path: str | Path) -> None:
-    extra = {}
+    extra: dict[str, np.ndarray] = {}
     if clip.object is not None:
         o = clip.object
         extra = {"object_name": np.array(o.shape.name), "object_planes": o.shape.planes, "object_pos_w": o.pos_w_m,
@@ -36,8 +36,10 @@ def write_clip_npz(clip: MotionClip, path: str | Path) -> None:
         extra.update(scene_names=np.array([shape.name for shape in clip.scene]),
                      scene_plane_counts=np.array([shape.planes.shape[0] for shape in clip.scene]),
                      scene_planes=np.concatenate([shape.planes for shape in clip.scene]))
+    # numpy's stub has a keyword `allow_pickle: bool` that mypy matches against **dict[str, ndarray].
     np.savez(
-        path, **extra, fps=np.array(clip.fps), joint_pos=clip.joint_pos_rad, joint_vel=clip.joint_vel_radps,
+        path, **extra,  # type: ignore[arg-type]
+        fps=np.array(clip.fps), joint_pos=clip.joint_pos_rad, joint_vel=clip.joint_vel_radps,
         body_pos_w=clip.body_pos_w_m, body_quat_w=clip.body_quat_wxyz, body_lin_vel_w=clip.body_lin_vel_w_mps,
         body_ang_vel_w=clip.body_ang_vel_w_radps, joint_names=np.array(clip.joint_names),
         body_names=np.array(clip.body_names), root_pos_w=clip.root_pos_w_m, root_quat_w=clip.root_quat_wxyz,

@@ -36,6 +36,15 @@ def load_motion(path: str | Path, joint_names: tuple[str, ...] | None = None, fp
                             f"{', '.join(HUMAN_EXTENSIONS + ROBOT_EXTENSIONS)}")
 
 
+def load_human_motion(path: str | Path, joint_names: tuple[str, ...] | None = None, fps: float | None = None,
+                      height_m: float | None = None) -> HumanMotion:
+    """`load_motion` for motion capture to retarget: a G1 clip (.csv, .npz) is refused."""
+    motion = load_motion(path, joint_names, fps, height_m)
+    if not isinstance(motion, HumanMotion):
+        raise MotionFormatError(f"{path}: a G1 clip, not human motion; expected one of {', '.join(HUMAN_EXTENSIONS)}")
+    return motion
+
+
 def save_clip(clip: MotionClip, path: str | Path) -> None:
     from g1_control.motion.formats import clip_npz, g1_csv
 

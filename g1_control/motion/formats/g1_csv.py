@@ -22,7 +22,7 @@ DEFAULT_FPS = 30.0
 
 def read_g1_csv(path: str | Path, fps: float = DEFAULT_FPS, style: str = "default") -> MotionClip:
     path = Path(path)
-    rows = []
+    rows: list[list[float]] = []
     try:
         text = path.read_bytes().decode("utf-8")
     except UnicodeDecodeError as exc:

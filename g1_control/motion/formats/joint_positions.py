@@ -23,7 +23,7 @@ from g1_control.motion.skeletons import SMPLH, skeleton_for_count
 
 MOCAP_FPS = 120.0
 if TYPE_CHECKING:
-    from g1_control.motion.objects import ObjectTrack
+    from g1_control.motion.objects import ObjectShape, ObjectTrack
 
 OMOMO_FPS = 30.0
 OMOMO_JOINT_COLUMNS = slice(162, 162 + 52 * 3)
@@ -49,7 +49,7 @@ def read_npy(path: str | Path, joint_names: tuple[str, ...] | None = None, fps: 
         height_m = height_m or skeleton.default_height_m
     if len(joint_names) != pos.shape[1]:
         raise MotionFormatError(f"{path}: {pos.shape[1]} joints in the file but {len(joint_names)} names in the joint map")
-    scene = ()
+    scene: tuple[ObjectShape, ...] = ()
     if (path.parent / "box_models").is_dir():  # the holosoma climbing layout: the boxes next to the data
         from g1_control.motion.objects import load_scene
 

@@ -510,14 +510,14 @@ class InstructionParser:
                 raise InstructionError(f"\"{where}\": reach for one place at a time")
             d = one("directions", "direction")
             length = one("lengths", "distance")
-            offset = None
+            offset: tuple[float, float, float] | None = None
             if d is not None or length is not None:
                 if d is None:
                     raise InstructionError(f"\"{where}\": which way? (forward, left, right, up, down)")
                 dist = length if length is not None else c.reach_m
                 vec = {"forward": (1, 0, 0), "backward": (-1, 0, 0), "left": (0, 1, 0), "right": (0, -1, 0),
                        "up": (0, 0, 1), "down": (0, 0, -1)}[d]
-                offset = tuple(float(dist * x) for x in vec)
+                offset = (float(dist * vec[0]), float(dist * vec[1]), float(dist * vec[2]))
             if not targets and offset is None:
                 raise InstructionError(f"\"{where}\": reach for what? a place (\"the cup\") or a direction "
                                        "(\"forward 20 cm\")")
@@ -631,7 +631,8 @@ class InstructionParser:
 
     def _manipulate(self, s: _Slots, verb, where, state, one, place, timeout, take) -> list[Step]:
         take("places")
-        objects, targets = [], []
+        objects: list[str] = []
+        targets: list[str] = []
         down = False
         for (prep, name), t in s.places:
             (targets if prep in TARGET_PREPS else objects).append(state.resolve(name, t))

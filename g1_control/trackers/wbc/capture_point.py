@@ -47,7 +47,8 @@ def convex_hull(points: np.ndarray) -> np.ndarray:
     def cross(o, a, b):
         return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
 
-    lower, upper = [], []
+    lower: list[tuple] = []
+    upper: list[tuple] = []
     for p in pts:
         while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
             lower.pop()
@@ -70,7 +71,8 @@ def project_into_polygon(point: np.ndarray, hull: np.ndarray) -> np.ndarray:
             break
     if inside:
         return np.array(point, dtype=float)
-    best, best_d = None, np.inf
+    best: np.ndarray | None = None
+    best_d = np.inf
     for i in range(n):
         a, b = hull[i], hull[(i + 1) % n]
         ab = b - a
@@ -79,6 +81,7 @@ def project_into_polygon(point: np.ndarray, hull: np.ndarray) -> np.ndarray:
         d = float(np.sum((point - c) ** 2))
         if d < best_d:
             best, best_d = c, d
+    assert best is not None  # an empty hull returned above; a NaN point counts as inside
     return best
 
 

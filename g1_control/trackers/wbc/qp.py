@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -85,7 +86,8 @@ class InverseDynamicsQP:
         c = self.config
         self._reg = np.concatenate([np.full(nv, c.accel_regularisation),
                                     np.tile([c.force_regularisation] * 3 + [c.moment_regularisation] * 3, 2)])
-        self._qp = None
+        self._qp: Any = None
+        """The proxsuite dense QP (untyped), warm-started between solves; None before the first."""
         self.solves = 0
 
     def reset(self) -> None:
