@@ -35,6 +35,7 @@ import signal
 import threading
 import time
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
 import yaml
@@ -81,7 +82,7 @@ class RunFolder:
         self.started_monotonic = time.monotonic()
         self.rows = 0
         self.closed = False
-        self._files: dict[str, object] = {}
+        self._files: dict[str, BinaryIO] = {}
         self._dtypes: dict[str, str] = {}
         self._meta: dict = {}
         self._events = open(self.run_dir / "events.jsonl", "a", buffering=1)
@@ -167,7 +168,8 @@ class RunFolder:
     def write_npz(self, log: dict[str, np.ndarray]) -> Path:
         """log.npz: the whole log in one file (the plot and video readers take it), with joint_names."""
         path = self.run_dir / "log.npz"
-        np.savez_compressed(path, joint_names=np.array(g1.JOINT_NAMES), **log)
+        # numpy's stub has a keyword `allow_pickle: bool` that mypy matches against **dict[str, ndarray].
+        np.savez_compressed(path, joint_names=np.array(g1.JOINT_NAMES), **log)  # type: ignore[arg-type]
         return path
 
     def close(self, status: str, end_reason: str, summary: dict, loop=None) -> dict[str, np.ndarray]:
@@ -220,7 +222,7 @@ def _jsonable(value):
         return value.item()
     if isinstance(value, Path):
         return str(value)
-    if dataclasses.is_dataclass(value):
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
         return dataclasses.asdict(value)
     return str(value)
 

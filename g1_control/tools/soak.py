@@ -48,14 +48,16 @@ class G1Process:
         self.proc = subprocess.Popen([sys.executable, "-m", "g1_control.cli.main", *args], cwd=_ROOT, env=env,
                                      stdin=subprocess.PIPE if stdin else subprocess.DEVNULL, stdout=subprocess.PIPE,
                                      stderr=subprocess.PIPE, text=True, bufsize=1)
+        stdout, stderr = self.proc.stdout, self.proc.stderr
+        assert stdout is not None and stderr is not None  # both are pipes
         self.lines: queue.Queue[str] = queue.Queue()
         self.seen: list[str] = []
         self.errors: list[str] = []
-        threading.Thread(target=self._pump, daemon=True).start()
-        threading.Thread(target=lambda: self.errors.extend(self.proc.stderr), daemon=True).start()
+        threading.Thread(target=self._pump, args=(stdout,), daemon=True).start()
+        threading.Thread(target=lambda: self.errors.extend(stderr), daemon=True).start()
 
-    def _pump(self) -> None:
-        for line in self.proc.stdout:
+    def _pump(self, stdout) -> None:
+        for line in stdout:
             self.lines.put(line.rstrip("\n"))
 
     @property
@@ -79,8 +81,10 @@ class G1Process:
 
     def ask(self, line: str) -> dict:
         """One line to stdin (`g1 sim-robot --control-stdin`), its JSON reply."""
-        self.proc.stdin.write(line + "\n")
-        self.proc.stdin.flush()
+        stdin = self.proc.stdin
+        assert stdin is not None, "started with stdin=True"
+        stdin.write(line + "\n")
+        stdin.flush()
         return json.loads(self.wait_for(r"^\{", 10))
 
     def rss_mb(self) -> float:
@@ -88,7 +92,8 @@ class G1Process:
             text = Path(f"/proc/{self.proc.pid}/status").read_text()
         except OSError:
             return float("nan")
-        return int(re.search(r"VmRSS:\s+(\d+) kB", text).group(1)) / 1024
+        found = re.search(r"VmRSS:\s+(\d+) kB", text)
+        return int(found.group(1)) / 1024 if found else float("nan")
 
     def kill(self) -> None:
         if self.proc.poll() is None:

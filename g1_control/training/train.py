@@ -103,8 +103,7 @@ def _to_torch(batch: dict):
 
 def check_splits(library_root: str | Path | None) -> None:
     """Refuse a library whose train or held-out ('test') split has no clip long enough for a window."""
-    from g1_control.library.builder import default_library_dir
-    from g1_control.motion.library import LibraryError, MotionLibrary
+    from g1_control.motion.library import LibraryError, MotionLibrary, default_library_dir
     from g1_control.training.dataset import CONTEXT_FRAMES, MAX_GAP
 
     lib = MotionLibrary(library_root or default_library_dir())

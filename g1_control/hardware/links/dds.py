@@ -119,7 +119,8 @@ class DdsLink(Link):
         self._write, self._take = ddspy_write, ddspy_take
         self._topics = (LOWSTATE_TOPIC, LOWCMD_TOPIC)
         self._own_writer = str(self._writer.guid)
-        self._publications = None
+        self._publications: Any = None
+        """The built-in DCPSPublication reader, made on the first peer_writers()."""
         self._writers: dict[int, tuple[str, str]] = {}
         self._peer_lock = threading.Lock()
         """Discovered writers on our two topics and partition: instance handle -> (topic, guid)."""
