@@ -1,6 +1,6 @@
-"""The malformed-file corpus (tests/corpus/, >= 50 files): every malformed launch file, policy spec and
+"""The malformed-file corpus (tests/launch/corpus/, >= 50 files): every malformed launch file, policy spec and
 motion clip is refused with its loader's own error class and exactly its one-line message naming what
-is wrong (tests/corpus/expected.yaml), never a traceback from deeper down. The exact text is asserted:
+is wrong (tests/launch/corpus/expected.yaml), never a traceback from deeper down. The exact text is asserted:
 it is what the operator reads (and a mutation run checks every branch and its words)."""
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from tests.paths import REPO
 
 CACHE = str(Path.home() / ".cache" / "g1-control")
 
-CORPUS = REPO / "tests" / "corpus"
+CORPUS = REPO / "tests" / "launch" / "corpus"
 EXPECTED = yaml.safe_load((CORPUS / "expected.yaml").read_text())
 LOADERS = {"launch": load_launch, "policy": load_spec, "clip": load_motion}
 CASES = [(kind, name) for kind in LOADERS for name in sorted(EXPECTED[kind])]

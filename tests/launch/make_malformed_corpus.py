@@ -1,8 +1,8 @@
-"""Writes the malformed-file corpus under tests/corpus/{launch,policy,clip}/ (run once; the files are
+"""Writes the malformed-file corpus under tests/launch/corpus/{launch,policy,clip}/ (run once; the files are
 kept in the repository, and tests/launch/test_malformed_corpus.py asserts the message for each one
-from tests/corpus/expected.yaml).
+from tests/launch/corpus/expected.yaml).
 
-    python tests/corpus/make_corpus.py
+    python tests/launch/make_malformed_corpus.py
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
+HERE = Path(__file__).resolve().parent / "corpus"
 
 LAUNCH_BASE = """name: corpus
 duration_s: 2.0
@@ -117,7 +117,9 @@ def launch_cases() -> dict[str, str | bytes]:
 
 
 def policy_cases() -> dict[str, str | bytes]:
-    base = (HERE.parents[1] / "g1_control" / "policies" / "specs" / "holosoma_loco_ppo.yaml").read_text()
+    shipped = HERE.parents[2] / "g1_control" / "policies" / "specs" / "holosoma_loco_ppo.yaml"
+    # Without the shipped file's comments (they cite project documents this corpus does not carry).
+    base = "".join(line for line in shipped.read_text().splitlines(keepends=True) if not line.startswith("#"))
     # A spec outside the package finds its ONNX through the asset, as the shipped one does.
     joints = "joint_names: metadata        # read from the ONNX metadata, checked against the robot\n"
     gains = "gains: metadata              # kp/kd from the ONNX metadata, checked against the robot's gains\n"
