@@ -149,9 +149,10 @@ class RunRecord:
             raise G1ControlError("RunRecord.dataframe needs pandas (pip install pandas); rec.log has numpy arrays") from None
         axes = {3: ("vx", "vy", "wz"), 4: ("w", "x", "y", "z")}
         columns: dict[str, np.ndarray] = {}
+        n = len(self.log["t_s"])
         for name, arr in self.log.items():
-            if name == "t_s":
-                continue
+            if name == "t_s" or arr.ndim == 0 or len(arr) != n:
+                continue  # not per tick (joint_names, style_names)
             if arr.ndim == 1:
                 columns[name] = arr
                 continue

@@ -143,6 +143,60 @@ def from_dict(cls: type[T], data: Any, path: str = "", error: type[Exception] = 
     return obj
 
 
+def read_yaml(path, error: type[Exception] = LaunchFileError):
+    """Parse the YAML file at `path`, refusing what yaml.safe_load lets through: a file that is not
+    UTF-8 text, and a key given twice in one mapping (safe_load keeps the last one silently). Every
+    refusal is one line naming the file (and the line)."""
+    from pathlib import Path
+
+    import yaml
+
+    path = Path(path)
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise error(f"{path}: not a UTF-8 text file (byte {exc.start} is 0x{exc.object[exc.start]:02x}); "
+                    "expected YAML") from None
+    except OSError as exc:
+        raise error(f"{path}: cannot be read: {exc.strerror}") from None
+    if "\x00" in text:
+        raise error(f"{path}: not a text file (it contains NUL bytes); expected YAML")
+    try:
+        return yaml.load(text, Loader=_StrictLoader)
+    except _DuplicateKey as exc:
+        raise error(f"{path}: {exc}") from None
+    except yaml.YAMLError as exc:
+        raise error(f"{path}: not valid YAML: {' '.join(str(exc).split())}") from None
+
+
+class _DuplicateKey(Exception):
+    pass
+
+
+def _strict_loader():
+    import yaml
+
+    class StrictLoader(yaml.SafeLoader):
+        def construct_mapping(self, node, deep=False):
+            seen: dict = {}
+            for key_node, _ in node.value:
+                key = self.construct_object(key_node, deep=deep)
+                try:
+                    hash(key)
+                except TypeError:
+                    continue  # the base class reports unhashable keys
+                if key in seen:
+                    raise _DuplicateKey(f"duplicate key '{key}' at line {key_node.start_mark.line + 1} (first given "
+                                        f"at line {seen[key] + 1}); YAML would silently keep the last one")
+                seen[key] = key_node.start_mark.line
+            return super().construct_mapping(node, deep=deep)
+
+    return StrictLoader
+
+
+_StrictLoader = _strict_loader()
+
+
 def to_dict(obj) -> dict:
     return dataclasses.asdict(obj)
 

@@ -75,3 +75,13 @@ class WbcConfigError(G1ControlError, ValueError):
 
 class WbcSolveError(G1ControlError, RuntimeError):
     """The whole-body inverse-dynamics QP found no solution for this tick."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM ended a run (after its run folder was closed); the exit status is 128 + signum."""
+
+    def __init__(self, signum: int):
+        import signal
+
+        super().__init__(f"{signal.Signals(signum).name} received")
+        self.signum = signum

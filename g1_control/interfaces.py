@@ -68,6 +68,12 @@ class Backend(ABC):
         """States dropped so far for a bad checksum (robot links; 0 for simulators)."""
         return 0
 
+    @property
+    def peer_fault(self) -> str | None:
+        """A robot link's complaint about its peers (a second publisher of the robot's state, another
+        writer of its commands), or None; simulators have no peers."""
+        return None
+
     @abstractmethod
     def close(self) -> None: ...
 

@@ -67,6 +67,8 @@ def register(subparsers) -> None:
     parser.add_argument("--duration", type=float, help="length of the control phase in seconds, then damping "
                         "(default: the launch file's duration_s, or until stopped)")
     parser.add_argument("--preflight-only", action="store_true", help="run the checklist and exit; nothing is sent")
+    parser.add_argument("--out", type=Path, help="run folder root (default: the launch file's output.dir); the run "
+                        "folder (per-tick log, transitions, safety events, summary) is written as the deploy goes")
     parser.add_argument("--json", type=Path, help="write the deploy report (preflight, states, link stats) as JSON")
     program = parser.add_mutually_exclusive_group()
     program.add_argument("--program", type=Path, metavar="FILE",
@@ -88,7 +90,7 @@ def _run(args) -> int:
     options = DeployOptions(yes=args.yes, overrides=frozenset(args.override), release_motion_service=args.release,
                             interface=args.interface, domain=args.domain, partition=args.partition,
                             duration_s=args.duration, preflight_only=args.preflight_only, program=program,
-                            program_text=text)
+                            program_text=text, out_root=args.out)
     try:
         report = deploy(args.file, options)
     except PreflightRefused as exc:

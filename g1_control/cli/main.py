@@ -31,6 +31,7 @@ SUBCOMMAND_MODULES = (
     "g1_control.cli.deploy_cmd",
     "g1_control.cli.library_cmd",
     "g1_control.cli.train_cmd",
+    "g1_control.cli.soak_cmd",
 )
 
 
@@ -74,9 +75,10 @@ def main(argv: list[str] | None = None) -> int:
     except G1ControlError as exc:
         print(f"g1 {args.command}: error: {exc}", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        print(f"g1 {args.command}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        signum = getattr(exc, "signum", 2)
+        print(f"g1 {args.command}: interrupted ({exc or 'SIGINT received'})", file=sys.stderr)
+        return 128 + signum
 
 
 if __name__ == "__main__":

@@ -41,6 +41,9 @@ def register(subparsers) -> None:
     parser.add_argument("--mode-machine", type=int, default=5, help="variant to report with --physics mock (4/5/6)")
     parser.add_argument("--no-builtin", action="store_true",
                         help="start with no built-in controller (as after debug mode on the remote)")
+    parser.add_argument("--rt-priority", type=int, default=30, metavar="N",
+                        help="SCHED_RR priority (default 30; 0: normal scheduling): the emulated robot keeps its 500 Hz "
+                        "on a busy host, as the robot's own computer would (needs root, else nice -10 with a warning)")
     parser.add_argument("--seconds", type=float, help="stop after this long (default: until Ctrl-C)")
     parser.add_argument("--control-stdin", action="store_true",
                         help="read fault names and remote commands ('press start', 'press A', 'stick ly 0.5', "
@@ -49,8 +52,10 @@ def register(subparsers) -> None:
 
 
 def _run(args) -> int:
+    from g1_control.loop.priority import realtime
     from g1_control.sim.emulator import RobotEmulator
 
+    realtime(args.rt_priority)
     physics: Backend
     if args.physics == "mujoco":
         from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
@@ -67,6 +72,10 @@ def _run(args) -> int:
         physics = MockG1(mode_machine=args.mode_machine)
     emulator = RobotEmulator(physics, args.interface, args.domain, partition=args.partition,
                              builtin_mode="" if args.no_builtin else "ai").start()
+    import gc
+
+    gc.collect()
+    gc.freeze()  # the 500 Hz robot loop never waits for a full collection of the startup heap
     stop = {"now": False}
 
     def _stop(signum, frame):

@@ -34,7 +34,8 @@ CHECKS: dict[str, str] = {
     "policy": "policy metadata fits the G1 (joint order, gains, default pose) and its ONNX file",
     "interface": "the robot link's network interface (or port) exists and is up",
     "variant": "the robot's mode_machine is the DoF variant the launch file and policy are for",
-    "state_stream": "LowState arrives at >= deploy.min_state_rate_hz with valid CRCs",
+    "state_stream": "LowState arrives at >= deploy.min_state_rate_hz with valid CRCs, every value finite",
+    "peers": "exactly one publisher of the robot's state (rt/lowstate) and no other writer of its commands",
     "imu_upright": "the pelvis leans less than deploy.max_start_tilt_rad",
     "joint_limits": "every joint reads inside its limits",
     "temperatures": "every motor is cooler than deploy.max_start_temperature_c",
@@ -45,6 +46,18 @@ CHECKS: dict[str, str] = {
 """Check name -> what it asserts (the names --override takes)."""
 
 PASS, FAIL, SKIP, NOT_RUN = "pass", "fail", "skip", "not run"
+
+
+def nonfinite_fields(state) -> list[str]:
+    """RobotState fields (with the joint or index) that hold NaN or inf."""
+    from g1_control.safety.filter import STATE_FIELDS
+
+    out = []
+    for name in STATE_FIELDS:
+        arr = np.asarray(getattr(state, name), dtype=float)
+        for i in np.nonzero(~np.isfinite(arr))[0]:
+            out.append(f"{name}[{g1.JOINT_NAMES[i] if arr.shape == (g1.NUM_JOINTS,) else i}] = {arr[i]}")
+    return out
 
 
 class PreflightRefused(G1ControlError):
@@ -127,6 +140,14 @@ class Preflight:
             self.record("policy", FAIL, f"policy '{spec.name}' is for the {variant} G1 but backend.expected_variant "
                         f"is {launch.backend.expected_variant}; use a policy made for this robot", overridable=False)
             return None, variant
+        over = [(name, float(np.max(gains)), cap) for name, gains, cap in
+                (("kp", spec.kp, launch.safety.max_kp), ("kd", spec.kd, launch.safety.max_kd)) if np.max(gains) > cap]
+        if over:
+            name, gain, cap = over[0]
+            self.record("policy", FAIL, f"policy '{spec.name}' uses {name} up to {gain:g} but safety.max_{name} is "
+                        f"{cap:g}: every command would be clamped; raise the cap or lower the policy's gains",
+                        overridable=False)
+            return None, variant
         self.record("policy", PASS, f"{spec.name}: {len(spec.joint_names)} joints in G1 order, gains and default pose "
                     f"match the robot, ONNX {spec.onnx_path.name}" + (f", for {variant}" if variant else ""))
         return spec, variant
@@ -149,7 +170,8 @@ class Preflight:
             state = backend.wait_for_state(launch.backend.connect_timeout_s)
         except RobotNotConnectedError as exc:
             self.record("state_stream", FAIL, str(exc), overridable=False)
-            self.not_run(("variant", "imu_upright", "joint_limits", "temperatures", "battery"), "no robot state")
+            self.not_run(("variant", "peers", "imu_upright", "joint_limits", "temperatures", "battery"),
+                         "no robot state")
             return None
         # Rate and CRC health over a window, from the transport's own counters.
         before, t0 = backend.stats(), time.monotonic()
@@ -168,8 +190,16 @@ class Preflight:
             self.record("state_stream", FAIL, f"{detail}; corrupted samples on {where}: check the cable, the switch "
                         "and that only one robot publishes on this domain")
         else:
-            self.record("state_stream", PASS, detail)
+            state = backend.read_state()
+            invalid = nonfinite_fields(state)
+            if invalid:
+                self.record("state_stream", FAIL, f"{detail}; the robot reports values that are not finite numbers: "
+                            f"{', '.join(invalid[:4])}{' ...' if len(invalid) > 4 else ''}: a sensor or its decoding "
+                            "is broken", overridable=False)
+            else:
+                self.record("state_stream", PASS, detail)
         state = backend.read_state()
+        self.check_peers(backend)
 
         try:
             variant = variant_of(state.mode_machine)
@@ -195,8 +225,14 @@ class Preflight:
 
         tol = cfg.joint_limit_tolerance_rad
         q = state.q_rad
+        nonfinite = [j for j in np.nonzero(active & ~np.isfinite(q))[0]]
         out = [j for j in np.nonzero(active & ((q < g1.Q_MIN_RAD - tol) | (q > g1.Q_MAX_RAD + tol)))[0]]
-        if out:
+        if nonfinite:
+            listed = ", ".join(f"{g1.JOINT_NAMES[j]} reads {q[j]}" for j in nonfinite[:3])
+            self.record("joint_limits", FAIL, f"{len(nonfinite)} joints read no number: {listed}"
+                        + (" ..." if len(nonfinite) > 3 else "") + "; the encoder or its decoding is broken: do not "
+                        "start", overridable=False)
+        elif out:
             listed = ", ".join(f"{g1.JOINT_NAMES[j]} {q[j]:+.3f} rad [{g1.Q_MIN_RAD[j]:+.3f}, {g1.Q_MAX_RAD[j]:+.3f}]"
                                for j in out[:3])
             self.record("joint_limits", FAIL, f"{len(out)} joints outside their limits: {listed}"
@@ -205,8 +241,9 @@ class Preflight:
             self.record("joint_limits", PASS, f"{int(active.sum())} joints inside their limits (±{tol:.2f} rad)")
 
         temps = np.where(active, state.motor_temperature_c, -np.inf)
-        j = int(np.argmax(temps))
-        if not np.isfinite(temps[j]) or temps[j] >= cfg.max_start_temperature_c:
+        bad = np.nonzero(active & ~np.isfinite(state.motor_temperature_c))[0]
+        j = int(bad[0]) if bad.size else int(np.argmax(temps))
+        if bad.size or not temps[j] < cfg.max_start_temperature_c:
             self.record("temperatures", FAIL, f"{g1.JOINT_NAMES[j]} motor at {temps[j]:.0f} °C (limit "
                         f"{cfg.max_start_temperature_c:.0f} °C): let the motors cool down")
         else:
@@ -217,11 +254,32 @@ class Preflight:
         if battery is None:
             self.record("battery", SKIP, "not reported: the G1's LowState_ carries no battery voltage (its BMS "
                         "publishes on its own topic); check the charge on the robot's display")
-        elif battery < cfg.min_battery_v:
+        elif not battery >= cfg.min_battery_v:  # NaN fails too
             self.record("battery", FAIL, f"battery at {battery:.1f} V (limit {cfg.min_battery_v:.1f} V): charge it")
         else:
             self.record("battery", PASS, f"battery at {battery:.1f} V")
         return state
+
+    def check_peers(self, backend) -> bool:
+        """One publisher of the robot's state, no other writer of its commands (where the link can tell)."""
+        refresh = getattr(backend, "refresh_peers", None)
+        if refresh is None:
+            return self.record("peers", SKIP, "this backend cannot see its peers")
+        refresh()
+        senders, writers, command_writers = backend.peers()
+        where = backend.link.describe()
+        if writers is None and senders == 0:
+            return self.record("peers", SKIP, f"{where} carries bytes, not writers: a second sender shows only as a "
+                               "tick running backwards, which trips the run")
+        n = max(writers or 0, senders)
+        if n > 1:
+            return self.record("peers", FAIL, f"{n} publishers on rt/lowstate ({senders} sent within the last second) "
+                               f"on {where}: another robot or program publishes robot state on this domain and "
+                               "partition; find and stop it (only one robot may talk to this host)", overridable=False)
+        if command_writers:
+            return self.record("peers", FAIL, f"{command_writers} other writer(s) of rt/lowcmd on {where}: another "
+                               "program commands this robot; stop it first", overridable=False)
+        return self.record("peers", PASS, f"one publisher on rt/lowstate, no other writer of rt/lowcmd ({where})")
 
     def check_input(self, device, launch: LaunchFile, open_error: str | None = None) -> bool:
         """The operator's device: opened, bound to an e-stop, not lost while polled."""

@@ -25,12 +25,14 @@ from g1_control.deploy.preflight import CHECKS, FAIL, Preflight
 from g1_control.deploy.state_machine import DeployState, DeployTracker, OperatorButtons, Transition
 from g1_control.errors import G1ControlError, LaunchFileError
 from g1_control.hardware.links.network import LOOPBACK
+from g1_control.launch.run_folder import RunFolder
 from g1_control.launch.schema import LaunchFile
+from g1_control.loop.priority import frozen_heap, realtime
 from g1_control.robot import g1
 
 log = logging.getLogger("g1_control.deploy")
 
-ROBOT_CHECKS = ("variant", "state_stream", "imu_upright", "joint_limits", "temperatures", "battery")
+ROBOT_CHECKS = ("variant", "state_stream", "peers", "imu_upright", "joint_limits", "temperatures", "battery")
 CLEAN_ENDINGS = ("operator stop", "control time over", "SIGINT received", "SIGTERM received")
 """Trip details that end a deploy as planned (exit code 0); any other trip is a fault (exit code 3)."""
 
@@ -54,6 +56,8 @@ class DeployOptions:
     program_text: str = ""
     """The English instruction `program` was parsed from: it is shown and must be confirmed (y) on
     a robot; --yes answers only on sim2sim."""
+    out_root: Path | None = None
+    """Where the run folder goes (None: the launch file's output.dir)."""
 
 
 @dataclass
@@ -74,6 +78,8 @@ class DeployReport:
     chain: dict = field(default_factory=dict)
     """The loop's stages (g1_control/launch/builder.py), the same the preflight's dry run ran."""
     dry_run_chain: dict = field(default_factory=dict)
+    run_dir: str | None = None
+    """The run folder (per-tick log, events, summary), written as the deploy went."""
 
     def to_json(self) -> str:
         return json.dumps(dataclasses.asdict(self), indent=2, default=float)
@@ -170,6 +176,8 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
 
     spec, policy_variant = pf.check_policy(launch)
     backend = device = None
+    normal, scheduling = realtime(launch.deploy.realtime_priority)
+    say(f"scheduling: {scheduling}")
     try:
         if pf.check_interface(launch):
             from g1_control.deploy.backends import open_robot_backend
@@ -199,7 +207,11 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             say(f"simulated dry run ({launch.deploy.dry_run_s:.0f} s lockstep MuJoCo"
                 + (", the whole program" if options.program is not None or launch.input.type == "program" else "")
                 + ") ...")
-            pf.check_dry_run(launch, options.program)
+            normal.restore()  # as fast as it can, but never ahead of the host's other work
+            try:
+                pf.check_dry_run(launch, options.program)
+            finally:
+                realtime(launch.deploy.realtime_priority)
         else:
             pf.not_run(["dry_run"], "no valid policy")
         report.preflight = pf.as_dict()
@@ -220,6 +232,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             device.close()
         if backend is not None:
             backend.close()
+        normal.restore()
 
 
 def _refuse(pf: Preflight, report: DeployReport, say) -> DeployReport:
@@ -238,8 +251,13 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
     buttons = OperatorButtons(device)
     t_start = time.monotonic()
 
+    folder: RunFolder | None = None
+
     def on_transition(t: Transition) -> None:
         say(f"[{t.t_s - t_start:7.2f} s] {t}")
+        if folder is not None:
+            folder.event({"type": "transition", "t_s": t.t_s, "from": t.source.value, "to": t.target.value,
+                          "reason": t.reason})
         if t.target == DeployState.HOLD and not options.yes:
             say(f"holding the default pose: press {_keys_for(device, 'run') or 'run'} to start the policy")
 
@@ -256,11 +274,13 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
         wrapped.append(tracker)
         return tracker
 
-    r = launch.rates
-    expected_s = (control_s or 600.0) + launch.deploy.ramp_s + 60.0
+    # The per-tick log streams into the run folder (attached below): the loop keeps one chunk only.
     loop = build_loop(launch, backend=backend, input_device=buttons, wrap_tracker=deploy_state_machine,
-                      wallclock=True, log_capacity=int(expected_s * r.tracker_hz))
+                      wallclock=True, log_capacity=1)
     tracker, safety = wrapped[0], loop.safety
+    # The variant the preflight accepted: a state reporting another mode_machine trips, and is never echoed.
+    if getattr(backend, "expected_mode_machine", None) is not None:
+        safety.expect_mode_machine(backend.expected_mode_machine)
     # A scripted timeline starts when control starts; so does a behaviour program (its own clock:
     # the operator device keeps the loop's).
     buttons.timeline_clock = tracker.control_elapsed_s
@@ -275,11 +295,15 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
     if dry and differs:
         raise G1ControlError("the robot's loop differs from the one the dry run checked: " + "; ".join(
             f"{k}: dry run {dry.get(k)!r}, robot {loop.chain.get(k)!r}" for k in differs))
+    folder = RunFolder.create(Path(options.out_root or launch.output.dir), launch)
+    folder.attach(loop)
+    report.run_dir = str(folder.run_dir)
+    say(f"run folder: {folder.run_dir} (log, events and summary written as the deploy goes)")
     say("control chain (as checked by the dry run): " + " -> ".join(loop.chain[k] for k in ("generator", "retargeter",
                                                                                             "tracker")))
 
     def on_signal(signum, frame):
-        safety.estop(f"{signal.Signals(signum).name} received", time.monotonic())
+        safety.estop(f"{signal.Signals(signum).name} received", time.monotonic(), planned=True)
         backend.damp()  # damping on the wire now, not at the next tick
         raise KeyboardInterrupt
 
@@ -303,7 +327,8 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
             return tracker.observe_safety(now) and tracker.time_in_state_s(now) >= exit_s
 
         t_loop0 = time.monotonic()
-        loop.scheduler.run(1 << 40, stop=finished)
+        with frozen_heap():  # no full garbage collection of the whole heap inside the loop
+            loop.scheduler.run(1 << 40, stop=finished)
     except KeyboardInterrupt:
         pass
     except G1ControlError as exc:
@@ -317,13 +342,19 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
             time.sleep(launch.deploy.exit_damping_s)  # damping keeps streaming before the link closes
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-    _fill_report(report, loop, tracker, backend, safety, t_loop0)
+    log = folder.close_log(loop)
+    _fill_report(report, log, loop, tracker, backend, safety, t_loop0)
+    folder.write_npz(log)
+    status = ("error" if error is not None else "fault" if report.fault
+              else "interrupted" if report.end_reason.startswith("SIG") else "completed")
+    folder.finish(status, report.end_reason, dataclasses.asdict(report))
     _print_summary(report, say)
     if error is not None:
         raise error
 
 
-def _fill_report(report: DeployReport, loop, tracker: DeployTracker, backend, safety, t_loop0: float) -> None:
+def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTracker, backend, safety,
+                 t_loop0: float) -> None:
     from g1_control.launch.runner import upper_body_rms_by_style
 
     report.sequence = tracker.sequence
@@ -332,10 +363,9 @@ def _fill_report(report: DeployReport, loop, tracker: DeployTracker, backend, sa
     trip = safety.trip_event
     report.end_reason = trip.detail if trip else "exit"
     report.fault = trip is None or not any(trip.detail.startswith(c) for c in CLEAN_ENDINGS)
-    report.safety_events = [{"t_s": e.t_s, "kind": e.kind.value, "detail": e.detail, "trips": e.trips}
-                            for e in safety.events]
+    report.safety_events = [{"t_s": e.t_s, "kind": e.kind.value, "detail": e.detail, "trips": e.trips,
+                             "planned": e.planned} for e in safety.events]
     report.link = dataclasses.asdict(backend.stats())
-    log_arrays = loop.log.arrays()
     control = [t for t in tracker.transitions if t.target == DeployState.CONTROL]
     if control:
         start = control[0].t_s
@@ -356,14 +386,19 @@ def _fill_report(report: DeployReport, loop, tracker: DeployTracker, backend, sa
     if program is not None:
         report.control["program"] = {"steps": [record_dict(r) for r in program.records],
                                      "finished": program.done and not program.runner.stopped}
+    late = loop.scheduler.lateness.summary()
     report.loop = {"deadline_misses": loop.scheduler.deadline_misses, "ticks": loop.scheduler.tick_index,
                    "tick_p99_us": loop.scheduler.report()["tick"]["p99_us"],
+                   "lateness_p99_ms": late["p99_us"] / 1000, "lateness_max_ms": loop.scheduler.max_lateness_s * 1000,
+                   "misses_over_period": loop.scheduler.misses_over_period,
                    "clamped_commands": safety.clamps.commands}
 
 
 def _print_summary(report: DeployReport, say) -> None:
     link = report.link
     say(f"deploy ended in damping: {report.end_reason}" + (" (FAULT)" if report.fault else ""))
+    if report.run_dir:
+        say(f"run folder: {report.run_dir}")
     say(f"states: {' -> '.join(report.sequence)}")
     say(f"lowcmd sent {link['commands_sent']} ({link['command_rate_hz']:.0f} Hz, p99 period "
         f"{link['command_period_p99_s'] * 1000:.2f} ms at the sender); lowstate received {link['states_received']}, "
@@ -375,7 +410,8 @@ def _print_summary(report: DeployReport, say) -> None:
             f"wz {v[2]:+.2f} (commanded {c[0]:+.2f}, {c[1]:+.2f}, {c[2]:+.2f})")
     for style, fig in (report.control.get("upper_body_vs_plan") or {}).items():
         say(f"upper body vs plan, style {style}: RMS {fig['rms_rad']:.3f} rad over {fig['seconds']:.1f} s")
-    say(f"loop: {report.loop['ticks']} ticks, {report.loop['deadline_misses']} deadline misses, "
+    say(f"loop: {report.loop['ticks']} ticks, {report.loop['deadline_misses']} deadline misses (worst "
+        f"{report.loop['lateness_max_ms']:.1f} ms late, p99 {report.loop['lateness_p99_ms']:.1f} ms), "
         f"{report.loop['clamped_commands']} commands clamped by the safety layer")
 
 

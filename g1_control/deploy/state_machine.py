@@ -161,7 +161,7 @@ class DeployTracker(Tracker):
         in_state = now - self.entered_s
         cfg = self.config
         if Button.STOP in pressed:
-            self.safety.estop("operator stop", now)
+            self.safety.estop("operator stop", now, planned=True)
             self._go(DeployState.DAMPING, "operator stop", now)
         elif self.state == DeployState.ZERO_TORQUE:
             if Button.START in pressed or (self.auto and in_state >= cfg.auto_start_s):
@@ -182,7 +182,7 @@ class DeployTracker(Tracker):
                 self.control_started_s = now
                 self._go(DeployState.CONTROL, "operator run" if self._run_requested else "run (--yes)", now)
         elif self.state == DeployState.CONTROL and self.control_s is not None and in_state >= self.control_s:
-            self.safety.estop(f"control time over ({self.control_s:.1f} s, launch duration_s)", now)
+            self.safety.estop(f"control time over ({self.control_s:.1f} s, launch duration_s)", now, planned=True)
             self._go(DeployState.DAMPING, f"control time over ({self.control_s:.1f} s)", now)
 
     def act(self, reference: JointReference, state: RobotState) -> MotorCommand:

@@ -2,9 +2,13 @@
 
 A writer thread resends the latest LowCmd_ at a fixed rate (500 Hz, as the robot expects a steady
 stream, whatever rate the controller runs at); a reader thread decodes every LowState_, checks its
-CRC and keeps the newest valid one. Every command carries a fresh CRC and echoes the mode_machine
-the robot reports. close() leaves a damping command streaming for a moment before the stream
-stops, so the last thing the robot heard is "damp".
+CRC and keeps the newest valid one. Every command carries a fresh CRC and the mode_machine accepted
+at reset (the expected one): a state that reports another one (a spoofing publisher, a variant
+change) is never echoed back to the motors. The reader also watches the link's peers: more than
+one writer of LowState_ (by sender, and where DDS discovery can tell, by publication), or another
+writer of LowCmd_, is reported as `peer_fault`, which the safety layer trips on. close() leaves a
+damping command streaming for a moment before the stream stops, so the last thing the robot
+heard is "damp".
 """
 
 from __future__ import annotations
@@ -30,11 +34,15 @@ from g1_control.hardware.unitree.conversions import (
     motor_command_to_lowcmd,
     variant_of,
 )
+from g1_control.hardware.unitree.messages import LOWCMD_TOPIC, LOWSTATE_TOPIC
 from g1_control.interfaces import Backend
 from g1_control.robot import g1
 from g1_control.types import MotorCommand, RobotState
 
 log = logging.getLogger(__name__)
+
+PEER_CHECK_PERIOD_S = 0.5
+"""How often the reader thread asks the link's discovery about other writers."""
 
 
 @dataclass
@@ -49,6 +57,12 @@ class LinkStats:
     command_rate_hz: float
     command_period_p99_s: float
     last_state_age_s: float
+    state_senders: int = 0
+    """Distinct writers whose LowState_ arrived within the last second (0 where the link cannot tell)."""
+    state_writers: int | None = None
+    """Writers of the state topic known to discovery (None where the link has no discovery)."""
+    command_writers: int | None = None
+    """Other writers of the command topic known to discovery (None where the link has no discovery)."""
 
 
 class LinkBackend(Backend):
@@ -81,6 +95,11 @@ class LinkBackend(Backend):
         self._received = 0
         self._state_times: deque[float] = deque(maxlen=2000)
         self._send_times: deque[float] = deque(maxlen=2000)
+        self.mode_machine: int | None = None
+        """The mode_machine every command carries, accepted at reset() (None before)."""
+        self._senders: dict[int, float] = {}
+        self._peer_counts: dict[str, int] | None = None
+        self._peers_checked_s = 0.0
         self._stop = threading.Event()
         self._threads: list[threading.Thread] = []
         self._closed = False
@@ -97,6 +116,7 @@ class LinkBackend(Backend):
                 f"setup expects {self.expected_mode_machine} ({want.name}); use a launch file and policy made "
                 "for this robot"
             )
+        self.mode_machine = int(state.mode_machine)
         return state
 
     def read_state(self) -> RobotState:
@@ -115,7 +135,7 @@ class LinkBackend(Backend):
             if np.shape(getattr(command, name)) != (g1.NUM_JOINTS,):
                 raise InvalidCommandError(
                     f"MotorCommand.{name} has shape {np.shape(getattr(command, name))}; expected ({g1.NUM_JOINTS},)")
-        msg = motor_command_to_lowcmd(command, mode_machine=state.mode_machine, mode_pr=self.mode_pr)
+        msg = motor_command_to_lowcmd(command, mode_machine=self._command_mode_machine(state), mode_pr=self.mode_pr)
         payload = self.link.encode(msg)
         with self._lock:
             self._payload = payload
@@ -126,10 +146,51 @@ class LinkBackend(Backend):
             state = self._state
         if state is None:
             return  # nothing was ever sent; the robot is not under our control
-        msg = motor_command_to_lowcmd(MotorCommand.damping(self.damping_kd), state.mode_machine, self.mode_pr)
+        msg = motor_command_to_lowcmd(MotorCommand.damping(self.damping_kd), self._command_mode_machine(state),
+                                      self.mode_pr)
         payload = self.link.encode(msg)
         with self._lock:
             self._payload = payload
+
+    def _command_mode_machine(self, state: RobotState) -> int:
+        """The accepted mode_machine, else the expected one, else (before any reset) the robot's."""
+        if self.mode_machine is not None:
+            return self.mode_machine
+        if self.expected_mode_machine is not None:
+            return self.expected_mode_machine
+        return state.mode_machine
+
+    def peers(self) -> tuple[int, int | None, int | None]:
+        """(writers whose LowState_ arrived within the last second, writers of the state topic known to
+        discovery, other writers of the command topic known to discovery); None where unknown."""
+        now = time.monotonic()
+        with self._lock:
+            for sender in [k for k, t in self._senders.items() if now - t > 5.0]:
+                del self._senders[sender]
+            senders = sum(1 for t in self._senders.values() if now - t <= 1.0)
+            counts = self._peer_counts
+        if counts is None:
+            return senders, None, None
+        return senders, counts.get(LOWSTATE_TOPIC), counts.get(LOWCMD_TOPIC)
+
+    @property
+    def peer_fault(self) -> str | None:
+        senders, state_writers, command_writers = self.peers()
+        where = self.link.describe()
+        if senders > 1 or (state_writers or 0) > 1:
+            n = max(senders, state_writers or 0)
+            return (f"{n} publishers on {LOWSTATE_TOPIC} ({senders} sent within the last second) on {where}: another "
+                    "robot or program publishes robot state on this domain and partition")
+        if command_writers:
+            return (f"{command_writers} other writer{'s' if command_writers > 1 else ''} of {LOWCMD_TOPIC} on "
+                    f"{where}: another program commands this robot")
+        return None
+
+    def refresh_peers(self) -> None:
+        """Ask the link's discovery about its peers now (the reader thread does so twice a second)."""
+        counts = self.link.peer_writers()
+        with self._lock:
+            self._peer_counts = counts
 
     def close(self) -> None:
         if self._closed:
@@ -164,6 +225,7 @@ class LinkBackend(Backend):
             sends = np.array(self._send_times)
             last = self._state.t_s if self._state is not None else float("nan")
             bad_crc, malformed, received = self._bad_crc, self._malformed, self._received
+        senders, state_writers, command_writers = self.peers()
         recent = sends[sends >= now - 1.0] if sends.size else sends
         periods = np.diff(sends) if sends.size > 1 else np.array([float("nan")])
         return LinkStats(
@@ -171,6 +233,7 @@ class LinkBackend(Backend):
             malformed=malformed, bad_frames=self.link.counters.bad_frames,
             state_rate_hz=float(len(state_times)), command_rate_hz=float(recent.size),
             command_period_p99_s=float(np.percentile(periods, 99)), last_state_age_s=now - last,
+            state_senders=senders, state_writers=state_writers, command_writers=command_writers,
         )
 
     # -- threads ---------------------------------------------------------------------------------
@@ -182,7 +245,11 @@ class LinkBackend(Backend):
 
     def _read_loop(self) -> None:
         while not self._stop.is_set():
-            for payload in self.link.receive(0.05):
+            now = time.monotonic()
+            if now - self._peers_checked_s >= PEER_CHECK_PERIOD_S:
+                self._peers_checked_s = now
+                self.refresh_peers()
+            for payload, sender in self.link.receive_tagged(0.05):
                 try:
                     msg = self.link.decode_state(payload)
                 except CrcMismatchError:
@@ -198,6 +265,8 @@ class LinkBackend(Backend):
                 with self._lock:
                     self._state = state
                     self._received += 1
+                    if sender is not None:
+                        self._senders[sender] = now
                     self._state_times.append(now)
                 self._state_event.set()
 

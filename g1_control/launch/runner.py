@@ -1,9 +1,13 @@
-"""Build the loop a launch file describes, run it, and write the run folder:
+"""Build the loop a launch file describes, run it, and write the run folder as it goes
+(g1_control/launch/run_folder.py; closed on the end, a fall, SIGINT or SIGTERM):
 
     runs/<name>-<time>/
       launch.yaml     the validated launch file as run
-      log.npz         per-tracker-tick log (see loop.control_loop.RunLog)
-      summary.json    fell or not, commanded vs achieved velocity per segment, stage timings, RTF
+      log/            per-tracker-tick log, streamed (fields.json + one raw float64 file per field)
+      events.jsonl    safety and loop events as they happen
+      log.npz         the same log, assembled at close (see loop.control_loop.RunLog)
+      summary.json    status and end reason; fell or not, commanded vs achieved velocity per segment,
+                      stage timings, RTF
       velocity.png    commanded vs achieved velocity and pelvis height
       video.mp4       when headless rendering is available (EGL or OSMesa)
 """
@@ -13,17 +17,19 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import json
+import signal
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-import yaml
 
+from g1_control.errors import Interrupted
 from g1_control.interfaces import InputDevice
 from g1_control.launch.builder import build_loop, make_sim_backend, timeline_of
 from g1_control.launch.overlay import overlay_lines
+from g1_control.launch.run_folder import RunFolder, interrupt_on_signals
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.robot import g1
@@ -135,8 +141,7 @@ def upper_body_rms_by_style(log: dict[str, np.ndarray], window: np.ndarray | Non
     return out
 
 
-def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentResult]:
-    log = loop.log.arrays()
+def segment_results(log: dict[str, np.ndarray], segments: list[Segment]) -> list[SegmentResult]:
     t = log["t_s"]
     achieved = log["velocity_true"] if not np.isnan(log["velocity_true"]).all() else log["velocity_est"]
     if segments:
@@ -158,7 +163,8 @@ def segment_results(loop: ControlLoop, segments: list[Segment]) -> list[SegmentR
 def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None = None,
         progress: bool = True, viewer: bool = False, web_port: int | None = None,
         input_device: InputDevice | None = None, end_with_program: bool = True) -> RunResult:
-    """Run `launch` to the end (or a fall); write the run folder when `out_root` is given.
+    """Run `launch` to the end (or a fall); write the run folder when `out_root` is given, as the run
+    goes (g1_control/launch/run_folder.py), closed on the end, a fall, SIGINT or SIGTERM.
 
     viewer: the MuJoCo viewer; web_port: the browser view (g1_control/sim/web.py) on that port;
     input_device: instead of the launch file's input (g1 say hands in its program input).
@@ -168,6 +174,26 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
     segments = timeline_of(launch)
     sim = make_sim_backend(launch)
     loop = build_loop(launch, backend=sim, input_device=input_device)
+    folder = RunFolder.create(Path(out_root), launch) if out_root is not None else None
+    if folder is None:
+        return _run_loop(launch, sim, loop, segments, None, progress, viewer, web_port,
+                         end_with_program=end_with_program)
+    try:
+        with interrupt_on_signals():
+            return _run_loop(launch, sim, loop, segments, folder, progress, viewer, web_port, video,
+                             end_with_program=end_with_program)
+    except BaseException as exc:
+        if not folder.closed:  # an error before the loop ran, or while closing: say so
+            folder.finish("error" if not isinstance(exc, KeyboardInterrupt) else "interrupted",
+                          f"{type(exc).__name__}: {exc}", {})
+        raise
+
+
+def _run_loop(launch: LaunchFile, sim: MujocoBackend, loop: ControlLoop, segments: list[Segment],
+              folder: RunFolder | None, progress: bool, viewer: bool, web_port: int | None,
+              video: bool | None = None, end_with_program: bool = True) -> RunResult:
+    if folder is not None:
+        folder.attach(loop)
     loop.reset()
     duration = launch.total_duration_s
     bar = None
@@ -213,8 +239,13 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
         def stop() -> bool:
             over = program.ended_s is not None and loop.now_s() - program.ended_s >= PROGRAM_END_HOLD_S
             return over or (viewer_closed is not None and viewer_closed())
+    interrupted: KeyboardInterrupt | None = None
     try:
         loop.scheduler.run(round(duration * loop.rates.lowlevel_hz), stop=stop, progress=on_tick)
+    except KeyboardInterrupt as exc:
+        if folder is None:
+            raise
+        interrupted = exc if isinstance(exc, Interrupted) else Interrupted(signal.SIGINT)
     finally:
         wall = time.perf_counter() - t0
         if bar is not None:
@@ -225,7 +256,8 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
             web.close()
         loop.input.close()
         loop.backend.close()
-    result = _result(launch, loop, segments, wall)
+    log = folder.close_log(loop) if folder is not None else loop.log.arrays()
+    result = _result(launch, loop, segments, wall, log)
     if watcher is not None:
         result.extra["goals"] = watcher.outcomes()
     if program is not None:
@@ -236,8 +268,10 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
         result.extra["program"] = {"steps": [record_dict(r) for r in program.records],
                                    "finished": program.done and not program.runner.stopped,
                                    "pose": program.pose_source}
-    if out_root is not None:
-        write_run_folder(result, launch, loop, Path(out_root), video)
+    if folder is not None:
+        write_run_folder(result, launch, folder, log, None if interrupted else video, interrupted, loop)
+    if interrupted is not None:
+        raise interrupted
     return result
 
 
@@ -282,8 +316,8 @@ def _update_viewer(view, loop: ControlLoop) -> None:
     update_viewer(view, *overlay_lines(loop))
 
 
-def _result(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], wall: float) -> RunResult:
-    log = loop.log.arrays()
+def _result(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], wall: float,
+            log: dict[str, np.ndarray]) -> RunResult:
     est_rms = None
     valid = ~np.isnan(log["velocity_true"][:, 0])
     if valid.sum() > 10:
@@ -293,48 +327,50 @@ def _result(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], wall
     return RunResult(
         name=launch.name, fell=fall is not None, fall=dataclasses.asdict(fall) if fall else None,
         duration_s=loop.time_s, wall_s=wall,
-        segments=segment_results(loop, segments), timings=loop.scheduler.report(),
+        segments=segment_results(log, segments), timings=loop.scheduler.report(),
         deadline_misses=loop.scheduler.deadline_misses, overruns=loop.scheduler.overruns,
         events=[dataclasses.asdict(e) for e in loop.events], estimator_rms_mps=est_rms, chain=dict(loop.chain),
     )
 
 
-def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, out_root: Path,
-                     video: bool | None) -> Path:
-    run_dir = out_root / f"{launch.name}-{time.strftime('%Y%m%d-%H%M%S')}"
-    suffix = 1
-    while run_dir.exists():
-        suffix += 1
-        run_dir = out_root / f"{launch.name}-{time.strftime('%Y%m%d-%H%M%S')}-{suffix}"
-    run_dir.mkdir(parents=True)
+def write_run_folder(result: RunResult, launch: LaunchFile, folder: RunFolder, log: dict[str, np.ndarray],
+                     video: bool | None, interrupted: KeyboardInterrupt | None = None,
+                     loop: ControlLoop | None = None) -> Path:
+    """Close `folder`: log.npz, the plot, the video (not after a signal), summary.json with the end reason."""
+    run_dir = folder.run_dir
     result.run_dir = run_dir
-    (run_dir / "launch.yaml").write_text(yaml.safe_dump(dataclasses.asdict(launch), sort_keys=False))
-    # numpy's stub has a keyword `allow_pickle: bool` that mypy matches against **dict[str, ndarray].
-    np.savez_compressed(run_dir / "log.npz", **loop.log.arrays())  # type: ignore[arg-type]
-    watcher = getattr(loop, "goal_watcher", None)
+    folder.write_npz(log)
+    watcher = getattr(loop, "goal_watcher", None) if loop is not None else None
     if watcher is not None:  # ground truth of the goals: hand points, soles, boxes (launch/outcomes.py)
         np.savez_compressed(run_dir / "truth.npz", **watcher.arrays())
     if launch.output.plot:
         from g1_control.launch.plots import plot_run
 
-        plot_run(loop.log.arrays(), result, run_dir / "velocity.png")
-    want_video = video if video is not None else launch.output.video in (True, "auto")
+        plot_run(log, result, run_dir / "velocity.png")
+    want_video = video if video is not None else (launch.output.video in (True, "auto") and interrupted is None)
     if want_video:
         from g1_control.launch.overlay import run_overlay_rows
         from g1_control.sim.render import render_video
 
-        overlay = run_overlay_rows(loop.log.arrays(), result.events, [dataclasses.asdict(s) for s in result.segments])
+        overlay = run_overlay_rows(log, result.events, [dataclasses.asdict(s) for s in result.segments])
         backend = render_video(run_dir / "log.npz", run_dir / "video.mp4", launch.output.video_fps,
                                launch.output.video_size, overlay=overlay, extra=_scene_arrays(launch, loop))
         result.video = str(run_dir / "video.mp4") if backend else None
         result.extra["render_backend"] = backend
-    (run_dir / "summary.json").write_text(json.dumps(summary_dict(result), indent=2))
+    if interrupted is not None:
+        status, reason = "interrupted", str(interrupted)
+    elif _tripped(result):
+        trip = next(e for e in result.events if "damping" in e["detail"])
+        status, reason = "fault", f"{trip['kind']}: {trip['detail']}"
+    else:
+        status, reason = "completed", f"duration reached ({result.duration_s:.1f} s)"
+    folder.finish(status, reason, summary_dict(result))
     return run_dir
 
 
-def _scene_arrays(launch: LaunchFile, loop: ControlLoop) -> dict | None:
+def _scene_arrays(launch: LaunchFile, loop: ControlLoop | None) -> dict | None:
     """The scene and where its boxes were (ground truth), for the video; None without a scene."""
-    watcher = getattr(loop, "goal_watcher", None)
+    watcher = getattr(loop, "goal_watcher", None) if loop is not None else None
     if launch.scene.empty or watcher is None:
         return None
     truth = watcher.arrays()
@@ -343,6 +379,10 @@ def _scene_arrays(launch: LaunchFile, loop: ControlLoop) -> dict | None:
         if key.startswith("box_") and len(rows):
             out["object_" + key.removeprefix("box_")] = rows
     return out
+
+
+def _tripped(result: RunResult) -> bool:
+    return any("damping" in e["detail"] for e in result.events)
 
 
 def summary_dict(result: RunResult) -> dict:

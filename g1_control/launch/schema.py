@@ -10,9 +10,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
-import yaml
-
-from g1_control.config import apply_overrides, from_dict
+from g1_control.config import apply_overrides, from_dict, read_yaml
 from g1_control.errors import LaunchFileError, SafetyConfigError
 from g1_control.loop.rates import LoopRates
 from g1_control.safety.config import SafetyConfig
@@ -119,6 +117,10 @@ class DeployConfig:
     """Lockstep MuJoCo run of the same launch file before the robot moves; it must not fall."""
     input_check_s: float = 0.3
     """The operator input is polled this long and must not be lost."""
+    realtime_priority: int = 20
+    """SCHED_RR priority of the deploy process (1..99; 0: normal scheduling): ordinary work on the host
+    cannot delay a real-time loop (g1_control/loop/priority.py). Needs root or CAP_SYS_NICE; without,
+    it falls back to nice -10 with a warning. The simulated dry run runs at normal priority."""
 
     def validate(self, where: str) -> None:
         if self.ramp_s < 2.0:
@@ -129,6 +131,9 @@ class DeployConfig:
         for name in ("auto_start_s", "auto_run_s", "min_hold_s", "exit_damping_s", "state_window_s", "input_check_s"):
             if getattr(self, name) < 0 or (name in ("state_window_s", "input_check_s") and getattr(self, name) == 0):
                 raise LaunchFileError(f"{where}.{name}: must be positive, got {getattr(self, name)}")
+        if not 0 <= self.realtime_priority <= 99:
+            raise LaunchFileError(f"{where}.realtime_priority: {self.realtime_priority} is not a real-time priority "
+                                  "(1..99, or 0 for normal scheduling)")
         if self.min_state_rate_hz <= 0 or self.max_start_tilt_rad <= 0 or self.joint_limit_tolerance_rad < 0:
             raise LaunchFileError(f"{where}: min_state_rate_hz and max_start_tilt_rad must be positive, "
                                   "joint_limit_tolerance_rad not negative")
@@ -272,6 +277,13 @@ class LimitsConfig:
     max_tilt_rad: float = 1.0
     """Beyond this pelvis tilt the robot counts as fallen and the loop damps it."""
 
+    def validate(self, where: str) -> None:
+        for name in ("max_vx_mps", "max_vy_mps", "max_wz_radps", "max_tilt_rad"):
+            value = getattr(self, name)
+            if not value > 0:
+                raise LaunchFileError(f"{where}.{name}: {value} must be > 0 (a limit on the magnitude, both "
+                                      "directions)")
+
 
 @dataclass
 class OutputConfig:
@@ -349,6 +361,13 @@ class LaunchFile:
                 self.input.parsed_program().validate(self.program_world())
             except ProgramError as exc:
                 raise LaunchFileError(f"input.program: {exc}") from None
+        from g1_control.generator.styles import STYLES
+
+        styles = [(f"input.timeline[{i}].style", seg.style) for i, seg in enumerate(self.input.timeline)]
+        styles.append(("input.random.style", self.input.random.style))
+        for key, style in styles:
+            if style not in STYLES:
+                raise LaunchFileError(f"{key}: unknown style '{style}'; known: {', '.join(STYLES)}")
         lim = self.limits
         for i, seg in enumerate(self.input.timeline):
             for name, limit in (("vx_mps", lim.max_vx_mps), ("vy_mps", lim.max_vy_mps), ("wz_radps", lim.max_wz_radps)):
@@ -426,10 +445,7 @@ def load_launch(path: str | Path, overrides: Iterable[str] = ()) -> LaunchFile:
     path = Path(path)
     if not path.is_file():
         raise LaunchFileError(f"{path}: no such launch file")
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise LaunchFileError(f"{path}: not valid YAML: {exc}") from None
+    data = read_yaml(path)
     if overrides:
         try:
             data = apply_overrides(data, overrides)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -30,10 +31,16 @@ class LoopEvent:
 
 @dataclass
 class RunLog:
-    """Per-tracker-tick records, preallocated for the whole run (no allocation in the loop)."""
+    """Per-tracker-tick records, preallocated (no allocation in the loop). Without a sink it holds the
+    whole run (capacity rows; later ticks are dropped). With a sink (a run folder, g1_control/launch/
+    run_folder.py) it is one chunk: when full, a copy goes to sink() and the chunk starts over, so
+    memory stays bounded however long the run."""
 
     capacity: int
+    sink: Callable[[dict[str, np.ndarray]], None] | None = None
     n: int = 0
+    total: int = 0
+    """Rows logged so far, over every chunk."""
     t_s: np.ndarray = field(init=False)
     command: np.ndarray = field(init=False)          # operator (vx, vy, wz)
     policy_command: np.ndarray = field(init=False)   # after velocity correction
@@ -61,12 +68,20 @@ class RunLog:
         self.yaw_rad = np.full(c, np.nan)
         self.tilt_rad = np.full(c, np.nan)
 
+    NAMES = ("t_s", "command", "policy_command", "velocity_est", "velocity_true", "base_pos_m", "base_quat_wxyz",
+             "yaw_rad", "tilt_rad", "q_rad", "q_target_rad", "q_ref_rad", "tau_nm", "style_id")
+    """The per-tick arrays (style_names, the names behind style_id, is not per tick)."""
+
     def arrays(self) -> dict[str, np.ndarray]:
-        names = ("t_s", "command", "policy_command", "velocity_est", "velocity_true", "base_pos_m", "base_quat_wxyz", "yaw_rad",
-                 "tilt_rad", "q_rad", "q_target_rad", "q_ref_rad", "tau_nm", "style_id")
-        out = {name: getattr(self, name)[: self.n] for name in names}
+        out = {name: getattr(self, name)[: self.n] for name in self.NAMES}
         out["style_names"] = np.array(self.style_names, dtype=str)
         return out
+
+    def flush(self) -> None:
+        """Hand the rows so far to the sink (a copy) and start a new chunk (style_names stay)."""
+        if self.sink is not None and self.n:
+            self.sink({name: getattr(self, name)[: self.n].copy() for name in self.NAMES})
+            self.n = 0
 
     def style_index(self, name: str) -> int:
         if name not in self.style_names:
@@ -104,6 +119,8 @@ class ControlLoop:
         self._tracker_command = self.motor_command
         self.invalid_commands = 0
         self.events: list[LoopEvent] = []
+        self.on_record: Callable[[dict], None] | None = None
+        """Called with each event as a JSON-able dict (a run folder's events.jsonl)."""
         self.chain: dict[str, str] = {}
         """What each stage is (set by g1_control/launch/builder.py): the same in a deploy's dry run and on the robot."""
         self.log = RunLog(max(1, log_capacity))
@@ -144,8 +161,10 @@ class ControlLoop:
     def time_s(self) -> float:
         return self.scheduler.time_s
 
-    def _event(self, kind: str, detail: str) -> None:
+    def _event(self, kind: str, detail: str, record: dict | None = None) -> None:
         self.events.append(LoopEvent(self.time_s, kind, detail))
+        if self.on_record is not None:
+            self.on_record(record or {"type": "loop", "t_s": self.time_s, "kind": kind, "detail": detail})
 
     def now_s(self) -> float:
         return self.time_s if self.backend.lockstep else time.monotonic()
@@ -164,7 +183,9 @@ class ControlLoop:
         return self.falls.fall is not None
 
     def _on_safety_event(self, event) -> None:
-        self._event(event.kind.value, event.detail + ("; damping" if event.trips else ""))
+        self._event(event.kind.value, event.detail + ("; damping" if event.trips else ""),
+                    {"type": "safety", "t_s": event.t_s, "loop_t_s": self.time_s, "kind": event.kind.value,
+                     "detail": event.detail, "trips": event.trips, "planned": event.planned})
 
     # -- stages --------------------------------------------------------------------------------------
     def _input(self) -> None:
@@ -223,11 +244,16 @@ class ControlLoop:
         self._tracker_command = self.tracker.act(self._joint_ref, state)
 
     def _safety(self) -> None:
-        # Robot links count states dropped for a bad CRC; a burst of them trips the filter.
+        # Robot links count states dropped for a bad CRC; a burst of them trips the filter. A second
+        # publisher of the robot's state (or another writer of its commands) trips it at once.
         self.safety.report_crc_errors(self.backend.bad_crc, self.now_s())
+        self.safety.report_peers(self.backend.peer_fault, self.now_s())
         # Missed deadlines endanger a robot that runs on its own; a simulator we step just slows down.
+        # A tick counts as an overrun when it finished more than safety.overrun_lateness_s late.
         if self.scheduler.wallclock and not self.backend.lockstep:
-            self.safety.report_deadline(self.scheduler.deadline_misses > self._misses_seen, self.now_s())
+            late = self.scheduler.take_lateness()
+            self.safety.report_deadline(late > self.safety.config.overrun_lateness_s, self.now_s(),
+                                        f"{late * 1000:.0f} ms late" if late > 0 else "")
             self._misses_seen = self.scheduler.deadline_misses
         now = self.now_s()
         self.motor_command = self.safety.filter(self._tracker_command, self.state, now)
@@ -262,7 +288,10 @@ class ControlLoop:
         log = self.log
         i = log.n
         if i >= log.capacity:
-            return
+            if log.sink is None:
+                return
+            log.flush()
+            i = 0
         s, est = self.state, self.estimator.estimate
         quat = s.imu_quat_wxyz
         log.t_s[i] = self.time_s
@@ -289,3 +318,4 @@ class ControlLoop:
         log.style_id[i] = log.style_index(self.command.style)
         log.tau_nm[i] = s.tau_nm
         log.n = i + 1
+        log.total += 1

@@ -17,6 +17,9 @@ class LoopRates:
     estimator_hz: float = 100.0
 
     def validate(self, where: str = "rates") -> None:
+        if not 0 < self.lowlevel_hz <= 10_000:
+            raise LaunchFileError(f"{where}.lowlevel_hz: {self.lowlevel_hz} Hz must be > 0 (and at most 10000): "
+                                  "the base tick of the loop")
         for name in ("tracker_hz", "input_hz", "estimator_hz"):
             rate = getattr(self, name)
             ratio = self.lowlevel_hz / rate if rate > 0 else 0

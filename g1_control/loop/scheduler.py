@@ -87,6 +87,12 @@ class Scheduler:
         self.deadline_misses = 0
         self.overruns = 0
         """Ticks whose compute alone took longer than the tick period (would miss in real time)."""
+        self.lateness = StageTimes(capacity=1 << 14)
+        """How late each wall-clock tick finished past its deadline (0 when on time), seconds."""
+        self.max_lateness_s = 0.0
+        self.misses_over_period = 0
+        """Ticks that finished more than a whole tick period late (the next tick's deadline passed too)."""
+        self._late_since_take = 0.0
         self._t0: float | None = None
         self._timed = [(s.period_ticks, s.fn, self.times[s.name]) for s in stages]
         every_tick = [s for s in stages if s.period_ticks == 1]
@@ -126,10 +132,21 @@ class Scheduler:
         self.tick_index += 1
         if self.wallclock:
             deadline = self._t0 + self.tick_index * self.dt_s
-            if end > deadline:
+            late = end - deadline
+            self.lateness.add(max(0.0, late))
+            if late > 0:
                 self.deadline_misses += 1
+                self.max_lateness_s = max(self.max_lateness_s, late)
+                if late > self.dt_s:
+                    self.misses_over_period += 1
+                self._late_since_take = max(self._late_since_take, late)
             else:
-                self.sleep(deadline - end)
+                self.sleep(-late)
+
+    def take_lateness(self) -> float:
+        """The worst lateness since the previous call (0 when every tick was on time)."""
+        late, self._late_since_take = self._late_since_take, 0.0
+        return late
 
     def _batchable(self, limit: int) -> int:
         """How many ticks from now (at most `limit`) only the batched stage is due on."""

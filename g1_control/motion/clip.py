@@ -41,6 +41,11 @@ ARRAY_FIELDS = ("root_pos_w_m", "root_quat_wxyz", "joint_pos_rad", "joint_vel_ra
                 "body_quat_wxyz", "body_lin_vel_w_mps", "body_ang_vel_w_radps", "contacts")
 
 
+JOINT_LIMIT_SLACK_RAD = 0.5
+"""A clip's joint may sit this far outside the G1's limit (retargeting and mocap overshoot); further is
+not an angle of this joint (degrees, radians of another joint order, corrupt data)."""
+
+
 @dataclass
 class MotionClip:
     fps: float
@@ -124,6 +129,18 @@ class MotionClip:
                 _check_frames(name, arr, self.source)
         if self.object is not None:
             self.object.validate(t, f"clip{where}")
+        unknown = [n for n in self.joint_names if n not in g1.JOINT_INDEX]
+        if unknown:
+            raise InvalidClipError(f"clip{where}: joint_names has joints the G1 does not have: {unknown[:3]}")
+        idx = [g1.JOINT_INDEX[n] for n in self.joint_names]
+        lo, hi = g1.Q_MIN_RAD[idx] - JOINT_LIMIT_SLACK_RAD, g1.Q_MAX_RAD[idx] + JOINT_LIMIT_SLACK_RAD
+        q = np.asarray(self.joint_pos_rad)
+        outside = (q < lo) | (q > hi)
+        if outside.any():
+            f, k = (int(v[0]) for v in np.nonzero(outside))
+            raise InvalidClipError(f"clip{where}: joint_pos_rad[{f}] puts {self.joint_names[k]} at {q[f, k]:+.3f} rad, "
+                                   f"more than {JOINT_LIMIT_SLACK_RAD} rad outside its limits: not a G1 angle "
+                                   "(degrees? another joint order?)")
         norms = np.linalg.norm(self.root_quat_wxyz, axis=-1)
         bad = np.flatnonzero(np.abs(norms - 1.0) > 1e-3)
         if bad.size:

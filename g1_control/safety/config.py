@@ -7,6 +7,13 @@ from dataclasses import dataclass, fields
 
 from g1_control.errors import SafetyConfigError
 
+MAX_KP_CAP = 1000.0
+"""The largest position-gain cap a SafetyConfig accepts (N m/rad): far above any G1 controller's
+gains (Unitree's examples and the shipped policies stay below 300), far below a value that stops
+being a cap."""
+MAX_KD_CAP = 100.0
+"""The largest velocity-gain cap a SafetyConfig accepts (N m s/rad)."""
+
 
 @dataclass(frozen=True)
 class SafetyConfig:
@@ -24,6 +31,8 @@ class SafetyConfig:
     overrun_burst_count: int = 5
     """Damp on this many control-loop deadline overruns within overrun_window_s."""
     overrun_window_s: float = 1.0
+    overrun_lateness_s: float = 0.0
+    """A control-loop tick counts as an overrun when it finishes more than this late (0: any lateness)."""
     input_zero_velocity_s: float = 0.2
     """With no fresh operator input for this long, velocity commands are zeroed (the robot stops)."""
     input_lost_s: float = 1.0
@@ -31,9 +40,16 @@ class SafetyConfig:
     position_margin_rad: float = 0.0
     """Position targets are kept this far inside the joint limits."""
     max_kp: float = 1000.0
+    """Position gains are clamped to this (N m/rad); at most MAX_KP_CAP."""
     max_kd: float = 100.0
+    """Velocity gains are clamped to this (N m s/rad); at most MAX_KD_CAP."""
     damping_kd: float = 2.0
-    """kd of the fail-safe damping command (kp 0)."""
+    """kd of the fail-safe damping command (kp 0); at most max_kd."""
+    state_limit_margin_rad: float = 0.25
+    """Damp when a joint reads further than this outside its limits (a sensor or decoding fault: the
+    joint's mechanical stop is much closer)."""
+    max_quat_norm_error: float = 0.1
+    """Damp when the IMU quaternion's norm differs from 1 by more than this."""
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -43,12 +59,18 @@ class SafetyConfig:
             if value < 0:
                 raise SafetyConfigError(f"SafetyConfig.{f.name} is {value}; it must not be negative")
         for name in ("stale_state_s", "max_tilt_rad", "overspeed_factor", "crc_burst_window_s",
-                     "overrun_window_s", "damping_kd"):
+                     "overrun_window_s", "damping_kd", "max_kp", "max_kd", "max_quat_norm_error"):
             if getattr(self, name) == 0:
                 raise SafetyConfigError(f"SafetyConfig.{name} is 0; it must be positive")
         for name in ("crc_burst_count", "overrun_burst_count"):
             if int(getattr(self, name)) != getattr(self, name) or getattr(self, name) < 1:
                 raise SafetyConfigError(f"SafetyConfig.{name} is {getattr(self, name)}; it must be a whole number >= 1")
+        if self.max_kp > MAX_KP_CAP:
+            raise SafetyConfigError(f"SafetyConfig.max_kp is {self.max_kp}; the gain cap may be at most {MAX_KP_CAP:g}")
+        if self.max_kd > MAX_KD_CAP:
+            raise SafetyConfigError(f"SafetyConfig.max_kd is {self.max_kd}; the gain cap may be at most {MAX_KD_CAP:g}")
+        if self.damping_kd > self.max_kd:
+            raise SafetyConfigError(f"SafetyConfig.damping_kd ({self.damping_kd}) exceeds max_kd ({self.max_kd})")
         if self.input_lost_s < self.input_zero_velocity_s:
             raise SafetyConfigError(
                 f"SafetyConfig.input_lost_s ({self.input_lost_s}) must not be shorter than "

@@ -20,6 +20,12 @@ class SafetyEventKind(str, Enum):
     OVER_TEMPERATURE = "over_temperature"
     FALL = "fall"
     """The robot fell (g1_control/safety/fall.py: tilt, pelvis low, a body other than the feet on the ground)."""
+    STATE_OUT_OF_RANGE = "state_out_of_range"
+    """A joint reads far outside its limits, the IMU quaternion is not a unit quaternion, or the tick ran backwards."""
+    MODE_MACHINE_CHANGED = "mode_machine_changed"
+    """The robot reports another mode_machine (DoF variant) than the one accepted at the start."""
+    FOREIGN_PEER = "foreign_peer"
+    """A second publisher of the robot's state, or another writer of its commands, on the link."""
     ESTOP = "estop"
 
 
@@ -30,6 +36,8 @@ class SafetyEvent:
     detail: str
     trips: bool
     """True when the event switched the robot to damping for good."""
+    planned: bool = False
+    """A planned ending (operator stop, end of the control time, a signal): logged at INFO, not as an error."""
 
     def __str__(self) -> str:
         return f"[{self.t_s:.3f} s] {self.kind.value}{' (damping)' if self.trips else ''}: {self.detail}"

@@ -1,10 +1,13 @@
 """SafetyFilter: vets every MotorCommand before a backend sees it.
 
 Until it trips, commands are clamped to the G1's joint position, velocity and torque limits and to
-sane gains (every clamp counted per joint). It trips on the first of: stale state, a burst of bad
-CRCs, tilt (fall), joint over-speed, NaN/inf anywhere, repeated deadline overruns, lost operator
-input, an over-temperature motor, or an e-stop; from then on it returns the damping command
-(kp 0, kd > 0) for good. A new filter is the only way back: resuming control is an operator
+sane gains (every clamp counted per joint). The robot's state is validated as a whole every tick:
+finite everywhere, joints within their limits (give or take state_limit_margin_rad), a unit IMU
+quaternion, the mode_machine accepted at the start (`expect_mode_machine`; else the first one
+seen), a tick that advances. It trips on the first of: an invalid state, stale state, a burst of
+bad CRCs, a second publisher on the link, tilt (fall), joint over-speed, NaN/inf in a command,
+repeated deadline overruns, lost operator input, an over-temperature motor, or an e-stop; from
+then on it returns the damping command (kp 0, kd > 0) for good. A new filter is the only way back: resuming control is an operator
 decision the deploy state machine makes, never this layer.
 
 All times (`now_s`, RobotState.t_s) are one clock: the backend's receive clock on the robot
@@ -30,6 +33,10 @@ from g1_control.types import Button, Command, MotorCommand, RobotState
 log = logging.getLogger("g1_control.safety")
 
 CLAMPED_FIELDS = ("q_rad", "dq_radps", "tau_nm", "kp", "kd")
+STATE_FIELDS = ("q_rad", "dq_radps", "tau_nm", "imu_quat_wxyz", "imu_gyro_radps", "imu_acc_mps2", "motor_temperature_c")
+"""The RobotState arrays that must be finite every tick."""
+TICK_MODULUS = 1 << 32
+"""LowState_.tick is a u32: it wraps."""
 
 
 def _inside_float32(lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -99,6 +106,10 @@ class SafetyFilter:
         self._crc_burst = _Burst(c.crc_burst_count, c.crc_burst_window_s)
         self._overruns = _Burst(c.overrun_burst_count, c.overrun_window_s)
         self._crc_total_seen: int | None = None
+        self.expected_mode_machine: int | None = None
+        """The robot's mode_machine as accepted at the start; None: the first state's."""
+        self._range_lo = g1.Q_MIN_RAD - c.state_limit_margin_rad
+        self._range_hi = g1.Q_MAX_RAD + c.state_limit_margin_rad
         self._tick: int | None = None
         self._tick_since_s = 0.0
         self._last_input_s: float | None = None
@@ -119,16 +130,41 @@ class SafetyFilter:
         # (np.add.reduce: ndarray.sum without its Python wrapper; the small vectors as Python floats.)
         add = np.add.reduce
         quat = state.imu_quat_wxyz.tolist()
-        total = (add(state.q_rad) + add(state.dq_radps) + sum(quat) + sum(state.imu_gyro_radps.tolist())
-                 + add(state.motor_temperature_c))
+        total = (add(state.q_rad) + add(state.dq_radps) + add(state.tau_nm) + sum(quat)
+                 + sum(state.imu_gyro_radps.tolist()) + sum(state.imu_acc_mps2.tolist()) + add(state.motor_temperature_c))
         if not math.isfinite(total):
-            arrays = {"q_rad": state.q_rad, "dq_radps": state.dq_radps, "imu_quat_wxyz": state.imu_quat_wxyz,
-                      "imu_gyro_radps": state.imu_gyro_radps, "motor_temperature_c": state.motor_temperature_c}
-            for name, arr in arrays.items():
-                if not np.all(np.isfinite(np.asarray(arr, dtype=float))):
-                    return self._trip(now_s, SafetyEventKind.NONFINITE_STATE, f"RobotState.{name} contains NaN or inf")
+            for name in STATE_FIELDS:
+                arr = np.asarray(getattr(state, name), dtype=float)
+                bad = np.nonzero(~np.isfinite(arr))[0]
+                if bad.size:
+                    where = g1.JOINT_NAMES[bad[0]] if arr.shape == (g1.NUM_JOINTS,) else f"[{bad[0]}]"
+                    return self._trip(now_s, SafetyEventKind.NONFINITE_STATE,
+                                      f"RobotState.{name} contains NaN or inf ({where} = {arr[bad[0]]})")
         if not math.isfinite(state.t_s) or not math.isfinite(now_s):
             return self._trip(now_s, SafetyEventKind.NONFINITE_STATE, f"time is not finite (state {state.t_s}, now {now_s})")
+        if self.expected_mode_machine is None:
+            self.expected_mode_machine = int(state.mode_machine)
+        elif state.mode_machine != self.expected_mode_machine:
+            return self._trip(now_s, SafetyEventKind.MODE_MACHINE_CHANGED,
+                              f"RobotState.mode_machine changed from {self.expected_mode_machine} to "
+                              f"{state.mode_machine} (another DoF variant, or a second publisher)")
+        outside = (state.q_rad < self._range_lo) | (state.q_rad > self._range_hi)
+        if outside.any():
+            j = int(np.argmax(outside))
+            return self._trip(now_s, SafetyEventKind.STATE_OUT_OF_RANGE,
+                              f"RobotState.q_rad ({g1.JOINT_NAMES[j]}) reads {state.q_rad[j]:+.3f} rad, more than "
+                              f"{c.state_limit_margin_rad:.2f} rad outside [{g1.Q_MIN_RAD[j]:+.3f}, {g1.Q_MAX_RAD[j]:+.3f}]")
+        quat = state.imu_quat_wxyz
+        norm = float(np.sqrt(quat @ quat))
+        if abs(norm - 1.0) > c.max_quat_norm_error:
+            return self._trip(now_s, SafetyEventKind.STATE_OUT_OF_RANGE,
+                              f"RobotState.imu_quat_wxyz has norm {norm:.3f} (expected 1 ± {c.max_quat_norm_error:g})")
+        if self._tick is not None and state.tick != self._tick:
+            step = (int(state.tick) - int(self._tick)) % TICK_MODULUS
+            if step >= TICK_MODULUS // 2:
+                return self._trip(now_s, SafetyEventKind.STATE_OUT_OF_RANGE,
+                                  f"RobotState.tick went back from {self._tick} to {state.tick} (a second publisher, "
+                                  "or the robot restarted)")
         age = now_s - state.t_s
         if age > c.stale_state_s:
             return self._trip(now_s, SafetyEventKind.STALE_STATE,
@@ -140,8 +176,6 @@ class SafetyFilter:
             return self._trip(now_s, SafetyEventKind.STALE_STATE,
                               f"state tick frozen at {state.tick} for {(now_s - self._tick_since_s) * 1000:.1f} ms "
                               f"(limit {c.stale_state_s * 1000:.0f} ms)")
-        if math.sqrt(sum(c * c for c in quat)) < 1e-6:
-            return self._trip(now_s, SafetyEventKind.NONFINITE_STATE, "IMU quaternion is zero")
         tilt = tilt_rad(state.imu_quat_wxyz)
         if tilt > c.max_tilt_rad:
             return self._trip(now_s, SafetyEventKind.TILT, f"pelvis tilted {tilt:.2f} rad (limit {c.max_tilt_rad:.2f})")
@@ -173,6 +207,16 @@ class SafetyFilter:
                        f"({bad_crc_total} in total)")
         return not self.tripped
 
+    def report_peers(self, fault: str | None, now_s: float) -> bool:
+        """Feed the link's complaint about its peers (Backend.peer_fault); False once tripped."""
+        if fault and not self.tripped:
+            self._trip(now_s, SafetyEventKind.FOREIGN_PEER, fault)
+        return not self.tripped
+
+    def expect_mode_machine(self, mode_machine: int) -> None:
+        """The mode_machine the preflight accepted: any other one trips."""
+        self.expected_mode_machine = int(mode_machine)
+
     def report_deadline(self, overran: bool, now_s: float, detail: str = "") -> bool:
         """Tell the filter whether this tick missed its deadline; False once tripped."""
         if overran and self._overruns.add(now_s) and not self.tripped:
@@ -181,9 +225,10 @@ class SafetyFilter:
                        + (f" ({detail})" if detail else ""))
         return not self.tripped
 
-    def estop(self, reason: str, now_s: float) -> None:
-        """Trip at once (e-stop button, SIGINT/SIGTERM, a fault found elsewhere)."""
-        self._trip(now_s, SafetyEventKind.ESTOP, reason)
+    def estop(self, reason: str, now_s: float, planned: bool = False) -> None:
+        """Trip at once (e-stop button, SIGINT/SIGTERM, a fault found elsewhere). planned: an ending the
+        operator or the program chose (stop, end of the control time, a signal), logged at INFO."""
+        self._trip(now_s, SafetyEventKind.ESTOP, reason, planned)
 
     def report_fall(self, detail: str, now_s: float) -> None:
         """The robot fell (judged by safety/fall.py): trip, unless already tripped."""
@@ -237,16 +282,16 @@ class SafetyFilter:
     def damping(self) -> MotorCommand:
         return self._damping.copy()
 
-    def _trip(self, now_s: float, kind: SafetyEventKind, detail: str) -> bool:
+    def _trip(self, now_s: float, kind: SafetyEventKind, detail: str, planned: bool = False) -> bool:
         if self.tripped:
             return False
-        event = SafetyEvent(float(now_s), kind, detail, trips=True)
+        event = SafetyEvent(float(now_s), kind, detail, trips=True, planned=planned)
         self.trip_event = event
         self._log(event)
         return False
 
     def _log(self, event: SafetyEvent) -> None:
         self.events.append(event)
-        (log.error if event.trips else log.warning)("%s", event)
+        (log.info if event.planned else log.error if event.trips else log.warning)("%s", event)
         if self.on_event is not None:
             self.on_event(event)

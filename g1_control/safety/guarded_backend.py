@@ -7,7 +7,8 @@
 
 Wall-clock backends are judged on time.monotonic() (the clock their states are stamped with);
 lockstep backends on the state's own simulation time, where staleness cannot happen.
-The transport's bad-CRC count (LinkBackend.bad_crc) feeds the CRC-burst watchdog on every write.
+The transport's bad-CRC count (LinkBackend.bad_crc) feeds the CRC-burst watchdog on every write,
+and its peer check (LinkBackend.peer_fault: a second publisher of the robot's state) trips it.
 """
 
 from __future__ import annotations
@@ -46,6 +47,7 @@ class GuardedBackend(Backend):
         state = self.inner.read_state()
         now = self.now_s(state)
         self.safety.report_crc_errors(self.inner.bad_crc, now)
+        self.safety.report_peers(self.inner.peer_fault, now)
         out = self.safety.filter(command, state, now)
         self.last_sent = out
         self.inner.write_command(out)
@@ -55,10 +57,10 @@ class GuardedBackend(Backend):
         if not self.safety.report_deadline(overran, now, detail):
             self._damp_now()
 
-    def estop(self, reason: str) -> None:
+    def estop(self, reason: str, planned: bool = False) -> None:
         """Trip and put damping on the wire now, without waiting for the next tick."""
         now = self._clock() if self._clock is not None else float("nan")
-        self.safety.estop(reason, now)
+        self.safety.estop(reason, now, planned)
         self._damp_now()
 
     def _damp_now(self) -> None:
@@ -78,7 +80,7 @@ def install_signal_damping(robot: GuardedBackend, signals=(signal.SIGINT, signal
     in the main thread so the program unwinds through its `with`/finally blocks, which close()."""
 
     def handler(signum, frame):
-        robot.estop(f"{signal.Signals(signum).name} received")
+        robot.estop(f"{signal.Signals(signum).name} received", planned=True)
         raise KeyboardInterrupt
 
     for sig in signals:

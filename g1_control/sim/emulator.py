@@ -262,6 +262,7 @@ class RobotEmulator:
         out["first_damping_time_s"] = self.endpoint.first_damping_time_s
         out["builtin_mode"] = self.service.active_mode
         out.update(self.endpoint.command_wire_stats())
+        out.update(self.endpoint.whole_run_period_stats())
         state = self.physics.read_state()
         out["base_pos_w_m"] = None if state.base_pos_w_m is None else [float(v) for v in state.base_pos_w_m]
         out["first_damping_base_pos_w_m"] = self.endpoint.first_damping_base_pos_w_m

@@ -29,6 +29,10 @@ from g1_control.interfaces import Backend
 from g1_control.robot import g1
 from g1_control.types import MotorCommand
 
+PERIOD_BIN_S = 1e-5
+PERIOD_BINS = 20_000
+"""LowCmd_ period histogram: 10 us bins up to 200 ms."""
+
 
 @dataclass
 class EndpointCounters:
@@ -58,6 +62,8 @@ class RobotEndpoint:
         """Simulated base position when that damping command arrived (None on MockG1)."""
         self.command_times: deque[float] = deque(maxlen=60_000)
         """time.monotonic() of every valid LowCmd_ taken off the link (two minutes at 500 Hz)."""
+        self.period_histogram = np.zeros(PERIOD_BINS + 1, dtype=np.int64)
+        """Every LowCmd_ period since start, in PERIOD_BIN_S bins (the last bin: longer), for whole-run percentiles."""
         self.builtin_active = False
         """While True (the built-in controller runs), valid commands are ignored, as on the robot, and
         the physics is paused at its standing pose (Unitree's controller itself is not emulated)."""
@@ -110,7 +116,10 @@ class RobotEndpoint:
             except MalformedMessageError:
                 self.counters.malformed += 1
                 continue
-            self.command_times.append(time.monotonic())
+            now = time.monotonic()
+            if self.command_times:
+                self.period_histogram[min(int((now - self.command_times[-1]) / PERIOD_BIN_S), PERIOD_BINS)] += 1
+            self.command_times.append(now)
             state = self.physics.read_state()
             if msg.mode_machine != state.mode_machine:
                 self.counters.wrong_mode_machine += 1
@@ -144,6 +153,23 @@ class RobotEndpoint:
         return {"lowcmd_count": int(times.size), "lowcmd_rate_hz": float((times.size - 1) / (times[-1] - times[0])),
                 "lowcmd_period_p50_ms": float(p50 * 1e3), "lowcmd_period_p99_ms": float(p99 * 1e3),
                 "lowcmd_period_max_ms": float(periods.max() * 1e3), "lowcmd_window_s": float(times[-1] - times[0])}
+
+    def whole_run_period_stats(self) -> dict:
+        """LowCmd_ period percentiles over every command since start (from the histogram, to PERIOD_BIN_S)."""
+        hist = self.period_histogram
+        n = int(hist.sum())
+        if n == 0:
+            return {"lowcmd_periods": 0}
+        cum = np.cumsum(hist)
+
+        def pct(p: float) -> float:
+            return float((np.searchsorted(cum, p / 100 * n) + 0.5) * PERIOD_BIN_S * 1e3)
+
+        top = int(np.nonzero(hist)[0][-1])
+        return {"lowcmd_periods": n, "lowcmd_period_all_p50_ms": pct(50), "lowcmd_period_all_p99_ms": pct(99),
+                "lowcmd_period_all_p999_ms": pct(99.9),
+                "lowcmd_period_all_max_ms": float((top + 1) * PERIOD_BIN_S * 1e3) if top < PERIOD_BINS else float("inf"),
+                "lowcmd_periods_over_10ms": int(hist[int(0.010 / PERIOD_BIN_S):].sum())}
 
     def mark_faults_clear(self) -> None:
         """Clear every fault switch and forget the last damping time (start of a fault trial)."""

@@ -16,10 +16,9 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
-import yaml
 
 from g1_control import assets
-from g1_control.config import from_dict
+from g1_control.config import from_dict, read_yaml
 from g1_control.errors import PolicyMismatchError
 from g1_control.robot import g1
 from g1_control.trackers.envelope import Envelope, envelope_path, read_envelope
@@ -172,10 +171,7 @@ def _onnx_path(onnx: str | OnnxAssetSection, spec_file: Path, fetch: bool) -> Pa
 
 def read_spec_file(spec_file: Path) -> PolicySpecFile:
     """The spec file, validated by the typed loader (unknown keys, types, ranges named by key)."""
-    try:
-        data = yaml.safe_load(spec_file.read_text())
-    except yaml.YAMLError as exc:
-        raise PolicyMismatchError(f"{spec_file}: not valid YAML: {exc}") from None
+    data = read_yaml(spec_file, PolicyMismatchError)  # duplicate keys and binary files refused too
     return from_dict(PolicySpecFile, data, spec_file.name, error=PolicyMismatchError)
 
 
@@ -190,7 +186,12 @@ def load_spec(name_or_path: str | Path, *, fetch: bool = True) -> PolicySpec:
         raise PolicyMismatchError(f"{spec_file}: ONNX file {onnx_path} does not exist")
     meta = dict(ort.InferenceSession(str(onnx_path), providers=["CPUExecutionProvider"])
                 .get_modelmeta().custom_metadata_map)
-    spec = _build(d, spec_file, onnx_path, meta)
+    try:
+        spec = _build(d, spec_file, onnx_path, meta)
+    except KeyError as exc:
+        raise PolicyMismatchError(f"{spec_file}: missing key {exc}") from None
+    except (TypeError, ValueError) as exc:
+        raise PolicyMismatchError(f"{spec_file}: {' '.join(str(exc).split())}") from None
     check_against_robot(spec)
     check_against_onnx(spec)
     return spec
@@ -257,8 +258,12 @@ def check_against_robot(spec: PolicySpec) -> None:
             f"({len(names)} policy joints, {g1.NUM_JOINTS} robot joints)"
         )
     for label, arr in (("kp", spec.kp), ("kd", spec.kd), ("default_q", spec.default_q_rad)):
-        if arr.shape != (g1.NUM_JOINTS,) or not np.all(np.isfinite(arr)):
+        if arr.shape != (g1.NUM_JOINTS,):
             raise PolicyMismatchError(f"policy '{spec.name}' {label} must be {g1.NUM_JOINTS} finite numbers, got shape {arr.shape}")
+        if not np.all(np.isfinite(arr)):
+            j = int(np.argmax(~np.isfinite(arr)))
+            raise PolicyMismatchError(f"policy '{spec.name}' {label} must be {g1.NUM_JOINTS} finite numbers; "
+                                      f"{g1.JOINT_NAMES[j]} is {arr[j]}")
     if np.any(spec.kp < 0) or np.any(spec.kd < 0):
         raise PolicyMismatchError(f"policy '{spec.name}' has negative gains")
     outside = np.nonzero((spec.default_q_rad < g1.Q_MIN_RAD) | (spec.default_q_rad > g1.Q_MAX_RAD))[0]

@@ -101,6 +101,23 @@ def _to_torch(batch: dict):
     return out
 
 
+def check_splits(library_root: str | Path | None) -> None:
+    """Refuse a library whose train or held-out ('test') split has no clip long enough for a window."""
+    from g1_control.motion.library import LibraryError, MotionLibrary, default_library_dir
+    from g1_control.training.dataset import CONTEXT_FRAMES, MAX_GAP
+
+    lib = MotionLibrary(library_root or default_library_dir())
+    need = CONTEXT_FRAMES + MAX_GAP + 1
+    for split, what in (("train", "training"), ("test", "held-out")):
+        entries = lib.select(split)
+        if not entries:
+            raise LibraryError(f"{lib.root}: the '{split}' split has no clips, so there is no {what} data; rebuild "
+                               "the library with clips in both splits (g1 library build)")
+        if max(e.num_frames for e in entries) < need:
+            raise LibraryError(f"{lib.root}: no clip of the '{split}' ({what}) split has the {need} frames a "
+                               "training window needs")
+
+
 def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | None = None,
           progress: bool = True) -> dict:
     import torch
@@ -116,6 +133,7 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | N
         dist.init_process_group("gloo")
     torch.manual_seed(config.seed)
     torch.set_num_threads(max(1, config.threads))
+    check_splits(library_root)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     feats, styles = load_split(library_root, "train")

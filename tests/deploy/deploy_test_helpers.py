@@ -37,7 +37,71 @@ def write_launch(folder: Path, changes: dict | None = None, name: str = "launch.
     return path
 
 
+def preflight_only(path: Path, partition: str, **options):
+    """g1 deploy --preflight-only in this process: (report, PreflightRefused or None, printed text)."""
+    from g1_control.deploy.preflight import PreflightRefused
+    from g1_control.deploy.session import DeployOptions, deploy
+
+    lines: list[str] = []
+    try:
+        report = deploy(path, DeployOptions(preflight_only=True, partition=partition, **options), say=lines.append)
+        return report, None, "\n".join(lines)
+    except PreflightRefused as exc:
+        return exc.report, exc, "\n".join(lines)
+
+
 FAST = {"deploy": {"state_window_s": 0.3, "input_check_s": 0.1}, "backend": {"connect_timeout_s": 2.0}}
 """Shorter listening windows for tests that only need the checklist's verdict."""
 
 
+
+
+class SecondPublisher:
+    """Another writer on rt/lowstate in the same domain and partition (lo, domain 1): valid CRCs, as a
+    second robot or a spoofing program would send. `source()` gives the RobotState to report. The
+    writer exists (and DDS discovery sees it) from start() + delay_s on."""
+
+    def __init__(self, partition: str, source, mode_machine: int = 5, rate_hz: float = 500.0):
+        import threading
+
+        self.partition, self.link = partition, None
+        self.source, self.mode_machine, self.period_s = source, mode_machine, 1.0 / rate_hz
+        self.sent = 0
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    def start(self, seconds: float, delay_s: float = 0.0) -> SecondPublisher:
+        import threading
+
+        self._thread = threading.Thread(target=self._run, args=(seconds, delay_s), daemon=True)
+        self._thread.start()
+        return self
+
+    def _run(self, seconds: float, delay_s: float) -> None:
+        import time
+
+        from g1_control.hardware.links.dds import DdsLink
+        from g1_control.hardware.unitree.conversions import robot_state_to_lowstate
+
+        if self._stop.wait(delay_s):
+            return
+        self.link = DdsLink("robot", "lo", 1, partition=self.partition)
+        end = time.monotonic() + seconds
+        tick = 10_000_000
+        while not self._stop.is_set() and time.monotonic() < end:
+            state = self.source()
+            state.mode_machine, state.tick = self.mode_machine, tick
+            self.link.send(self.link.encode(robot_state_to_lowstate(state)))
+            self.sent += 1
+            tick += 1
+            self._stop.wait(self.period_s)
+
+    def join(self) -> None:
+        if self._thread is not None:
+            self._thread.join()
+
+    def close(self) -> None:
+        self._stop.set()
+        self.join()
+        if self.link is not None:
+            self.link.close()

@@ -15,6 +15,8 @@ from g1_control.deploy.session import DeployOptions, deploy
 from g1_control.errors import TransportError
 from g1_control.launch.schema import load_launch
 
+pytestmark = pytest.mark.timing
+
 BENCH = {"rates": {"lowlevel_hz": 50}, "backend": {"command_rate_hz": 100, "interface": None, "domain": 0,
                                                    "connect_timeout_s": 2.0},
          "deploy": {"min_state_rate_hz": 50, "state_window_s": 0.3, "input_check_s": 0.1, "exit_damping_s": 0.3},

@@ -7,26 +7,18 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
-from deploy_test_helpers import FAST, write_launch
+from deploy_test_helpers import FAST, preflight_only, write_launch
 
 from g1_control.cli.main import main
-from g1_control.deploy.preflight import PreflightRefused
-from g1_control.deploy.session import DeployOptions, deploy
 from g1_control.robot import g1
 
+pytestmark = pytest.mark.timing
 
-def _preflight(path: Path, partition: str, **options):
-    lines: list[str] = []
-    try:
-        report = deploy(path, DeployOptions(preflight_only=True, partition=partition, **options), say=lines.append)
-        return report, None, "\n".join(lines)
-    except PreflightRefused as exc:
-        return exc.report, exc, "\n".join(lines)
+
 
 
 def _status(report) -> dict[str, str]:
@@ -39,7 +31,7 @@ def _reason(report, name: str) -> str:
 
 def test_healthy_emulated_robot_passes_and_nothing_is_sent(tmp_path, partition, mock_robot):
     robot = mock_robot().start()
-    report, refused, text = _preflight(write_launch(tmp_path, FAST), partition)
+    report, refused, text = preflight_only(write_launch(tmp_path, FAST), partition)
     assert refused is None, text
     status = _status(report)
     assert status.pop("battery") == "skip" and set(status.values()) == {"pass"}, text
@@ -49,7 +41,7 @@ def test_healthy_emulated_robot_passes_and_nothing_is_sent(tmp_path, partition, 
 
 
 def test_wrong_interface_name_is_refused_before_any_dds(tmp_path, partition):
-    report, refused, _ = _preflight(write_launch(tmp_path, FAST), partition, interface="nonexistent0")
+    report, refused, _ = preflight_only(write_launch(tmp_path, FAST), partition, interface="nonexistent0")
     assert refused is not None
     assert _status(report)["interface"] == "fail"
     assert "network interface 'nonexistent0' does not exist; interfaces here: " in _reason(report, "interface")
@@ -59,7 +51,7 @@ def test_wrong_interface_name_is_refused_before_any_dds(tmp_path, partition):
 
 def test_no_robot_times_out_and_cannot_be_overridden(tmp_path, partition):
     path = write_launch(tmp_path, {**FAST, "backend": {"connect_timeout_s": 0.5}})
-    report, refused, _ = _preflight(path, partition, overrides=frozenset({"state_stream"}))
+    report, refused, _ = preflight_only(path, partition, overrides=frozenset({"state_stream"}))
     assert refused is not None
     reason = _reason(report, "state_stream")
     assert reason.startswith("no valid LowState from the robot within 0.5 s on DDS (interface lo, domain 1")
@@ -71,7 +63,7 @@ def test_no_robot_times_out_and_cannot_be_overridden(tmp_path, partition):
 
 def test_robot_of_another_dof_variant_is_refused(tmp_path, partition, mock_robot):
     mock_robot(mode_machine=4).start()
-    report, refused, _ = _preflight(write_launch(tmp_path, FAST), partition, overrides=frozenset({"variant"}))
+    report, refused, _ = preflight_only(write_launch(tmp_path, FAST), partition, overrides=frozenset({"variant"}))
     assert refused is not None and _status(report)["variant"] == "fail"
     assert _reason(report, "variant").startswith(
         "the robot reports mode_machine 4 (g1_23dof, 23 DoF) but the launch file expects g1_29dof and the policy is "
@@ -86,7 +78,7 @@ def test_policy_for_another_robot_is_refused(tmp_path, partition, mock_robot):
     (tmp_path / "other.yaml").write_text(yaml.safe_dump(spec))
     mock_robot().start()
     path = write_launch(tmp_path, {**FAST, "tracker": {"policy": str(tmp_path / "other.yaml")}})
-    report, refused, _ = _preflight(path, partition)
+    report, refused, _ = preflight_only(path, partition)
     assert refused is not None and _status(report)["policy"] == "fail"
     assert "is for the g1_23dof G1 but backend.expected_variant is g1_29dof; use a policy made for this robot" \
         in _reason(report, "policy")
@@ -98,7 +90,7 @@ def test_corrupted_crcs_are_refused(tmp_path, partition, mock_robot):
     robot.endpoint.corrupt_state_crc = True
     robot.start()
     path = write_launch(tmp_path, {**FAST, "backend": {"connect_timeout_s": 0.5}})
-    report, refused, _ = _preflight(path, partition)
+    report, refused, _ = preflight_only(path, partition)
     reason = _reason(report, "state_stream")
     assert refused is not None
     assert "no valid LowState from the robot within 0.5 s" in reason and "samples had a bad CRC" in reason
@@ -117,7 +109,7 @@ def test_intermittent_bad_crcs_fail_the_stream_check(tmp_path, partition, mock_r
     thread = threading.Thread(target=flicker, daemon=True)
     thread.start()
     try:
-        report, refused, _ = _preflight(write_launch(tmp_path, FAST), partition)
+        report, refused, _ = preflight_only(write_launch(tmp_path, FAST), partition)
     finally:
         stop.set()
         thread.join()
@@ -142,7 +134,7 @@ def test_short_samples_are_refused(tmp_path, partition, mock_robot):
     thread.start()
     try:
         path = write_launch(tmp_path, {**FAST, "backend": {"connect_timeout_s": 0.5}})
-        report, refused, _ = _preflight(path, partition)
+        report, refused, _ = preflight_only(path, partition)
     finally:
         stop.set()
         thread.join()
@@ -159,7 +151,7 @@ def test_hot_tilted_robot_with_a_joint_past_its_limit_is_refused_then_overridden
     mock.imu_quat_wxyz = np.array([np.cos(0.25), np.sin(0.25), 0.0, 0.0])  # 0.5 rad roll
     robot.start()
     path = write_launch(tmp_path, FAST)
-    report, refused, _ = _preflight(path, partition)
+    report, refused, _ = preflight_only(path, partition)
     assert refused is not None
     status = _status(report)
     assert (status["temperatures"], status["imu_upright"], status["joint_limits"]) == ("fail",) * 3
@@ -171,7 +163,7 @@ def test_hot_tilted_robot_with_a_joint_past_its_limit_is_refused_then_overridden
 
     caplog.set_level(logging.ERROR, logger="g1_control.deploy")
     overrides = frozenset({"temperatures", "imu_upright", "joint_limits"})
-    report, refused, text = _preflight(path, partition, overrides=overrides)
+    report, refused, text = preflight_only(path, partition, overrides=overrides)
     assert refused is None, text
     assert {n for n, s in _status(report).items() if s == "overridden"} == overrides
     assert "temperatures  OVERRIDDEN" in text
@@ -185,7 +177,7 @@ def test_an_input_device_that_cannot_open_is_refused(tmp_path, partition, mock_r
     not_a_tty.write_text("")
     path = write_launch(tmp_path, {**FAST, "input": {"type": "keyboard", "timeline": None,
                                                       "device": {"path": str(not_a_tty)}}})
-    report, refused, _ = _preflight(path, partition, overrides=frozenset({"estop_input"}))
+    report, refused, _ = preflight_only(path, partition, overrides=frozenset({"estop_input"}))
     assert refused is not None and _status(report)["estop_input"] == "fail"
     assert _reason(report, "estop_input").startswith("keyboard cannot be opened: ")
     assert "cannot be overridden" in _reason(report, "estop_input")
@@ -239,18 +231,18 @@ def test_robot_launch_file_names_no_interface_until_the_operator_does(tmp_path, 
     """launch/robot.yaml refuses to guess a NIC; pointed at an emulated robot on lo it passes."""
     from deploy_test_helpers import ROOT
 
-    report, refused, _ = _preflight(ROOT / "launch" / "robot.yaml", partition)
+    report, refused, _ = preflight_only(ROOT / "launch" / "robot.yaml", partition)
     assert refused is not None
     assert "network interface 'CHANGE_ME' does not exist" in _reason(report, "interface")
     mock_robot().start()
     fast = write_launch(tmp_path, FAST, base=ROOT / "launch" / "robot.yaml")
-    report, refused, text = _preflight(fast, partition, interface="lo", domain=1)
+    report, refused, text = preflight_only(fast, partition, interface="lo", domain=1)
     assert refused is None, text
     assert _reason(report, "estop_input") == "unitree_remote answering; e-stop on L1+R1"
 
 
 def test_yes_is_refused_off_loopback(tmp_path, partition):
-    report, refused, _ = _preflight(write_launch(tmp_path, FAST), partition, interface="eth9", yes=True)
+    report, refused, _ = preflight_only(write_launch(tmp_path, FAST), partition, interface="eth9", yes=True)
     assert refused is not None and _status(report)["interface"] == "not run"
     assert "--yes answers start and run with nobody watching; it is only for g1 sim-robot on 'lo'" \
         in _reason(report, "launch_file")

@@ -7,73 +7,22 @@ Thresholds are loose (shared 2-core host): the figures themselves are printed fo
 from __future__ import annotations
 
 import json
-import os
-import queue
-import re
 import signal
 import subprocess
-import sys
-import threading
 import time
 
 import pytest
-from deploy_test_helpers import ROOT, write_launch
+from deploy_test_helpers import write_launch
 
-ENV = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+from g1_control.tools.soak import G1Process as Proc
 
-
-class Proc:
-    """A `g1` subprocess whose stdout lines are read on a thread (so waits can time out)."""
-
-    def __init__(self, *args: str, stdin: bool = False):
-        self.proc = subprocess.Popen([sys.executable, "-m", "g1_control.cli.main", *args], cwd=ROOT, env=ENV,
-                                     stdin=subprocess.PIPE if stdin else subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                     stderr=subprocess.PIPE, text=True, bufsize=1)
-        self.lines: queue.Queue[str] = queue.Queue()
-        self.seen: list[str] = []
-        self.errors: list[str] = []
-        threading.Thread(target=self._pump, daemon=True).start()
-        # stderr is drained too: a full pipe would block the process on its next log line.
-        threading.Thread(target=lambda: self.errors.extend(self.proc.stderr), daemon=True).start()
-
-    def _pump(self) -> None:
-        for line in self.proc.stdout:
-            self.lines.put(line.rstrip("\n"))
-
-    @property
-    def stderr(self) -> str:
-        return "".join(self.errors)
-
-    def wait_for(self, pattern: str, timeout_s: float) -> str:
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
-            try:
-                line = self.lines.get(timeout=0.1)
-            except queue.Empty:
-                if self.proc.poll() is not None and self.lines.empty():
-                    break
-                continue
-            self.seen.append(line)
-            if re.search(pattern, line):
-                return line
-        raise AssertionError(f"no line matching {pattern!r} within {timeout_s} s; got:\n" + "\n".join(self.seen)
-                             + "\nstderr:\n" + self.stderr)
-
-    def kill(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.kill()
-            self.proc.wait(timeout=10)
+pytestmark = pytest.mark.timing
 
 
 class Emulator(Proc):
     def __init__(self, partition: str, *flags: str):
         super().__init__("sim-robot", "--partition", partition, "--control-stdin", *flags, stdin=True)
         self.wait_for("^ready$", 60)
-
-    def ask(self, line: str) -> dict:
-        self.proc.stdin.write(line + "\n")
-        self.proc.stdin.flush()
-        return json.loads(self.wait_for(r"^\{", 10))
 
     def close(self) -> None:
         try:
@@ -98,7 +47,7 @@ def test_sim2sim_walks_forward_and_ends_in_damping(tmp_path, partition, processe
     processes.append(robot)
     report_path = tmp_path / "deploy.json"
     host = Proc("deploy", "launch/sim2sim.yaml", "--yes", "--partition", partition, "--duration", "5",
-                "--json", str(report_path))
+                "--json", str(report_path), "--out", str(tmp_path))
     processes.append(host)
     host.wait_for(r"zero torque: the robot is limp", 90)
     host.wait_for(r"control -> damping: control time over", 60)
@@ -138,7 +87,8 @@ def test_operator_drives_with_the_unitree_remote_and_stops_with_b(tmp_path, part
                                                                     "device": {"stale_after_s": 0.5}}})
     robot = Emulator(partition, "--lower-gantry-on-policy")
     processes.append(robot)
-    host = Proc("deploy", str(launch), "--partition", partition, "--json", str(tmp_path / "deploy.json"))
+    host = Proc("deploy", str(launch), "--partition", partition, "--json", str(tmp_path / "deploy.json"),
+                "--out", str(tmp_path))
     processes.append(host)
     line = host.wait_for(r"zero torque: the robot is limp", 90)
     assert "Press start to ramp" in line and "e-stop: L1+R1" in line and "stop (damping): B" in line
@@ -169,7 +119,7 @@ def test_a_signal_during_control_puts_damping_on_the_wire(tmp_path, partition, p
     robot = Emulator(partition, "--physics", "mock")
     processes.append(robot)
     launch = write_launch(tmp_path, {"deploy": {"state_window_s": 0.3}})
-    host = Proc("deploy", str(launch), "--yes", "--partition", partition, "--duration", "60")
+    host = Proc("deploy", str(launch), "--yes", "--partition", partition, "--duration", "60", "--out", str(tmp_path))
     processes.append(host)
     host.wait_for(r"hold -> control: run \(--yes\)", 90)
     time.sleep(0.5)
@@ -192,7 +142,7 @@ def test_a_fault_during_control_damps_and_exits_3_in_debug_mode(tmp_path, partit
     processes.append(robot)
     launch = write_launch(tmp_path, {"deploy": {"state_window_s": 0.3}})
     host = Proc("deploy", str(launch), "--yes", "--no-release-motion-service", "--partition", partition,
-                "--duration", "60")
+                "--duration", "60", "--out", str(tmp_path))
     processes.append(host)
     line = host.wait_for(r"zero torque: the robot is limp", 90)
     assert not any("releasing the robot's built-in motion service" in s for s in host.seen), line

@@ -22,7 +22,13 @@ from g1_control.sim.mock_robot import MockG1
 from g1_control.sim.robot_endpoint import RobotEndpoint
 from g1_control.types import MotorCommand
 
+pytestmark = pytest.mark.timing
+
 RATE_HZ = 200.0  # byte links run at bench rates; the stream logic is the DDS one
+CLASSIC_CAN_RATE_HZ = 50.0
+"""Classic CAN (8-byte frames) needs ~390 frames per state+command pair: a bench rate of 50 Hz (see
+can_bus.py). At 200 Hz the Python virtual bus falls behind and the test measured the host, not the link."""
+DRIVE_S = 0.8
 
 
 def _target() -> MotorCommand:
@@ -31,14 +37,14 @@ def _target() -> MotorCommand:
     return MotorCommand(q_rad=q, kp=g1.KP_DEFAULT.copy(), kd=g1.KD_DEFAULT.copy())
 
 
-def _drive(host_link, robot_link):
-    """Run backend <-> endpoint for a moment; return (backend stats, endpoint, final state)."""
-    endpoint = RobotEndpoint(robot_link, MockG1(mode_machine=5), rate_hz=RATE_HZ).start()
-    backend = LinkBackend(host_link, command_rate_hz=RATE_HZ, connect_timeout_s=3.0, close_damping_s=0.05)
+def _drive(host_link, robot_link, rate_hz: float = RATE_HZ):
+    """Run backend <-> endpoint for DRIVE_S; return (backend stats, endpoint, final state)."""
+    endpoint = RobotEndpoint(robot_link, MockG1(mode_machine=5), rate_hz=rate_hz).start()
+    backend = LinkBackend(host_link, command_rate_hz=rate_hz, connect_timeout_s=3.0, close_damping_s=0.05)
     try:
         backend.reset()
         backend.write_command(_target())
-        time.sleep(0.8)
+        time.sleep(DRIVE_S)
         state = backend.read_state()
         stats = backend.stats()
     finally:
@@ -94,9 +100,11 @@ def test_can_virtual_bus_closes_the_loop(fd):
     channel = f"g1test-{uuid.uuid4().hex[:8]}"
     host_bus = can.Bus(interface="virtual", channel=channel, fd=fd)
     robot_bus = can.Bus(interface="virtual", channel=channel, fd=fd)
-    stats, endpoint, state = _drive(CanLink("host", host_bus, fd=fd), CanLink("robot", robot_bus, fd=fd))
-    assert stats.bad_crc == 0 and stats.bad_frames == 0 and stats.states_received > 30
-    assert endpoint.counters.commands_applied > 30
+    rate = RATE_HZ if fd else CLASSIC_CAN_RATE_HZ
+    stats, endpoint, state = _drive(CanLink("host", host_bus, fd=fd), CanLink("robot", robot_bus, fd=fd), rate)
+    # At least half the stream's rate arrives, both ways, over the whole drive.
+    assert stats.bad_crc == 0 and stats.bad_frames == 0 and stats.states_received > 0.5 * rate * DRIVE_S
+    assert endpoint.counters.commands_applied > 0.5 * rate * DRIVE_S
     assert state.q_rad[3] == pytest.approx(g1.DEFAULT_Q_RAD[3] + 0.3, abs=0.05)
 
 

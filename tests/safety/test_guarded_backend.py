@@ -17,7 +17,10 @@ def test_lockstep_backend_gets_clamped_commands_and_sim_time():
         robot.write_command(cmd)
         robot.step(0.002)
     assert robot.last_sent.q_rad[3] <= g1.Q_MAX_RAD[3]
-    assert robot.read_state().q_rad[3] <= g1.Q_MAX_RAD[3] + 1e-9
+    # What the motors were given (MockG1 keeps the last command; it clips its own joints, so the
+    # state cannot tell whether the guard clamped): the clamped target, not the 10 rad asked for.
+    assert robot.inner._command.q_rad[3] <= g1.Q_MAX_RAD[3]
+    assert robot.inner._command.q_rad[3] == robot.last_sent.q_rad[3]
     assert robot.safety.clamps.per_joint["q_rad"][3] == 200 and not robot.safety.tripped
 
 

@@ -21,6 +21,8 @@ from g1_control.sim.emulator import RobotEmulator
 from g1_control.sim.mock_robot import MockG1
 from g1_control.types import MotorCommand
 
+pytestmark = pytest.mark.timing
+
 ROOT = Path(__file__).resolve().parents[2]
 
 

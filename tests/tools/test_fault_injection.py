@@ -8,6 +8,8 @@ import pytest
 
 from g1_control.tools.fault_suite import ALL_FAULTS, format_table, run_suite
 
+pytestmark = pytest.mark.timing
+
 EXPECTED_TRIP = {
     "state_stops": ("stale_state", 250), "state_frozen": ("stale_state", 300), "crc_corrupted": ("crc_burst", 200),
     "tilt": ("tilt", 200), "overspeed": ("joint_overspeed", 200), "over_temperature": ("over_temperature", 200),

@@ -46,6 +46,17 @@ class Link(ABC):
     def receive(self, timeout_s: float) -> list[bytes]:
         """Messages that arrived, waiting up to `timeout_s` for the first one; [] on timeout."""
 
+    def receive_tagged(self, timeout_s: float) -> list[tuple[bytes, int | None]]:
+        """As receive(), each message with an id of the writer that sent it where the transport can
+        tell writers apart (DDS: the publication handle), else None."""
+        return [(payload, None) for payload in self.receive(timeout_s)]
+
+    def peer_writers(self) -> dict[str, int] | None:
+        """Writers discovered on this link's two topics, by topic name, not counting this side's own
+        writer: {state topic: n, command topic: n}. None where the transport cannot tell (CAN and
+        serial carry bytes, not writers; the tick order is checked every tick instead)."""
+        return None
+
     def close(self) -> None:
         """Release the transport."""
 

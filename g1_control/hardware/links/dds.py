@@ -117,6 +117,13 @@ class DdsLink(Link):
         from cyclonedds._clayer import ddspy_take, ddspy_write
 
         self._write, self._take = ddspy_write, ddspy_take
+        self._topics = (LOWSTATE_TOPIC, LOWCMD_TOPIC)
+        self._own_writer = str(self._writer.guid)
+        self._publications: Any = None
+        """The built-in DCPSPublication reader, made on the first peer_writers()."""
+        self._writers: dict[int, tuple[str, str]] = {}
+        self._peer_lock = threading.Lock()
+        """Discovered writers on our two topics and partition: instance handle -> (topic, guid)."""
         self._closed = False
 
     def describe(self) -> str:
@@ -130,15 +137,50 @@ class DdsLink(Link):
         self._count("sent")
 
     def receive(self, timeout_s: float) -> list[bytes]:
+        return [payload for payload, _ in self.receive_tagged(timeout_s)]
+
+    def receive_tagged(self, timeout_s: float) -> list[tuple[bytes, int | None]]:
         samples = self._take(self._reader._ref, self._depth)
         if isinstance(samples, int) or not samples:
             self._waitset.wait(int(timeout_s * 1e9))
             samples = self._take(self._reader._ref, self._depth)
             if isinstance(samples, int):
                 return []
-        payloads = [data for data, info in samples if info.valid_data]
-        self._count("received", len(payloads))
-        return payloads
+        tagged = [(data, info.publication_handle) for data, info in samples if info.valid_data]
+        self._count("received", len(tagged))
+        return tagged
+
+    def peer_writers(self) -> dict[str, int]:
+        """Writers of rt/lowstate and rt/lowcmd in this domain and partition, from DDS discovery (the
+        built-in DCPSPublication topic), not counting this link's own writer. New discovery samples
+        only are taken each call, so a call costs little once the domain is known."""
+        from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication
+        from cyclonedds.core import InstanceState
+        from cyclonedds.qos import Policy
+
+        with self._peer_lock:
+            if self._publications is None:
+                self._publications = BuiltinDataReader(self._participant, BuiltinTopicDcpsPublication)
+            return self._update_writers(InstanceState, Policy)
+
+    def _update_writers(self, InstanceState, Policy) -> dict[str, int]:
+        ours = {self.partition or ""}
+        for sample in self._publications.take(N=256):
+            info = sample.sample_info
+            handle = info.instance_handle
+            if info.instance_state != InstanceState.Alive or not info.valid_data:
+                self._writers.pop(handle, None)
+                continue
+            if sample.topic_name not in self._topics or str(sample.key) == self._own_writer:
+                continue
+            partition = sample.qos[Policy.Partition] if sample.qos is not None else None
+            theirs = set(partition.partitions) if partition is not None and partition.partitions else {""}
+            if theirs & ours:
+                self._writers[handle] = (sample.topic_name, str(sample.key))
+        counts = dict.fromkeys(self._topics, 0)
+        for topic, _ in self._writers.values():
+            counts[topic] += 1
+        return counts
 
     def close(self) -> None:
         # Entities are reclaimed with the participant; dropping our references is enough, and the
@@ -146,4 +188,4 @@ class DdsLink(Link):
         if not self._closed:
             self._closed = True
             self._waitset.detach(self._condition)
-            del self._writer, self._reader, self._condition, self._waitset, self._participant
+            del self._writer, self._reader, self._condition, self._waitset, self._participant, self._publications

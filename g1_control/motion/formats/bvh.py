@@ -78,7 +78,10 @@ def read_bvh(path: str | Path, unit_m: float = 0.01, y_up: bool = True, height_m
             if len(tokens) != 4:
                 raise MotionFormatError(f"{path}: line {i}: OFFSET needs 3 numbers")
             if not in_end_site and stack and stack[-1] >= 0:
-                joints[stack[-1]].offset = np.array([float(t) for t in tokens[1:]])
+                try:
+                    joints[stack[-1]].offset = np.array([float(t) for t in tokens[1:]])
+                except ValueError as exc:
+                    raise MotionFormatError(f"{path}: line {i}: OFFSET: {exc}") from None
         elif key == "CHANNELS":
             if not stack or stack[-1] < 0:
                 raise MotionFormatError(f"{path}: line {i}: CHANNELS outside a joint")
@@ -128,7 +131,10 @@ def read_bvh(path: str | Path, unit_m: float = 0.01, y_up: bool = True, height_m
         if len(parts) != n_channels:
             raise MotionFormatError(f"{path}: frame {k} has {len(parts)} values; the hierarchy declares {n_channels} "
                                     "channels (missing channels)")
-        values = np.array([float(p) for p in parts])
+        try:
+            values = np.array([float(p) for p in parts])
+        except ValueError as exc:
+            raise MotionFormatError(f"{path}: frame {k}: {exc}") from None
         if not np.all(np.isfinite(values)):
             raise MotionFormatError(f"{path}: frame {k} contains NaN or inf")
         rows.append(values)

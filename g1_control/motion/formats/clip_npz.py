@@ -50,6 +50,10 @@ def write_clip_npz(clip: MotionClip, path: str | Path) -> None:
 
 def read_clip_npz(path: str | Path) -> MotionClip:
     path = Path(path)
+    with path.open("rb") as fh:
+        magic = fh.read(4)
+    if magic != b"PK\x03\x04":
+        raise MotionFormatError(f"{path}: not an npz file (it does not start with the zip signature)")
     try:
         data = np.load(path, allow_pickle=False)
     except Exception as exc:

@@ -23,21 +23,24 @@ DEFAULT_FPS = 30.0
 def read_g1_csv(path: str | Path, fps: float = DEFAULT_FPS, style: str = "default") -> MotionClip:
     path = Path(path)
     rows: list[list[float]] = []
-    with path.open() as fh:
-        for lineno, line in enumerate(fh, start=1):
-            if not line.strip():
-                continue
-            parts = line.strip().split(",")
-            if len(parts) != NUM_COLUMNS:
-                raise MotionFormatError(f"{path}: line {lineno} has {len(parts)} columns; a G1 CSV has {NUM_COLUMNS} "
-                                        "(root xyz, root quaternion xyzw, 29 joints)")
-            try:
-                values = [float(p) for p in parts]
-            except ValueError as exc:
-                raise MotionFormatError(f"{path}: line {lineno}: {exc}") from None
-            if not np.all(np.isfinite(values)):
-                raise MotionFormatError(f"{path}: frame {len(rows)} (line {lineno}) contains NaN or inf")
-            rows.append(values)
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise MotionFormatError(f"{path}: not a UTF-8 text file (byte {exc.start}); a G1 CSV is text") from None
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        if not line.strip():
+            continue
+        parts = line.strip().split(",")
+        if len(parts) != NUM_COLUMNS:
+            raise MotionFormatError(f"{path}: line {lineno} has {len(parts)} columns; a G1 CSV has {NUM_COLUMNS} "
+                                    "(root xyz, root quaternion xyzw, 29 joints)")
+        try:
+            values = [float(p) for p in parts]
+        except ValueError as exc:
+            raise MotionFormatError(f"{path}: line {lineno}: {exc}") from None
+        if not np.all(np.isfinite(values)):
+            raise MotionFormatError(f"{path}: frame {len(rows)} (line {lineno}) contains NaN or inf")
+        rows.append(values)
     if not rows:
         raise MotionFormatError(f"{path}: no frames (empty file)")
     data = np.array(rows)

@@ -1,0 +1,26 @@
+"""Suite-wide fixtures."""
+
+from __future__ import annotations
+
+import pytest
+
+TIMING_RT_PRIORITY = 10
+"""Real-time priority for the system under test in `timing` tests (below g1 deploy's 20 and the
+emulator's 30, which they raise to where they start them)."""
+
+
+@pytest.fixture(autouse=True)
+def _realtime_for_timing_tests(request):
+    """A `timing` test measures the robot path as it runs on a robot: at a real-time priority (see
+    g1_control/loop/priority.py), so that other work on the host (CI's load generator, other jobs)
+    cannot starve it. Subprocesses started by the test inherit it. Without permission: as it is."""
+    if request.node.get_closest_marker("timing") is None:
+        yield
+        return
+    from g1_control.loop.priority import realtime
+
+    normal, _ = realtime(TIMING_RT_PRIORITY)
+    try:
+        yield
+    finally:
+        normal.restore()
