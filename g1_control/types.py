@@ -127,6 +127,8 @@ class KinematicReference:
     upper_body_override: bool = False
     """True when the plan's waist and arm posture is meant to be followed; False leaves them to a
     balancing tracker's own judgement (a walking policy's own arm swing)."""
+    hand_q_rad: np.ndarray | None = None
+    """Dex3 finger angles (14, generator.skeleton.FINGER_JOINTS order) on a G1 with hands; None otherwise."""
 
 
 @dataclass

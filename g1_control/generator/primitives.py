@@ -16,12 +16,12 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from g1_control.generator import features as F
 from g1_control.robot import g1
 
 LN2 = math.log(2.0)
@@ -71,20 +71,34 @@ def spring_root_trajectory(start: RootState, v_cmd_heading: np.ndarray, wz_cmd: 
     c, s = np.cos(yaw), np.sin(yaw)
     target_w = np.stack([c * v_cmd[0] - s * v_cmd[1], s * v_cmd[0] + c * v_cmd[1]], axis=1)
     # v_k = d v_{k-1} + (1 - d) target_k  =>  v = d^k v0 + W @ target with W[k, j] = (1 - d) d^(k - j), j <= k
-    lag = k[:, None] - k[None, :]
-    weights = np.where(lag >= 0, (1 - decay) * decay ** np.maximum(lag, 0), 0.0)
-    vel = decay ** k[:, None] * start.vel_xy[None, :] + weights @ target_w
+    weights, powers = _spring_weights(n, decay)
+    vel = powers[:, None] * start.vel_xy[None, :] + weights @ target_w
     pos = start.pos_xy[None, :] + np.cumsum(vel, axis=0) * dt_s
     return pos, yaw
 
 
+@functools.lru_cache(maxsize=16)
+def _spring_weights(n: int, decay: float) -> tuple[np.ndarray, np.ndarray]:
+    """The velocity spring's (n, n) lower-triangular weights and decay^k (cached: one per horizon)."""
+    k = np.arange(1, n + 1)
+    lag = k[:, None] - k[None, :]
+    weights = np.where(lag >= 0, (1 - decay) * decay ** np.maximum(lag, 0), 0.0)
+    for a in (weights, k):
+        a.setflags(write=False)
+    powers = decay ** k
+    powers.setflags(write=False)
+    return weights, powers
+
+
 def root_features(pos_xy: np.ndarray, height: float, yaw: float, tilt_rot: np.ndarray | None = None) -> np.ndarray:
     """Root block (9,) of a world-frame feature vector: position and a yaw-only (or given) rotation."""
-    rot = F.rot_z(np.array(yaw))
-    if tilt_rot is not None:
-        rot = rot @ tilt_rot
     out = np.zeros(9)
     out[0:2], out[2] = pos_xy, height
+    c, s = math.cos(yaw), math.sin(yaw)
+    if tilt_rot is None:
+        out[3], out[4], out[7], out[6] = c, s, c, -s
+        return out
+    rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ tilt_rot
     out[3:6], out[6:9] = rot[:, 0], rot[:, 1]
     return out
 

@@ -62,6 +62,9 @@ def make_tracker(launch: LaunchFile) -> Tracker:
     raise LaunchFileError(f"tracker.type: unknown tracker '{cfg.type}'")
 
 
+LEARNED_GENERATORS = ("backbone", "learned_motion_matching")
+
+
 def make_generator(launch: LaunchFile) -> tuple[Generator, Retargeter]:
     cfg = launch.generator
     if cfg.type == "scripted":
@@ -71,7 +74,13 @@ def make_generator(launch: LaunchFile) -> tuple[Generator, Retargeter]:
         return TrajectoryGenerator(trajectory), TrajectoryRetargeter(trajectory)
     from g1_control.generator.factory import make_generator as make_named
 
-    return make_named(cfg.type, model=cfg.model or None, limits=launch.limits)
+    skeleton = "g1_29dof"
+    if cfg.type in LEARNED_GENERATORS + ("motion_matching",):
+        from g1_control.generator.skeleton import skeleton_for_robot
+
+        skeleton = skeleton_for_robot(launch.backend.expected_variant, launch.backend.hands)
+    return make_named(cfg.type, model=cfg.model or None, limits=launch.limits, skeleton=skeleton,
+                      feedback=cfg.feedback)
 
 
 def command_ranges(tracker: Tracker) -> dict | None:
