@@ -22,6 +22,9 @@ SHIPPED_DIR = Path(__file__).resolve().parents[1] / "policies" / "generator"
 """policies/generator/: the shipped model (trained on every skeleton)."""
 MODEL_FORMAT = 2
 PATCH = 2
+MAX_GAP_FRAMES = 30
+PADDED_GAP = MAX_GAP_FRAMES + (MAX_GAP_FRAMES % PATCH)
+"""The exported graph's fixed gap length (frames); shorter gaps are masked inside it."""
 
 
 def model_info(path: str | Path) -> dict:
@@ -42,20 +45,21 @@ def check_skeleton(path: str | Path, skeleton: str) -> None:
 
 def prepare_inputs(context, target, target_mask, gap, skeleton: str | np.ndarray = "g1_29dof",
                    gap_goal=None, gap_mask=None, style=None) -> dict[str, np.ndarray]:
-    """The model's inputs (float32, the gap padded to an even length) from canonical arrays.
-    skeleton: a name, or (B,) names/indices are not needed - pass a name or a (B, W) descriptor."""
+    """The model's inputs from canonical arrays: float32, the gap padded to the graph's fixed
+    PADDED_GAP frames (gap_len says how many are real). skeleton: a name, or a tuple
+    (descriptors (B, W), present masks (B, D))."""
     b = context.shape[0]
     last = context[:, -1]
     filled = fill_target(last, target, target_mask, gap)
-    padded = gap + (gap % PATCH)
-    base = interpolate(last, filled, gap)
+    padded = PADDED_GAP
+    base = np.empty((b, padded, F.DIM), np.float32)
+    base[:, :gap] = interpolate(last, filled, gap)
+    base[:, gap:] = filled[:, None, :]
     goal = np.zeros((b, padded, F.DIM), np.float32)
     given = np.zeros((b, padded, F.DIM), np.float32)
     if gap_goal is not None:
         goal[:, :gap] = np.where(gap_mask, gap_goal, 0.0)
         given[:, :gap] = gap_mask
-    if padded != gap:
-        base = np.concatenate([base, filled[:, None, :]], axis=1)
     if isinstance(skeleton, str):
         sk = S.skeleton(skeleton)
         desc = np.broadcast_to(sk.descriptor().reshape(1, -1), (b, S.NUM_SLOTS * S.DESCRIPTOR_WIDTH))
@@ -67,10 +71,12 @@ def prepare_inputs(context, target, target_mask, gap, skeleton: str | np.ndarray
             "gap_goal": goal, "gap_given": given,
             "style": np.zeros(b, np.int64) if style is None else np.asarray(style, dtype=np.int64),
             "skeleton": np.ascontiguousarray(desc, dtype=np.float32),
-            "present": np.ascontiguousarray(present, dtype=np.float32)}
+            "present": np.ascontiguousarray(present, dtype=np.float32),
+            "gap_len": np.full(b, gap, np.int64)}
 
 
-INPUT_NAMES = ("context", "target", "target_given", "base", "gap_goal", "gap_given", "style", "skeleton", "present")
+INPUT_NAMES = ("context", "target", "target_given", "base", "gap_goal", "gap_given", "style", "skeleton", "present",
+               "gap_len")
 
 
 def finish(frames: np.ndarray, gap: int) -> np.ndarray:

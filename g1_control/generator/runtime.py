@@ -91,6 +91,13 @@ class RuntimeConfig:
     reach_early_m: float = 0.35
     """While walking to a stance point, the goal joins the keyframe once the spring's keyframe
     root is this close to it."""
+    goal_error_gain: float = 0.6
+    """Goal-error feedback: while an effector goal is held (its effector within goal_error_near_m),
+    each replan adds this fraction of the remaining error - measured by forward kinematics of the
+    last executed frame, the model's own output, no IK - to the goal the model is given (an
+    integrator, at most goal_error_max_m). 0 disables."""
+    goal_error_near_m: float = 0.25
+    goal_error_max_m: float = 0.15
 
 
 @dataclass
@@ -127,6 +134,7 @@ class InbetweeningGenerator(Generator):
         self._q_lo = np.where(self.skeleton.present, self.skeleton.q_min, 0.0)
         self._q_hi = np.where(self.skeleton.present, self.skeleton.q_max, 0.0)
         self._reach: dict[str, list] = {}
+        self._goal_offset: dict[str, tuple] = {}
         self._gap_goals: list[tuple[int, np.ndarray, np.ndarray]] = []
         self.stats = PlanStats()
         self.ref = KinematicReference()
@@ -164,6 +172,7 @@ class InbetweeningGenerator(Generator):
         self._last_cmd = None
         self._object = None
         self._reach = {}
+        self._goal_offset = {}
         self.stats = PlanStats()
 
     # ------------------------------------------------------------------ planning
@@ -255,6 +264,7 @@ class InbetweeningGenerator(Generator):
                 cols = np.r_[0:3]
             else:
                 cols = np.r_[F.effector_slice(name)]
+                point = point + self._goal_error(name, point, cols)
             values[cols] = point
             given[cols] = True
             frame = gap - 1
@@ -303,6 +313,27 @@ class InbetweeningGenerator(Generator):
         c, s_ = math.cos(root.yaw), math.sin(root.yaw)
         d = (spot - root.pos_xy) / dist * min(cfg.spring.max_vx_mps, dist)
         return spot, face, np.array([c * d[0] + s_ * d[1], -s_ * d[0] + c * d[1]])
+
+    def _goal_error(self, name: str, point: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """The goal-error feedback's offset for an effector goal (see RuntimeConfig.goal_error_gain)."""
+        cfg = self.config
+        key = tuple(np.round(point, 3))
+        prev = self._goal_offset.get(name)
+        offset = prev[1] if prev is not None and prev[0] == key else np.zeros(3)
+        if cfg.goal_error_gain > 0:
+            last = self.history[-1]
+            pos, rot = F.bodies_of(last)
+            from g1_control.motion.kinematics import default_body_names
+
+            reached = F.effectors_from_bodies(pos, rot, default_body_names())[F.EFFECTOR_BODIES.index(name)]
+            error = point - reached
+            if float(np.linalg.norm(error)) < cfg.goal_error_near_m:
+                offset = offset + cfg.goal_error_gain * error
+                norm = float(np.linalg.norm(offset))
+                if norm > cfg.goal_error_max_m:
+                    offset *= cfg.goal_error_max_m / norm
+        self._goal_offset[name] = (key, offset)
+        return offset
 
     def _goal_active(self, name: str, values: np.ndarray) -> bool:
         """A goal joins the keyframe once its stance point is reached or about to be."""

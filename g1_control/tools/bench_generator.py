@@ -214,7 +214,7 @@ def _start_frames(test_f, rng, n: int):
     return out
 
 
-def _cylinder_goal(rng, frame, r=(0.25, 1.5), z=(0.65, 1.25)):
+def _cylinder_goal(rng, frame, r=(0.25, 1.5), z=(0.8, 1.25)):
     """A goal point in a cylinder around a robot frame (uniform over the annulus' area, any
     direction around the robot, height in z)."""
     radius = np.sqrt(rng.uniform(r[0] ** 2, r[1] ** 2))
@@ -446,17 +446,23 @@ def main(args) -> int:
         print(f"  duration head on held-out 15- and 30-frame transitions: mean error {figures['duration_mae_frames']:.1f} "
               "frames (a constant guess of 22.5 frames: 7.5)\n")
 
-    def runtime(inbetweener, fb=None):
-        return InbetweeningGenerator(inbetweener, styles, feedback=fb)
+    def runtime(inbetweener, fb=None, goal_error: bool = True):
+        from g1_control.generator.runtime import RuntimeConfig
+
+        config = RuntimeConfig() if goal_error else RuntimeConfig(goal_error_gain=0.0)
+        return InbetweeningGenerator(inbetweener, styles, config, feedback=fb)
 
     if "goals" in sections:
         print("joint-level goals, model only (FK of the runtime's reference, no IK): hand goals in a cylinder "
-              "r 0.25-1.5 m, z 0.65-1.25 m around the robot, from unseen held-out start poses, 8 s each")
+              "r 0.25-1.5 m, z 0.8-1.25 m around the robot, from unseen held-out start poses, 8 s each.\n"
+              "single shot: the network's plans alone; the other rows add the runtime's goal-error feedback (the "
+              "remaining error of the model's own last frame, by FK, added to the goal it is given)")
         header = f"{'runtime':<24} {'success<5cm':>11} {'held at end':>11} {'DTG end m':>9} {'DTG best m':>10} {'t reach s':>9}"
         print(header)
         print("-" * len(header))
         figures["goals"] = {}
         for label, factory in (("interpolation", lambda: runtime(interp)),
+                               ("backbone, single shot", lambda: runtime(backbone, goal_error=False)),
                                ("backbone", lambda: runtime(backbone)),
                                ("backbone+feedback", lambda: runtime(backbone, ReferenceFeedback.load(fb_path, "g1_29dof")))):
             r = wandr_goals(factory, test_f)

@@ -39,7 +39,9 @@ from g1_control.generator.inbetween import CONTEXT_FRAMES, MAX_GAP
 PATCH = 2
 """Frames per token."""
 CONTEXT_TOKENS = CONTEXT_FRAMES // PATCH
-MAX_TOKENS = CONTEXT_TOKENS + (MAX_GAP + PATCH - 1) // PATCH + 1
+GAP_TOKENS = (MAX_GAP + PATCH - 1) // PATCH
+PADDED_GAP = GAP_TOKENS * PATCH
+MAX_TOKENS = CONTEXT_TOKENS + GAP_TOKENS + 1
 
 
 @dataclass
@@ -74,12 +76,15 @@ class _Block(nn.Module):
         self.mlp = nn.Sequential(nn.Linear(d, ff), nn.GELU(), nn.Linear(ff, d))
         self.drop = nn.Dropout(dropout)
 
-    def forward(self, x):
-        b, n, d = x.shape
-        h = self.heads
-        q, k, v = self.qkv(self.norm1(x)).reshape(b, n, 3, h, d // h).permute(2, 0, 3, 1, 4)
-        att = torch.softmax(q @ k.transpose(-1, -2) * (d // h) ** -0.5, dim=-1)
-        y = (att @ v).transpose(1, 2).reshape(b, n, d)
+    def forward(self, x, n: int | None = None, bias=None):
+        """x (B, n, d). n: the token count as a Python int (exported graphs: constant reshapes),
+        bias: additive attention bias on the keys (B, 1, 1, n) or None."""
+        d, h = self.proj.in_features, self.heads
+        n = x.shape[1] if n is None else n
+        q, k, v = self.qkv(self.norm1(x)).reshape(-1, n, 3, h, d // h).permute(2, 0, 3, 1, 4)
+        logits = q @ k.transpose(-1, -2) * (d // h) ** -0.5
+        att = torch.softmax(logits if bias is None else logits + bias, dim=-1)
+        y = (att @ v).transpose(1, 2).reshape(-1, n, d)
         x = x + self.drop(self.proj(y))
         return x + self.drop(self.mlp(self.norm2(x)))
 
@@ -108,19 +113,23 @@ class Backbone(nn.Module):
         self.register_buffer("feat_mean", torch.zeros(F.DIM))
         self.register_buffer("feat_std", torch.ones(F.DIM))
 
-    @staticmethod
-    def _patch(x):
-        """(B, T, D) with T even -> (B, T/2, 2D)."""
-        b, t, d = x.shape
-        return x.reshape(b, t // PATCH, PATCH * d)
-
-    def forward(self, context, target, target_given, base, gap_goal, gap_given, style, skeleton, present):
+    def forward(self, context, target, target_given, base, gap_goal, gap_given, style, skeleton, present,
+                gap_len=None):
         """Raw canonical units: context (B, C, D), target (B, D) (0 where not given), target_given (B, D),
         base (B, G, D) interpolation (G even), gap_goal / gap_given (B, G, D) goals on gap frames, style
         (B,) long, skeleton (B, NUM_SLOTS * DESCRIPTOR_WIDTH) descriptor, present (B, D) {0, 1} features
-        the skeleton has. Returns (frames (B, G, D), duration (B,) frames)."""
+        the skeleton has. Returns (frames (B, G, D), duration (B,) frames).
+
+        gap_len (B,) long, for the exported graph: the gap inputs are then padded to PADDED_GAP frames
+        and the tokens past each window's gap are masked out of attention, so every shape in the
+        graph is a constant (no shape arithmetic at run time); the result on the real gap frames is
+        the same function as with a gap of exactly that length (training uses that form)."""
+        static = gap_len is not None
+        dim = F.DIM
+        n_gap = GAP_TOKENS if static else base.shape[1] // PATCH
+        n_tok = CONTEXT_TOKENS + n_gap + 1
         mean, std = self.feat_mean, self.feat_std
-        pres = present[:, None, :]
+        pres = present.unsqueeze(1)
         ctx = (context - mean) / std * pres
         tgt_given = target_given * present
         tgt = (target - mean) / std * tgt_given
@@ -128,22 +137,34 @@ class Backbone(nn.Module):
         g_given = gap_given * pres
         goal = (gap_goal - mean) / std * g_given
         gap_vals = bas * (1.0 - g_given) + goal
-        ctx_tok = torch.cat([self._patch(ctx), self._patch(pres.expand_as(ctx))], dim=-1)
-        gap_tok = torch.cat([self._patch(gap_vals), self._patch(g_given)], dim=-1)
+        pair = PATCH * dim
+        ctx_tok = torch.cat([ctx.reshape(-1, CONTEXT_TOKENS, pair),
+                             (pres * torch.ones_like(ctx)).reshape(-1, CONTEXT_TOKENS, pair)], dim=-1)
+        gap_tok = torch.cat([gap_vals.reshape(-1, n_gap, pair), g_given.reshape(-1, n_gap, pair)], dim=-1)
         zero = torch.zeros_like(tgt)
-        tgt_tok = torch.cat([tgt, zero, tgt_given, zero], dim=-1)[:, None, :]
+        tgt_tok = torch.cat([tgt, zero, tgt_given, zero], dim=-1).unsqueeze(1)
         x = self.inp(torch.cat([ctx_tok, gap_tok, tgt_tok], dim=1))
-        n_gap = gap_tok.shape[1]
-        x = x + self.pos[:CONTEXT_TOKENS + n_gap + 1]
+        # positions: context and gap tokens by index, the target at its true distance
+        if static:
+            used = torch.div(gap_len + (PATCH - 1), PATCH, rounding_mode="floor")
+            tgt_pos = self.pos[CONTEXT_TOKENS + used]
+            keys = torch.arange(GAP_TOKENS, device=x.device).unsqueeze(0) < used.unsqueeze(1)
+            ones = torch.ones_like(keys[:, :1])
+            keep = torch.cat([ones.expand(-1, CONTEXT_TOKENS), keys, ones], dim=1)
+            bias = ((~keep).to(x.dtype) * -1e9).reshape(-1, 1, 1, n_tok)
+        else:
+            tgt_pos = self.pos[CONTEXT_TOKENS + n_gap].unsqueeze(0).expand(x.shape[0], -1)
+            bias = None
+        pos = torch.cat([self.pos[:CONTEXT_TOKENS + n_gap].unsqueeze(0).expand(x.shape[0], -1, -1),
+                         tgt_pos.unsqueeze(1)], dim=1)
         roles = torch.cat([self.role[0:1].expand(CONTEXT_TOKENS, -1), self.role[1:2].expand(n_gap, -1),
                            self.role[2:3]], dim=0)
-        x = x + roles + (self.style(style) + self.skeleton(skeleton))[:, None, :]
+        x = x + pos + roles + (self.style(style) + self.skeleton(skeleton)).unsqueeze(1)
         for block in self.blocks:
-            x = block(x)
+            x = block(x, n_tok, bias)
         delta = self.out(self.norm(x[:, CONTEXT_TOKENS:CONTEXT_TOKENS + n_gap]))
-        b = delta.shape[0]
-        out = (bas + delta.reshape(b, n_gap * PATCH, F.DIM)) * std + mean
+        out = (bas + delta.reshape(-1, n_gap * PATCH, dim)) * std + mean
         out = out * pres
-        root_in = torch.cat([ctx[..., :9].reshape(b, -1), tgt[:, :9], tgt_given[:, :9]], dim=-1)
+        root_in = torch.cat([ctx[..., :9].reshape(-1, CONTEXT_FRAMES * 9), tgt[:, :9], tgt_given[:, :9]], dim=-1)
         duration = nn.functional.softplus(self.duration(root_in))[:, 0] * 10.0
         return out, duration

@@ -103,8 +103,8 @@ class WindowSampler:
             out[chosen] = self._subset(int(chosen.sum()), 0.7, 0.4, 0.4)
         return out
 
-    def gap_goals(self, b: int, gap: int) -> np.ndarray:
-        """(b, gap, D) bool: goal masks on gap frames."""
+    def gap_goals(self, b: int, gap: int, present: np.ndarray | None = None) -> np.ndarray:
+        """(b, gap, D) bool: goal masks on gap frames (only features in `present` (b, D))."""
         out = np.zeros((b, gap, F.DIM), dtype=bool)
         for i in np.flatnonzero(self.rng.random(b) < self.goal_probability):
             for _ in range(int(self.rng.integers(1, 3))):
@@ -112,6 +112,8 @@ class WindowSampler:
                 m = self._subset(1, 0.0, 0.45, 0.25)[0]
                 if self.rng.random() < 0.3:
                     m |= PELVIS_MASK
+                if present is not None:
+                    m &= present[i]
                 if not m.any():
                     m |= EFFECTOR_MASKS[int(self.rng.integers(0, F.NUM_EFFECTORS))]
                 out[i, k] |= m
@@ -176,7 +178,7 @@ class WindowSampler:
         present = self.present[skel]
         reaches = self._reach(wins, present, gap) if self.reach_probability > 0 else []
         mask = self.masks(batch)
-        goals = self.gap_goals(batch, gap)
+        goals = self.gap_goals(batch, gap, present)
         for i, arms, end in reaches:
             # mostly: the root and the reaching hand(s) given - at the reach's end frame when it
             # falls inside the gap, and on the target

@@ -50,6 +50,8 @@ class TrainConfig:
     skeletons: tuple[str, ...] = ("g1_29dof",)
     """Skeletons to train on, each from its own library (skeleton.SKELETONS)."""
     goal_probability: float = 0.5
+    reach_probability: float = 0.35
+    """Share of training windows given a random arm reach (dataset.py: the reaching augmentation)."""
     model: dict = field(default_factory=dict)
     """Overrides of BackboneConfig fields (d_model, layers, ...)."""
 
@@ -80,9 +82,7 @@ def _fk_terms(pred, truth, pos_scale=None):
 
 
 def model_inputs(batch: dict) -> list:
-    from g1_control.generator.learned import INPUT_NAMES
-
-    return [batch[k] for k in INPUT_NAMES]
+    return [batch[k] for k in TRAIN_INPUTS]
 
 
 def loss_fn(model, batch, config: TrainConfig, subsample: bool = True, pos_scale=None):
@@ -129,7 +129,8 @@ def loss_fn(model, batch, config: TrainConfig, subsample: bool = True, pos_scale
 
 
 def pad_batch(batch: dict) -> dict:
-    """Pad the gap of a sampled batch to the model's even length (as learned.prepare_inputs does)."""
+    """Pad the gap of a sampled batch to an even length (training runs the model's dynamic form:
+    only the tokens a gap needs, no gap_len)."""
     from g1_control.generator.learned import PATCH
 
     g = batch["base"].shape[1]
@@ -142,6 +143,9 @@ def pad_batch(batch: dict) -> dict:
     for k in ("gap_goal", "gap_given"):
         out[k] = np.concatenate([batch[k], np.zeros_like(batch[k][:, :1])], axis=1)
     return out
+
+
+TRAIN_INPUTS = ("context", "target", "target_given", "base", "gap_goal", "gap_given", "style", "skeleton", "present")
 
 
 def _to_torch(batch: dict):
@@ -199,7 +203,7 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | d
         {config.skeletons[0]: library_root} if library_root is not None else {})
     feats, styles, names = load_skeletons(config.skeletons, "train", roots)
     sampler = WindowSampler(feats, styles, len(STYLES), seed=config.seed + 1000 * rank, skeletons=names,
-                            goal_probability=config.goal_probability)
+                            goal_probability=config.goal_probability, reach_probability=config.reach_probability)
     model_cfg = BackboneConfig(num_styles=len(STYLES), **{"skeletons": tuple(config.skeletons), **config.model})
     model = Backbone(model_cfg)
     samples = [sampler.sample(256) for _ in range(8)]
@@ -229,7 +233,7 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | d
     # a fixed validation set from the held-out clips (gaps of 15 and 30 frames)
     vfeats, vstyles, vnames = load_skeletons(config.skeletons, "test", roots)
     vsampler = WindowSampler(vfeats, vstyles, len(STYLES), seed=12345, style_dropout=0.0, skeletons=vnames,
-                             goal_probability=config.goal_probability)
+                             goal_probability=config.goal_probability, reach_probability=config.reach_probability)
     history: list[dict] = []
     best = (float("inf"), None)
 
@@ -359,15 +363,15 @@ def export_onnx(model, path: Path) -> None:
     from g1_control.generator import skeleton as S
     from g1_control.generator.learned import INPUT_NAMES
 
+    from g1_control.generator.learned import PADDED_GAP
+
     model.eval()
-    b, g = 2, 16
+    b, g = 2, PADDED_GAP
     args = (torch.zeros(b, 10, F.DIM), torch.zeros(b, F.DIM), torch.ones(b, F.DIM), torch.zeros(b, g, F.DIM),
             torch.zeros(b, g, F.DIM), torch.zeros(b, g, F.DIM), torch.zeros(b, dtype=torch.long),
-            torch.zeros(b, S.NUM_SLOTS * S.DESCRIPTOR_WIDTH), torch.ones(b, F.DIM))
+            torch.zeros(b, S.NUM_SLOTS * S.DESCRIPTOR_WIDTH), torch.ones(b, F.DIM), torch.full((b,), g))
     axes = {name: {0: "batch"} for name in INPUT_NAMES}
-    for name in ("base", "gap_goal", "gap_given"):
-        axes[name] = {0: "batch", 1: "gap"}
-    axes["frames"] = {0: "batch", 1: "gap"}
+    axes["frames"] = {0: "batch"}
     axes["duration"] = {0: "batch"}
     torch.onnx.export(model, args, str(path), input_names=list(INPUT_NAMES), output_names=["frames", "duration"],
                       dynamo=False, opset_version=17, dynamic_axes=axes)

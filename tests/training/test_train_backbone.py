@@ -34,7 +34,8 @@ def library(tmp_path_factory):
 @pytest.fixture(scope="module")
 def trained(library, tmp_path_factory):
     out = tmp_path_factory.mktemp("run")
-    result = train(out, TrainConfig(steps=60, batch=32, eval_every=20, warmup_steps=5, lr=3e-3, model=TINY),
+    result = train(out, TrainConfig(steps=60, batch=32, eval_every=20, warmup_steps=5, lr=3e-3, model=TINY,
+                                    reach_probability=0.0),
                    library, progress=False)
     return out, result
 
@@ -141,7 +142,7 @@ def test_goal_masks_cover_subsets_and_never_give_missing_joints():
     rng = np.random.default_rng(0)
     clips = [np.cumsum(rng.normal(scale=0.01, size=(80, F.DIM)), axis=0) for _ in range(4)]
     sampler = WindowSampler(clips, [0] * 4, 11, skeletons=["g1_23dof", "g1_23dof", "g1_29dof", "g1_29dof"],
-                            goal_probability=1.0)
+                            goal_probability=1.0, reach_probability=0.0)
     b = sampler.sample(400, gap=20)
     given, goals, present = b["given"] > 0, b["gap_given"] > 0, b["present"] > 0
     assert not (given & ~present).any() and not (goals & ~present[:, None, :]).any()
@@ -157,6 +158,32 @@ def test_goal_masks_cover_subsets_and_never_give_missing_joints():
     assert goals[..., hand].any() and (goals[..., hand].all(-1) == goals[..., hand].any(-1)).all()  # xyz together
     # goal values are the truth at the goal frames, 0 elsewhere
     assert np.allclose(b["gap_goal"][goals], b["truth"][goals]) and not b["gap_goal"][~goals].any()
+
+
+def test_reaching_augmentation_moves_arms_after_the_context_consistently_with_fk():
+    from g1_control.training.dataset import WindowSampler
+
+    rng = np.random.default_rng(1)
+    base = np.zeros((90, F.DIM))
+    base[:, 0] = np.linspace(0, 1, 90)
+    base[:, 2], base[:, 3], base[:, 7] = 0.75, 1.0, 1.0
+    base[:, F.JOINTS] = g1.DEFAULT_Q_RAD
+    body = (np.arange(F.DIM) >= 9) & (np.arange(F.DIM) < F.FINGERS.start)
+    clips = [F.fix_effectors(base + rng.normal(scale=1e-3, size=base.shape) * body)]
+    plain = WindowSampler(clips, [0], 11, seed=3, reach_probability=0.0, goal_probability=0.0).sample(64, gap=24)
+    moved = WindowSampler(clips, [0], 11, seed=3, reach_probability=1.0, goal_probability=0.0).sample(64, gap=24)
+    assert np.allclose(moved["context"], plain["context"])  # reaches start after the context
+    arms = F.JOINT_SLOTS[list(g1.ARM_JOINTS)]
+    change = np.abs(moved["truth"][..., arms] - plain["truth"][..., arms]).max(axis=(1, 2))
+    assert (change > 0.2).mean() > 0.9
+    legs = F.JOINT_SLOTS[list(g1.LEG_JOINTS)]
+    assert np.allclose(moved["truth"][..., legs], plain["truth"][..., legs])
+    frames = np.concatenate([moved["context"], moved["truth"]], axis=1)
+    assert np.abs(F.fix_effectors(frames)[..., F.EFFECTORS] - frames[..., F.EFFECTORS]).max() < 1e-6
+    hand = F.effector_slice("right_wrist_yaw_link")
+    lo = np.concatenate([moved["truth"][:, -1, hand], moved["context"][:, -1, hand]])
+    assert np.ptp(lo[:, 2]) > 0.3  # hands all over the workspace, not at the style postures
+    assert (moved["given"][:, hand].all(axis=1)).mean() > 0.3  # the reaching hand is usually a goal
 
 
 def test_goals_on_gap_frames_steer_the_trained_model(trained, library):
