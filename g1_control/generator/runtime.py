@@ -18,8 +18,11 @@ reference mixture, except near a goal.
 
 Joint-level goals: Command.goals on hands, feet, head or the pelvis (EffectorGoal) become goals
 inside the model. A goal beyond arm's reach is walked to first (a stance point next to it,
-facing it - the WANDR-style reaching setup), then given on the keyframe and on the plan's last
-frame (or on the frame of its t_s, when that falls inside the plan). The skeleton (29-DoF,
+facing it - the WANDR-style reaching setup), then given on the keyframe and on gap frames: from
+the frame the effector can reach it at hand speed, held every 2 frames to the plan's end (a goal
+on one frame only is touched and left: measured, the model keeps a goal local to its token), or
+on the frame of its t_s when that falls inside the plan. The goal-error feedback adds the model's
+own remaining error at the goal frame (FK of its joints, no IK) to the next plan's goal. The skeleton (29-DoF,
 23-DoF, with hands) is an input of the model; joints it lacks stay at 0 and, on the G1 with hands,
 the reference carries the finger angles (KinematicReference.hand_q_rad).
 """
@@ -91,13 +94,19 @@ class RuntimeConfig:
     reach_early_m: float = 0.35
     """While walking to a stance point, the goal joins the keyframe once the spring's keyframe
     root is this close to it."""
-    goal_error_gain: float = 0.6
-    """Goal-error feedback: while an effector goal is held (its effector within goal_error_near_m),
-    each replan adds this fraction of the remaining error - measured by forward kinematics of the
-    last executed frame, the model's own output, no IK - to the goal the model is given (an
-    integrator, at most goal_error_max_m). 0 disables."""
-    goal_error_near_m: float = 0.25
-    goal_error_max_m: float = 0.15
+    goal_error_gain: float = 0.7
+    """Goal-error feedback: after each plan, this fraction of the error left at an effector goal's
+    frame - forward kinematics of the model's planned joints, no IK - is added to the goal the
+    model is given next time (an integrator on the model's static error, at most goal_error_max_m,
+    updated while the error is under goal_error_near_m). 0 disables."""
+    goal_error_near_m: float = 0.3
+    goal_error_max_m: float = 0.2
+    effector_speed_mps: float = 0.5
+    """A goal near its effector is put on the gap frame the effector reaches at this speed..."""
+    min_goal_frame: int = 8
+    """... but not before this frame (0-based)."""
+    hold_every_frames: int = 2
+    """A goal without a time is held: given again every this many frames after its first frame."""
 
 
 @dataclass
@@ -135,7 +144,7 @@ class InbetweeningGenerator(Generator):
         self._q_hi = np.where(self.skeleton.present, self.skeleton.q_max, 0.0)
         self._reach: dict[str, list] = {}
         self._goal_offset: dict[str, tuple] = {}
-        self._gap_goals: list[tuple[int, np.ndarray, np.ndarray]] = []
+        self._gap_goals: list[tuple] = []  # (frame, columns, value given, goal name, goal point)
         self.stats = PlanStats()
         self.ref = KinematicReference()
         self._dt = 1.0 / self.config.fps
@@ -260,17 +269,25 @@ class InbetweeningGenerator(Generator):
             if name in ("left_wrist_yaw_link", "right_wrist_yaw_link"):  # the goal's arm is free of the style pose
                 side = 15 if name.startswith("left") else 22
                 given[9 + side:9 + side + 7] = False
+            frame = gap - 1
             if name == g1.BASE_BODY:
                 cols = np.r_[0:3]
+                given_point = point
             else:
                 cols = np.r_[F.effector_slice(name)]
-                point = point + self._goal_error(name, point, cols)
-            values[cols] = point
+                given_point = point + self._goal_offset_for(name, point)
+                # a goal close by is reached at hand speed, not at the plan's end (replanning comes
+                # after replan_low_frames: a goal on the last frame would never be executed)
+                dist = float(np.linalg.norm(self._effector_now(name) - point))
+                frame = int(np.clip(math.ceil(dist / cfg.effector_speed_mps * cfg.fps), cfg.min_goal_frame, gap - 1))
+            values[cols] = given_point
             given[cols] = True
-            frame = gap - 1
             if goal.t_s is not None:
                 frame = int(np.clip(round(goal.t_s * cfg.fps) - 1, 0, gap - 1))
-            self._gap_goals.append((frame, cols, point))
+            self._gap_goals.append((frame, cols, given_point, name, point))
+            if goal.t_s is None:  # held: the goal stays given on later frames of the plan too
+                for later in range(frame + cfg.hold_every_frames, gap, cfg.hold_every_frames):
+                    self._gap_goals.append((later, cols, given_point, None, point))
         given &= self.present
         return Keyframe(values, given, gap, style, targets)
 
@@ -314,26 +331,40 @@ class InbetweeningGenerator(Generator):
         d = (spot - root.pos_xy) / dist * min(cfg.spring.max_vx_mps, dist)
         return spot, face, np.array([c * d[0] + s_ * d[1], -s_ * d[0] + c * d[1]])
 
-    def _goal_error(self, name: str, point: np.ndarray, cols: np.ndarray) -> np.ndarray:
-        """The goal-error feedback's offset for an effector goal (see RuntimeConfig.goal_error_gain)."""
-        cfg = self.config
-        key = tuple(np.round(point, 3))
+    def _goal_offset_for(self, name: str, point: np.ndarray) -> np.ndarray:
+        """The goal-error feedback's current offset for an effector goal (0 for a new goal)."""
         prev = self._goal_offset.get(name)
-        offset = prev[1] if prev is not None and prev[0] == key else np.zeros(3)
-        if cfg.goal_error_gain > 0:
-            last = self.history[-1]
-            pos, rot = F.bodies_of(last)
-            from g1_control.motion.kinematics import default_body_names
+        return prev[1] if prev is not None and prev[0] == tuple(np.round(point, 3)) else np.zeros(3)
 
+    def _effector_now(self, name: str) -> np.ndarray:
+        """An effector's position in the last executed frame, by FK (the model's own output)."""
+        from g1_control.motion.kinematics import default_body_names
+
+        pos, rot = F.bodies_of(self.history[-1])
+        return F.effectors_from_bodies(pos, rot, default_body_names())[F.EFFECTOR_BODIES.index(name)]
+
+    def _update_goal_errors(self, frames: np.ndarray) -> None:
+        """After a plan: for each effector goal, the error of the planned frame that was to reach it
+        (FK of the model's joints) feeds the offset given with that goal next time (an integrator on
+        the model's static error; RuntimeConfig.goal_error_gain)."""
+        cfg = self.config
+        if cfg.goal_error_gain <= 0:
+            return
+        from g1_control.motion.kinematics import default_body_names
+
+        for frame, _, _, name, point in self._gap_goals:
+            if name is None or name == g1.BASE_BODY or frame >= len(frames):
+                continue
+            pos, rot = F.bodies_of(frames[frame])
             reached = F.effectors_from_bodies(pos, rot, default_body_names())[F.EFFECTOR_BODIES.index(name)]
             error = point - reached
+            offset = self._goal_offset_for(name, point)
             if float(np.linalg.norm(error)) < cfg.goal_error_near_m:
                 offset = offset + cfg.goal_error_gain * error
                 norm = float(np.linalg.norm(offset))
                 if norm > cfg.goal_error_max_m:
                     offset *= cfg.goal_error_max_m / norm
-        self._goal_offset[name] = (key, offset)
-        return offset
+            self._goal_offset[name] = (tuple(np.round(point, 3)), offset)
 
     def _goal_active(self, name: str, values: np.ndarray) -> bool:
         """A goal joins the keyframe once its stance point is reached or about to be."""
@@ -354,8 +385,8 @@ class InbetweeningGenerator(Generator):
         if self._gap_goals and hasattr(self.model, "set_goals"):
             goal = np.zeros((key.gap, F.DIM))
             mask = np.zeros((key.gap, F.DIM), dtype=bool)
-            for frame, cols, point in self._gap_goals:
-                goal[frame, cols] = point if len(cols) == 3 else 0.0
+            for frame, cols, point, _, _ in self._gap_goals:
+                goal[frame, cols] = point
                 mask[frame, cols] = True
             goal = F.transform_one(goal, origin, yaw)
             goal[~mask] = 0.0
@@ -363,6 +394,8 @@ class InbetweeningGenerator(Generator):
         frames_c = self.model.infill(ctx_c, tgt_c, key.given[None], key.gap, np.array([style_id(key.style)]))
         frames = F.transform_one(frames_c[0], origin, yaw, inverse=True)
         frames = self._stabilize(frames, key)
+        if self._gap_goals:
+            self._update_goal_errors(frames)
         # cross-fade: the old plan's frames still ahead (same times) blend into the new plan
         old = self.plan
         n = min(cfg.crossfade_frames, len(old), len(frames))
@@ -385,8 +418,8 @@ class InbetweeningGenerator(Generator):
             frames = interpolate(last[None], np.where(key.given, key.values, last)[None], key.gap)[0]
         if self.feedback is not None:
             self.feedback.set_style(key.style)
-            goal_frames = [f for f, _, _ in self._gap_goals]
-            eff = [(np.r_[cols], point) for _, cols, point in self._gap_goals if len(cols) == 3]
+            goal_frames = [f for f, *_ in self._gap_goals]
+            eff = [(cols, point) for _, cols, _, _, point in self._gap_goals]
             weights = self.feedback.frame_weights(len(frames), goal_frames, key.gap if goal_frames else None,
                                                   frames, eff)
             frames = self.feedback.apply(frames, weights)
