@@ -9,6 +9,7 @@ SkeletonError naming both.
 
 from __future__ import annotations
 
+import functools
 import json
 from pathlib import Path
 
@@ -61,18 +62,29 @@ def prepare_inputs(context, target, target_mask, gap, skeleton: str | np.ndarray
         goal[:, :gap] = np.where(gap_mask, gap_goal, 0.0)
         given[:, :gap] = gap_mask
     if isinstance(skeleton, str):
-        sk = S.skeleton(skeleton)
-        desc = np.broadcast_to(sk.descriptor().reshape(1, -1), (b, S.NUM_SLOTS * S.DESCRIPTOR_WIDTH))
-        present = np.broadcast_to(F.present_mask(sk.present)[None].astype(np.float32), (b, F.DIM))
+        desc, present = _skeleton_inputs(skeleton, b)
     else:
         desc, present = skeleton
     return {"context": context.astype(np.float32), "target": np.where(target_mask, target, 0.0).astype(np.float32),
-            "target_given": target_mask.astype(np.float32), "base": base.astype(np.float32),
+            "target_given": target_mask.astype(np.float32), "base": base,
             "gap_goal": goal, "gap_given": given,
             "style": np.zeros(b, np.int64) if style is None else np.asarray(style, dtype=np.int64),
             "skeleton": np.ascontiguousarray(desc, dtype=np.float32),
             "present": np.ascontiguousarray(present, dtype=np.float32),
             "gap_len": np.full(b, gap, np.int64)}
+
+
+@functools.lru_cache(maxsize=32)
+def _skeleton_inputs(name: str, b: int) -> tuple[np.ndarray, np.ndarray]:
+    """A skeleton's descriptor and present-feature rows for a batch of b (cached: every replan
+    asks for the same ones)."""
+    sk = S.skeleton(name)
+    desc = np.ascontiguousarray(np.broadcast_to(sk.descriptor().reshape(1, -1), (b, S.NUM_SLOTS * S.DESCRIPTOR_WIDTH)),
+                                dtype=np.float32)
+    present = np.ascontiguousarray(np.broadcast_to(F.present_mask(sk.present)[None], (b, F.DIM)), dtype=np.float32)
+    for a in (desc, present):
+        a.setflags(write=False)
+    return desc, present
 
 
 INPUT_NAMES = ("context", "target", "target_given", "base", "gap_goal", "gap_given", "style", "skeleton", "present",

@@ -42,7 +42,7 @@ for _k, _name in enumerate(F.EFFECTOR_BODIES):
 PELVIS_MASK = np.zeros(F.DIM, dtype=bool)
 PELVIS_MASK[F.ROOT_POS] = True
 MASK_KINDS = ("full", "root", "root+upper", "subset")
-MASK_PROBS = (0.3, 0.15, 0.15, 0.4)
+MASK_PROBS = (0.35, 0.15, 0.15, 0.35)
 ARM_SLOTS = {"left": [g1.JOINT_INDEX[f"left_{n}_joint"] for n in ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow",
                                                                   "wrist_roll", "wrist_pitch", "wrist_yaw")],
              "right": [g1.JOINT_INDEX[f"right_{n}_joint"] for n in ("shoulder_pitch", "shoulder_roll", "shoulder_yaw",
@@ -55,7 +55,7 @@ WAIST_RANGE = {"waist_yaw_joint": (-0.6, 0.6), "waist_roll_joint": (-0.15, 0.15)
 class WindowSampler:
     def __init__(self, clip_feats: list[np.ndarray], styles: list[int], num_styles: int, seed: int = 0,
                  min_gap: int = 5, style_dropout: float = 0.1, skeletons: list[str] | None = None,
-                 goal_probability: float = 0.5, reach_probability: float = 0.35):
+                 goal_probability: float = 0.5, reach_probability: float = 0.25):
         need = CONTEXT_FRAMES + MAX_GAP + 1
         skeletons = skeletons or ["g1_29dof"] * len(clip_feats)
         keep = [i for i, c in enumerate(clip_feats) if c.shape[0] >= need]
