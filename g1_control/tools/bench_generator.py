@@ -17,7 +17,7 @@ measured in the same run.
 
 Models: G1_GENERATOR_ONNX (backbone, default the shipped one), G1_GENERATOR_LMM (folder, default
 policies/generator/lmm), G1_GENERATOR_VARIANT_RUNS (folder holding gen_<skeleton>/backbone.onnx,
-default runs/). G1_BENCH_SECTIONS=quality,goals,variants,codebook,speed,rollout picks sections.
+default runs/). G1_BENCH_SECTIONS=quality,goals,variants,models,codebook,speed,rollout picks sections.
 """
 
 from __future__ import annotations
@@ -322,8 +322,34 @@ def goal_sequence(gen, feedback_ref, minutes: float = 10.0, per_goal_s: float = 
 
 def _sections() -> set[str]:
     raw = os.environ.get("G1_BENCH_SECTIONS")
-    all_ = {"quality", "goals", "variants", "codebook", "speed", "rollout"}
+    all_ = {"quality", "goals", "variants", "models", "codebook", "speed", "rollout"}
     return all_ if not raw else {s.strip() for s in raw.split(",")} & all_
+
+
+def _models_table(model_path, lmm_dir, runs_dir, figures: dict) -> None:
+    """Training time (wall and CPU) and file sizes of every model the bench uses."""
+    from pathlib import Path
+
+    from g1_control.generator import skeleton as S
+
+    print("models: training time on this CPU and shipped sizes")
+    rows = [("backbone (shared)", Path(model_path).parent, ("backbone.onnx", "backbone.pt", "feedback.npz")),
+            ("learned motion matching", Path(lmm_dir), ("lmm.onnx", "lmm.pt"))]
+    rows += [(f"backbone {sk} only", Path(runs_dir) / f"gen_{sk}", ("backbone.onnx", "backbone.pt"))
+             for sk in S.SKELETONS]
+    figures["models"] = {}
+    for label, folder, files in rows:
+        cfg = folder / "train_config.json"
+        if not cfg.is_file():
+            continue
+        res = json.loads(cfg.read_text()).get("result", {})
+        sizes = {f: (folder / f).stat().st_size for f in files if (folder / f).is_file()}
+        figures["models"][label] = {"result": res, "bytes": sizes}
+        cpu = f"{res['cpu_s'] / 60:.1f} CPU-min" if "cpu_s" in res else "CPU time not recorded"
+        load = f", load average {res['load_average']:.1f}" if "load_average" in res else ""
+        print(f"  {label:<28} {res.get('wall_s', float('nan')) / 60:5.1f} min wall, {cpu}{load}; "
+              + ", ".join(f"{f} {b / 2**20:.2f} MB" for f, b in sizes.items()))
+    print()
 
 
 def _variant_table(shared_path, runs_dir, figures: dict) -> None:
@@ -492,6 +518,8 @@ def main(args) -> int:
               f"of {eff['goals']}, distance to goal mean {eff['mean_m']:.3f} m, max {eff['max_m']:.3f} m\n")
     if "variants" in sections:
         _variant_table(model_path, runs_dir, figures)
+    if "models" in sections:
+        _models_table(model_path, lmm_dir, runs_dir, figures)
     if "codebook" in sections:
         stats30 = E.PositionStats.from_windows(E.make_windows(train_f, train_s, 30))
         r = _codebook_floor(train_f, windows[30], stats30)
