@@ -332,6 +332,8 @@ class KinematicReference:
         self.contacts[:] = j.contacts
         self.phase = j.phase
         return self
+    hand_q_rad: np.ndarray | None = None
+    """Dex3 finger angles (14, generator.skeleton.FINGER_JOINTS order) on a G1 with hands; None otherwise."""
 
 
 @dataclass

@@ -3,6 +3,8 @@
     g1 library build                  # into the user cache (~/.cache/g1-control/library)
     g1 library build -o lib/ --force  # elsewhere, rebuilt even when the cache matches
     g1 library show                   # styles, clips and frames per split
+    g1 library build --variant g1_23dof            # the 23-DoF G1's library, from the 29-DoF one
+    g1 library build --variant g1_29dof_with_hand  # the G1 with Dex3 hands (synthesized fingers)
 
 Sources: MuJoCo rollouts of the holosoma locomotion policy under seeded random commands, one
 upper-body style per rollout (tracked in physics through the policy's upper-body override); the
@@ -30,6 +32,9 @@ def register(subparsers) -> None:
     build.add_argument("--no-dance", action="store_true", help="leave out the WBT dance clip")
     build.add_argument("--no-demo", action="store_true", help="leave out the retargeted demo mocap")
     build.add_argument("--jobs", type=int, default=2, help="rollout worker processes (default 2)")
+    build.add_argument("--variant", default="g1_29dof", choices=("g1_29dof", "g1_23dof", "g1_29dof_with_hand"),
+                       help="robot variant (default g1_29dof; the others are derived from the 29-DoF library through "
+                            "the IK, see g1_control/library/variants.py)")
     build.set_defaults(func=_build)
     show = sub.add_parser("show", help="print styles, clips and frames per split",
                           description="Print the built library's styles, clips and frame counts per split "
@@ -44,6 +49,14 @@ def _build(args) -> int:
 
     config = LibraryConfig(rollout_seconds=args.rollout_seconds, rollouts_per_style=args.rollouts_per_style,
                            dance=not args.no_dance, demo=not args.no_demo)
+    if args.variant != "g1_29dof":
+        from g1_control.library.variants import build_variant_library
+
+        base = build_library(default_library_dir(), config, jobs=max(1, args.jobs))  # no-op when cached
+        lib = build_variant_library(args.variant, base.root, args.output, force=args.force)
+        print(lib.summary())
+        print(f"library {args.variant}: {lib.root} (built in {lib.index['build_s']} s from {base.root})")
+        return 0
     out = args.output or default_library_dir()
     lib = build_library(out, config, force=args.force, jobs=max(1, args.jobs))
     print(lib.summary())

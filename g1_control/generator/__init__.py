@@ -6,9 +6,13 @@ runtime.py       InbetweeningGenerator: smart primitives -> keyframe -> in-betwe
 primitives.py    critically damped springs (root, heading), style poses, height, box, effectors
 inbetween.py     the Inbetweener interface (canonical frames, partial keyframes)
 baselines.py     interpolation and motion matching
-backbone.py      the learned root + pose modules (torch); train.py / dataset.py train them
-learned.py       the trained backbone through ONNX Runtime (g1_control/policies/generator/backbone.onnx)
-features.py, fk.py   the 50-D frame representation and batched forward kinematics
+learned.py       the trained backbone through ONNX Runtime (g1_control/policies/generator/backbone.onnx;
+                 training/backbone.py is the torch model)
+lmm.py           learned motion matching (decompressor, stepper, projector) through ONNX Runtime
+feedback.py      reference-guided feedback toward per-style Gaussian mixtures of library poses
+skeleton.py      the G1 variants (29-DoF, 23-DoF, with Dex3 hands) over one set of joint slots
+data.py          a built library as generator features (any variant)
+features.py, fk.py   the 67-D frame representation and batched forward kinematics
 evaluation.py, bench.py   Harvey et al. protocol (L2P, L2Q, NPSS) and `g1 bench generator`
 retarget.py, factory.py   the IK path to the locomotion tracker; generators by name for launch files
 """

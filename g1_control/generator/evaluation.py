@@ -23,6 +23,7 @@ import numpy as np
 from g1_control import rotations as quat
 from g1_control.generator import features as F
 from g1_control.generator.inbetween import CONTEXT_FRAMES, Inbetweener
+from g1_control.robot import g1
 
 WINDOW_STRIDE = 20
 STANCE_ANKLE_Z_M = 0.034
@@ -99,7 +100,7 @@ def foot_quality(feats: np.ndarray, fps: float) -> tuple[float, float]:
     from g1_control.motion.kinematics import default_body_names
 
     names = default_body_names()
-    feet = pos[..., [names.index(b) for b in F.EFFECTOR_BODIES[2:]], :]  # (N, T, 2, 3)
+    feet = pos[..., [names.index(b) for b in g1.FOOT_BODIES], :]  # (N, T, 2, 3)
     speed = np.linalg.norm(np.diff(feet[..., :2], axis=1), axis=-1) * fps
     contact = feet[:, 1:, :, 2] < STANCE_ANKLE_Z_M + CONTACT_BAND_M
     skate = float(speed[contact].mean()) if contact.any() else 0.0

@@ -5,17 +5,17 @@ pelvis projected onto the ground at the origin, its heading along +x. That makes
 invariant to where the robot is and which way it faces, so it never sees world coordinates that
 grow without bound over a long session.
 
-Frame feature vector (D = 50), all in the canonical frame:
+Frame feature vector (D = 67), all in the canonical frame, the same layout for every skeleton
+(skeleton.py; a slot a variant lacks holds 0):
     [0:3]    pelvis position, m
     [3:9]    pelvis rotation, first two columns of its rotation matrix (continuous 6D form)
-    [9:38]   29 joint angles, rad, g1.JOINT_NAMES order
-    [38:50]  effector positions, m: left hand, right hand, left foot, right foot
-             (wrist-yaw and ankle-roll link origins)
+    [9:38]   29 body joint angles, rad, g1.JOINT_NAMES order
+    [38:53]  effector positions, m: left hand, right hand, left foot, right foot (wrist-yaw and
+             ankle-roll link origins), head (the head link's centre of mass, on the torso)
+    [53:67]  14 Dex3 finger joint angles, rad, skeleton.FINGER_JOINTS order
 """
 
 from __future__ import annotations
-
-from pathlib import Path
 
 import numpy as np
 
@@ -26,24 +26,44 @@ ROOT_POS = slice(0, 3)
 ROOT_ROT = slice(3, 9)
 ROOT = slice(0, 9)
 JOINTS = slice(9, 38)
-EFFECTORS = slice(38, 50)
-DIM = 50
-EFFECTOR_BODIES = g1.HAND_BODIES + g1.FOOT_BODIES
+EFFECTORS = slice(38, 53)
+FINGERS = slice(53, 67)
+DIM = 67
+HEAD = "head"
+EFFECTOR_BODIES = g1.HAND_BODIES + g1.FOOT_BODIES + (HEAD,)
+"""Effector names (goal frames): wrist-yaw links, ankle-roll links, and the head point."""
+NUM_EFFECTORS = len(EFFECTOR_BODIES)
+JOINT_SLOTS = np.r_[9:38, 53:67]
+"""Feature index of each joint slot (skeleton.SLOT_NAMES order)."""
 HEIGHT_ONLY = np.zeros(DIM, dtype=bool)
 HEIGHT_ONLY[2] = True
 
 
-def effector_indices(body_names: tuple[str, ...]) -> list[int]:
-    return [body_names.index(b) for b in EFFECTOR_BODIES]
+def effector_slice(name: str) -> slice:
+    """Feature columns of an effector's position."""
+    k = EFFECTOR_BODIES.index(name)
+    return slice(38 + 3 * k, 41 + 3 * k)
 
 
+def present_mask(skeleton_present: np.ndarray) -> np.ndarray:
+    """(DIM,) bool: which features exist on a skeleton (root and effectors always)."""
+    out = np.ones(DIM, dtype=bool)
+    out[JOINT_SLOTS] = skeleton_present
+    return out
 
 
+def effectors_from_bodies(pos: np.ndarray, rot: np.ndarray, body_names: tuple[str, ...]) -> np.ndarray:
+    """Effector positions (..., NUM_EFFECTORS, 3) from body positions/rotations (..., B, 3[, 3])."""
+    from g1_control.generator.fk import head_offset
 
+    ends = pos[..., [body_names.index(b) for b in EFFECTOR_BODIES[:4]], :]
+    t = body_names.index(g1.TORSO_BODY)
+    head = pos[..., t, :] + np.einsum("...ij,j->...i", rot[..., t, :, :], head_offset())
+    return np.concatenate([ends, head[..., None, :]], axis=-2)
 
 def rot6d_to_matrix(r6: np.ndarray) -> np.ndarray:
     """Gram-Schmidt of the two stored columns -> (..., 3, 3). Written out (no np.cross /
-    np.linalg.norm): this runs several times per replan."""
+    np.linalg.norm / np.stack): this runs several times per replan."""
     a0, a1, a2, b0, b1, b2 = (r6[..., i] for i in range(6))
     na = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2) + 1e-12
     x0, x1, x2 = a0 / na, a1 / na, a2 / na
@@ -51,28 +71,52 @@ def rot6d_to_matrix(r6: np.ndarray) -> np.ndarray:
     b0, b1, b2 = b0 - d * x0, b1 - d * x1, b2 - d * x2
     nb = np.sqrt(b0 * b0 + b1 * b1 + b2 * b2) + 1e-12
     y0, y1, y2 = b0 / nb, b1 / nb, b2 / nb
-    z0, z1, z2 = x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0
-    return np.stack([np.stack([x0, y0, z0], -1), np.stack([x1, y1, z1], -1), np.stack([x2, y2, z2], -1)], -2)
-
-
-def world_features(root_pos: np.ndarray, root_rot: np.ndarray, joints: np.ndarray,
-                   effectors: np.ndarray) -> np.ndarray:
-    """(T, 3), (T, 3, 3), (T, 29), (T, 4, 3) world quantities -> (T, D) features (world frame)."""
-    t = root_pos.shape[0]
-    out = np.empty((t, DIM))
-    out[:, ROOT_POS] = root_pos
-    out[:, ROOT_ROT] = np.concatenate([root_rot[:, :, 0], root_rot[:, :, 1]], axis=-1)
-    out[:, JOINTS] = joints
-    out[:, EFFECTORS] = effectors.reshape(t, 12)
+    out = np.empty(r6.shape[:-1] + (3, 3))
+    out[..., 0, 0], out[..., 1, 0], out[..., 2, 0] = x0, x1, x2
+    out[..., 0, 1], out[..., 1, 1], out[..., 2, 1] = y0, y1, y2
+    out[..., 0, 2], out[..., 1, 2], out[..., 2, 2] = x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0
     return out
 
 
-def clip_features(clip) -> np.ndarray:
-    """World-frame features of a MotionClip, (T, D)."""
+def orthonormalize_rot6d(frames: np.ndarray) -> None:
+    """Re-orthonormalize the pelvis 6D columns of feature frames (..., D) in place."""
+    r6 = frames[..., ROOT_ROT]
+    a0, a1, a2, b0, b1, b2 = (r6[..., i] for i in range(6))
+    na = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2) + 1e-12
+    x0, x1, x2 = a0 / na, a1 / na, a2 / na
+    d = x0 * b0 + x1 * b1 + x2 * b2
+    b0, b1, b2 = b0 - d * x0, b1 - d * x1, b2 - d * x2
+    nb = np.sqrt(b0 * b0 + b1 * b1 + b2 * b2) + 1e-12
+    frames[..., 3], frames[..., 4], frames[..., 5] = x0, x1, x2
+    frames[..., 6], frames[..., 7], frames[..., 8] = b0 / nb, b1 / nb, b2 / nb
+
+
+def heading(frames: np.ndarray) -> np.ndarray:
+    """Yaw of the pelvis x axis of feature frames (...,)."""
+    return np.arctan2(frames[..., 4], frames[..., 3])
+
+
+def world_features(root_pos: np.ndarray, root_rot: np.ndarray, joints: np.ndarray,
+                   effectors: np.ndarray, fingers: np.ndarray | None = None) -> np.ndarray:
+    """(T, 3), (T, 3, 3), (T, 29), (T, NUM_EFFECTORS, 3)[, (T, 14)] world quantities -> (T, D)
+    features (world frame)."""
+    t = root_pos.shape[0]
+    out = np.zeros((t, DIM))
+    out[:, ROOT_POS] = root_pos
+    out[:, ROOT_ROT] = np.concatenate([root_rot[:, :, 0], root_rot[:, :, 1]], axis=-1)
+    out[:, JOINTS] = joints
+    out[:, EFFECTORS] = effectors.reshape(t, 3 * NUM_EFFECTORS)
+    if fingers is not None:
+        out[:, FINGERS] = fingers
+    return out
+
+
+def clip_features(clip, fingers: np.ndarray | None = None) -> np.ndarray:
+    """World-frame features of a MotionClip (+ its finger angles, for the G1 with hands), (T, D)."""
     from g1_control import rotations as quat
 
-    eff = clip.body_pos_w_m[:, effector_indices(clip.body_names)]
-    return world_features(clip.root_pos_w_m, quat.to_matrix(clip.root_quat_wxyz), clip.joint_pos_rad, eff)
+    eff = effectors_from_bodies(clip.body_pos_w_m, quat.to_matrix(clip.body_quat_wxyz), clip.body_names)
+    return world_features(clip.root_pos_w_m, quat.to_matrix(clip.root_quat_wxyz), clip.joint_pos_rad, eff, fingers)
 
 
 def reference_of(features: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -97,11 +141,41 @@ def transform(features: np.ndarray, origin_xy: np.ndarray, yaw: np.ndarray, inve
     out[..., ROOT_POS] = pos(features[..., ROOT_POS])
     out[..., 3:6] = np.einsum("...ij,...j->...i", r, features[..., 3:6])
     out[..., 6:9] = np.einsum("...ij,...j->...i", r, features[..., 6:9])
-    eff = features[..., EFFECTORS].reshape(features.shape[:-1] + (4, 3))
+    eff = features[..., EFFECTORS].reshape(features.shape[:-1] + (NUM_EFFECTORS, 3))
     r4 = r[..., None, :, :]
     o4 = o[..., None, :]
     eff = (np.einsum("...ij,...j->...i", r4, eff - o4) if not inverse else np.einsum("...ij,...j->...i", r4, eff) + o4)
-    out[..., EFFECTORS] = eff.reshape(features.shape[:-1] + (12,))
+    out[..., EFFECTORS] = eff.reshape(features.shape[:-1] + (3 * NUM_EFFECTORS,))
+    return out
+
+
+_PLANAR_X = np.r_[0, 3, 6, 38:53:3]
+_PLANAR_Y = _PLANAR_X + 1
+
+
+def transform_one(features: np.ndarray, origin_xy: np.ndarray, yaw: float, inverse: bool = False) -> np.ndarray:
+    """transform() for one frame set (T, D) and one planar frame, written for the per-replan path
+    (a 2x2 rotation of the x/y columns; transform() costs ~5x more for this case)."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    out = features.copy()
+    xs, ys = _PLANAR_X, _PLANAR_Y
+    x, y = features[..., xs], features[..., ys]
+    if inverse:
+        out[..., xs] = c * x - s * y
+        out[..., ys] = s * x + c * y
+        out[..., 0] += origin_xy[0]
+        out[..., 1] += origin_xy[1]
+        out[..., 38:53:3] += origin_xy[0]
+        out[..., 39:53:3] += origin_xy[1]
+    else:
+        x = x.copy()
+        y = y.copy()
+        x[..., 0] -= origin_xy[0]
+        y[..., 0] -= origin_xy[1]
+        x[..., 3:] -= origin_xy[0]
+        y[..., 3:] -= origin_xy[1]
+        out[..., xs] = c * x + s * y
+        out[..., ys] = -s * x + c * y
     return out
 
 
@@ -121,24 +195,13 @@ def bodies_of(features: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def fix_effectors(features: np.ndarray) -> np.ndarray:
     """Features with the effector block recomputed from root + joints (so generated frames are
     self-consistent)."""
-    pos, _ = bodies_of(features)
+    pos, rot = bodies_of(features)
     from g1_control.motion.kinematics import default_body_names
 
     out = features.copy()
-    idx = effector_indices(default_body_names())
-    out[..., EFFECTORS] = pos[..., idx, :].reshape(features.shape[:-1] + (12,))
+    eff = effectors_from_bodies(pos, rot, default_body_names())
+    out[..., EFFECTORS] = eff.reshape(features.shape[:-1] + (3 * NUM_EFFECTORS,))
     return out
-
-
-def load_split(library_root: str | Path | None, split: str) -> tuple[list[np.ndarray], list[int]]:
-    """Features (clip_features) and style ids of the clips of one split ("train", "test") of a
-    built motion library (default: the library's default folder)."""
-    from g1_control.generator.styles import style_id
-    from g1_control.motion.library import MotionLibrary, default_library_dir
-
-    lib = MotionLibrary(library_root or default_library_dir())
-    clips = lib.clips(split)
-    return [clip_features(c) for c in clips], [style_id(c.style) for c in clips]
 
 
 def matrix_to_quat(rot: np.ndarray) -> np.ndarray:

@@ -47,6 +47,22 @@ def kinematic_tree() -> KinematicTree:
     return KinematicTree(tuple(parent), np.array(pos), np.array(rot), tuple(axis))
 
 
+@functools.cache
+def head_offset() -> np.ndarray:
+    """The head point in the torso link frame: the head link's placement plus its centre of mass,
+    read from the URDF (the head is rigid on the torso)."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(description.urdf_path()).getroot()
+    joint = next(j for j in root.iter("joint") if j.get("name") == "head_joint")
+    link = next(lk for lk in root.iter("link") if lk.get("name") == "head_link")
+    placement = np.array([float(v) for v in joint.find("origin").get("xyz").split()])
+    com = np.array([float(v) for v in link.find("inertial/origin").get("xyz").split()])
+    out = placement + com  # the head joint's rpy is zero in Unitree's description
+    out.setflags(write=False)
+    return out
+
+
 def _axis_rotation_np(axis: int, angle: np.ndarray) -> np.ndarray:
     c, s = np.cos(angle), np.sin(angle)
     out = np.zeros(angle.shape + (3, 3))
@@ -94,3 +110,22 @@ def fk_torch(root_pos, root_rot, joints):
             m = torch.stack([c, -s, zero, s, c, zero, zero, zero, one], -1)
         rot.append(r @ off_r[k] @ m.reshape(q.shape + (3, 3)))
     return torch.stack(pos, dim=-2), torch.stack(rot, dim=-3)
+
+
+@functools.cache
+def _effector_body_indices() -> tuple[tuple[int, ...], int]:
+    from g1_control.motion.kinematics import default_body_names
+
+    names = default_body_names()
+    ends = (*g1.HAND_BODIES, *g1.FOOT_BODIES)
+    return tuple(names.index(b) for b in ends), names.index(g1.TORSO_BODY)
+
+
+def effectors_torch(pos, rot):
+    """Effector positions (..., 5, 3) (features.EFFECTOR_BODIES order) from fk_torch's bodies."""
+    import torch
+
+    ends, torso = _effector_body_indices()
+    off = torch.tensor(np.array(head_offset()), dtype=pos.dtype)
+    head = pos[..., torso, :] + (rot[..., torso, :, :] @ off.unsqueeze(-1)).squeeze(-1)
+    return torch.cat([pos[..., list(ends), :], head.unsqueeze(-2)], dim=-2)

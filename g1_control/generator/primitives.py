@@ -16,12 +16,12 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from g1_control.generator import features as F
 from g1_control.robot import g1
 
 LN2 = math.log(2.0)
@@ -54,14 +54,14 @@ def spring_root_trajectory(start: RootState, v_cmd_heading: np.ndarray, wz_cmd: 
     Heading with an absolute target: critically damped x(t) = x_d + (j0 + j1 t) e^{-y t}, y = 2 ln2 / half-life.
     """
     n = max(1, round(horizon_s / dt_s))
-    k = np.arange(1, n + 1)
-    t = k * dt_s
     decay = math.exp(-LN2 / cfg.velocity_halflife_s * dt_s)
-    v_cmd = np.clip(v_cmd_heading, [-cfg.max_vx_mps, -cfg.max_vy_mps], [cfg.max_vx_mps, cfg.max_vy_mps])
-    wz_cmd = float(np.clip(wz_cmd, -cfg.max_wz_radps, cfg.max_wz_radps))
+    weights, powers, _k, t = _spring_weights(n, decay, dt_s)
+    vx = min(max(float(v_cmd_heading[0]), -cfg.max_vx_mps), cfg.max_vx_mps)
+    vy = min(max(float(v_cmd_heading[1]), -cfg.max_vy_mps), cfg.max_vy_mps)
+    wz_cmd = min(max(float(wz_cmd), -cfg.max_wz_radps), cfg.max_wz_radps)
     # Closed forms evaluated at every frame (vectorized: this runs on every replan).
     if heading_cmd is None:
-        rate = wz_cmd + (start.yaw_rate - wz_cmd) * decay ** k
+        rate = wz_cmd + (start.yaw_rate - wz_cmd) * powers
         yaw = start.yaw + np.cumsum(rate) * dt_s
     else:
         y = 2.0 * LN2 / cfg.heading_halflife_s
@@ -69,22 +69,39 @@ def spring_root_trajectory(start: RootState, v_cmd_heading: np.ndarray, wz_cmd: 
         j1 = start.yaw_rate + err0 * y
         yaw = heading_cmd + (err0 + j1 * t) * np.exp(-y * t)
     c, s = np.cos(yaw), np.sin(yaw)
-    target_w = np.stack([c * v_cmd[0] - s * v_cmd[1], s * v_cmd[0] + c * v_cmd[1]], axis=1)
+    target_w = np.empty((n, 2))
+    target_w[:, 0] = c * vx - s * vy
+    target_w[:, 1] = s * vx + c * vy
     # v_k = d v_{k-1} + (1 - d) target_k  =>  v = d^k v0 + W @ target with W[k, j] = (1 - d) d^(k - j), j <= k
-    lag = k[:, None] - k[None, :]
-    weights = np.where(lag >= 0, (1 - decay) * decay ** np.maximum(lag, 0), 0.0)
-    vel = decay ** k[:, None] * start.vel_xy[None, :] + weights @ target_w
+    vel = weights @ target_w
+    vel += powers[:, None] * start.vel_xy[None, :]
     pos = start.pos_xy[None, :] + np.cumsum(vel, axis=0) * dt_s
     return pos, yaw
 
 
+@functools.lru_cache(maxsize=16)
+def _spring_weights(n: int, decay: float, dt_s: float) -> tuple[np.ndarray, ...]:
+    """The velocity spring's (n, n) lower-triangular weights, decay^k, k and t = k dt (cached: the
+    same for every replan of a horizon)."""
+    k = np.arange(1, n + 1)
+    lag = k[:, None] - k[None, :]
+    weights = np.where(lag >= 0, (1 - decay) * decay ** np.maximum(lag, 0), 0.0)
+    powers = decay ** k
+    t = k * dt_s
+    for a in (weights, powers, k, t):
+        a.setflags(write=False)
+    return weights, powers, k, t
+
+
 def root_features(pos_xy: np.ndarray, height: float, yaw: float, tilt_rot: np.ndarray | None = None) -> np.ndarray:
     """Root block (9,) of a world-frame feature vector: position and a yaw-only (or given) rotation."""
-    rot = F.rot_z(np.array(yaw))
-    if tilt_rot is not None:
-        rot = rot @ tilt_rot
     out = np.zeros(9)
     out[0:2], out[2] = pos_xy, height
+    c, s = math.cos(yaw), math.sin(yaw)
+    if tilt_rot is None:
+        out[3], out[4], out[7], out[6] = c, s, c, -s
+        return out
+    rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ tilt_rot
     out[3:6], out[6:9] = rot[:, 0], rot[:, 1]
     return out
 

@@ -12,7 +12,19 @@ Long-horizon stability (COMET's point: autoregressive generation drifts off the 
 unless fed back towards it): every plan is checked and corrected before it is used - joints
 clamped to the robot's limits, the pelvis height kept within the style's observed range (plus
 margin), the root kept upright within the library's tilt, and a plan that is not finite is
-replaced by interpolation toward the keyframe (counted in `fallbacks`).
+replaced by interpolation toward the keyframe (counted in `fallbacks`). With a
+ReferenceFeedback (feedback.py) every plan's poses are also attracted toward the current style's
+reference mixture, except near a goal.
+
+Joint-level goals: Command.goals on hands, feet, head or the pelvis (EffectorGoal) become goals
+inside the model. A goal beyond arm's reach is walked to first (a stance point next to it,
+facing it - the WANDR-style reaching setup), then given on the keyframe and on gap frames: from
+the frame the effector can reach it at hand speed, held every 2 frames to the plan's end (a goal
+on one frame only is touched and left: measured, the model keeps a goal local to its token), or
+on the frame of its t_s when that falls inside the plan. The goal-error feedback adds the model's
+own remaining error at the goal frame (FK of its joints, no IK) to the next plan's goal. The skeleton (29-DoF,
+23-DoF, with hands) is an input of the model; joints it lacks stay at 0 and, on the G1 with hands,
+the reference carries the finger angles (KinematicReference.hand_q_rad).
 """
 
 from __future__ import annotations
@@ -23,6 +35,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from g1_control.generator import features as F
+from g1_control.generator import skeleton as S
+from g1_control.generator.feedback import ReferenceFeedback
 from g1_control.generator.inbetween import CONTEXT_FRAMES, Inbetweener
 from g1_control.generator.primitives import (
     Keyframe,
@@ -45,6 +59,22 @@ _WAIST_LEAN = [F.JOINTS.start + g1.JOINT_INDEX[name] for name in ("waist_roll_jo
 OBJECT_GOALS = ("box_pick", "box_climb")
 """EffectorGoal.frame values that name an object goal instead of a robot frame; pos_w_m is then
 the centre of a box standing on the floor."""
+GOAL_FRAMES = F.EFFECTOR_BODIES + ("head_link", g1.BASE_BODY)
+"""EffectorGoal.frame values the model takes as joint-level goals ('head' and 'head_link' are the
+head point; 'pelvis' is the root position)."""
+STANCE_OFFSET = {"left_wrist_yaw_link": (0.22, 0.2), "right_wrist_yaw_link": (0.22, -0.2), "head": (0.1, 0.0)}
+"""Where a reaching goal sits relative to the pelvis once there (m, heading frame: forward, left);
+for a hand, the forward distance shrinks for goals far above or below the shoulder
+(`hand_forward_m`)."""
+SHOULDER_ABOVE_PELVIS_M = 0.29
+ARM_REACH_M = 0.30
+"""Shoulder-pitch joint to wrist-yaw link of the G1, arm straight (0.28 m) plus a little lean."""
+
+
+def hand_forward_m(goal_z: float, pelvis_z: float, most: float = 0.22) -> float:
+    """How far ahead of the pelvis a hand goal at goal_z can be reached standing (m)."""
+    dz = goal_z - (pelvis_z + SHOULDER_ABOVE_PELVIS_M)
+    return float(np.clip(math.sqrt(max(0.0, ARM_REACH_M ** 2 - dz * dz)) - 0.03, 0.05, most))
 
 
 @dataclass
@@ -67,6 +97,24 @@ class RuntimeConfig:
     styled-walking tracker sagged the waist pitch to its 0.52 rad limit (carry, wave, reach_up in
     style_stats.json: 0.48-0.52), which no style intends; the tracker leaves waist roll/pitch to
     the walking policy in any case."""
+    reach_radius_m: float = 0.15
+    """A reaching goal's stance point counts as reached within this distance (then latched)."""
+    reach_early_m: float = 0.35
+    """While walking to a stance point, the goal joins the keyframe once the spring's keyframe
+    root is this close to it."""
+    goal_error_gain: float = 0.7
+    """Goal-error feedback: after each plan, this fraction of the error left at an effector goal's
+    frame - forward kinematics of the model's planned joints, no IK - is added to the goal the
+    model is given next time (an integrator on the model's static error, at most goal_error_max_m,
+    updated while the error is under goal_error_near_m). 0 disables."""
+    goal_error_near_m: float = 0.3
+    goal_error_max_m: float = 0.2
+    effector_speed_mps: float = 0.5
+    """A goal near its effector is put on the gap frame the effector reaches at this speed..."""
+    min_goal_frame: int = 8
+    """... but not before this frame (0-based)."""
+    hold_every_frames: int = 2
+    """A goal without a time is held: given again every this many frames after its first frame."""
 
 
 @dataclass
@@ -92,10 +140,19 @@ def _same_command(a: Command | None, b: Command, tol: float) -> bool:
 
 
 class InbetweeningGenerator(Generator):
-    def __init__(self, inbetweener: Inbetweener, styles: dict[str, StyleStats], config: RuntimeConfig | None = None):
+    def __init__(self, inbetweener: Inbetweener, styles: dict[str, StyleStats], config: RuntimeConfig | None = None,
+                 skeleton: str = "g1_29dof", feedback: ReferenceFeedback | None = None):
         self.model = inbetweener
         self.styles = styles
         self.config = config or RuntimeConfig()
+        self.skeleton = S.skeleton(skeleton)
+        self.present = F.present_mask(self.skeleton.present)
+        self.feedback = feedback
+        self._q_lo = np.where(self.skeleton.present, self.skeleton.q_min, 0.0)
+        self._q_hi = np.where(self.skeleton.present, self.skeleton.q_max, 0.0)
+        self._reach: dict[str, list] = {}
+        self._goal_offset: dict[str, tuple] = {}
+        self._gap_goals: list[tuple] = []  # (frame, columns, value given, goal name, goal point)
         self.stats = PlanStats()
         self.ref = KinematicReference()
         self._dt = 1.0 / self.config.fps
@@ -116,21 +173,31 @@ class InbetweeningGenerator(Generator):
         frame = np.zeros(F.DIM)
         frame[F.ROOT] = root_features(np.asarray(pos[:2], float), float(pos[2]), yaw)
         frame[F.JOINTS] = state.q_rad
-        frame = F.fix_effectors(frame[None])[0]
-        self.history = np.repeat(frame[None], CONTEXT_FRAMES, axis=0)
-        self.plan = frame[None].copy()
-        self.plan_t0 = state.t_s
-        self._t = state.t_s
+        frame = F.fix_effectors(frame[None])[0] * self.present
+        self.reset_from_frames(np.repeat(frame[None], CONTEXT_FRAMES, axis=0), state.t_s)
+
+    def reset_from_frames(self, frames: np.ndarray, t_s: float = 0.0) -> None:
+        """Start from recorded world-frame features (the last CONTEXT_FRAMES of them are the
+        context of the first plan): e.g. an unseen start pose from held-out clips."""
+        frames = np.asarray(frames, dtype=float)[-CONTEXT_FRAMES:] * self.present
+        if len(frames) < CONTEXT_FRAMES:
+            frames = np.concatenate([np.repeat(frames[:1], CONTEXT_FRAMES - len(frames), axis=0), frames])
+        self.history = frames.copy()
+        self.plan = frames[-1:].copy()
+        self.plan_t0 = t_s
+        self._t = t_s
         self._last_cmd = None
         self._object = None
+        self._reach = {}
+        self._goal_offset = {}
         self.stats = PlanStats()
 
     # ------------------------------------------------------------------ planning
     def _root_state(self) -> RootState:
         h = self.history
         last, prev = h[-1], h[-2]
-        yaw = float(F.yaw_of_matrix(F.rot6d_to_matrix(last[F.ROOT_ROT])))
-        yaw_prev = float(F.yaw_of_matrix(F.rot6d_to_matrix(prev[F.ROOT_ROT])))
+        yaw = math.atan2(last[4], last[3])
+        yaw_prev = math.atan2(prev[4], prev[3])
         rate = ((yaw - yaw_prev + math.pi) % (2 * math.pi) - math.pi) * self.config.fps
         return RootState(last[0:2].copy(), (last[0:2] - prev[0:2]) * self.config.fps, yaw, rate)
 
@@ -192,27 +259,153 @@ class InbetweeningGenerator(Generator):
             lean = cfg.max_waist_lean_rad
             values[_WAIST_LEAN] = np.clip(values[_WAIST_LEAN], -lean, lean)
             given[ub] = True
-        for goal in command.goals:
-            if goal.frame in OBJECT_GOALS:
+        self._gap_goals = []
+        reaching = [g for g in command.goals if g.frame not in OBJECT_GOALS]
+        if reaching and obj is None:
+            root_xy, root_yaw, walk = self._reach_plan(reaching, root)
+            if walk is not None:
+                path, yaws = spring_root_trajectory(root, walk, 0.0, root_yaw, gap / cfg.fps, 1.0 / cfg.fps, cfg.spring)
+                values[F.ROOT] = root_features(path[-1], height, float(yaws[-1]))
+            else:
+                values[F.ROOT] = root_features(root_xy, height, root_yaw)
+        for goal in reaching:
+            point = np.asarray(goal.pos_w_m, float)
+            name = "head" if goal.frame == "head_link" else goal.frame
+            targets[goal.frame] = np.concatenate([point, [1.0, 0.0, 0.0, 0.0]])
+            if name not in F.EFFECTOR_BODIES and name != g1.BASE_BODY:
+                continue  # another frame: the IK's frame target only
+            if obj is None and not self._goal_active(name, values):
                 continue
-            targets[goal.frame] = np.concatenate([np.asarray(goal.pos_w_m, float), [1.0, 0.0, 0.0, 0.0]])
-        for name, pose7 in targets.items():
-            if name in F.EFFECTOR_BODIES:
-                k = F.EFFECTOR_BODIES.index(name)
-                values[38 + 3 * k:41 + 3 * k] = pose7[:3]
-                given[38 + 3 * k:41 + 3 * k] = True
+            if name in ("left_wrist_yaw_link", "right_wrist_yaw_link"):  # the goal's arm is free of the style pose
+                side = 15 if name.startswith("left") else 22
+                given[9 + side:9 + side + 7] = False
+            frame = gap - 1
+            if name == g1.BASE_BODY:
+                cols = np.r_[0:3]
+                given_point = point
+            else:
+                cols = np.r_[F.effector_slice(name)]
+                given_point = point + self._goal_offset_for(name, point)
+                # a goal close by is reached at hand speed, not at the plan's end (replanning comes
+                # after replan_low_frames: a goal on the last frame would never be executed)
+                dist = float(np.linalg.norm(self._effector_now(name) - point))
+                frame = int(np.clip(math.ceil(dist / cfg.effector_speed_mps * cfg.fps), cfg.min_goal_frame, gap - 1))
+            values[cols] = given_point
+            given[cols] = True
+            if goal.t_s is not None:
+                frame = int(np.clip(round(goal.t_s * cfg.fps) - 1, 0, gap - 1))
+            self._gap_goals.append((frame, cols, given_point, name, point))
+            if goal.t_s is None:  # held: the goal stays given on later frames of the plan too
+                for later in range(frame + cfg.hold_every_frames, gap, cfg.hold_every_frames):
+                    self._gap_goals.append((later, cols, given_point, None, point))
+        given &= self.present
         return Keyframe(values, given, gap, style, targets)
+
+    def _reach_plan(self, goals, root: RootState) -> tuple[np.ndarray, float, np.ndarray | None]:
+        """Where to stand for the goals (their stance points, averaged) and, while not there, the
+        heading-frame walking velocity toward it; (stance xy, facing yaw, velocity or None)."""
+        cfg = self.config
+        spots, faces = [], []
+        for goal in goals:
+            name = "head" if goal.frame == "head_link" else goal.frame
+            point = np.asarray(goal.pos_w_m, float)
+            key = (name, tuple(np.round(point, 3)))
+            entry = self._reach.get(name)
+            if entry is None or entry[0] != key:
+                if name == g1.BASE_BODY:
+                    d = point[:2] - root.pos_xy
+                    face = math.atan2(d[1], d[0]) if np.linalg.norm(d) > 0.3 else root.yaw
+                    spot = point[:2].copy()
+                elif name in STANCE_OFFSET:
+                    d = point[:2] - root.pos_xy
+                    face = math.atan2(d[1], d[0]) if np.linalg.norm(d) > 0.2 else root.yaw
+                    fx, fy = STANCE_OFFSET[name]
+                    if name != "head":
+                        fx = hand_forward_m(point[2], float(self.history[-1][2]), fx)
+                    c, s_ = math.cos(face), math.sin(face)
+                    spot = point[:2] - np.array([c * fx - s_ * fy, s_ * fx + c * fy])
+                else:  # feet: step where the foot goes, facing as now
+                    spot, face = root.pos_xy.copy(), root.yaw
+                entry = self._reach[name] = [key, spot, face, False]
+            spots.append(entry[1])
+            faces.append(entry[2])
+        spot = np.mean(spots, axis=0)
+        face = float(math.atan2(np.mean(np.sin(faces)), np.mean(np.cos(faces))))
+        dist = float(np.linalg.norm(spot - root.pos_xy))
+        arrived = all(e[3] for e in self._reach.values()) or dist <= cfg.reach_radius_m
+        for e in self._reach.values():
+            e[3] = arrived
+        if arrived:
+            return spot, face, None
+        c, s_ = math.cos(root.yaw), math.sin(root.yaw)
+        d = (spot - root.pos_xy) / dist * min(cfg.spring.max_vx_mps, dist)
+        return spot, face, np.array([c * d[0] + s_ * d[1], -s_ * d[0] + c * d[1]])
+
+    def _goal_offset_for(self, name: str, point: np.ndarray) -> np.ndarray:
+        """The goal-error feedback's current offset for an effector goal (0 for a new goal)."""
+        prev = self._goal_offset.get(name)
+        return prev[1] if prev is not None and prev[0] == tuple(np.round(point, 3)) else np.zeros(3)
+
+    def _effector_now(self, name: str) -> np.ndarray:
+        """An effector's position in the last executed frame, by FK (the model's own output)."""
+        from g1_control.motion.kinematics import default_body_names
+
+        pos, rot = F.bodies_of(self.history[-1])
+        return F.effectors_from_bodies(pos, rot, default_body_names())[F.EFFECTOR_BODIES.index(name)]
+
+    def _update_goal_errors(self, frames: np.ndarray) -> None:
+        """After a plan: for each effector goal, the error of the planned frame that was to reach it
+        (FK of the model's joints) feeds the offset given with that goal next time (an integrator on
+        the model's static error; RuntimeConfig.goal_error_gain)."""
+        cfg = self.config
+        if cfg.goal_error_gain <= 0:
+            return
+        from g1_control.motion.kinematics import default_body_names
+
+        for frame, _, _, name, point in self._gap_goals:
+            if name is None or name == g1.BASE_BODY or frame >= len(frames):
+                continue
+            pos, rot = F.bodies_of(frames[frame])
+            reached = F.effectors_from_bodies(pos, rot, default_body_names())[F.EFFECTOR_BODIES.index(name)]
+            error = point - reached
+            offset = self._goal_offset_for(name, point)
+            if float(np.linalg.norm(error)) < cfg.goal_error_near_m:
+                offset = offset + cfg.goal_error_gain * error
+                norm = float(np.linalg.norm(offset))
+                if norm > cfg.goal_error_max_m:
+                    offset *= cfg.goal_error_max_m / norm
+            self._goal_offset[name] = (tuple(np.round(point, 3)), offset)
+
+    def _goal_active(self, name: str, values: np.ndarray) -> bool:
+        """A goal joins the keyframe once its stance point is reached or about to be."""
+        entry = self._reach.get(name)
+        if entry is None or entry[3]:
+            return True
+        return float(np.linalg.norm(values[0:2] - entry[1])) < self.config.reach_early_m
 
     def _replan(self, command: Command, reason: str) -> None:
         cfg = self.config
         key = self.keyframe(command)
         context = self.history[-CONTEXT_FRAMES:]
-        origin, yaw = F.reference_of(context[-1])
-        ctx_c = F.transform(context[None], origin, yaw)
-        tgt_c = F.transform(key.values[None, None], origin, yaw)[:, 0]
+        last = context[-1]
+        origin = last[0:2].copy()
+        yaw = math.atan2(last[4], last[3])  # heading of the pelvis x axis (first 6D column)
+        ctx_c = F.transform_one(context, origin, yaw)[None]
+        tgt_c = F.transform_one(key.values[None], origin, yaw)
+        if self._gap_goals and hasattr(self.model, "set_goals"):
+            goal = np.zeros((key.gap, F.DIM))
+            mask = np.zeros((key.gap, F.DIM), dtype=bool)
+            for frame, cols, point, _, _ in self._gap_goals:
+                goal[frame, cols] = point
+                mask[frame, cols] = True
+            goal = F.transform_one(goal, origin, yaw)
+            goal[~mask] = 0.0
+            self.model.set_goals(goal[None], mask[None])
         frames_c = self.model.infill(ctx_c, tgt_c, key.given[None], key.gap, np.array([style_id(key.style)]))
-        frames = F.transform(frames_c, origin, yaw, inverse=True)[0]
+        frames = F.transform_one(frames_c[0], origin, yaw, inverse=True)
         frames = self._stabilize(frames, key)
+        if self._gap_goals:
+            self._update_goal_errors(frames)
         # cross-fade: the old plan's frames still ahead (same times) blend into the new plan
         old = self.plan
         n = min(cfg.crossfade_frames, len(old), len(frames))
@@ -233,15 +426,24 @@ class InbetweeningGenerator(Generator):
             self.stats.fallbacks += 1
             last = self.history[-1]
             frames = interpolate(last[None], np.where(key.given, key.values, last)[None], key.gap)[0]
-        frames[:, F.JOINTS] = np.clip(frames[:, F.JOINTS], g1.Q_MIN_RAD, g1.Q_MAX_RAD)
+        if self.feedback is not None:
+            self.feedback.set_style(key.style)
+            goal_frames = [f for f, *_ in self._gap_goals]
+            eff = [(cols, point) for _, cols, _, _, point in self._gap_goals]
+            weights = self.feedback.frame_weights(len(frames), goal_frames, key.gap if goal_frames else None,
+                                                  frames, eff)
+            frames = self.feedback.apply(frames, weights)
+        frames[:, F.JOINT_SLOTS] = np.clip(frames[:, F.JOINT_SLOTS], self._q_lo, self._q_hi)
         frames[:, _WAIST_LEAN] = np.clip(frames[:, _WAIST_LEAN], -cfg.max_waist_lean_rad, cfg.max_waist_lean_rad)
         lo, _, hi = self._style_stats(key.style).pelvis_height_m
         floor = min(lo, key.values[2]) - cfg.height_margin_m
         ceil = max(hi, key.values[2]) + cfg.height_margin_m
         frames[:, 2] = np.clip(frames[:, 2], floor, ceil)
-        rot = F.rot6d_to_matrix(frames[:, F.ROOT_ROT])
-        tilt = np.arccos(np.clip(rot[:, 2, 2], -1.0, 1.0))
-        if np.any(tilt > cfg.max_tilt_rad):
+        # tilt from the 6D columns: the pelvis z axis' vertical component is x_x y_y - x_y y_x
+        up = frames[:, 3] * frames[:, 7] - frames[:, 4] * frames[:, 6]
+        if np.any(up < math.cos(cfg.max_tilt_rad)):
+            rot = F.rot6d_to_matrix(frames[:, F.ROOT_ROT])
+            tilt = np.arccos(np.clip(rot[:, 2, 2], -1.0, 1.0))
             upright = F.rot_z(F.yaw_of_matrix(rot))
             bad = tilt > cfg.max_tilt_rad
             rot[bad] = upright[bad]
@@ -305,8 +507,10 @@ class InbetweeningGenerator(Generator):
             wz = 0.0
         ref.root_linvel_h_mps = v
         ref.root_angvel_h_radps = np.array([0.0, 0.0, wz])
-        feet = frame[F.EFFECTORS].reshape(4, 3)[2:]
+        feet = frame[F.EFFECTORS].reshape(F.NUM_EFFECTORS, 3)[2:4]
         ref.contacts = feet[:, 2] < 0.034 + 0.025
+        if self.skeleton.has_fingers:
+            ref.hand_q_rad = frame[F.FINGERS].copy()
         ref.frame_targets_w = dict(self._frame_targets)
         ref.style = self._style
         ref.pelvis_height_m = self._last_cmd.pelvis_height_m if self._last_cmd is not None else None

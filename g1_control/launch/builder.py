@@ -78,6 +78,9 @@ def make_tracker(launch: LaunchFile) -> Tracker:
     raise LaunchFileError(f"tracker.type: unknown tracker '{cfg.type}'")
 
 
+LEARNED_GENERATORS = ("backbone", "learned_motion_matching")
+
+
 def command_limits(launch: LaunchFile, tracker_limits: CommandLimits | None) -> CommandLimits:
     """The one source of operator velocity limits: the launch file's `limits` within the range the
     tracker can follow (Tracker.command_limits). Teleop sticks scale to it; the generator clamps to it."""
@@ -98,7 +101,13 @@ def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
         return TrajectoryGenerator(trajectory), TrajectoryRetargeter(trajectory)
     from g1_control.generator.factory import make_generator as make_named
 
-    generator, retargeter = make_named(cfg.type, model=cfg.model or None, limits=limits)
+    skeleton = "g1_29dof"
+    if cfg.type in LEARNED_GENERATORS + ("motion_matching",):
+        from g1_control.generator.skeleton import skeleton_for_robot
+
+        skeleton = skeleton_for_robot(launch.backend.expected_variant, launch.backend.hands)
+    generator, retargeter = make_named(cfg.type, model=cfg.model or None, limits=limits, skeleton=skeleton,
+                                       feedback=cfg.feedback)
     if launch.tracker.type != "layer":
         return generator, retargeter
     from g1_control.generator.goals.executor import GoalConfig, GoalGenerator, GoalRetargeter

@@ -52,6 +52,8 @@ class BackendConfig:
     release_motion_service: bool = True
     """Release the robot's built-in controller first (false: the operator used the remote's debug mode)."""
     expected_variant: Literal["g1_23dof", "g1_29dof", "g1_29dof_locked_waist"] = "g1_29dof"
+    hands: Literal["none", "dex3"] = "none"
+    """Dex3-1 hands on the robot (g1_29dof only): the generator then plans the fingers too."""
     connect_timeout_s: float = 3.0
     command_rate_hz: float = 500.0
     mode_pr: int = 0
@@ -173,9 +175,14 @@ class GeneratorConfig:
     g1_control/generator/scripted.py), for the whole-body controller.
     """
 
-    type: Literal["velocity", "backbone", "interpolation", "motion_matching", "scripted"] = "velocity"
+    type: Literal["velocity", "backbone", "learned_motion_matching", "interpolation", "motion_matching",
+                  "scripted"] = "velocity"
     model: str = ""
-    """Backbone ONNX file; empty: the shipped g1_control/policies/generator/backbone.onnx."""
+    """Backbone ONNX file (or, for learned_motion_matching, its folder); empty: the shipped model
+    (g1_control/policies/generator/). The model must serve the robot's variant
+    (backend.expected_variant, backend.hands): it is checked when the launch file is read."""
+    feedback: bool = True
+    """Reference-guided feedback toward the style's library poses (generator/feedback.py)."""
     reference: str = "stand"
     """type scripted: which reference (stand, arm_wave, crouch, lean_reach, step_in_place, walk)."""
     reference_params: dict[str, float] = field(default_factory=dict)
@@ -334,6 +341,8 @@ class LaunchFile:
             if unknown:
                 raise LaunchFileError(f"generator.reference_params: {', '.join(unknown)} not a parameter of reference "
                                       f"'{self.generator.reference}'; known: {', '.join(accepted)}")
+        if self.generator.type in ("backbone", "learned_motion_matching", "motion_matching"):
+            self._check_generator_variant()
         if self.tracker.type in ("wbc", "layer"):
             if self.rates.tracker_hz < MIN_WBC_TRACKER_HZ:
                 raise LaunchFileError(f"rates.tracker_hz: {self.rates.tracker_hz:g} Hz is too slow for tracker.type "
@@ -411,6 +420,24 @@ class LaunchFile:
             return World.from_scene(self.scene, extra)
         except ProgramError as exc:
             raise LaunchFileError(f"input.{str(exc).removeprefix('world.')}") from None
+    def _check_generator_variant(self) -> None:
+        """The robot variant must have a generator skeleton, and a given model must serve it."""
+        from g1_control.generator.skeleton import SkeletonError, skeleton_for_robot
+
+        try:
+            skeleton = skeleton_for_robot(self.backend.expected_variant, self.backend.hands)
+            if self.generator.model and self.generator.type != "motion_matching":
+                model = Path(self.generator.model)
+                folder = model if model.is_dir() else model.parent
+                if (folder / "model.json").is_file():
+                    import json
+
+                    trained = json.loads((folder / "model.json").read_text()).get("skeletons", ["g1_29dof"])
+                    if skeleton not in trained:
+                        raise SkeletonError(f"{model} was trained for {', '.join(trained)}; the robot is {skeleton}")
+        except SkeletonError as exc:
+            raise LaunchFileError(f"generator.model: {exc} (backend.expected_variant "
+                                  f"{self.backend.expected_variant}, backend.hands {self.backend.hands})") from None
 
     @property
     def total_duration_s(self) -> float:

@@ -1,19 +1,27 @@
-"""The in-betweening backbone (torch): a root module, then a pose module, both transformers over
-the same token sequence [context frames | gap frames | target keyframe].
+"""The in-betweening backbone (torch): one transformer over [context | gap | target] tokens, for
+every G1 skeleton.
 
-Root module: from the context and the target, the pelvis trajectory across the gap (a residual
-over interpolation) and the transition's duration in frames, so a caller that gives a keyframe
-without a time can ask how long the motion should take (MotionBricks plans root, then pose).
-Pose module: joints and effector positions for every gap frame given the root trajectory.
+Tokens: two consecutive frames per token (10 context frames -> 5 tokens, a gap of G frames -> G/2
+tokens, the target keyframe -> 1 token): motion at 30 fps is smooth over 2 frames, and halving the
+tokens is what brings a replan under a millisecond on one core (attention and MLP cost scale with
+the token count). Each token carries its frames' values and per-feature "given" masks:
+- context frames: everything the skeleton has is given;
+- gap frames: the interpolation baseline, plus joint-level goals - any subset of joints or
+  effector positions (hands, feet, head) or the pelvis, at any gap frame, given with its mask
+  (COMET-style partial keyframes, generalised from the target to every future frame);
+- the target keyframe: a full pose, the root only, root + upper body, or any subset.
+Added to every token: a position (token index), a role (context/gap/target), a style embedding
+(one per styles.STYLES entry plus "unknown"), and the skeleton embedding - a linear map of the
+skeleton descriptor (skeleton.py: per joint slot present / placement / axis), so one network
+serves the 29-DoF G1, the 23-DoF G1 and the G1 with hands, and a slot a skeleton lacks is never
+given and is zeroed in the output.
 
-Conditioning (COMET-style partial keyframes): every token carries its feature values and a
-per-feature "given" mask, so a target may be a full pose, the root only, or chosen joints /
-effector positions; a style embedding (one per styles.STYLES entry, plus "unknown") is added to
-every token. Poses are continuous (not tokenised): the benchmark prints the error floor a
-512-code pose codebook would impose, which is above the continuous model's error.
+Outputs are residuals over interpolation (zero-initialised head: the untrained model is exactly
+interpolation), plus the transition's duration in frames from the context and the target's root
+alone (a small MLP, no positions: MotionBricks' root planner answers how long a motion takes).
 
-Everything is in normalized canonical features (features.py); `base` is the interpolation
-baseline the outputs are residuals of, computed outside so the gap length is a dynamic axis of
+Everything is in normalized canonical features (features.py); `base` (interpolation), the gap's
+goals and masks come padded to an even length from learned.py, so the gap stays a dynamic axis of
 the exported ONNX graph.
 """
 
@@ -25,32 +33,38 @@ import torch
 from torch import nn
 
 from g1_control.generator import features as F
+from g1_control.generator import skeleton as S
 from g1_control.generator.inbetween import CONTEXT_FRAMES, MAX_GAP
+
+PATCH = 2
+"""Frames per token."""
+CONTEXT_TOKENS = CONTEXT_FRAMES // PATCH
+GAP_TOKENS = (MAX_GAP + PATCH - 1) // PATCH
+PADDED_GAP = GAP_TOKENS * PATCH
+MAX_TOKENS = CONTEXT_TOKENS + GAP_TOKENS + 1
 
 
 @dataclass
 class BackboneConfig:
     num_styles: int
-    d_model: int = 64
+    d_model: int = 96
     layers: int = 3
     heads: int = 4
     ff: int = 192
-    root_d_model: int = 48
-    root_layers: int = 2
     dropout: float = 0.0
-    pose_refines_root: bool = True
-    """The pose module also adds a correction to the root module's pelvis path. Measured with the
-    first shipped model (False): the small root module left the lateral pelvis sway of walking at
-    interpolation's error (2.0 vs 2.3 cm; motion matching 0.9 cm), which dominated L2P."""
+    duration_hidden: int = 64
+    skeletons: tuple[str, ...] = ("g1_29dof",)
+    """Skeletons the model was trained on (model.json; the runtime refuses others)."""
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        d = asdict(self)
+        d["skeletons"] = list(self.skeletons)
+        return d
 
 
 class _Block(nn.Module):
-    """Pre-norm transformer block. Written out (not nn.TransformerEncoderLayer) because the
-    TorchScript ONNX exporter bakes that layer's sequence length into its reshapes, and the
-    gap length must stay a dynamic axis of the exported graph."""
+    """Pre-norm transformer block, written out (not nn.TransformerEncoderLayer) so the exported
+    graph keeps the token count dynamic."""
 
     def __init__(self, d: int, heads: int, ff: int, dropout: float):
         super().__init__()
@@ -62,41 +76,17 @@ class _Block(nn.Module):
         self.mlp = nn.Sequential(nn.Linear(d, ff), nn.GELU(), nn.Linear(ff, d))
         self.drop = nn.Dropout(dropout)
 
-    def forward(self, x):
-        b, n, d = x.shape
-        h = self.heads
-        q, k, v = self.qkv(self.norm1(x)).reshape(b, n, 3, h, d // h).permute(2, 0, 3, 1, 4)
-        att = torch.softmax(q @ k.transpose(-1, -2) * (d // h) ** -0.5, dim=-1)
-        y = (att @ v).transpose(1, 2).reshape(b, n, d)
+    def forward(self, x, n: int | None = None, bias=None):
+        """x (B, n, d). n: the token count as a Python int (exported graphs: constant reshapes),
+        bias: additive attention bias on the keys (B, 1, 1, n) or None."""
+        d, h = self.proj.in_features, self.heads
+        n = x.shape[1] if n is None else n
+        q, k, v = self.qkv(self.norm1(x)).reshape(-1, n, 3, h, d // h).permute(2, 0, 3, 1, 4)
+        logits = q @ k.transpose(-1, -2) * (d // h) ** -0.5
+        att = torch.softmax(logits if bias is None else logits + bias, dim=-1)
+        y = (att @ v).transpose(1, 2).reshape(-1, n, d)
         x = x + self.drop(self.proj(y))
         return x + self.drop(self.mlp(self.norm2(x)))
-
-
-class _TokenModule(nn.Module):
-    """Tokens (values ++ given-mask) + position + role + style -> transformer -> per-token vectors."""
-
-    def __init__(self, in_dim: int, d: int, heads: int, ff: int, layers: int, num_styles: int, dropout: float):
-        super().__init__()
-        self.inp = nn.Linear(2 * in_dim, d)
-        self.pos = nn.Parameter(torch.zeros(CONTEXT_FRAMES + MAX_GAP + 1, d))
-        self.role = nn.Parameter(torch.zeros(3, d))
-        self.style = nn.Embedding(num_styles + 1, d)
-        self.blocks = nn.ModuleList(_Block(d, heads, ff, dropout) for _ in range(layers))
-        self.norm = nn.LayerNorm(d)
-        nn.init.normal_(self.pos, std=0.02)
-        nn.init.normal_(self.role, std=0.02)
-
-    def forward(self, values, given, style, gap: int):
-        _b, length, _ = values.shape
-        x = self.inp(torch.cat([values, given], dim=-1))
-        # positions: context 0..C-1, gap C..C+G-1, target at C+G (its true distance in frames)
-        x = x + self.pos[:length]
-        roles = torch.cat([self.role[0:1].expand(CONTEXT_FRAMES, -1), self.role[1:2].expand(gap, -1),
-                           self.role[2:3]], dim=0)
-        x = x + roles + self.style(style)[:, None, :]
-        for block in self.blocks:
-            x = block(x)
-        return self.norm(x)
 
 
 class Backbone(nn.Module):
@@ -107,49 +97,77 @@ class Backbone(nn.Module):
         super().__init__()
         self.config = config
         c = config
-        self.root = _TokenModule(9, c.root_d_model, max(1, c.heads // 2), 2 * c.root_d_model, c.root_layers,
-                                 c.num_styles, c.dropout)
-        self.root_out = nn.Linear(c.root_d_model, 9)
-        self.duration_out = nn.Linear(c.root_d_model, 1)
-        self.pose = _TokenModule(F.DIM, c.d_model, c.heads, c.ff, c.layers, c.num_styles, c.dropout)
-        self.pose_out = nn.Linear(c.d_model, F.DIM if c.pose_refines_root else F.DIM - 9)
-        for head in (self.root_out, self.pose_out):
-            nn.init.zeros_(head.weight)
-            nn.init.zeros_(head.bias)
+        d = c.d_model
+        self.inp = nn.Linear(2 * PATCH * F.DIM, d)
+        self.pos = nn.Parameter(torch.zeros(MAX_TOKENS, d))
+        self.role = nn.Parameter(torch.zeros(3, d))
+        self.style = nn.Embedding(c.num_styles + 1, d)
+        self.skeleton = nn.Linear(S.NUM_SLOTS * S.DESCRIPTOR_WIDTH, d)
+        self.blocks = nn.ModuleList(_Block(d, c.heads, c.ff, c.dropout) for _ in range(c.layers))
+        self.norm = nn.LayerNorm(d)
+        self.out = nn.Linear(d, PATCH * F.DIM)
+        nn.init.zeros_(self.out.weight)
+        nn.init.zeros_(self.out.bias)
+        nn.init.normal_(self.pos, std=0.02)
+        nn.init.normal_(self.role, std=0.02)
+        root_in = (CONTEXT_FRAMES + 2) * 9
+        self.duration = nn.Sequential(nn.Linear(root_in, c.duration_hidden), nn.GELU(),
+                                      nn.Linear(c.duration_hidden, 1))
         self.register_buffer("feat_mean", torch.zeros(F.DIM))
         self.register_buffer("feat_std", torch.ones(F.DIM))
 
-    def forward(self, context, target, target_given, base, style):
-        """All in raw canonical units: context (B, C, D), target (B, D), target_given (B, D) in {0, 1},
-        base (B, G, D) interpolation baseline, style (B,) long. Returns (frames (B, G, D), duration (B,))."""
-        gap = base.shape[1]
+    def forward(self, context, target, target_given, base, gap_goal, gap_given, style, skeleton, present,
+                gap_len=None):
+        """Raw canonical units: context (B, C, D), target (B, D) (0 where not given), target_given (B, D),
+        base (B, G, D) interpolation (G even), gap_goal / gap_given (B, G, D) goals on gap frames, style
+        (B,) long, skeleton (B, NUM_SLOTS * DESCRIPTOR_WIDTH) descriptor, present (B, D) {0, 1} features
+        the skeleton has. Returns (frames (B, G, D), duration (B,) frames).
+
+        gap_len (B,) long, for the exported graph: the gap inputs are then padded to PADDED_GAP frames
+        and the tokens past each window's gap are masked out of attention, so every shape in the
+        graph is a constant (no shape arithmetic at run time); the result on the real gap frames is
+        the same function as with a gap of exactly that length (training uses that form)."""
+        static = gap_len is not None
+        dim = F.DIM
+        n_gap = GAP_TOKENS if static else base.shape[1] // PATCH
+        n_tok = CONTEXT_TOKENS + n_gap + 1
         mean, std = self.feat_mean, self.feat_std
-        ctx = (context - mean) / std
-        tgt = (target - mean) / std * target_given
-        bas = (base - mean) / std
-        ones_c = torch.ones_like(ctx)
-        zeros_g = torch.zeros_like(bas)
-        # root module
-        rv = torch.cat([ctx[..., :9], bas[..., :9], tgt[:, None, :9]], dim=1)
-        rg = torch.cat([ones_c[..., :9], zeros_g[..., :9], target_given[:, None, :9]], dim=1)
-        rh = self.root(rv, rg, style, gap)
-        root = bas[..., :9] + self.root_out(rh[:, CONTEXT_FRAMES:CONTEXT_FRAMES + gap])
-        # Duration from context + target alone: in the pass above the target token's position
-        # is the gap itself (measured: the head then just read it back, 0.02 frames "error").
-        # Here the target sits right after the context, so the time must come from the motion.
-        dv = torch.cat([ctx[..., :9], tgt[:, None, :9]], dim=1)
-        dg = torch.cat([ones_c[..., :9], target_given[:, None, :9]], dim=1)
-        dh = self.root(dv, dg, style, 0)
-        duration = nn.functional.softplus(self.duration_out(dh[:, -1]))[:, 0] * 10.0
-        # pose module: the planned root counts as given on the gap tokens
-        gap_vals = torch.cat([root, bas[..., 9:]], dim=-1)
-        gap_given = torch.cat([torch.ones_like(root), zeros_g[..., 9:]], dim=-1)
-        pv = torch.cat([ctx, gap_vals, tgt[:, None]], dim=1)
-        pg = torch.cat([ones_c, gap_given, target_given[:, None]], dim=1)
-        ph = self.pose(pv, pg, style, gap)
-        delta = self.pose_out(ph[:, CONTEXT_FRAMES:CONTEXT_FRAMES + gap])
-        if self.config.pose_refines_root:
-            root = root + delta[..., :9]
-            delta = delta[..., 9:]
-        out = torch.cat([root, bas[..., 9:] + delta], dim=-1) * std + mean
+        pres = present.unsqueeze(1)
+        ctx = (context - mean) / std * pres
+        tgt_given = target_given * present
+        tgt = (target - mean) / std * tgt_given
+        bas = (base - mean) / std * pres
+        g_given = gap_given * pres
+        goal = (gap_goal - mean) / std * g_given
+        gap_vals = bas * (1.0 - g_given) + goal
+        pair = PATCH * dim
+        ctx_tok = torch.cat([ctx.reshape(-1, CONTEXT_TOKENS, pair),
+                             (pres * torch.ones_like(ctx)).reshape(-1, CONTEXT_TOKENS, pair)], dim=-1)
+        gap_tok = torch.cat([gap_vals.reshape(-1, n_gap, pair), g_given.reshape(-1, n_gap, pair)], dim=-1)
+        zero = torch.zeros_like(tgt)
+        tgt_tok = torch.cat([tgt, zero, tgt_given, zero], dim=-1).unsqueeze(1)
+        x = self.inp(torch.cat([ctx_tok, gap_tok, tgt_tok], dim=1))
+        # positions: context and gap tokens by index, the target at its true distance
+        if static:
+            used = torch.div(gap_len + (PATCH - 1), PATCH, rounding_mode="floor")
+            tgt_pos = self.pos[CONTEXT_TOKENS + used]
+            keys = torch.arange(GAP_TOKENS, device=x.device).unsqueeze(0) < used.unsqueeze(1)
+            ones = torch.ones_like(keys[:, :1])
+            keep = torch.cat([ones.expand(-1, CONTEXT_TOKENS), keys, ones], dim=1)
+            bias = ((~keep).to(x.dtype) * -1e9).reshape(-1, 1, 1, n_tok)
+        else:
+            tgt_pos = self.pos[CONTEXT_TOKENS + n_gap].unsqueeze(0).expand(x.shape[0], -1)
+            bias = None
+        pos = torch.cat([self.pos[:CONTEXT_TOKENS + n_gap].unsqueeze(0).expand(x.shape[0], -1, -1),
+                         tgt_pos.unsqueeze(1)], dim=1)
+        roles = torch.cat([self.role[0:1].expand(CONTEXT_TOKENS, -1), self.role[1:2].expand(n_gap, -1),
+                           self.role[2:3]], dim=0)
+        x = x + pos + roles + (self.style(style) + self.skeleton(skeleton)).unsqueeze(1)
+        for block in self.blocks:
+            x = block(x, n_tok, bias)
+        delta = self.out(self.norm(x[:, CONTEXT_TOKENS:CONTEXT_TOKENS + n_gap]))
+        out = (bas + delta.reshape(-1, n_gap * PATCH, dim)) * std + mean
+        out = out * pres
+        root_in = torch.cat([ctx[..., :9].reshape(-1, CONTEXT_FRAMES * 9), tgt[:, :9], tgt_given[:, :9]], dim=-1)
+        duration = nn.functional.softplus(self.duration(root_in))[:, 0] * 10.0
         return out, duration

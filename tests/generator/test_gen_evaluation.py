@@ -21,11 +21,7 @@ def _walk(n=120, speed=0.5, turn=0.0, seed=0, sway=0.3):
     joints[:, 6] -= sway * np.sin(2 * np.pi * t + seed)
     joints[:, 15] += sway * np.sin(2 * np.pi * t + seed)
     rot = F.rot_z(yaw)
-    pos, _ = F.bodies_of(F.world_features(root, rot, joints, np.zeros((n, 4, 3))))
-    from g1_control.motion.kinematics import default_body_names
-
-    eff = pos[:, [default_body_names().index(b) for b in F.EFFECTOR_BODIES]]
-    return F.world_features(root, rot, joints, eff)
+    return F.fix_effectors(F.world_features(root, rot, joints, np.zeros((n, F.NUM_EFFECTORS, 3))))
 
 
 def test_perfect_prediction_scores_zero_and_errors_grow_with_noise():
@@ -53,7 +49,7 @@ def test_windows_are_canonical_in_the_last_context_frame():
 
 def test_interpolation_is_exact_on_linear_motion():
     w = E.make_windows([_walk(sway=0.0)], [0], 15)
-    pred = InterpolationInbetweener().infill(w.context, w.target, np.ones((len(w.frames), 50), bool), 15, w.style)
+    pred = InterpolationInbetweener().infill(w.context, w.target, np.ones((len(w.frames), F.DIM), bool), 15, w.style)
     assert np.abs(pred[..., :2] - w.truth[..., :2]).max() < 1e-9
     assert np.abs(pred[..., 2] - w.truth[..., 2]).max() < 0.021  # the 1 cm pelvis bob is not linear
     assert np.abs(pred[..., F.JOINTS] - w.truth[..., F.JOINTS]).max() < 1e-9
@@ -63,7 +59,7 @@ def test_motion_matching_recovers_a_window_it_has_seen_and_beats_interpolation()
     clips = [_walk(seed=s, turn=0.3 * s) for s in range(4)]
     w = E.make_windows(clips[:1], [0], 15)
     mm = MotionMatchingInbetweener(clips)
-    mask = np.ones((len(w.frames), 50), bool)
+    mask = np.ones((len(w.frames), F.DIM), bool)
     pred = mm.infill(w.context, w.target, mask, 15, w.style)
     assert np.abs(pred - w.truth).max() < 1e-6
     stats = E.PositionStats.from_windows(w)
@@ -73,7 +69,7 @@ def test_motion_matching_recovers_a_window_it_has_seen_and_beats_interpolation()
 def test_infill_refuses_nan_and_bad_gap():
     w = E.make_windows([_walk()], [0], 15)
     ctx = w.context[:1].copy()
-    mask = np.ones((1, 50), bool)
+    mask = np.ones((1, F.DIM), bool)
     with pytest.raises(InbetweenError, match="gap must be 1..30"):
         InterpolationInbetweener().infill(ctx, w.target[:1], mask, 31, w.style[:1])
     ctx[0, 3, 5] = np.nan

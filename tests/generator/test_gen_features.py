@@ -46,8 +46,8 @@ def test_canonicalize_puts_reference_frame_at_origin_facing_x_and_inverts():
     q[:, 1:3] *= 0.1  # mostly upright
     q = quat.normalize(q)
     rot = quat.to_matrix(q)
-    pos, _ = fk_numpy(root, rot, joints)
-    eff = pos[:, [default_body_names().index(b) for b in F.EFFECTOR_BODIES]]
+    pos, brot = fk_numpy(root, rot, joints)
+    eff = F.effectors_from_bodies(pos, brot, default_body_names())
     feats = F.world_features(root, rot, joints, eff)
     canon = F.canonicalize(feats, 2)
     assert np.allclose(canon[2, 0:2], 0.0) and np.isclose(canon[2, 2], root[2, 2])
@@ -55,6 +55,9 @@ def test_canonicalize_puts_reference_frame_at_origin_facing_x_and_inverts():
     origin, yaw = F.reference_of(feats[2])
     back = F.transform(canon, origin, yaw, inverse=True)
     assert np.allclose(back, feats, atol=1e-12)
+    # the per-replan fast path agrees with the general transform both ways
+    assert np.allclose(F.transform_one(feats, origin, float(yaw)), canon, atol=1e-12)
+    assert np.allclose(F.transform_one(canon, origin, float(yaw), inverse=True), feats, atol=1e-12)
     # effectors stay consistent with FK after the transform
     assert np.allclose(F.fix_effectors(canon)[:, F.EFFECTORS], canon[:, F.EFFECTORS], atol=1e-9)
 
@@ -70,10 +73,18 @@ def test_rot6d_orthonormalizes_and_matrix_to_quat_agrees_with_scipy():
     assert np.allclose(ours, quat.from_matrix(rot), atol=1e-12)
 
 
-@pytest.mark.parametrize("bad", [np.zeros((2, 50)), np.zeros((1, 2, 49))])
+def test_head_point_is_on_the_torso_above_the_shoulders():
+    pos, brot = fk_numpy(np.array([[0, 0, 0.75]]), np.eye(3)[None], np.zeros((1, 29)))
+    eff = F.effectors_from_bodies(pos, brot, default_body_names())
+    torso = pos[0, default_body_names().index("torso_link")]
+    head = eff[0, F.EFFECTOR_BODIES.index("head")]
+    assert 0.35 < head[2] - torso[2] < 0.45 and abs(head[1]) < 1e-3  # centre of the head, on the mid-plane
+
+
+@pytest.mark.parametrize("bad", [np.zeros((2, F.DIM)), np.zeros((1, 2, F.DIM - 1))])
 def test_inbetweener_refuses_bad_shapes(bad):
     from g1_control.generator.baselines import InterpolationInbetweener
     from g1_control.generator.inbetween import InbetweenError
 
     with pytest.raises(InbetweenError, match="context must have shape"):
-        InterpolationInbetweener().infill(bad, np.zeros((1, 50)), np.ones((1, 50), bool), 5, np.zeros(1, int))
+        InterpolationInbetweener().infill(bad, np.zeros((1, F.DIM)), np.ones((1, F.DIM), bool), 5, np.zeros(1, int))
