@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -161,7 +162,9 @@ class SceneConfig:
 
     def validate(self, where: str) -> None:
         names: dict[str, str] = {}
-        for kind, items in (("tables", self.tables), ("platforms", self.platforms), ("boxes", self.boxes)):
+        groups: tuple[tuple[str, list[Any]], ...] = (("tables", self.tables), ("platforms", self.platforms),
+                                                     ("boxes", self.boxes))  # every kind has a .name
+        for kind, items in groups:
             for i, item in enumerate(items):
                 w = f"{where}.{kind}[{i}]"
                 if item.name in names or item.name == FLOOR:

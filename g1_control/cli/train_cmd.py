@@ -63,7 +63,8 @@ def _generator(args) -> int:
     from g1_control.errors import G1ControlError
     from g1_control.generator.learned import SHIPPED_DIR
     from g1_control.generator.skeleton import SKELETONS
-    from g1_control.library.builder import build_library, default_library_dir
+    from g1_control.library.builder import build_library
+    from g1_control.motion.library import default_library_dir
     from g1_control.training.train import TrainConfig, train
 
     try:
@@ -102,7 +103,8 @@ def _generator(args) -> int:
 
 def _lmm(args) -> int:
     from g1_control.generator.lmm import SHIPPED_LMM_DIR
-    from g1_control.library.builder import build_library, default_library_dir
+    from g1_control.library.builder import build_library
+    from g1_control.motion.library import default_library_dir
     from g1_control.training.lmm import LmmTrainConfig, train_lmm
 
     if args.library is None:

@@ -20,6 +20,7 @@ The mixture is switched per style at run time (set_style), and a whole set can b
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -113,8 +114,9 @@ class ReferenceFeedback:
     def mixture(self) -> Mixture | None:
         return self.mixtures.get(self.style) or self.mixtures.get("default")
 
-    def frame_weights(self, n: int, goal_frames: list[int] = (), target_frame: int | None = None,
-                      frames: np.ndarray | None = None, effector_goals: list[tuple[slice, np.ndarray]] = ()) -> np.ndarray:
+    def frame_weights(self, n: int, goal_frames: Sequence[int] = (), target_frame: int | None = None,
+                      frames: np.ndarray | None = None,
+                      effector_goals: Sequence[tuple[slice, np.ndarray]] = ()) -> np.ndarray:
         """(n,) feedback weight per frame: `strength`, faded near goals in time (frame indices,
         0-based; the target keyframe at `target_frame`) and in space (effector columns, goal point)."""
         w = np.full(n, self.strength)
@@ -144,6 +146,8 @@ class ReferenceFeedback:
     def distance(self, frames: np.ndarray) -> np.ndarray:
         """Per frame: normalized Mahalanobis distance to the nearest component (the drift measure)."""
         m = self.mixture
+        if m is None:
+            raise ValueError("no reference mixture for this style (nor a default one)")
         _, d = m.responsibilities(frames[:, m.columns])
         return d.min(axis=1)
 

@@ -56,8 +56,11 @@ def head_offset() -> np.ndarray:
     root = ET.parse(description.urdf_path()).getroot()
     joint = next(j for j in root.iter("joint") if j.get("name") == "head_joint")
     link = next(lk for lk in root.iter("link") if lk.get("name") == "head_link")
-    placement = np.array([float(v) for v in joint.find("origin").get("xyz").split()])
-    com = np.array([float(v) for v in link.find("inertial/origin").get("xyz").split()])
+    origin, inertial = joint.find("origin"), link.find("inertial/origin")
+    if origin is None or inertial is None:
+        raise ValueError(f"{description.urdf_path()}: head_joint has no origin or head_link no inertial origin")
+    placement = np.array([float(v) for v in origin.get("xyz", "0 0 0").split()])
+    com = np.array([float(v) for v in inertial.get("xyz", "0 0 0").split()])
     out = placement + com  # the head joint's rpy is zero in Unitree's description
     out.setflags(write=False)
     return out

@@ -123,12 +123,12 @@ def judge_goal(goal_id: str, info: dict, a: dict[str, np.ndarray]) -> dict:
         soles = a["soles_w_m"]
         h = info.get("height_m", 0.15)
         window = (t >= (out["start_s"] or 0.0)) & (t <= (out["end_s"] or t[-1]))
-        up = (soles[:, :, 2] > h - 0.015).all(axis=1)
+        up = np.asarray((soles[:, :, 2] > h - 0.015).all(axis=1))
         if kind == "step_up":
             out["both_feet_on_top_s"] = float(up[window].sum() * np.median(np.diff(t))) if window.any() else 0.0
             out["on_top_at_end"] = bool(up[window][-1]) if window.any() else False
         else:
-            down = (soles[:, :, 2] < 0.015).all(axis=1)
+            down = np.asarray((soles[:, :, 2] < 0.015).all(axis=1))
             out["on_floor_at_end"] = bool(down[window][-1]) if window.any() else False
     return out
 

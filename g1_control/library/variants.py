@@ -174,8 +174,8 @@ def build_variant_library(variant: str, base_dir: str | Path | None = None, out_
                           *, force: bool = False, progress: bool = True) -> MotionLibrary:
     from tqdm import tqdm
 
-    from g1_control.library.builder import default_library_dir
     from g1_control.motion.formats.clip_npz import write_clip_npz
+    from g1_control.motion.library import default_library_dir
     from g1_control.motion.mirror import mirror
 
     if variant == "g1_29dof":

@@ -248,7 +248,9 @@ def wandr_goals(gen_factory, test_f, episodes: int = 40, seconds: float = 8.0, s
 
     rng = np.random.default_rng(seed)
     probe = _HandProbe()
-    final, closest, reach_t = [], [], []
+    final_l: list[float] = []
+    closest_l: list[float] = []
+    reach_t: list[float] = []
     for frames in _start_frames(test_f, rng, episodes):
         gen = gen_factory()
         gen.reset_from_frames(frames, 0.0)
@@ -265,10 +267,10 @@ def wandr_goals(gen_factory, test_f, episodes: int = 40, seconds: float = 8.0, s
             if d < threshold_m and t_hit is None:
                 t_hit = state.t_s
             best = min(best, d)
-        final.append(d)
-        closest.append(best)
+        final_l.append(d)
+        closest_l.append(best)
         reach_t.append(t_hit if t_hit is not None else np.nan)
-    final, closest = np.array(final), np.array(closest)
+    final, closest = np.array(final_l), np.array(closest_l)
     return {"episodes": episodes, "success": float((closest < threshold_m).mean()),
             "dtg_final_m": float(final.mean()), "dtg_final_median_m": float(np.median(final)),
             "dtg_closest_m": float(closest.mean()), "held_at_end": float((final < threshold_m).mean()),
@@ -428,7 +430,7 @@ def main(args) -> int:
           f"LMM {lmm_dir if lmm else '(none: g1 train lmm)'}")
     print(f"load average at start: {os.getloadavg()[0]:.2f} (2 cores shared: wall timings are noisy; CPU-time "
           "figures count this process' own core time)\n")
-    methods = [interp, mm] + ([lmm] if lmm else []) + [backbone, with_fb]
+    methods: list = [interp, mm] + ([lmm] if lmm else []) + [backbone, with_fb]
     windows = {gap: E.make_windows(test_f, test_s, gap) for gap in (15, 30)}
     if "quality" in sections:
         table: dict = {}
@@ -454,10 +456,10 @@ def main(args) -> int:
         print(f"{'(ground truth)':<24} {'':>7} {'':>7} {'':>8} {'':>7} {'':>7} {'':>8} {truth[0]:>9.3f}")
         figures["quality_table"] = table
         bb, ip, mt = table["backbone"], table["interpolation"], table["motion_matching"]
-        for gap in ("15", "30"):
-            print(f"  gap {gap}: backbone / interpolation L2P {bb[gap]['l2p'] / ip[gap]['l2p']:.2f}x, / motion matching "
-                  f"{bb[gap]['l2p'] / mt[gap]['l2p']:.2f}x" + (
-                      f"; learned MM / motion matching L2P {table['learned_motion_matching'][gap]['l2p'] / mt[gap]['l2p']:.2f}x"
+        for key in ("15", "30"):
+            print(f"  gap {key}: backbone / interpolation L2P {bb[key]['l2p'] / ip[key]['l2p']:.2f}x, / motion matching "
+                  f"{bb[key]['l2p'] / mt[key]['l2p']:.2f}x" + (
+                      f"; learned MM / motion matching L2P {table['learned_motion_matching'][key]['l2p'] / mt[key]['l2p']:.2f}x"
                       if lmm else ""))
         if lmm:
             print(f"  learned motion matching keeps {table['learned_motion_matching']['memory_bytes'] / 2**20:.2f} MB of "
@@ -523,10 +525,10 @@ def main(args) -> int:
         _models_table(model_path, lmm_dir, runs_dir, figures)
     if "codebook" in sections:
         stats30 = E.PositionStats.from_windows(E.make_windows(train_f, train_s, 30))
-        r = _codebook_floor(train_f, windows[30], stats30)
-        figures["codebook512_l2q_30"] = r.l2q
-        print(f"tokenisation floor: joints snapped to a 512-code k-means codebook leave L2Q {r.l2q:.3f} at gap 30 "
-              f"(L2P {r.l2p:.3f})\n")
+        floor = _codebook_floor(train_f, windows[30], stats30)
+        figures["codebook512_l2q_30"] = floor.l2q
+        print(f"tokenisation floor: joints snapped to a 512-code k-means codebook leave L2Q {floor.l2q:.3f} at gap 30 "
+              f"(L2P {floor.l2p:.3f})\n")
     if "speed" in sections:
         print("speed (this CPU, 1 inference thread): replan = primitives + model + feedback + stabilization")
         speed_methods = [("interpolation", interp, None), ("backbone", backbone, None),
@@ -550,9 +552,10 @@ def main(args) -> int:
         for m in [interp] + ([lmm] if lmm else []) + [backbone]:
             thr[m.name] = _throughput(m, windows[30])
         figures["throughput_fps"] = {k: {"wall": v[0], "cpu": v[1]} for k, v in thr.items()}
-        for k, (wall, cpu) in thr.items():
-            print(f"  batched 256 x 30 frames: {k:<24} {wall:>10,.0f} frames/s wall, {cpu:>10,.0f} frames/CPU-s "
-                  f"(ratio to interpolation {wall / thr['interpolation'][0]:.2f} wall, {cpu / thr['interpolation'][1]:.2f} CPU)")
+        for k, (wall_fps, cpu_fps) in thr.items():
+            print(f"  batched 256 x 30 frames: {k:<24} {wall_fps:>10,.0f} frames/s wall, {cpu_fps:>10,.0f} frames/CPU-s "
+                  f"(ratio to interpolation {wall_fps / thr['interpolation'][0]:.2f} wall, "
+                  f"{cpu_fps / thr['interpolation'][1]:.2f} CPU)")
         print("  goal: >= 150,000 frames/s\n")
     if "rollout" in sections:
         print("10-minute autoregressive rollout under random commands and styles (backbone + feedback)")

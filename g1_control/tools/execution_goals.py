@@ -55,7 +55,7 @@ def reach_points(hand: str, seed: int, n: int = REACH_POINTS) -> list[np.ndarray
     rng = np.random.default_rng(1000 * seed + (0 if hand == "left" else 1) + 17)
     shoulder = SHOULDER_W_M[hand]
     outward = 1.0 if hand == "left" else -1.0
-    points = []
+    points: list = []
     while len(points) < n:
         r = rng.uniform(0.20, 0.50)
         z = rng.uniform(0.55, 1.30)
@@ -187,7 +187,9 @@ def box_outcome(result: TrialResult) -> tuple[bool, float | None, str]:
                             f"{place.get('message') if place else ''}"
     err = place.get("place_error_xy_m")
     dropped = bool(pick.get("dropped")) or bool(place.get("dropped"))
-    ok = err is not None and err <= PLACE_TOLERANCE_M and not dropped
+    if err is None:
+        return False, None, "place reported no position error"
+    ok = err <= PLACE_TOLERANCE_M and not dropped
     return ok, err, f"placed {err * 100:.1f} cm off" + (", dropped" if dropped else "")
 
 

@@ -124,7 +124,7 @@ class WindowSampler:
         returns (window, arms, end frame index in the gap or -1 for the target) per reach."""
         rng = self.rng
         picked = np.flatnonzero(rng.random(len(wins)) < self.reach_probability)
-        out = []
+        out: list = []
         if not picked.size:
             return out
         length = wins.shape[1]

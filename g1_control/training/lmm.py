@@ -225,10 +225,10 @@ def train_lmm(out_dir: str | Path, config: LmmTrainConfig, library_root=None, pr
     deadline = Deadline("projector")
     b = bar(total, "lmm projector")
     for step in range(total):
-        i = rng.integers(0, n, config.batch)
+        rows = rng.integers(0, n, config.batch)
         noise = rng.normal(size=(config.batch, X_DIM)) * rng.uniform(0.0, 1.0, size=(config.batch, 1))
         noise[:, style] = 0.0  # the style is always known exactly
-        q = X[torch.as_tensor(i)] + torch.as_tensor(noise, dtype=torch.float32)
+        q = X[torch.as_tensor(rows)] + torch.as_tensor(noise, dtype=torch.float32)
         with torch.no_grad():
             nn_idx = nearest(q)
         pred = projector(q)

@@ -86,7 +86,12 @@ def test_launch_file_refuses_a_model_that_does_not_serve_its_robot(model_29_only
 def test_model_inputs_carry_the_skeleton_and_pad_the_gap():
     ctx = np.zeros((2, 10, F.DIM))
     feed = prepare_inputs(ctx, ctx[:, -1], np.ones((2, F.DIM), bool), 15, "g1_23dof")
-    assert feed["base"].shape == (2, 16, F.DIM) and feed["gap_goal"].shape == (2, 16, F.DIM)
+    from g1_control.generator.learned import PADDED_GAP
+
+    # constant-shape graph: the gap is padded to PADDED_GAP frames and gap_len says how many are real
+    assert feed["base"].shape == (2, PADDED_GAP, F.DIM) and feed["gap_goal"].shape == (2, PADDED_GAP, F.DIM)
+    assert PADDED_GAP > 15 and (feed["gap_len"] == 15).all()
+    assert not feed["gap_given"][:, 15:].any()
     assert np.allclose(feed["skeleton"][0], S.skeleton("g1_23dof").descriptor().reshape(-1))
     present = feed["present"][0] > 0
     assert not present[F.JOINT_SLOTS[g1.JOINT_INDEX["waist_roll_joint"]]] and not present[F.FINGERS].any()

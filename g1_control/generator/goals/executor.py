@@ -178,7 +178,7 @@ class GoalGenerator(Generator):
         self._walk = np.zeros(3)
         self._held: Held | None = None
         self.on_platform: str | None = None
-        self.box_positions = {b.name: self.scene.box_center(b) for b in self.scene.boxes}
+        self.box_positions: dict[str, np.ndarray | None] = {b.name: self.scene.box_center(b) for b in self.scene.boxes}
         self._height: float | None = None
         self._style = "default"
         self._overlay = None
@@ -308,7 +308,7 @@ class GoalGenerator(Generator):
         self._height, self._style = height, style_name
         yield from self._run(keyframe_trajectory("height", [(0.0, q0), (duration, q_goal)]), keep=True)
         if style.wave_hz:
-            self._overlay = (style, self._t - duration)
+            self._overlay = (style, self._t - duration)  # type: ignore[assignment]  # declared None at start
 
     def _hand_back(self) -> Iterator[None]:
         """Stand up with the default arms and hand over to the walking policy."""
@@ -712,8 +712,9 @@ class GoalGenerator(Generator):
             return block
         s = self._state
         assert s is not None and s.base_pos_w_m is not None
-        best = min(self.scene.platforms, key=lambda p: p.distance_xy(s.base_pos_w_m[:2]), default=None)
-        if best is None or best.distance_xy(s.base_pos_w_m[:2]) > 4.0:
+        here = s.base_pos_w_m[:2]
+        best = min(self.scene.platforms, key=lambda p: p.distance_xy(here), default=None)
+        if best is None or best.distance_xy(here) > 4.0:
             raise GoalFailed("no platform within 4 m")
         return best
 

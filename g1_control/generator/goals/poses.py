@@ -59,7 +59,7 @@ def flat_soles(ik: WholeBodyIK, q: np.ndarray) -> list[Sole]:
     out = []
     for name in SOLE_FRAMES:
         p, r = ik.frame_pose(q, name)
-        out.append((p.copy(), rot_z(math.atan2(r[1, 0], r[0, 0]))))
+        out.append((p.copy(), rot_z(np.asarray(math.atan2(r[1, 0], r[0, 0])))))
     return out
 
 
@@ -182,7 +182,7 @@ class PosePlanner:
                  heading: float, com_shift_h: np.ndarray | None = None) -> PoseResult:
         """Both hands at points (a grasp), palms facing each other across the heading."""
         hands = [(HAND_FRAMES[0], targets[0]), (HAND_FRAMES[1], targets[1])]
-        rot = rot_z(heading)
+        rot = rot_z(np.asarray(heading))
         ground = min(s[0][2] for s in soles)
         z_nominal = ground + self.nominal_pelvis_m
         q = self._solve(q0, soles, self.com_over(soles, com_shift_h), z_nominal, heading, g1.DEFAULT_Q_RAD,

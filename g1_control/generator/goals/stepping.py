@@ -305,7 +305,9 @@ def stepping_trajectory(ik: WholeBodyIK, q0: np.ndarray, footsteps: list[Footste
     yaws = np.repeat(stance.yaw[None], n, axis=0)
     contacts = np.ones((n, 2), dtype=bool)
     zmp = np.repeat((stance.mid_xy + offset_w(stance.heading))[None], n, axis=0)
-    levels: list[tuple[float, float, float, float, float, float]] = []
+    # (double support from, swing from, touchdown, lowest sole before/after, mean sole height before/after,
+    #  the other foot's height)
+    levels: list[tuple[float, ...]] = []
     """Per step: (double support start, swing start, touchdown, lower foot before/after, mean before/after)."""
     current = stance.copy()
     prev_zmp = zmp[0].copy()
