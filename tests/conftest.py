@@ -24,3 +24,11 @@ def _realtime_for_timing_tests(request):
         yield
     finally:
         normal.restore()
+
+
+@pytest.fixture(autouse=True)
+def _working_directory_is_scratch(tmp_path, monkeypatch):
+    """Every test runs in its own empty working directory: runs and deploys write their run folders
+    under the launch file's output.dir (relative: the working directory), never into the
+    repository, and a test that reads a relative path fails here rather than passing by luck."""
+    monkeypatch.chdir(tmp_path)

@@ -41,11 +41,12 @@ STICKS = {"ly": (-0.3, 0.7), "lx": (-0.3, 0.3), "rx": (-0.5, 0.5)}
 
 class G1Process:
     """A `g1 ...` subprocess (this checkout first on PYTHONPATH) whose stdout lines are read on a
-    thread, so waits can time out; stderr is drained too (a full pipe would block the process)."""
+    thread, so waits can time out; stderr is drained too (a full pipe would block the process). It runs
+    in the caller's working directory (where a deploy's run folder goes, as for `g1 deploy` itself)."""
 
     def __init__(self, *args: str, stdin: bool = False):
         env = {**os.environ, "PYTHONPATH": str(_ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
-        self.proc = subprocess.Popen([sys.executable, "-m", "g1_control.cli.main", *args], cwd=_ROOT, env=env,
+        self.proc = subprocess.Popen([sys.executable, "-m", "g1_control.cli.main", *args], env=env,
                                      stdin=subprocess.PIPE if stdin else subprocess.DEVNULL, stdout=subprocess.PIPE,
                                      stderr=subprocess.PIPE, text=True, bufsize=1)
         stdout, stderr = self.proc.stdout, self.proc.stderr

@@ -27,3 +27,4 @@ def mock_robot(partition):
     yield make
     for emulator in made:
         emulator.close()
+

@@ -15,7 +15,7 @@ def test_feedforward_scales_the_moving_axes_only():
 
 def test_feedforward_and_integral_add():
     corr = VelocityCorrector(VelocityCorrectionConfig(feedforward=(1.1, 1, 1), ki=(2, 0, 0),
-                                                      velocity_filter_tau_s=0.0), dt_s=0.02)
+                                                      velocity_filter_tau_s=0.0, settle_s=0.0), dt_s=0.02)
     out = corr(np.array([0.5, 0.0, 0.0]), np.array([0.3, 0.0, 0.0]))
     assert out[0] == pytest.approx(1.1 * 0.5 + 2 * (0.5 - 0.3) * 0.02)
 

@@ -48,17 +48,22 @@ def write_clip_npz(clip: MotionClip, path: str | Path) -> None:
     )
 
 
-def read_clip_npz(path: str | Path) -> MotionClip:
-    path = Path(path)
+def open_npz(path: Path):
+    """np.load of an npz file, refusing anything that is not one (a pickle, text, a truncated zip)
+    with one line naming the problem."""
     with path.open("rb") as fh:
         magic = fh.read(4)
     if magic != b"PK\x03\x04":
         raise MotionFormatError(f"{path}: not an npz file (it does not start with the zip signature)")
     try:
-        data = np.load(path, allow_pickle=False)
+        return np.load(path, allow_pickle=False)
     except Exception as exc:
         raise MotionFormatError(f"{path}: not a readable npz file ({exc})") from None
-    with data:
+
+
+def read_clip_npz(path: str | Path) -> MotionClip:
+    path = Path(path)
+    with open_npz(path) as data:
         missing = [k for k in REQUIRED if k not in data.files]
         if missing:
             raise MotionFormatError(f"{path}: missing keys {missing}; a motion npz has {list(REQUIRED)}")

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.exceptions import MotionFormatError
 from g1_control.motion.human import HumanMotion
@@ -34,11 +32,8 @@ def load_motion(path: str | Path, joint_names: tuple[str, ...] | None = None, fp
     if ext == ".csv":
         return g1_csv.read_g1_csv(path, fps or g1_csv.DEFAULT_FPS)
     if ext == ".npz":
-        try:
-            with np.load(path, allow_pickle=False) as data:
-                keys = list(data.files)
-        except (OSError, ValueError) as exc:
-            raise MotionFormatError(f"{path}: not a readable npz file ({exc})") from None
+        with clip_npz.open_npz(path) as data:
+            keys = list(data.files)
         if robot_qpos.is_holosoma_npz(keys):
             return robot_qpos.read_holosoma_npz(path, fps)
         return clip_npz.read_clip_npz(path)
