@@ -55,9 +55,11 @@ def test_wheel_carries_runtime_files_launch_files_docs_and_licenses(wheel):
     for doc in ("README.md", "LICENSE", "THIRD_PARTY_LICENSES.md", "architecture.md", "api.md", "robot_facts.md"):
         assert f"g1_control/_shipped/docs/{doc}" in names
     assert "g1_control/deploy/README.md" in names and "g1_control/teleop/README.md" in names
-    assert "g1_control/policies/generator/backbone.onnx" in names
+    # what the generators read at run time: the backbone, its skeletons and mixtures, learned motion matching
+    for shipped in ("backbone.onnx", "model.json", "feedback.npz", "style_stats.json", "lmm/lmm.onnx", "lmm/model.json"):
+        assert f"g1_control/policies/generator/{shipped}" in names
     assert any(n.endswith(".dist-info/licenses/LICENSE") for n in names)
-    leftovers = [n for n in names if n.endswith(("backbone.pt", "loss_history.json", "loss.png"))]
+    leftovers = [n for n in names if n.endswith((".pt", "loss_history.json", "loss.png"))]
     assert not leftovers, f"training leftovers in the wheel: {leftovers}"
     assert not [n for n in names if n.startswith(("tests/", "examples/", "scripts/"))]
 
