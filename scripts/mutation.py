@@ -60,7 +60,8 @@ GROUPS: dict[str, dict[str, list[str]]] = {
         # locomotion.py is mutated whole; only VelocityCorrector's mutants are counted (the tracker's
         # other code is covered by physics tests that are too slow to run per mutant).
         "mutate": ["g1_control/trackers/locomotion.py"],
-        "tests": ["tests/trackers/test_velocity_correction.py", "tests/trackers/test_velocity_feedforward.py"],
+        "tests": ["tests/trackers/test_velocity_correction.py", "tests/trackers/test_velocity_feedforward.py",
+                  "tests/trackers/test_velocity_settle.py"],
         "only": ["VelocityCorrector"],
     },
 }
