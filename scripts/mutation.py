@@ -54,7 +54,8 @@ GROUPS: dict[str, dict[str, list[str]]] = {
         "mutate": ["g1_control/launch/schema.py"],
         "tests": ["tests/launch/test_launch_schema.py", "tests/launch/test_launch_refusals.py",
                   "tests/launch/test_malformed_corpus.py", "tests/launch/test_launch_schema_bounds.py",
-                  "tests/deploy/test_deploy_launch_schema.py"],
+                  "tests/deploy/test_deploy_launch_schema.py", "tests/launch/test_launch_goals.py",
+                  "tests/launch/test_launch_schema_paths.py"],
     },
     "velocity": {
         # locomotion.py is mutated whole; only VelocityCorrector's mutants are counted (the tracker's
