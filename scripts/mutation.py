@@ -48,7 +48,8 @@ GROUPS: dict[str, dict[str, list[str]]] = {
         "mutate": ["g1_control/hardware/unitree/messages.py", "g1_control/hardware/unitree/conversions.py",
                    "g1_control/hardware/unitree/remote.py"],
         "tests": ["tests/hardware/test_unitree_hg.py", "tests/hardware/test_hw_conversions.py",
-                  "tests/hardware/test_decoder_fuzz.py", "tests/hardware/test_decoder_fields.py"],
+                  "tests/hardware/test_decoder_fuzz.py", "tests/hardware/test_decoder_fields.py",
+                  "tests/hardware/test_decoder_edges.py"],
     },
     "schema": {
         "mutate": ["g1_control/launch/schema.py"],
