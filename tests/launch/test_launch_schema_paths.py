@@ -184,6 +184,8 @@ G = "<launch>: input.timeline[1].goals[0]"
 
 @pytest.mark.parametrize(("goal", "scene", "message"), [
     ({"kind": "pick", "object": "crate"}, SCENE, f"{G}.object: 'crate' is not a box of the scene; known: box"),
+    ({"kind": "pick", "object": "crate"}, {**SCENE, "boxes": [*SCENE["boxes"], {"name": "box2", "xy_m": [1.0, 1.0]}]},
+     f"{G}.object: 'crate' is not a box of the scene; known: box, box2"),
     ({"kind": "pick", "object": "crate"}, {}, f"{G}.object: 'crate' is not a box of the scene; known: none "
                                               "(scene.boxes is empty)"),
     ({"kind": "place", "target": "shelf"}, SCENE, f"{G}.target: 'shelf' is not a place of the scene; known: table_a, "
