@@ -51,7 +51,7 @@ def test_a_simulator_launch_file_is_refused_for_good():
     path = LAUNCH_DIR / "sim_walk.yaml"
     assert pf.check_launch_file(path) is None
     r = _only(pf, "launch_file")
-    assert r.status == FAIL and not r.overridable and not r.overridden and r.blocks
+    assert r.status == FAIL and r.overridable is False and not r.overridden and r.blocks
     assert r.reason == (f"{path}: backend.type is mujoco; g1 deploy drives a robot link (unitree_dds, can, serial). "
                         "Simulate with `g1 launch` (--override launch_file refused: this failure cannot be overridden)")
 
@@ -89,7 +89,7 @@ def test_an_unknown_policy_is_refused(launch):
     pf = Preflight()
     assert pf.check_policy(other) == (None, None)
     r = _only(pf, "policy")
-    assert r.status == FAIL and not r.overridable and "no_such_policy" in r.reason
+    assert r.status == FAIL and r.overridable is False and "no_such_policy" in r.reason
 
 
 @pytest.mark.parametrize("gain", ["kp", "kd"])
@@ -113,12 +113,13 @@ def test_policy_gains_above_the_safety_caps_are_refused(launch, gain):
 def test_the_interface_check(launch):
     pf = Preflight()
     assert pf.check_interface(launch)
-    assert _only(pf, "interface").reason == "interface lo exists and is up (loopback: simulation)"
+    r = _only(pf, "interface")
+    assert (r.status, r.reason) == (PASS, "interface lo exists and is up (loopback: simulation)")
     missing = dataclasses.replace(launch, backend=dataclasses.replace(launch.backend, interface="g1nosuch0"))
     pf = Preflight()
     assert not pf.check_interface(missing)
     r = _only(pf, "interface")
-    assert r.status == FAIL and not r.overridable and "g1nosuch0" in r.reason
+    assert r.status == FAIL and r.overridable is False and "g1nosuch0" in r.reason
 
 
 # -- operator input --------------------------------------------------------------------------------------
@@ -149,14 +150,15 @@ def test_a_device_that_cannot_open_is_refused_for_good(launch):
     pf = Preflight(frozenset({"estop_input"}))
     assert not pf.check_input(None, launch, open_error="no gamepad at /dev/input/event9")
     r = _only(pf, "estop_input")
-    assert r.status == FAIL and not r.overridable and r.reason.startswith("no gamepad at /dev/input/event9")
+    assert r.status == FAIL and r.overridable is False and r.reason.startswith("no gamepad at /dev/input/event9")
 
 
 @pytest.mark.parametrize("kind", ["scripted", "random", "gamepad_script", "program"])
 def test_inputs_without_an_operator_pass_only_against_the_emulator(launch, kind):
     pf = Preflight()
     assert pf.check_input(None, _teleop(launch, kind))
-    assert _only(pf, "estop_input").reason == (f"{kind} input against the emulator on lo (sim2sim): no operator "
+    assert _only(pf, "estop_input").status == PASS
+    assert pf.results["estop_input"].reason == (f"{kind} input against the emulator on lo (sim2sim): no operator "
                                                "e-stop; Ctrl-C or SIGTERM damps")
     for backend in ({"interface": "eth0"}, {"type": "can", "can_interface": "virtual", "channel": "b"}):
         pf = Preflight()
@@ -171,7 +173,8 @@ def test_a_device_with_an_estop_passes_naming_its_chords(launch):
     device = _Device(chords=(("RB", "LB"), ("start",)))
     assert pf.check_input(device, _teleop(launch))
     assert device.polls >= 2
-    assert _only(pf, "estop_input").reason == "gamepad answering; e-stop on LB+RB, start"
+    r = _only(pf, "estop_input")
+    assert (r.status, r.reason) == (PASS, "gamepad answering; e-stop on LB+RB, start")
 
 
 def test_a_device_without_an_estop_fails_and_may_be_overridden(launch):
@@ -191,7 +194,7 @@ def test_a_device_lost_while_polled_is_refused_for_good(launch, lose_after):
     device = _Device(lose_after=lose_after, reason="no events for 0.5 s")
     assert not pf.check_input(device, _teleop(launch, "unitree_remote"))
     r = _only(pf, "estop_input")
-    assert r.status == FAIL and not r.overridable and r.blocks
+    assert r.status == FAIL and r.overridable is False and r.blocks
     assert r.reason.startswith("unitree_remote lost: no events for 0.5 s; reconnect it and start again")
 
 
@@ -239,7 +242,8 @@ def test_a_dry_run_without_a_fall_passes(launch, dry):
     dry["result"] = _result()
     pf = Preflight()
     assert pf.check_dry_run(launch)
-    assert _only(pf, "dry_run").reason == f"no fall: {WHAT}; {MOVED}"
+    r = _only(pf, "dry_run")
+    assert (r.status, r.reason) == (PASS, f"no fall: {WHAT}; {MOVED}")
     assert pf.dry_run is dry["result"]
     assert dry["kwargs"] == {"progress": False, "end_with_program": False}
     assert dry["sim"].backend.type == "mujoco" and dry["sim"].name == "sim2sim-dry-run"
@@ -367,3 +371,41 @@ def test_the_table():
     assert pf.as_dict()[0] == {"name": "launch_file", "status": NOT_RUN, "reason": "not run", "overridable": True,
                                "overridden": False}
     assert list(pf_module.CHECKS) == [r["name"] for r in pf.as_dict()]
+
+
+def test_the_device_is_polled_throughout_the_window_with_the_time(launch, monkeypatch):
+    now = [50.0]
+    monkeypatch.setattr(pf_module, "time", SimpleNamespace(monotonic=lambda: now[0],
+                                                           sleep=lambda s: now.__setitem__(0, now[0] + s)))
+    seen = []
+    device = _Device()
+    device.poll = lambda t: seen.append(round(t - 50.0, 6))
+    assert Preflight().check_input(device, _teleop(launch))  # input_check_s 0.05: polls at 0, 0.02, 0.04, then once more
+    assert seen == [0.0, 0.02, 0.04, 0.06]
+
+
+def test_a_lost_device_without_a_reason_says_so(launch):
+    device = SimpleNamespace(lost=True, poll=lambda now: None,
+                             mapper=SimpleNamespace(config=SimpleNamespace(buttons={frozenset({"B"}): "estop"})))
+    pf = Preflight()
+    assert not pf.check_input(device, _teleop(launch))
+    assert pf.results["estop_input"].reason == "gamepad lost: ?; reconnect it and start again"
+
+
+def test_the_dry_run_runs_the_program_it_is_given(launch, dry):
+    from g1_control.program import parse_instruction
+
+    dry["result"] = _result(segments=[], program={"finished": True, "steps": []})
+    assert Preflight().check_dry_run(launch, parse_instruction("walk forward 1 m"))
+    assert dry["sim"].input.type == "program" and [s["kind"] for s in dry["sim"].input.program] == ["walk"]
+
+
+def test_the_dry_run_never_opens_a_viewer_and_keeps_the_physics_step(launch):
+    shown = dataclasses.replace(launch, viewer=True, backend=dataclasses.replace(launch.backend, physics_dt_s=0.001))
+    assert dry_run_launch(shown).viewer is False
+    said = dataclasses.replace(shown, input=InputConfig(type="program", instruction="walk forward 1 m"))
+    dry = dry_run_launch(said)
+    assert dry.viewer is False and dry.input.instruction == "walk forward 1 m"
+    assert (dry.backend.type, dry.backend.mode, dry.backend.physics_dt_s) == ("mujoco", "lockstep", 0.001)
+    given = dry_run_launch(said, program=said.input.parsed_program())
+    assert given.input.instruction == "" and [s["kind"] for s in given.input.program] == ["walk"]
