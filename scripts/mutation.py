@@ -38,7 +38,8 @@ GROUPS: dict[str, dict[str, list[str]]] = {
         # test_safety_properties.py (hypothesis, hundreds of examples per run) is left out: too slow
         # to run per mutant on 2 cores; it runs in every CI run.
         "tests": ["tests/safety/test_safety_filter.py", "tests/safety/test_safety_guards.py",
-                  "tests/safety/test_guarded_backend.py"],
+                  "tests/safety/test_guarded_backend.py", "tests/safety/test_safety_edges.py",
+                  "tests/safety/test_guarded_backend_edges.py"],
     },
     "preflight": {
         "mutate": ["g1_control/deploy/preflight.py"],
