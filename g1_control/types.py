@@ -320,6 +320,9 @@ class KinematicReference:
     controller follows them: manipulation, stepping onto platforms, heights a walking policy
     cannot hold). The tracking layer hands over between its controllers by this."""
 
+    hand_q_rad: np.ndarray | None = None
+    """Dex3 finger angles (14, generator.skeleton.FINGER_JOINTS order) on a G1 with hands; None otherwise."""
+
     def set_from(self, j: JointReference) -> KinematicReference:
         """Root pose and twist, joints, contacts and phase from a joint reference (a whole-body
         plan sampled as both); returns self."""
@@ -332,8 +335,6 @@ class KinematicReference:
         self.contacts[:] = j.contacts
         self.phase = j.phase
         return self
-    hand_q_rad: np.ndarray | None = None
-    """Dex3 finger angles (14, generator.skeleton.FINGER_JOINTS order) on a G1 with hands; None otherwise."""
 
 
 @dataclass
