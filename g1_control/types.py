@@ -166,7 +166,8 @@ class TaskGoal:
     place      set the held box down: on table/platform `target` (at pos_w_m's xy if given, else
                the middle of its near edge), or at pos_w_m (floor), or (neither) in front
     step_up    step onto platform `target` (None: the nearest in front) and stand on it
-    step_down  step off the platform the robot stands on (back where it came from) and stand
+    step_down  step off the platform the robot stands on (back where it came from, then back clear of
+               its edge: GoalConfig.clear_of_platform_m) and stand
 
     A goal is started the first tick a Command carries its `goal_id` and runs to its end even
     when later commands no longer carry it; goals queue in the order they arrive.
