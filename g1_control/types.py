@@ -166,7 +166,8 @@ class TaskGoal:
     place      set the held box down: on table/platform `target` (at pos_w_m's xy if given, else
                the middle of its near edge), or at pos_w_m (floor), or (neither) in front
     step_up    step onto platform `target` (None: the nearest in front) and stand on it
-    step_down  step off the platform the robot stands on (back where it came from) and stand
+    step_down  step off the platform the robot stands on (back where it came from, then back clear of
+               its edge: GoalConfig.clear_of_platform_m) and stand
 
     A goal is started the first tick a Command carries its `goal_id` and runs to its end even
     when later commands no longer carry it; goals queue in the order they arrive.
@@ -320,6 +321,9 @@ class KinematicReference:
     controller follows them: manipulation, stepping onto platforms, heights a walking policy
     cannot hold). The tracking layer hands over between its controllers by this."""
 
+    hand_q_rad: np.ndarray | None = None
+    """Dex3 finger angles (14, generator.skeleton.FINGER_JOINTS order) on a G1 with hands; None otherwise."""
+
     def set_from(self, j: JointReference) -> KinematicReference:
         """Root pose and twist, joints, contacts and phase from a joint reference (a whole-body
         plan sampled as both); returns self."""
@@ -332,8 +336,6 @@ class KinematicReference:
         self.contacts[:] = j.contacts
         self.phase = j.phase
         return self
-    hand_q_rad: np.ndarray | None = None
-    """Dex3 finger angles (14, generator.skeleton.FINGER_JOINTS order) on a G1 with hands; None otherwise."""
 
 
 @dataclass

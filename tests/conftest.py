@@ -13,15 +13,19 @@ emulator's 30, which they raise to where they start them)."""
 def _realtime_for_timing_tests(request):
     """A `timing` test measures the robot path as it runs on a robot: at a real-time priority (see
     g1_control/loop/priority.py), so that other work on the host (CI's load generator, other jobs)
-    cannot starve it. Subprocesses started by the test inherit it. Without permission: as it is."""
+    cannot starve it. Subprocesses started by the test inherit it. Without permission: as it is.
+    The test process's heap (everything the suite has loaded so far) is frozen for the test, as the
+    deploy freezes its own (loop/priority.frozen_heap): an in-process robot and deploy share one
+    GIL, and a full collection of a late-suite heap stalled both past the 250 ms stale-state limit."""
     if request.node.get_closest_marker("timing") is None:
         yield
         return
-    from g1_control.loop.priority import realtime
+    from g1_control.loop.priority import frozen_heap, realtime
 
     normal, _ = realtime(TIMING_RT_PRIORITY)
     try:
-        yield
+        with frozen_heap():
+            yield
     finally:
         normal.restore()
 

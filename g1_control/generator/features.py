@@ -61,16 +61,21 @@ def effectors_from_bodies(pos: np.ndarray, rot: np.ndarray, body_names: tuple[st
     head = pos[..., t, :] + np.einsum("...ij,j->...i", rot[..., t, :, :], head_offset())
     return np.concatenate([ends, head[..., None, :]], axis=-2)
 
-def rot6d_to_matrix(r6: np.ndarray) -> np.ndarray:
-    """Gram-Schmidt of the two stored columns -> (..., 3, 3). Written out (no np.cross /
-    np.linalg.norm / np.stack): this runs several times per replan."""
+def _gram_schmidt(r6: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The two orthonormal columns (x0, x1, x2, y0, y1, y2) of 6D rotations (..., 6). Written out
+    (no np.cross / np.linalg.norm / np.stack): this runs several times per replan."""
     a0, a1, a2, b0, b1, b2 = (r6[..., i] for i in range(6))
     na = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2) + 1e-12
     x0, x1, x2 = a0 / na, a1 / na, a2 / na
     d = x0 * b0 + x1 * b1 + x2 * b2
     b0, b1, b2 = b0 - d * x0, b1 - d * x1, b2 - d * x2
     nb = np.sqrt(b0 * b0 + b1 * b1 + b2 * b2) + 1e-12
-    y0, y1, y2 = b0 / nb, b1 / nb, b2 / nb
+    return x0, x1, x2, b0 / nb, b1 / nb, b2 / nb
+
+
+def rot6d_to_matrix(r6: np.ndarray) -> np.ndarray:
+    """Gram-Schmidt of the two stored columns -> (..., 3, 3)."""
+    x0, x1, x2, y0, y1, y2 = _gram_schmidt(r6)
     out = np.empty(r6.shape[:-1] + (3, 3))
     out[..., 0, 0], out[..., 1, 0], out[..., 2, 0] = x0, x1, x2
     out[..., 0, 1], out[..., 1, 1], out[..., 2, 1] = y0, y1, y2
@@ -80,15 +85,9 @@ def rot6d_to_matrix(r6: np.ndarray) -> np.ndarray:
 
 def orthonormalize_rot6d(frames: np.ndarray) -> None:
     """Re-orthonormalize the pelvis 6D columns of feature frames (..., D) in place."""
-    r6 = frames[..., ROOT_ROT]
-    a0, a1, a2, b0, b1, b2 = (r6[..., i] for i in range(6))
-    na = np.sqrt(a0 * a0 + a1 * a1 + a2 * a2) + 1e-12
-    x0, x1, x2 = a0 / na, a1 / na, a2 / na
-    d = x0 * b0 + x1 * b1 + x2 * b2
-    b0, b1, b2 = b0 - d * x0, b1 - d * x1, b2 - d * x2
-    nb = np.sqrt(b0 * b0 + b1 * b1 + b2 * b2) + 1e-12
+    x0, x1, x2, y0, y1, y2 = _gram_schmidt(frames[..., ROOT_ROT])
     frames[..., 3], frames[..., 4], frames[..., 5] = x0, x1, x2
-    frames[..., 6], frames[..., 7], frames[..., 8] = b0 / nb, b1 / nb, b2 / nb
+    frames[..., 6], frames[..., 7], frames[..., 8] = y0, y1, y2
 
 
 def heading(frames: np.ndarray) -> np.ndarray:

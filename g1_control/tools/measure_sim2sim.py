@@ -30,7 +30,7 @@ _ROOT = Path(__file__).resolve().parents[2]
 
 def _g1(*args: str, **kwargs) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": str(_ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
-    return subprocess.Popen([sys.executable, "-m", "g1_control.cli.main", *args], cwd=_ROOT, env=env, text=True,
+    return subprocess.Popen([sys.executable, "-m", "g1_control.cli.main", *args], env=env, text=True,
                             bufsize=1, **kwargs)
 
 
@@ -39,6 +39,10 @@ STYLE_S = 3.5
 
 
 def measure(launch: str = "launch/sim2sim.yaml", generator: bool = False) -> dict:
+    if not Path(launch).is_file() and (_ROOT / launch).is_file():  # the checkout's launch files from anywhere
+        launch = str(_ROOT / launch)
+    if not Path(launch).is_file():
+        raise FileNotFoundError(f"{launch}: no such launch file")
     partition = f"g1measure-{os.getpid()}-{uuid.uuid4().hex[:6]}"
     robot = _g1("sim-robot", "--lower-gantry-on-policy", "--partition", partition, "--control-stdin",
                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
@@ -75,6 +79,9 @@ def measure(launch: str = "launch/sim2sim.yaml", generator: bool = False) -> dic
                             ask("press right")
                             next_style_s = now + STYLE_S
                 time.sleep(0.25)
+            if not report_path.is_file():
+                raise RuntimeError(f"g1 deploy {launch} ended (exit {host.returncode}) without a report; run it "
+                                   "by hand to see why")
             report = json.loads(report_path.read_text())
         wire = ask("report")
         end = wire["first_damping_time_s"]
@@ -103,8 +110,20 @@ def measure(launch: str = "launch/sim2sim.yaml", generator: bool = False) -> dic
             robot.kill()
 
 
+def main(argv: list[str] | None = None) -> int:
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="python -m g1_control.tools.measure_sim2sim",
+                                     description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("launch", nargs="?", help="a sim2sim launch file (default launch/sim2sim.yaml, or "
+                        "launch/sim2sim_generator.yaml with --generator)")
+    parser.add_argument("--generator", action="store_true", help="step through the styles with the d-pad and "
+                        "report the upper body vs the plan per style")
+    args = parser.parse_args(argv)
+    default = "launch/sim2sim_generator.yaml" if args.generator else "launch/sim2sim.yaml"
+    print(json.dumps(measure(args.launch or default, generator=args.generator), indent=2))
+    return 0
+
+
 if __name__ == "__main__":
-    if "--generator" in sys.argv[1:]:
-        print(json.dumps(measure("launch/sim2sim_generator.yaml", generator=True), indent=2))
-    else:
-        print(json.dumps(measure(sys.argv[1]) if len(sys.argv) > 1 else measure(), indent=2))
+    sys.exit(main())

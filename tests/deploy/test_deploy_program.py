@@ -13,6 +13,7 @@ from g1_control.deploy.session import DeployOptions, deploy
 from g1_control.launch.schema import load_launch
 from g1_control.program import parse_instruction, save_program
 from tests.deploy.test_deploy_sim2sim import Emulator, Proc
+from tests.paths import LAUNCH_DIR
 
 ROBOT = ROOT / "launch" / "robot.yaml"
 
@@ -63,7 +64,7 @@ def test_sim2sim_program_file_drives_the_robot(tmp_path, partition, processes):
     robot = Emulator(partition, "--lower-gantry-on-policy")
     processes.append(robot)
     report_path = tmp_path / "deploy.json"
-    host = Proc("deploy", "launch/sim2sim.yaml", "--yes", "--partition", partition, "--duration", "14",
+    host = Proc("deploy", str(LAUNCH_DIR / "sim2sim.yaml"), "--yes", "--partition", partition, "--duration", "14",
                 "--program", str(program_file), "--json", str(report_path))
     processes.append(host)
     host.wait_for(r"behaviour program \(from the program file\)", 60)

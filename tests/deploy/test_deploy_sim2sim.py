@@ -15,6 +15,7 @@ import pytest
 from deploy_test_helpers import write_launch
 
 from g1_control.tools.soak import G1Process as Proc
+from tests.paths import LAUNCH_DIR
 
 pytestmark = pytest.mark.timing
 
@@ -46,7 +47,7 @@ def test_sim2sim_walks_forward_and_ends_in_damping(tmp_path, partition, processe
     robot = Emulator(partition, "--lower-gantry-on-policy")
     processes.append(robot)
     report_path = tmp_path / "deploy.json"
-    host = Proc("deploy", "launch/sim2sim.yaml", "--yes", "--partition", partition, "--duration", "5",
+    host = Proc("deploy", str(LAUNCH_DIR / "sim2sim.yaml"), "--yes", "--partition", partition, "--duration", "5",
                 "--json", str(report_path), "--out", str(tmp_path))
     processes.append(host)
     host.wait_for(r"zero torque: the robot is limp", 90)

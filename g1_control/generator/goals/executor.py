@@ -55,7 +55,7 @@ from g1_control.generator.whole_body import WholeBodyTrajectory, keyframe_trajec
 from g1_control.interfaces import Generator, Retargeter
 from g1_control.robot import g1
 from g1_control.rotations import wrap_angle, yaw_of
-from g1_control.scene import Box, SceneConfig
+from g1_control.scene import Block, Box, SceneConfig
 from g1_control.types import (
     PHASE_LOCOMOTION,
     PHASE_WHOLE_BODY,
@@ -121,6 +121,12 @@ class GoalConfig:
     """Stepping up: the toes stop this short of the platform's edge."""
     past_edge_m: float = 0.12
     """Stepping up: the sole's centre lands this far past the edge (the heel is 0.085 m behind it)."""
+    clear_of_platform_m: float = 0.30
+    """After stepping down, the stance's mid-point steps back to at least this far from the
+    platform before the hand-back: the step down lands where the step up started (mid-point
+    0.16 m from the edge), and the walking policy turning in place there put a sole centre 4 cm
+    from the edge and the shin on the platform's top edge (measured: program 20 of g1 bench
+    program, a fall). The walking policy knows nothing of the platform."""
     policy_height_m: tuple[float, float] = (0.63, 0.78)
     """Pelvis heights the walking policy holds (its envelope); others stand under the WBC."""
     height_min_m: float = 0.45
@@ -776,8 +782,23 @@ class GoalGenerator(Generator):
         plan = yield from self._compute("step down", lambda: stepping_trajectory(self.ik, q0, steps, cfg.steps,
                                                                                name="step down"))
         yield from self._run(plan.trajectory)
+        block = self.scene.block(self.on_platform)
         self.on_platform = None
+        if block is not None:
+            yield from self._clear_of(block)
         yield from self._hand_back()
+
+    def _clear_of(self, block: Block) -> Iterator[None]:
+        """Step straight back until the stance's mid-point is `clear_of_platform_m` from `block`."""
+        cfg = self.config
+        stance = Stance.of(self.ik, self._hold_q())
+        gap = block.distance_xy(stance.mid_xy - self._offset())
+        back_m = cfg.clear_of_platform_m - gap
+        if back_m < 0.01:
+            return
+        self._note(f"{gap * 100:.0f} cm from '{block.name}': stepping {back_m * 100:.0f} cm back clear of it")
+        back = stance.mid_xy - back_m * np.array([math.cos(stance.heading), math.sin(stance.heading)])
+        yield from self._step_to(back, stance.heading, cfg.steps, name="clear of the platform", first_back_m=back_m)
 
 
 class GoalRetargeter(Retargeter):
