@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import uuid
+from dataclasses import dataclass
 from pathlib import Path
 
 import yaml
@@ -105,3 +106,26 @@ class SecondPublisher:
         self.join()
         if self.link is not None:
             self.link.close()
+
+
+@dataclass
+class LinkStats:
+    """A robot link's transport counters (LinkBackend.stats()), for stand-in backends of preflight tests."""
+
+    states_received: int = 0
+    bad_crc: int = 0
+    malformed: int = 0
+    bad_frames: int = 0
+
+
+def standing_state(**changes):
+    """A healthy 29-DoF robot's RobotState at the default pose, 40 °C, with `changes` set on it."""
+    import numpy as np
+
+    from g1_control.robot import g1
+    from g1_control.types import RobotState
+
+    state = RobotState(q_rad=g1.DEFAULT_Q_RAD.copy(), motor_temperature_c=np.full(29, 40.0), mode_machine=5)
+    for k, v in changes.items():
+        setattr(state, k, v)
+    return state

@@ -3,25 +3,17 @@ non-finite joints, temperatures and battery, the peer check. Fast, so a mutation
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
-from deploy_test_helpers import write_launch
+from deploy_test_helpers import LinkStats as _Stats
+from deploy_test_helpers import standing_state, write_launch
 
 from g1_control.deploy.preflight import FAIL, PASS, SKIP, Preflight
 from g1_control.launch.schema import load_launch
 from g1_control.robot import g1
 from g1_control.types import RobotState
-
-
-@dataclass
-class _Stats:
-    states_received: int = 0
-    bad_crc: int = 0
-    malformed: int = 0
-    bad_frames: int = 0
 
 
 class _Link:
@@ -61,11 +53,7 @@ def launch(tmp_path_factory):
     return load_launch(path)
 
 
-def _state(**changes) -> RobotState:
-    state = RobotState(q_rad=g1.DEFAULT_Q_RAD.copy(), motor_temperature_c=np.full(29, 40.0), mode_machine=5)
-    for k, v in changes.items():
-        setattr(state, k, v)
-    return state
+_state = standing_state
 
 
 def _run(launch, backend) -> Preflight:
