@@ -41,3 +41,15 @@ def test_the_state_is_one_value_per_axis():
     for cmd in (np.zeros(3), np.array([0.5, 0.0, 0.0])):
         corr(cmd, np.zeros(3))
         assert corr.integral.shape == (3,) and corr.moving_s.shape == (3,) and corr.v_filtered.shape == (3,)
+
+
+def test_reset_starts_over_as_a_new_corrector():
+    used = _corrector()
+    for _ in range(6):
+        used(np.array([0.5, 0.0, 0.2]), np.array([0.3, 0.1, 0.0]))
+    assert np.any(used.integral != 0.0) and np.any(used.v_filtered != 0.0) and np.any(used.moving_s != 0.0)
+    used.reset()
+    assert np.all(used.integral == 0.0) and np.all(used.v_filtered == 0.0) and np.all(used.moving_s == 0.0)
+    fresh = _corrector()
+    for cmd, v in [((0.0, 0.4, 0.0), (0.0, 0.2, 0.1))] * 5 + [((0.5, 0.0, 0.0), (0.4, 0.0, 0.0))] * 4:
+        np.testing.assert_array_equal(used(np.array(cmd), np.array(v)), fresh(np.array(cmd), np.array(v)))
