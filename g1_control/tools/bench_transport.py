@@ -12,21 +12,10 @@ import time
 import numpy as np
 
 from g1_control.hardware.unitree.conversions import lowstate_to_robot_state, motor_command_to_lowcmd
-from g1_control.hardware.unitree.crc import crc32_words, crc32_words_table
+from g1_control.hardware.unitree.crc import crc32_words, crc32_words_bitwise, crc32_words_table
 from g1_control.hardware.unitree.messages import LowState, compute_crc
 from g1_control.robot import g1
 from g1_control.types import MotorCommand, RobotState
-
-
-def _crc_bitwise(words) -> int:
-    crc = 0xFFFFFFFF
-    for word in words:
-        for bit in range(31, -1, -1):
-            feedback = ((crc >> 31) ^ (int(word) >> bit)) & 1
-            crc = (crc << 1) & 0xFFFFFFFF
-            if feedback:
-                crc ^= 0x04C11DB7
-    return crc
 
 
 def _time_us(fn, budget_s: float, min_runs: int = 3) -> float:
@@ -64,7 +53,7 @@ def main(args) -> int:
     state = RobotState(q_rad=g1.DEFAULT_Q_RAD.copy())
 
     cases = {
-        "crc bitwise python (baseline)": lambda: _crc_bitwise(words),
+        "crc bitwise python (baseline)": lambda: crc32_words_bitwise(words),
         "crc table-driven python": lambda: crc32_words_table(words),
         "crc zlib (used)": lambda: crc32_words(image[:-4]),
         "LowCmd pack + crc": lambda: compute_crc(lowcmd),

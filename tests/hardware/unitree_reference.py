@@ -28,19 +28,11 @@ if "unitree_sdk2py" not in sys.modules:
 from unitree_sdk2py.idl.unitree_api.msg import dds_ as api  # noqa: E402  (after the package stub above)
 from unitree_sdk2py.idl.unitree_hg.msg import dds_ as hg  # noqa: E402
 
+from g1_control.hardware.unitree.crc import crc32_words_bitwise  # noqa: E402
+
 __all__ = ["api", "crc32_bitwise", "hg", "official_crc"]
 
-
-def crc32_bitwise(words) -> int:
-    """CRC-32 of 32-bit words: poly 0x04C11DB7, init all ones, MSB first, no reflection or xor-out."""
-    crc = 0xFFFFFFFF
-    for word in words:
-        for bit in range(31, -1, -1):
-            feedback = ((crc >> 31) ^ (int(word) >> bit)) & 1
-            crc = (crc << 1) & 0xFFFFFFFF
-            if feedback:
-                crc ^= 0x04C11DB7
-    return crc
+crc32_bitwise = crc32_words_bitwise  # the CRC as its definition reads (g1_control/hardware/unitree/crc.py)
 
 
 class _ReferenceCrcLib:

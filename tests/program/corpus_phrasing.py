@@ -24,58 +24,9 @@ Conventions decided here, before writing (beyond the part-1 ones in the README):
 - A typo must be refused (UnknownWordError), never guessed.
 """
 
-import math
+from tests.program.corpus_steps import deg, height, par, pick, place, rep, stand, style, turn, walk
 
 STEP_M = 0.3
-
-
-def deg(x):
-    return math.radians(x)
-
-
-def walk(**kw):
-    return {"kind": "walk", **kw}
-
-
-def turn(**kw):
-    return {"kind": "turn", **kw}
-
-
-def stand(d):
-    return {"kind": "stand", "duration_s": float(d)}
-
-
-def style(name, d=None):
-    out = {"kind": "style", "name": name}
-    if d is not None:
-        out["duration_s"] = float(d)
-    return out
-
-
-def height(**kw):
-    return {"kind": "height", **kw}
-
-
-def pick(obj, hands=None):
-    out = {"kind": "pick", "object": obj}
-    if hands:
-        out["hands"] = hands
-    return out
-
-
-def place(obj, target=None):
-    out = {"kind": "place", "object": obj}
-    if target:
-        out["target"] = target
-    return out
-
-
-def par(main, *alongside):
-    return {"kind": "parallel", "main": main, "alongside": list(alongside)}
-
-
-def rep(n, *steps):
-    return {"kind": "repeat", "count": n, "steps": list(steps)}
 
 
 PHRASING = [
