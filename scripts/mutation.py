@@ -11,8 +11,7 @@ mutmut configuration that mutates only the group's files and runs only the group
 run with fewer examples there (G1_FUZZ_EXAMPLES=25). It prints, per group, killed / survived /
 no covering test / timeout and the score (killed / (killed + survived)), lists every survivor,
 and writes everything to runs/mutation-<rev>/report.json. Surviving mutants are either killed by
-a new test or listed with the reason they are equivalent in docs: see /work/notes or the README of
-the run. Needs `pip install mutmut` (3.8 or later; 3.3.1's wheel shipped a top-level `tests`
+a new test or listed with the reason they are equivalent in docs/mutation.md. Needs `pip install mutmut` (3.8 or later; 3.3.1's wheel shipped a top-level `tests`
 package into site-packages).
 """
 

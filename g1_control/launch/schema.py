@@ -29,7 +29,7 @@ PROGRAM_END_HOLD_S = 1.0
 MIN_WBC_TRACKER_HZ = 100.0
 """The whole-body controller's slowest rate in use: every task of issue 17 (standing at any height,
 reaching, holding and carrying a box, stepping onto a platform) was tracked at 100 Hz as at
-250 Hz (notes 17b_findings.md, 17_part2.md)."""
+250 Hz in the execution bench's debugging runs (`g1 bench execution --only reach,height,box,step`)."""
 
 
 @dataclass

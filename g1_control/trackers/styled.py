@@ -1,7 +1,7 @@
 """Styled walking on a velocity-command walking policy: the plan drives the upper body while the
 policy keeps balancing with the legs, and the legs crouch to a planned pelvis height.
 
-Why this shape (measured, /work/notes/17a_findings.md): the holosoma walking policy was trained
+Why this shape (measured in MuJoCo before this tracker existed): the holosoma walking policy was trained
 with its own arms and waist. Forcing a plan's arm pose on its motors while it observes them far
 from where it keeps them cost 45-100 % of the commanded speed; with the pose forced and no one
 compensating the upper body's gravity, the waist pitch sagged to its 0.52 rad limit. Per tick,

@@ -1,7 +1,7 @@
 """The second held-out set (corpus_phrasing.py): instructions phrased as other people write them.
 
 Its first evaluation, before any parser change and before its failures were seen, was 33/61
-exact (54.1 %; notes /work/notes/15_part2.md lists the 28 failures). The parser was then fixed
+exact (54.1 %; g1_control/program/README.md names the 28 failures). The parser was then fixed
 on the development side only (corpus_dev.py gained the constructs in other sentences); the rate
 printed here is therefore no longer a blind figure. The assertion guards against regressions.
 """
