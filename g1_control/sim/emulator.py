@@ -163,10 +163,27 @@ class Gantry(Backend):
             rot = d.xmat[self._pelvis].reshape(3, 3)
             z_body = rot[:, 2]
             omega_w = rot @ d.qvel[3:6]  # free-joint angular velocity is in the body frame
-            torque = self.k_rot * np.cross(z_body, [0.0, 0.0, 1.0])
-            torque[:2] -= self.c_rot * omega_w[:2]
+            torque = self.k_rot * np.cross(z_body, [0.0, 0.0, 1.0]) + self._damping_torque(rot, omega_w)
             d.xfrc_applied[self._pelvis, 3:] = torque
             self.inner.step(self.dt)
+
+    def _damping_torque(self, rot: np.ndarray, omega_w: np.ndarray) -> np.ndarray:
+        """The roll/pitch damper, integrated implicitly: tau = -C (omega + dt A tau), A = the pelvis'
+        angular mobility in the world frame (the free joint's block of M^-1, joints free). Explicitly
+        (tau = -C omega) it is unstable whenever c dt exceeds twice the pelvis' effective inertia: the
+        limp pelvis alone has ~0.009 kg m^2, so c = 80 N m s/rad at 2 ms made the emulated robot's
+        pelvis and waist flip +-40 rad/s every step while its motors damped, and the host's
+        over-speed check tripped."""
+        import mujoco
+
+        m, d = self.inner.model, self.inner.data
+        unit = np.zeros((3, m.nv))
+        unit[0, 3], unit[1, 4], unit[2, 5] = 1.0, 1.0, 1.0
+        solved = np.zeros_like(unit)
+        mujoco.mj_solveM(m, d, solved, unit)  # uses the factorised mass matrix of the last step
+        mobility_w = rot @ solved[:, 3:6] @ rot.T
+        c = np.diag([self.c_rot, self.c_rot, 0.0])
+        return -np.linalg.solve(np.eye(3) + self.dt * c @ mobility_w, c @ omega_w)
 
     def close(self) -> None:
         self.inner.data.xfrc_applied[self._pelvis, 3:] = 0.0
