@@ -132,9 +132,7 @@ def run_soak(minutes: float, seed: int = 0, out: Path | None = None, progress=pr
         host = G1Process("deploy", str(soak_launch(work)), "--partition", partition, "--json",
                          str(work / "deploy.json"), "--out", str(work))
         host.wait_for(r"zero torque: the robot is limp", 180)
-        # as an operator does: start once the limp robot has settled on its gantry. Pressed 0.3 s
-        # into zero torque, the emulated waist pitch still reads 32-39 rad/s (a limp torso meeting
-        # its joint stop) and the ramp trips the 30 rad/s over-speed check at once.
+        # as an operator does: start once the limp robot has hung in its gantry for a moment
         time.sleep(START_AFTER_LIMP_S)
         robot.ask("press start")
         host.wait_for(r"ramp -> hold", 30)
