@@ -30,14 +30,22 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-def screenshot(url: str, out, size=(800, 600), wait_ms: int = 8000) -> np.ndarray:
-    """Load `url` in headless Chromium and return the screenshot as an (H, W, 3) array."""
+def screenshot(url: str, out, size=(800, 600), wait_ms: int = 8000, attempts: int = 3) -> np.ndarray:
+    """Load `url` in headless Chromium and return the screenshot as an (H, W, 3) array. Headless
+    Chromium now and then never finishes its virtual-time budget on the page's websocket (seen once
+    in ~20 runs: killed at 120 s); a fresh browser is tried again, up to `attempts` times."""
     import imageio.v2 as imageio
 
-    with tempfile.TemporaryDirectory(prefix="g1-chromium-") as profile:
-        subprocess.run([CHROMIUM, *CHROMIUM_FLAGS, f"--user-data-dir={profile}", f"--window-size={size[0]},{size[1]}",
-                        f"--virtual-time-budget={wait_ms}", f"--screenshot={out}", url],
-                       capture_output=True, timeout=120, check=True)
+    for attempt in range(attempts):
+        with tempfile.TemporaryDirectory(prefix="g1-chromium-") as profile:
+            try:
+                subprocess.run([CHROMIUM, *CHROMIUM_FLAGS, f"--user-data-dir={profile}",
+                                f"--window-size={size[0]},{size[1]}", f"--virtual-time-budget={wait_ms}",
+                                f"--screenshot={out}", url], capture_output=True, timeout=90, check=True)
+                break
+            except subprocess.TimeoutExpired:
+                if attempt == attempts - 1:
+                    raise
     return imageio.imread(out)[..., :3]
 
 
