@@ -21,7 +21,7 @@ def test_examples_are_there():
 @pytest.mark.parametrize("script", EXAMPLES, ids=[p.stem for p in EXAMPLES])
 def test_example_runs(script, tmp_path):
     if script.stem == "retarget_clip" and not assets.is_fetched("holosoma-demo-mocap"):
-        pytest.skip("demo mocap not fetched (scripts/setup.sh --test fetches it)")
+        pytest.fail("demo mocap not fetched: run the README's test command (scripts/setup.sh --test fetches it)")
     env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""), MPLBACKEND="Agg")
     proc = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True,
                           timeout=600, check=False)

@@ -1,6 +1,7 @@
 """g1 replay / g1 view: playbacks from run folders and clips, their overlay, the gait-cycle mean."""
 
 import json
+import os
 
 import imageio.v2 as imageio
 import numpy as np
@@ -106,8 +107,8 @@ def test_replay_and_view_write_frames_with_overlay(tmp_path, capsys):
     clip = tmp_path / "clip.npz"
     save_clip(_clip(), clip)
     rc = main(["replay", str(tmp_path / "run"), "--frame", "1.0", "--size", "320", "240"])
-    if rc != 0 and "no headless rendering" in capsys.readouterr().err:
-        pytest.skip("no EGL/OSMesa here")
+    if rc != 0 and "no headless rendering" in capsys.readouterr().err and not os.environ.get("CI"):
+        pytest.skip("no EGL/OSMesa here (scripts/setup.sh installs them with root; CI fails instead)")
     assert rc == 0
     frame = imageio.imread(tmp_path / "run" / "replay-1s.png")
     assert frame.shape[:2] == (240, 320)
