@@ -120,6 +120,10 @@ class Gantry(Backend):
         self.lowered_base_pos_m: np.ndarray | None = None
         self._held_q: np.ndarray | None = None
         self._held_since_s = 0.0
+        # the pelvis' rotational unit vectors in joint space, and M^-1 of them (reused every step)
+        self._unit = np.zeros((3, inner.model.nv))
+        self._unit[0, 3] = self._unit[1, 4] = self._unit[2, 5] = 1.0
+        self._solved = np.zeros_like(self._unit)
 
     def reset(self) -> RobotState:
         state = self.inner.reset()
@@ -176,12 +180,8 @@ class Gantry(Backend):
         over-speed check tripped."""
         import mujoco
 
-        m, d = self.inner.model, self.inner.data
-        unit = np.zeros((3, m.nv))
-        unit[0, 3], unit[1, 4], unit[2, 5] = 1.0, 1.0, 1.0
-        solved = np.zeros_like(unit)
-        mujoco.mj_solveM(m, d, solved, unit)  # uses the factorised mass matrix of the last step
-        mobility_w = rot @ solved[:, 3:6] @ rot.T
+        mujoco.mj_solveM(self.inner.model, self.inner.data, self._solved, self._unit)  # last step's factor
+        mobility_w = rot @ self._solved[:, 3:6] @ rot.T
         c = np.diag([self.c_rot, self.c_rot, 0.0])
         return -np.linalg.solve(np.eye(3) + self.dt * c @ mobility_w, c @ omega_w)
 
