@@ -64,6 +64,9 @@ class RobotEndpoint:
         """time.monotonic() of every valid LowCmd_ taken off the link (two minutes at 500 Hz)."""
         self.period_histogram = np.zeros(PERIOD_BINS + 1, dtype=np.int64)
         """Every LowCmd_ period since start, in PERIOD_BIN_S bins (the last bin: longer), for whole-run percentiles."""
+        self._timing_lock = threading.Lock()
+        """Held while command_times/period_histogram change and while a report copies them: reports run on
+        another thread (the emulator's stdin server) and must never see them half-updated."""
         self.builtin_active = False
         """While True (the built-in controller runs), valid commands are ignored, as on the robot, and
         the physics is paused at its standing pose (Unitree's controller itself is not emulated)."""
@@ -116,10 +119,7 @@ class RobotEndpoint:
             except MalformedMessageError:
                 self.counters.malformed += 1
                 continue
-            now = time.monotonic()
-            if self.command_times:
-                self.period_histogram[min(int((now - self.command_times[-1]) / PERIOD_BIN_S), PERIOD_BINS)] += 1
-            self.command_times.append(now)
+            self._record_command_time(time.monotonic())
             state = self.physics.read_state()
             if msg.mode_machine != state.mode_machine:
                 self.counters.wrong_mode_machine += 1
@@ -140,10 +140,18 @@ class RobotEndpoint:
             self.last_command_time_s = time.monotonic()
             self.counters.commands_applied += 1
 
+    def _record_command_time(self, now: float) -> None:
+        """Add one valid LowCmd_ arrival (time.monotonic()) to the period record."""
+        with self._timing_lock:
+            if self.command_times:
+                self.period_histogram[min(int((now - self.command_times[-1]) / PERIOD_BIN_S), PERIOD_BINS)] += 1
+            self.command_times.append(now)
+
     def command_wire_stats(self, window_s: float | None = None) -> dict:
         """Rate and period percentiles of the LowCmd_ stream as this end took it off the link (the
         robot's view of the host's 500 Hz stream: sender jitter + transport + this loop's wake-ups)."""
-        times = np.array(self.command_times)
+        with self._timing_lock:
+            times = np.array(self.command_times)
         if window_s is not None and times.size:
             times = times[times >= times[-1] - window_s]
         if times.size < 3:
@@ -156,7 +164,8 @@ class RobotEndpoint:
 
     def whole_run_period_stats(self) -> dict:
         """LowCmd_ period percentiles over every command since start (from the histogram, to PERIOD_BIN_S)."""
-        hist = self.period_histogram
+        with self._timing_lock:
+            hist = self.period_histogram.copy()
         n = int(hist.sum())
         if n == 0:
             return {"lowcmd_periods": 0}
