@@ -138,17 +138,30 @@ def train_lmm(out_dir: str | Path, config: LmmTrainConfig, library_root=None, pr
         def passed(self) -> bool:
             return time.process_time() > self.cpu or time.perf_counter() > self.wall
 
+    def fit(name: str, params, total: int, batch_loss) -> None:
+        """One stage: AdamW with a cosine schedule for `total` steps or until the stage's deadline;
+        batch_loss() draws a batch and returns (loss, extra figures for the history)."""
+        opt = torch.optim.AdamW(params, lr=config.lr, weight_decay=1e-4)
+        sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, total)
+        deadline = Deadline(name)
+        with bar(total, f"lmm {name}") as b:
+            for step in range(total):
+                loss, extra = batch_loss()
+                opt.zero_grad(set_to_none=True)
+                loss.backward()
+                opt.step()
+                sched.step()
+                b.update()
+                history[name].append({"step": step, "loss": loss.item(), **extra})
+                if deadline.passed():
+                    break
+
     # ------------------------------------------------------------------ 1. compressor + decompressor
     compressor = _mlp(Y_DIM, h, lat)
     decompressor = _mlp(X_DIM + lat, h, Y_DIM)
-    params = list(compressor.parameters()) + list(decompressor.parameters())
-    opt = torch.optim.AdamW(params, lr=config.lr, weight_decay=1e-4)
-    total = steps(config.decompressor_steps)
-    sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, total)
     pairs = np.flatnonzero(valid_next)
-    deadline = Deadline("decompressor")
-    b = bar(total, "lmm decompressor")
-    for step in range(total):
+
+    def decompressor_loss():
         i = torch.as_tensor(rng.choice(pairs, config.batch))
         j = i + 1
         z_i, z_j = compressor(Y[i]), compressor(Y[j])
@@ -159,16 +172,10 @@ def train_lmm(out_dir: str | Path, config: LmmTrainConfig, library_root=None, pr
         raw_p, raw_t = y_i * ys + ym, Y[i] * ys + ym
         fk = (_pose_fk_torch(raw_p, ym, ys) - _pose_fk_torch(raw_t, ym, ys)).abs().mean() * 10.0
         reg = 0.01 * (z_i ** 2).mean()
-        loss = rec + vel + fk + reg
-        opt.zero_grad(set_to_none=True)
-        loss.backward()
-        opt.step()
-        sched.step()
-        b.update()
-        history["decompressor"].append({"step": step, "loss": loss.item(), "rec": rec.item(), "fk": fk.item()})
-        if deadline.passed():
-            break
-    b.close()
+        return rec + vel + fk + reg, {"rec": rec.item(), "fk": fk.item()}
+
+    fit("decompressor", list(compressor.parameters()) + list(decompressor.parameters()),
+        steps(config.decompressor_steps), decompressor_loss)
     compressor.eval()
     decompressor.eval()
     with torch.no_grad():
@@ -178,14 +185,10 @@ def train_lmm(out_dir: str | Path, config: LmmTrainConfig, library_root=None, pr
     timings["decompressor_s"] = time.perf_counter() - started - sum(timings.values())
     # ------------------------------------------------------------------ 2. stepper
     stepper = _mlp(X_DIM + lat, h, X_DIM + lat)
-    opt = torch.optim.AdamW(stepper.parameters(), lr=config.lr, weight_decay=1e-4)
-    total = steps(config.stepper_steps)
-    sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, total)
     w = config.stepper_window
     starts_ok = np.flatnonzero(run_end - np.arange(n) > w)
-    deadline = Deadline("stepper")
-    b = bar(total, "lmm stepper")
-    for step in range(total):
+
+    def stepper_loss():
         i0 = rng.choice(starts_ok, config.batch // 4)
         x, z = X[torch.as_tensor(i0)], Z[torch.as_tensor(i0)]
         loss = 0.0
@@ -194,16 +197,9 @@ def train_lmm(out_dir: str | Path, config: LmmTrainConfig, library_root=None, pr
             x, z = x + d[:, :X_DIM], z + d[:, X_DIM:]
             idx = torch.as_tensor(i0 + k)
             loss = loss + (x - X[idx]).abs().mean() + (z - Z[idx]).abs().mean()
-        loss = loss / (w - 1)
-        opt.zero_grad(set_to_none=True)
-        loss.backward()
-        opt.step()
-        sched.step()
-        b.update()
-        history["stepper"].append({"step": step, "loss": loss.item()})
-        if deadline.passed():
-            break
-    b.close()
+        return loss / (w - 1), {}
+
+    fit("stepper", stepper.parameters(), steps(config.stepper_steps), stepper_loss)
     stepper.eval()
     timings["stepper_s"] = time.perf_counter() - started - sum(timings.values())
     # ------------------------------------------------------------------ 3. projector
@@ -218,13 +214,10 @@ def train_lmm(out_dir: str | Path, config: LmmTrainConfig, library_root=None, pr
         # exact nearest neighbours by brute force (a KD-tree degrades to it in 44 dimensions)
         qw = q * Wt
         return (db_sq[None, :] - 2.0 * qw @ db.T).argmin(dim=1)
+
     projector = _mlp(X_DIM, h, X_DIM + lat, layers=4)
-    opt = torch.optim.AdamW(projector.parameters(), lr=config.lr, weight_decay=1e-4)
-    total = steps(config.projector_steps)
-    sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, total)
-    deadline = Deadline("projector")
-    b = bar(total, "lmm projector")
-    for step in range(total):
+
+    def projector_loss():
         rows = rng.integers(0, n, config.batch)
         noise = rng.normal(size=(config.batch, X_DIM)) * rng.uniform(0.0, 1.0, size=(config.batch, 1))
         noise[:, style] = 0.0  # the style is always known exactly
@@ -233,15 +226,9 @@ def train_lmm(out_dir: str | Path, config: LmmTrainConfig, library_root=None, pr
             nn_idx = nearest(q)
         pred = projector(q)
         loss = ((pred[:, :X_DIM] - X[nn_idx]) * Wt).abs().mean() * 5.0 + (pred[:, X_DIM:] - Z[nn_idx]).abs().mean()
-        opt.zero_grad(set_to_none=True)
-        loss.backward()
-        opt.step()
-        sched.step()
-        b.update()
-        history["projector"].append({"step": step, "loss": loss.item()})
-        if deadline.passed():
-            break
-    b.close()
+        return loss, {}
+
+    fit("projector", projector.parameters(), steps(config.projector_steps), projector_loss)
     projector.eval()
     wall = time.perf_counter() - started
     timings["projector_s"] = wall - sum(timings.values())
