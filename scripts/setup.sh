@@ -60,20 +60,24 @@ pip() { "$PY" -m pip -q --disable-pip-version-check "$@"; }
 say "installing into $("$PY" -c 'import sys; print(sys.prefix)') ($("$PY" --version))"
 
 # 2. Root-only steps (apt): headless rendering libraries for run videos (EGL through Mesa, OSMesa
-#    as the fallback; optional: runs work without them and say so) and the DDS library for the robot.
+#    as the fallback; optional: runs work without them and say so), with --test headless Chromium
+#    (the browser-view test screenshots the viser page), and the DDS library for the robot.
 apt_pkgs=""
 for pkg in libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6; do
   dpkg -s "$pkg" >/dev/null 2>&1 || apt_pkgs="$apt_pkgs $pkg"
 done
+if [ -n "$test_extras" ] && ! command -v chromium >/dev/null 2>&1 && ! command -v chromium-browser >/dev/null 2>&1; then
+  apt_pkgs="$apt_pkgs chromium"
+fi
 dds_lib=yes
 dpkg -s cyclonedds-dev >/dev/null 2>&1 || dds_lib=""
 if is_root && have_apt; then
   if [ -n "$apt_pkgs" ]; then
-    say "apt:$apt_pkgs (headless rendering)"
+    say "apt:$apt_pkgs (headless rendering${test_extras:+, browser for the view test})"
     apt_install $apt_pkgs
   fi
 else
-  skipped="${apt_pkgs:+$apt_pkgs (videos)}"
+  skipped="${apt_pkgs:+$apt_pkgs (videos${test_extras:+, the browser-view test})}"
   if [ -z "$dds_lib" ]; then skipped="$skipped cyclonedds-dev (robot DDS)"; fi
   if [ -n "$skipped" ]; then say "skipping what needs root and apt:$skipped; run scripts/setup.sh once as root for them"; fi
 fi

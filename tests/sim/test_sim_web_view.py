@@ -20,8 +20,8 @@ CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--enable-unsaf
 def _needs(what: str, ok: bool) -> None:
     if not ok:
         if os.environ.get("CI"):
-            pytest.fail(f"{what} is missing in CI (.ci/run installs it)")
-        pytest.skip(f"{what} not installed")
+            pytest.fail(f"{what} is missing in CI (scripts/setup.sh --test installs it as root)")
+        pytest.skip(f"{what} not installed (scripts/setup.sh --test installs it as root)")
 
 
 def _free_port() -> int:
