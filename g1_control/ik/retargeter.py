@@ -112,7 +112,6 @@ class IKConfig:
     projection_steps: int = 4
     step_halvings: int = 3
     soft_contact_cost: float = 100.0
-
     """Cost of the contact when the hard hold is infeasible in a tick (then held as a task)."""
 
     def validate(self) -> IKConfig:
