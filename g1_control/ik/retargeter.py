@@ -325,15 +325,6 @@ class IKRetargeter(Retargeter):
             pose = pin.SE3(pose.rotation, pose.translation - (worst - 1e-4) * push)
         return pose
 
-    def _support_under(self, point_w: np.ndarray, sole_height: float) -> float:
-        """Height of the floor, or of a scene shape's top, under a sole at (point x, y, sole_height)."""
-        if not self.config.scene:
-            return self.config.ground_height_m
-        bottom = np.array([[point_w[0], point_w[1], sole_height]])
-        # a top at most ground_snap_m above the sole still counts: the touchdown snaps up onto it
-        return float(support_height(self.config.scene, bottom, self.config.ground_height_m,
-                                    self.config.ground_snap_m)[0])
-
     def _update_contacts(self, ref: KinematicReference) -> None:
         if not self.config.hold_contacts:
             return
