@@ -116,15 +116,19 @@ class GroundLimit(Limit):
         lower = np.concatenate(lowers)
         return RowConstraint(np.concatenate(matrices), lower, np.full(lower.shape, INF))
 
-    def deepest_in_scene(self, configuration: Configuration) -> float:
-        """Smallest clearance (m; < 0 inside) of a sphere of a foot not in skip_links to a scene shape."""
-        if not self.scene:
-            return float("inf")
+    def _unskipped_clearances(self, configuration: Configuration) -> np.ndarray:
+        """scene_clearances with the spheres of the skip_links feet at +inf (never inside)."""
         clear = self.scene_clearances(configuration)
         for link, _, _, rows in self._grouped():
             if link in self.skip_links:
                 clear[rows] = np.inf
-        return float(clear.min())
+        return clear
+
+    def deepest_in_scene(self, configuration: Configuration) -> float:
+        """Smallest clearance (m; < 0 inside) of a sphere of a foot not in skip_links to a scene shape."""
+        if not self.scene:
+            return float("inf")
+        return float(self._unskipped_clearances(configuration).min())
 
     def missed_pairs(self, configuration: Configuration) -> np.ndarray:
         """(spheres, shapes) bool: sphere-shape pairs more than miss_tolerance_m inside each other
@@ -133,11 +137,7 @@ class GroundLimit(Limit):
         the step again with them in `include`. Held feet (skip_links) are never missed."""
         if not self.scene:
             return self.include.copy()
-        missed = (self.scene_clearances(configuration) < -self.miss_tolerance_m) & ~self._scene_rowed
-        for link, _, _, rows in self._grouped():
-            if link in self.skip_links:
-                missed[rows] = False
-        return missed
+        return (self._unskipped_clearances(configuration) < -self.miss_tolerance_m) & ~self._scene_rowed
 
     def _floor_rows(self, configuration: Configuration) -> RowConstraint | None:
         m, nv = len(self.points), configuration.nv
