@@ -98,6 +98,7 @@ class Configuration:
         self.nq, self.nv = self.model.nq, self.model.nv
         self._frame_ids: dict[str, int] = {}
         self._support_masks: dict[tuple[int, ...], np.ndarray] = {}
+        self._joint_masks: np.ndarray | None = None
         self.layout_cache: dict[tuple, Any] = {}
         """Per-task-set data (row layouts) that tasks keep between ticks; keyed by the tasks. The values
         are the tasks' own (g1_control/ik/tasks/frame_task.py: _Layout)."""
@@ -180,14 +181,21 @@ class Configuration:
         Jacobian is read off the world joint Jacobians `data.J` (see ik/kernels.py)."""
         masks = self._support_masks.get(frame_ids)
         if masks is None:
-            masks = np.zeros((len(frame_ids), self.nv))
-            for k, fid in enumerate(frame_ids):
-                for joint in self.model.supports[self.model.frames[fid].parentJoint]:
-                    if joint > 0:  # 0 is the universe
-                        jm = self.model.joints[joint]
-                        masks[k, jm.idx_v:jm.idx_v + jm.nv] = 1.0
+            masks = self.joint_support_masks()[[self.model.frames[fid].parentJoint for fid in frame_ids]]
             self._support_masks[frame_ids] = masks  # shared: callers must not write to it
         return masks
+
+    def joint_support_masks(self) -> np.ndarray:
+        """(njoints, nv): support_masks per joint of the model (row 0, the universe: all 0.0)."""
+        if self._joint_masks is None:
+            masks = np.zeros((self.model.njoints, self.nv))
+            for j in range(1, self.model.njoints):
+                for joint in self.model.supports[j]:
+                    if joint > 0:  # 0 is the universe
+                        jm = self.model.joints[joint]
+                        masks[j, jm.idx_v:jm.idx_v + jm.nv] = 1.0
+            self._joint_masks = masks  # shared: callers must not write to it
+        return self._joint_masks
 
     @property
     def joint_jacobians_w(self) -> np.ndarray:

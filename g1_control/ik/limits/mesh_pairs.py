@@ -97,10 +97,9 @@ class MeshPairLimit(Limit):
         self._joint_pos = np.zeros((pmodel.njoints, 3))
         self._ends = np.zeros((len(geoms), 2, 3))
         self._gaps = np.zeros(len(all_pairs))
-        self._masks: np.ndarray | None = None
         self._mask_a = self._geom_joint[self._pair_a]
         self._mask_b = np.where(self._pair_shape < 0, self._geom_joint[self._pair_b], -1)
-        """Row of `_joint_masks` for each pair's a and b (b static: -1)."""
+        """Row of Configuration.joint_support_masks for each pair's a and b (b static: -1)."""
         self.include = np.zeros(len(all_pairs), dtype=bool)
         """Pairs given rows whatever their distance (see `missed_pairs`); the caller sets and clears it."""
         self._rows = np.zeros(len(all_pairs), dtype=bool)
@@ -115,19 +114,6 @@ class MeshPairLimit(Limit):
         retargeter's fallback when pushing out is infeasible this step)."""
 
     # ------------------------------------------------------------------ geometry
-    def _joint_masks(self, configuration: Configuration) -> np.ndarray:
-        """(joints, nv) 1.0 for the velocity coordinates that move each joint (its supports)."""
-        if self._masks is None or self._masks.shape[1] != configuration.nv:
-            model = configuration.model
-            masks = np.zeros((model.njoints, configuration.nv))
-            for j in range(1, model.njoints):
-                for s in model.supports[j]:
-                    if s > 0:
-                        jm = model.joints[s]
-                        masks[j, jm.idx_v:jm.idx_v + jm.nv] = 1.0
-            self._masks = masks
-        return self._masks
-
     def lower_bounds(self, configuration: Configuration) -> np.ndarray:
         """(P,) gap of every pair bounded from below by the bounding capsules (exact is larger)."""
         key = configuration.q.tobytes()
@@ -187,10 +173,9 @@ class MeshPairLimit(Limit):
             return None
         chosen = candidates[keep]
         self._rows[chosen] = True
-        masks = self._joint_masks(configuration)
         rows = np.zeros((chosen.size, configuration.nv))
-        kernels.witness_rows(configuration.joint_jacobians_w, masks, pa[keep], self._mask_a[chosen], pb[keep],
-                             self._mask_b[chosen], normal[keep], rows)
+        kernels.witness_rows(configuration.joint_jacobians_w, configuration.joint_support_masks(), pa[keep],
+                             self._mask_a[chosen], pb[keep], self._mask_b[chosen], normal[keep], rows)
         lower = np.minimum(self.margin_m - dist[keep], 0.0 if self.relaxed else self.max_push_m)
         return RowConstraint(rows, lower, np.full(chosen.size, INF))
 
