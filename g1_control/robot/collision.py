@@ -78,17 +78,14 @@ def bounding_capsule(points: np.ndarray, radius: float = 0.0) -> tuple[np.ndarra
     return p0, p1, r + radius
 
 
-def _convex_hull(points: np.ndarray):
+def convex_shape(vertices: np.ndarray):
+    """A coal convex shape: the convex hull of `vertices` (N, 3), in their coordinates (a mesh's
+    frame, or the world for a scene shape)."""
     import coal
 
     vec = coal.StdVec_Vec3s()
-    vec.extend(list(np.asarray(points, dtype=float)))
+    vec.extend(list(np.asarray(vertices, dtype=float)))
     return coal.Convex.convexHull(vec, True, "Qt")
-
-
-def convex_shape(vertices: np.ndarray):
-    """A coal convex shape (the convex hull of `vertices` (N, 3), world coordinates)."""
-    return _convex_hull(vertices)
 
 
 def _shape_points(geometry, placement) -> tuple[np.ndarray, float]:
@@ -122,7 +119,7 @@ class CollisionModel:
         geometries = []
         for go in gm.geometryObjects:
             if isinstance(go.geometry, coal.BVHModelBase):
-                go.geometry = _convex_hull(np.asarray(go.geometry.vertices()))
+                go.geometry = convex_shape(np.asarray(go.geometry.vertices()))
             points, radius = _shape_points(go.geometry, go.placement)
             lo, hi = points.min(axis=0), points.max(axis=0)
             centre = 0.5 * (lo + hi)
@@ -323,7 +320,7 @@ class StandIn:
             return coal.Sphere(self.params[0])
         if self.kind == "cylinder":
             return coal.Cylinder(self.params[0], 2.0 * self.params[1])
-        return _convex_hull(self.points)
+        return convex_shape(self.points)
 
 
 def _build_stand_ins(model: CollisionModel) -> list[StandIn]:
