@@ -23,8 +23,6 @@ from g1_control.robot import g1
 pytestmark = pytest.mark.timing
 
 
-
-
 def _row(report, name: str) -> dict:
     return next(r for r in report.preflight if r["name"] == name)
 
@@ -53,7 +51,7 @@ def test_a_nan_joint_fails_the_preflight_and_nothing_is_released(tmp_path, parti
     assert robot.endpoint.counters.commands_applied == 0
 
 
-def test_a_second_lowstate_publisher_is_refused_at_thepreflight_only(tmp_path, partition, mock_robot):
+def test_a_second_lowstate_publisher_is_refused_at_the_preflight(tmp_path, partition, mock_robot):
     robot = mock_robot().start()
     spoof = SecondPublisher(partition, robot.physics.read_state).start(seconds=30.0)
     try:
