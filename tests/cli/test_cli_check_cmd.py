@@ -9,15 +9,11 @@ from g1_control.cli.main import main
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.formats.clip_npz import write_clip_npz
 from g1_control.motion.objects import ObjectShape
-from g1_control.robot import collision, description, g1
+from tests.retarget.standing_clips import standing_clip
 
 
 def _standing(t: int = 20) -> MotionClip:
-    q = np.tile(np.asarray(g1.DEFAULT_Q_RAD), (t, 1))
-    model = collision.collision_model()
-    model.set_configuration(description.pinocchio_q(np.zeros(3), np.array([1.0, 0, 0, 0]), q[0]))
-    root = np.tile([0.0, 0.0, -model.lowest_points().min()], (t, 1))
-    return MotionClip.from_joint_trajectory(30.0, root, np.tile([1.0, 0, 0, 0], (t, 1)), q, source="stand")
+    return standing_clip(t)
 
 
 def test_clean_clip_passes_and_a_sliding_gmr_clip_fails(tmp_path, capsys):

@@ -27,4 +27,3 @@ def mock_robot(partition):
     yield make
     for emulator in made:
         emulator.close()
-

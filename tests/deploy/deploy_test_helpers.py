@@ -55,8 +55,6 @@ FAST = {"deploy": {"state_window_s": 0.3, "input_check_s": 0.1}, "backend": {"co
 """Shorter listening windows for tests that only need the checklist's verdict."""
 
 
-
-
 class SecondPublisher:
     """Another writer on rt/lowstate in the same domain and partition (lo, domain 1): valid CRCs, as a
     second robot or a spoofing program would send. `source()` gives the RobotState to report. The

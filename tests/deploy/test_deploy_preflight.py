@@ -19,8 +19,6 @@ from g1_control.robot import g1
 pytestmark = pytest.mark.timing
 
 
-
-
 def _status(report) -> dict[str, str]:
     return {r["name"]: ("overridden" if r["overridden"] else r["status"]) for r in report.preflight}
 

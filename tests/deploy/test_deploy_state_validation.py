@@ -23,8 +23,6 @@ from g1_control.robot import g1
 pytestmark = pytest.mark.timing
 
 
-
-
 def _row(report, name: str) -> dict:
     return next(r for r in report.preflight if r["name"] == name)
 
@@ -53,7 +51,7 @@ def test_a_nan_joint_fails_the_preflight_and_nothing_is_released(tmp_path, parti
     assert robot.endpoint.counters.commands_applied == 0
 
 
-def test_a_second_lowstate_publisher_is_refused_at_thepreflight_only(tmp_path, partition, mock_robot):
+def test_a_second_lowstate_publisher_is_refused_at_the_preflight(tmp_path, partition, mock_robot):
     robot = mock_robot().start()
     spoof = SecondPublisher(partition, robot.physics.read_state).start(seconds=30.0)
     try:
@@ -67,9 +65,11 @@ def test_a_second_lowstate_publisher_is_refused_at_thepreflight_only(tmp_path, p
     assert "2 publishers on rt/lowstate" in row["reason"], row
 
 
-def _deploy_with_spoof(tmp_path, partition, robot, mode_machine: int, spoof_s: float):
-    """A --yes deploy (3 s of control) during which a second publisher sends `spoof_s` of LowState_
-    with `mode_machine`, starting 0.5 s into control. Returns (report or None, exception, lines, spoof)."""
+def _deploy_with_spoof(tmp_path, partition, mock_robot, mode_machine: int, spoof_s: float):
+    """An emulated robot and a --yes deploy to it (3 s of control) during which a second publisher sends
+    `spoof_s` of LowState_ with `mode_machine`, starting 0.5 s into control; the deploy must end without
+    an exception. Returns (robot, report, spoof)."""
+    robot = mock_robot().start()
     spoof = SecondPublisher(partition, robot.physics.read_state, mode_machine=mode_machine)
     control = threading.Event()
     lines: list[str] = []
@@ -89,15 +89,14 @@ def _deploy_with_spoof(tmp_path, partition, robot, mode_machine: int, spoof_s: f
     finally:
         spoof.close()
     time.sleep(0.2)
-    return report, error, lines, spoof
-
-
-def test_a_spoofed_mode_machine_mid_run_trips_and_never_reaches_the_wire(tmp_path, partition, mock_robot):
-    robot = mock_robot().start()
-    report, error, lines, spoof = _deploy_with_spoof(tmp_path, partition, robot, mode_machine=4, spoof_s=1.0)
     text = "\n".join(lines)
     print("\n" + text)
     assert error is None, f"{error!r}\n{text}"
+    return robot, report, spoof
+
+
+def test_a_spoofed_mode_machine_mid_run_trips_and_never_reaches_the_wire(tmp_path, partition, mock_robot):
+    robot, report, spoof = _deploy_with_spoof(tmp_path, partition, mock_robot, mode_machine=4, spoof_s=1.0)
     assert spoof.sent > 100, "the second publisher ran"
     wire = robot.report()
     assert wire["wrong_mode_machine"] == 0, f"{wire['wrong_mode_machine']} LowCmd_ frames carried the spoofed " \
@@ -109,11 +108,7 @@ def test_a_spoofed_mode_machine_mid_run_trips_and_never_reaches_the_wire(tmp_pat
 
 
 def test_a_second_publisher_appearing_mid_run_trips(tmp_path, partition, mock_robot):
-    robot = mock_robot().start()
-    report, error, lines, _spoof = _deploy_with_spoof(tmp_path, partition, robot, mode_machine=5, spoof_s=1.0)
-    text = "\n".join(lines)
-    print("\n" + text)
-    assert error is None, f"{error!r}\n{text}"
+    robot, report, _spoof = _deploy_with_spoof(tmp_path, partition, mock_robot, mode_machine=5, spoof_s=1.0)
     assert report.fault, f"the deploy ended as planned ({report.end_reason}) with a second publisher"
     assert "publisher" in report.end_reason or "tick" in report.end_reason, report.end_reason
     assert robot.report()["last_command_is_damping"] is True

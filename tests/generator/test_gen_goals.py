@@ -39,11 +39,11 @@ def _styles():
             "wave": StyleStats("wave", wave, (0.66, 0.70, 0.73))}
 
 
-def _run(gen, command, seconds, hz=30.0, t0=0.0):
+def _run(gen, command, seconds, hz=30.0):
     state = RobotState(q_rad=g1.DEFAULT_Q_RAD.copy(), base_pos_w_m=np.array([0.0, 0.0, 0.76]))
     ref = None
     for i in range(int(seconds * hz)):
-        state.t_s = t0 + i / hz
+        state.t_s = i / hz
         ref = gen.update(command, state)
     return ref
 

@@ -6,15 +6,11 @@ from __future__ import annotations
 import pytest
 
 from g1_control.launch.schema import parse_launch
-
-BASE = {"name": "bounds", "input": {"type": "scripted", "timeline": [{"duration_s": 1.0}]}, "output": {"video": False}}
-DDS = {"type": "unitree_dds", "interface": "lo"}
+from tests.launch.launch_schema_data import DDS, launch_data
 
 
 def _with(**sections) -> dict:
-    data = {k: (dict(v) if isinstance(v, dict) else v) for k, v in BASE.items()}
-    data.update(sections)
-    return data
+    return launch_data("bounds", **sections)
 
 
 @pytest.mark.parametrize("sections", [

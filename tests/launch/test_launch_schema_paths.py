@@ -12,16 +12,12 @@ import yaml
 
 from g1_control.errors import LaunchFileError
 from g1_control.launch.schema import InputConfig, load_launch, parse_launch
+from tests.launch.launch_schema_data import DDS, launch_data
 from tests.paths import LAUNCH_DIR
-
-BASE = {"name": "paths", "input": {"type": "scripted", "timeline": [{"duration_s": 1.0}]}, "output": {"video": False}}
-DDS = {"type": "unitree_dds", "interface": "lo"}
 
 
 def _with(**sections) -> dict:
-    data = {k: (dict(v) if isinstance(v, dict) else v) for k, v in BASE.items()}
-    data.update(sections)
-    return data
+    return launch_data("paths", **sections)
 
 
 def _program(input_section: dict, **extra) -> dict:

@@ -48,4 +48,3 @@ def test_a_signal_during_g1_launch_keeps_the_run_folder(tmp_path, sig):
     assert len(t) > 50 and np.all(np.diff(t) > 0), "the per-tick log was kept up to the signal"
     assert abs(summary["duration_s"] - t[-1]) < 0.1
     assert list(log["joint_names"]) == list(json.loads((run_dir / "log" / "fields.json").read_text())["joint_names"])
-

@@ -8,20 +8,11 @@ from g1_control.motion.objects import ObjectShape
 from g1_control.retarget.clip_geometry import measure, mujoco_cross_check
 from g1_control.retarget.metrics import compute_metrics, format_table, plot_metrics
 from g1_control.robot import collision, description, g1
-
-
-def _sole_lift(q: np.ndarray) -> float:
-    """Pelvis height that puts the lowest foot sphere of pose q exactly on the floor."""
-    model = collision.collision_model()
-    model.set_configuration(description.pinocchio_q(np.zeros(3), np.array([1.0, 0, 0, 0]), q))
-    return -model.lowest_points().min()
+from tests.retarget.standing_clips import standing_clip
 
 
 def standing(t: int = 30, fps: float = 30.0) -> MotionClip:
-    q = np.tile(np.asarray(g1.DEFAULT_Q_RAD), (t, 1))
-    root = np.tile([0.0, 0.0, _sole_lift(q[0])], (t, 1))
-    quat = np.tile([1.0, 0.0, 0.0, 0.0], (t, 1))
-    return MotionClip.from_joint_trajectory(fps, root, quat, q, contacts=np.ones((t, 2), bool), source="stand")
+    return standing_clip(t, fps, contacts=np.ones((t, 2), bool))
 
 
 def test_clean_standing_clip_has_no_violations():

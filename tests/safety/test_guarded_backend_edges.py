@@ -10,11 +10,11 @@ import signal
 import numpy as np
 import pytest
 
-from g1_control.robot import g1
 from g1_control.safety import GuardedBackend, SafetyConfig, SafetyEventKind
 from g1_control.safety.guarded_backend import install_signal_damping
 from g1_control.sim.mock_robot import MockG1
 from g1_control.types import MotorCommand
+from tests.safety.safety_test_helpers import command as _cmd
 
 
 class _Link(MockG1):
@@ -36,10 +36,6 @@ class _Link(MockG1):
     def damp(self) -> None:
         self.damped += 1
         super().damp()
-
-
-def _cmd() -> MotorCommand:
-    return MotorCommand(q_rad=g1.DEFAULT_Q_RAD.copy(), kp=g1.KP_DEFAULT.copy(), kd=g1.KD_DEFAULT.copy())
 
 
 def _damping(cmd: MotorCommand) -> bool:

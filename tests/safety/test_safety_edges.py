@@ -15,16 +15,9 @@ from g1_control.errors import SafetyConfigError
 from g1_control.robot import g1
 from g1_control.rotations import tilt_rad
 from g1_control.safety import SafetyConfig, SafetyEvent, SafetyEventKind, SafetyFilter
-from g1_control.types import Command, MotorCommand, RobotState
-
-
-def _state(t_s=0.0, tick=None, **kw) -> RobotState:
-    tick = round(t_s * 500) if tick is None else tick
-    return RobotState(t_s=t_s, q_rad=g1.DEFAULT_Q_RAD.copy(), motor_temperature_c=np.full(29, 40.0), tick=tick, **kw)
-
-
-def _cmd(**kw) -> MotorCommand:
-    return MotorCommand(q_rad=g1.DEFAULT_Q_RAD.copy(), kp=g1.KP_DEFAULT.copy(), kd=g1.KD_DEFAULT.copy(), **kw)
+from g1_control.types import Command
+from tests.safety.safety_test_helpers import command as _cmd
+from tests.safety.safety_test_helpers import state as _state
 
 
 def _tripped(f: SafetyFilter, kind: SafetyEventKind, detail: str) -> None:

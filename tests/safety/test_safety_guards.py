@@ -13,17 +13,8 @@ from g1_control.errors import SafetyConfigError
 from g1_control.robot import g1
 from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter
 from g1_control.safety.config import MAX_KD_CAP, MAX_KP_CAP
-from g1_control.types import MotorCommand, RobotState
-
-
-def _state(t_s=0.0, tick=None, **kw) -> RobotState:
-    tick = round(t_s * 500) if tick is None else tick
-    return RobotState(t_s=t_s, q_rad=g1.DEFAULT_Q_RAD.copy(), motor_temperature_c=np.full(29, 40.0), tick=tick, **kw)
-
-
-def _cmd(kp=None, kd=None) -> MotorCommand:
-    return MotorCommand(q_rad=g1.DEFAULT_Q_RAD.copy(), kp=g1.KP_DEFAULT.copy() if kp is None else kp,
-                        kd=g1.KD_DEFAULT.copy() if kd is None else kd)
+from tests.safety.safety_test_helpers import command as _cmd
+from tests.safety.safety_test_helpers import state as _state
 
 
 def _tilted(angle_rad: float) -> np.ndarray:
