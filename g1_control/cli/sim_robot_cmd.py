@@ -52,7 +52,7 @@ def register(subparsers) -> None:
 
 
 def _run(args) -> int:
-    from g1_control.loop.priority import realtime
+    from g1_control.loop.priority import frozen_heap, realtime
     from g1_control.sim.emulator import RobotEmulator
 
     realtime(args.rt_priority)
@@ -72,31 +72,28 @@ def _run(args) -> int:
         physics = MockG1(mode_machine=args.mode_machine)
     emulator = RobotEmulator(physics, args.interface, args.domain, partition=args.partition,
                              builtin_mode="" if args.no_builtin else "ai").start()
-    import gc
-
-    gc.collect()
-    gc.freeze()  # the 500 Hz robot loop never waits for a full collection of the startup heap
     stop = {"now": False}
 
     def _stop(signum, frame):
         stop["now"] = True
 
     signal.signal(signal.SIGTERM, _stop)
-    print(f"g1 sim-robot: emulating a G1 ({args.physics}) on interface {args.interface}, domain {args.domain}"
-          + (f", partition {args.partition}" if args.partition else ""), file=sys.stderr, flush=True)
-    print("ready", flush=True)
-    try:
-        if args.control_stdin:
-            emulator.serve_stdin()
-        else:
-            end = time.monotonic() + args.seconds if args.seconds else float("inf")
-            while not stop["now"] and time.monotonic() < end:
-                time.sleep(0.05)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        report = emulator.report()
-        emulator.close()
+    with frozen_heap():  # the 500 Hz robot loop never waits for a full collection of the startup heap
+        print(f"g1 sim-robot: emulating a G1 ({args.physics}) on interface {args.interface}, domain {args.domain}"
+              + (f", partition {args.partition}" if args.partition else ""), file=sys.stderr, flush=True)
+        print("ready", flush=True)
+        try:
+            if args.control_stdin:
+                emulator.serve_stdin()
+            else:
+                end = time.monotonic() + args.seconds if args.seconds else float("inf")
+                while not stop["now"] and time.monotonic() < end:
+                    time.sleep(0.05)
+        except KeyboardInterrupt:
+            pass
+        finally:
+            report = emulator.report()
+            emulator.close()
     print(f"g1 sim-robot: {report['states_sent']} states sent, {report['commands_applied']} commands applied, "
           f"{report['bad_crc']} bad CRC, {report['wrong_mode_machine']} wrong mode_machine, "
           f"{report['ignored_while_builtin_active']} ignored while the built-in controller ran", file=sys.stderr)

@@ -175,15 +175,16 @@ class LinkBackend(Backend):
 
     @property
     def peer_fault(self) -> str | None:
+        # Asked every control tick: the link's description is formatted only for a complaint.
         senders, state_writers, command_writers = self.peers()
-        where = self.link.describe()
         if senders > 1 or (state_writers or 0) > 1:
             n = max(senders, state_writers or 0)
-            return (f"{n} publishers on {LOWSTATE_TOPIC} ({senders} sent within the last second) on {where}: another "
-                    "robot or program publishes robot state on this domain and partition")
+            return (f"{n} publishers on {LOWSTATE_TOPIC} ({senders} sent within the last second) on "
+                    f"{self.link.describe()}: another robot or program publishes robot state on this domain and "
+                    "partition")
         if command_writers:
             return (f"{command_writers} other writer{'s' if command_writers > 1 else ''} of {LOWCMD_TOPIC} on "
-                    f"{where}: another program commands this robot")
+                    f"{self.link.describe()}: another program commands this robot")
         return None
 
     def refresh_peers(self) -> None:

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 from g1_control.errors import LaunchFileError
 from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, Tracker
-from g1_control.launch.schema import LaunchFile
+from g1_control.launch.schema import SKELETON_GENERATORS, LaunchFile
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.safety import SafetyConfig, SafetyFilter
 from g1_control.safety.fall import FallMonitor
@@ -78,9 +78,6 @@ def make_tracker(launch: LaunchFile) -> Tracker:
     raise LaunchFileError(f"tracker.type: unknown tracker '{cfg.type}'")
 
 
-LEARNED_GENERATORS = ("backbone", "learned_motion_matching")
-
-
 def command_limits(launch: LaunchFile, tracker_limits: CommandLimits | None) -> CommandLimits:
     """The one source of operator velocity limits: the launch file's `limits` within the range the
     tracker can follow (Tracker.command_limits). Teleop sticks scale to it; the generator clamps to it."""
@@ -102,7 +99,7 @@ def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
     from g1_control.generator.factory import make_generator as make_named
 
     skeleton = "g1_29dof"
-    if cfg.type in LEARNED_GENERATORS + ("motion_matching",):
+    if cfg.type in SKELETON_GENERATORS:
         from g1_control.generator.skeleton import skeleton_for_robot
 
         skeleton = skeleton_for_robot(launch.backend.expected_variant, launch.backend.hands)

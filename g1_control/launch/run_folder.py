@@ -1,9 +1,11 @@
 """The run folder, written as the run goes: `g1 launch` and `g1 deploy` alike.
 
-    folder = RunFolder.create(out_root, launch, kind="launch")
+    folder = RunFolder.create(out_root, launch)
     folder.attach(loop)                 # the loop's per-tick log now streams into folder/log/
     ...                                 # run; folder.event({...}) for anything else worth keeping
-    log = folder.close("completed", "duration reached", summary)   # log.npz + summary.json
+    log = folder.close_log(loop)        # the whole log, read back (the run's figures come from it)
+    folder.write_npz(log)               # log.npz
+    folder.finish("completed", "duration reached", summary)   # summary.json
 
 Layout (documented for users in the README, "The run folder"):
 
@@ -172,16 +174,8 @@ class RunFolder:
         np.savez_compressed(path, joint_names=np.array(g1.JOINT_NAMES), **log)  # type: ignore[arg-type]
         return path
 
-    def close(self, status: str, end_reason: str, summary: dict, loop=None) -> dict[str, np.ndarray]:
-        """Flush and assemble the log, write the final summary.json (status: completed, interrupted,
-        fault, error); return the whole log."""
-        log = self.close_log(loop)
-        self.write_npz(log)
-        self.finish(status, end_reason, summary)
-        return log
-
     def finish(self, status: str, end_reason: str, summary: dict) -> None:
-        """The final summary.json; the events file closes."""
+        """The final summary.json (status: completed, interrupted, fault, error); the events file closes."""
         self._write_json("summary.json", {"status": status, "end_reason": end_reason,
                                           "run_dir": str(self.run_dir), "ticks_logged": self.rows, **summary})
         if not self.closed:

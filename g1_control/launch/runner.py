@@ -269,7 +269,7 @@ def _run_loop(launch: LaunchFile, sim: MujocoBackend, loop: ControlLoop, segment
                                    "finished": program.done and not program.runner.stopped,
                                    "pose": program.pose_source}
     if folder is not None:
-        write_run_folder(result, launch, folder, log, None if interrupted else video, interrupted, loop)
+        write_run_folder(result, launch, loop, folder, log, video, interrupted)
     if interrupted is not None:
         raise interrupted
     return result
@@ -333,21 +333,21 @@ def _result(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], wall
     )
 
 
-def write_run_folder(result: RunResult, launch: LaunchFile, folder: RunFolder, log: dict[str, np.ndarray],
-                     video: bool | None, interrupted: KeyboardInterrupt | None = None,
-                     loop: ControlLoop | None = None) -> Path:
+def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, folder: RunFolder,
+                     log: dict[str, np.ndarray], video: bool | None,
+                     interrupted: KeyboardInterrupt | None = None) -> Path:
     """Close `folder`: log.npz, the plot, the video (not after a signal), summary.json with the end reason."""
     run_dir = folder.run_dir
     result.run_dir = run_dir
     folder.write_npz(log)
-    watcher = getattr(loop, "goal_watcher", None) if loop is not None else None
+    watcher = getattr(loop, "goal_watcher", None)
     if watcher is not None:  # ground truth of the goals: hand points, soles, boxes (launch/outcomes.py)
         np.savez_compressed(run_dir / "truth.npz", **watcher.arrays())
     if launch.output.plot:
         from g1_control.launch.plots import plot_run
 
         plot_run(log, result, run_dir / "velocity.png")
-    want_video = video if video is not None else (launch.output.video in (True, "auto") and interrupted is None)
+    want_video = interrupted is None and (video if video is not None else launch.output.video in (True, "auto"))
     if want_video:
         from g1_control.launch.overlay import run_overlay_rows
         from g1_control.sim.render import render_video
@@ -357,10 +357,10 @@ def write_run_folder(result: RunResult, launch: LaunchFile, folder: RunFolder, l
                                launch.output.video_size, overlay=overlay, extra=_scene_arrays(launch, loop))
         result.video = str(run_dir / "video.mp4") if backend else None
         result.extra["render_backend"] = backend
+    trip = next((e for e in result.events if "damping" in e["detail"]), None)
     if interrupted is not None:
         status, reason = "interrupted", str(interrupted)
-    elif _tripped(result):
-        trip = next(e for e in result.events if "damping" in e["detail"])
+    elif trip is not None:
         status, reason = "fault", f"{trip['kind']}: {trip['detail']}"
     else:
         status, reason = "completed", f"duration reached ({result.duration_s:.1f} s)"
@@ -368,9 +368,9 @@ def write_run_folder(result: RunResult, launch: LaunchFile, folder: RunFolder, l
     return run_dir
 
 
-def _scene_arrays(launch: LaunchFile, loop: ControlLoop | None) -> dict | None:
+def _scene_arrays(launch: LaunchFile, loop: ControlLoop) -> dict | None:
     """The scene and where its boxes were (ground truth), for the video; None without a scene."""
-    watcher = getattr(loop, "goal_watcher", None) if loop is not None else None
+    watcher = getattr(loop, "goal_watcher", None)
     if launch.scene.empty or watcher is None:
         return None
     truth = watcher.arrays()
@@ -379,10 +379,6 @@ def _scene_arrays(launch: LaunchFile, loop: ControlLoop | None) -> dict | None:
         if key.startswith("box_") and len(rows):
             out["object_" + key.removeprefix("box_")] = rows
     return out
-
-
-def _tripped(result: RunResult) -> bool:
-    return any("damping" in e["detail"] for e in result.events)
 
 
 def summary_dict(result: RunResult) -> dict:

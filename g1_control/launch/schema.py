@@ -26,6 +26,10 @@ VARIANT_NAMES = ("g1_23dof", "g1_29dof", "g1_29dof_locked_waist")
 PROGRAM_END_HOLD_S = 1.0
 """A program run goes on this long after its last step (the robot comes to rest; measured)."""
 
+SKELETON_GENERATORS = ("backbone", "learned_motion_matching", "motion_matching")
+"""generator.type values that generate for the robot variant's skeleton (backend.expected_variant,
+backend.hands): checked when the launch file is read, chosen when the loop is built."""
+
 MIN_WBC_TRACKER_HZ = 100.0
 """The whole-body controller's slowest rate in use: every task of issue 17 (standing at any height,
 reaching, holding and carrying a box, stepping onto a platform) was tracked at 100 Hz as at
@@ -341,7 +345,7 @@ class LaunchFile:
             if unknown:
                 raise LaunchFileError(f"generator.reference_params: {', '.join(unknown)} not a parameter of reference "
                                       f"'{self.generator.reference}'; known: {', '.join(accepted)}")
-        if self.generator.type in ("backbone", "learned_motion_matching", "motion_matching"):
+        if self.generator.type in SKELETON_GENERATORS:
             self._check_generator_variant()
         if self.tracker.type in ("wbc", "layer"):
             if self.rates.tracker_hz < MIN_WBC_TRACKER_HZ:

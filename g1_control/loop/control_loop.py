@@ -39,8 +39,6 @@ class RunLog:
     capacity: int
     sink: Callable[[dict[str, np.ndarray]], None] | None = None
     n: int = 0
-    total: int = 0
-    """Rows logged so far, over every chunk."""
     t_s: np.ndarray = field(init=False)
     command: np.ndarray = field(init=False)          # operator (vx, vy, wz)
     policy_command: np.ndarray = field(init=False)   # after velocity correction
@@ -141,7 +139,6 @@ class ControlLoop:
         self._kin_ref: KinematicReference | None = None
         self._joint_ref: JointReference | None = None
         self._state_tick = -1
-        self._misses_seen = 0
         self.safety.on_event = self._on_safety_event
 
     # -- lifecycle ---------------------------------------------------------------------------------
@@ -254,7 +251,6 @@ class ControlLoop:
             late = self.scheduler.take_lateness()
             self.safety.report_deadline(late > self.safety.config.overrun_lateness_s, self.now_s(),
                                         f"{late * 1000:.0f} ms late" if late > 0 else "")
-            self._misses_seen = self.scheduler.deadline_misses
         now = self.now_s()
         self.motor_command = self.safety.filter(self._tracker_command, self.state, now)
         if self.falls.fall is None:
@@ -318,4 +314,3 @@ class ControlLoop:
         log.style_id[i] = log.style_index(self.command.style)
         log.tau_nm[i] = s.tau_nm
         log.n = i + 1
-        log.total += 1

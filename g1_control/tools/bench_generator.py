@@ -218,7 +218,7 @@ def _cylinder_goal(rng, frame, r=(0.25, 1.5), z=(0.8, 1.25)):
     """A goal point in a cylinder around a robot frame (uniform over the annulus' area, any
     direction around the robot, height in z)."""
     radius = np.sqrt(rng.uniform(r[0] ** 2, r[1] ** 2))
-    yaw = float(np.arctan2(frame[4], frame[3])) + rng.uniform(-np.pi, np.pi)
+    yaw = float(F.heading(frame)) + rng.uniform(-np.pi, np.pi)
     return np.array([frame[0] + radius * np.cos(yaw), frame[1] + radius * np.sin(yaw), rng.uniform(*z)])
 
 

@@ -28,7 +28,9 @@ from pathlib import Path
 _ROOT = Path(__file__).resolve().parents[2]
 
 
-def _g1(*args: str, **kwargs) -> subprocess.Popen:
+def g1_subprocess(*args: str, **kwargs) -> subprocess.Popen:
+    """`python -m g1_control.cli.main *args` with this checkout first on PYTHONPATH, in the caller's
+    working directory (text mode, line-buffered; kwargs go to Popen)."""
     env = {**os.environ, "PYTHONPATH": str(_ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
     return subprocess.Popen([sys.executable, "-m", "g1_control.cli.main", *args], env=env, text=True,
                             bufsize=1, **kwargs)
@@ -44,7 +46,7 @@ def measure(launch: str = "launch/sim2sim.yaml", generator: bool = False) -> dic
     if not Path(launch).is_file():
         raise FileNotFoundError(f"{launch}: no such launch file")
     partition = f"g1measure-{os.getpid()}-{uuid.uuid4().hex[:6]}"
-    robot = _g1("sim-robot", "--lower-gantry-on-policy", "--partition", partition, "--control-stdin",
+    robot = g1_subprocess("sim-robot", "--lower-gantry-on-policy", "--partition", partition, "--control-stdin",
                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
     to_robot, from_robot = robot.stdin, robot.stdout
     assert to_robot is not None and from_robot is not None  # both opened as pipes just above
@@ -60,7 +62,7 @@ def measure(launch: str = "launch/sim2sim.yaml", generator: bool = False) -> dic
             raise RuntimeError("the emulator did not start")
         with tempfile.TemporaryDirectory() as tmp:
             report_path = Path(tmp) / "deploy.json"
-            host = _g1("deploy", launch, "--yes", "--partition", partition, "--json", str(report_path),
+            host = g1_subprocess("deploy", launch, "--yes", "--partition", partition, "--json", str(report_path),
                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
             samples = []
             next_style_s, walking = None, False

@@ -34,6 +34,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from g1_control.tools.measure_sim2sim import g1_subprocess
+
 _ROOT = Path(__file__).resolve().parents[2]
 STICKS = {"ly": (-0.3, 0.7), "lx": (-0.3, 0.3), "rx": (-0.5, 0.5)}
 """Random stick ranges (the remote's own scale, [-1, 1]): forward, sideways, turning."""
@@ -45,10 +47,8 @@ class G1Process:
     in the caller's working directory (where a deploy's run folder goes, as for `g1 deploy` itself)."""
 
     def __init__(self, *args: str, stdin: bool = False):
-        env = {**os.environ, "PYTHONPATH": str(_ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
-        self.proc = subprocess.Popen([sys.executable, "-m", "g1_control.cli.main", *args], env=env,
-                                     stdin=subprocess.PIPE if stdin else subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                     stderr=subprocess.PIPE, text=True, bufsize=1)
+        self.proc = g1_subprocess(*args, stdin=subprocess.PIPE if stdin else subprocess.DEVNULL,
+                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE)
         stdout, stderr = self.proc.stdout, self.proc.stderr
         assert stdout is not None and stderr is not None  # both are pipes
         self.lines: queue.Queue[str] = queue.Queue()
