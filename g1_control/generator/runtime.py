@@ -148,8 +148,6 @@ class InbetweeningGenerator(Generator):
         self.skeleton = S.skeleton(skeleton)
         self.present = F.present_mask(self.skeleton.present)
         self.feedback = feedback
-        self._q_lo = np.where(self.skeleton.present, self.skeleton.q_min, 0.0)
-        self._q_hi = np.where(self.skeleton.present, self.skeleton.q_max, 0.0)
         self._reach: dict[str, list] = {}
         self._goal_offset: dict[str, tuple] = {}
         self._gap_goals: list[tuple] = []  # (frame, columns, value given, goal name, goal point)
@@ -433,7 +431,7 @@ class InbetweeningGenerator(Generator):
             weights = self.feedback.frame_weights(len(frames), goal_frames, key.gap if goal_frames else None,
                                                   frames, eff)
             frames = self.feedback.apply(frames, weights)
-        frames[:, F.JOINT_SLOTS] = np.clip(frames[:, F.JOINT_SLOTS], self._q_lo, self._q_hi)
+        frames[:, F.JOINT_SLOTS] = np.clip(frames[:, F.JOINT_SLOTS], self.skeleton.q_min, self.skeleton.q_max)
         frames[:, _WAIST_LEAN] = np.clip(frames[:, _WAIST_LEAN], -cfg.max_waist_lean_rad, cfg.max_waist_lean_rad)
         lo, _, hi = self._style_stats(key.style).pelvis_height_m
         floor = min(lo, key.values[2]) - cfg.height_margin_m
