@@ -61,13 +61,6 @@ class Mixture:
         r /= r.sum(axis=1, keepdims=True)
         return r, np.sqrt(m2 / z.shape[1])
 
-    def log_likelihood(self, z: np.ndarray) -> np.ndarray:
-        diff = z[:, None, :] - self.means[None]
-        m2 = (diff * diff / self.variances[None]).sum(-1)
-        logp = (np.log(self.weights)[None] - 0.5 * m2 - 0.5 * np.log(2 * np.pi * self.variances).sum(-1)[None])
-        top = logp.max(axis=1, keepdims=True)
-        return (top + np.log(np.exp(logp - top).sum(axis=1, keepdims=True)))[:, 0]
-
 
 def save_mixtures(mixtures: dict[str, dict[str, Mixture]], path: Path) -> None:
     blob = {}
@@ -97,7 +90,6 @@ class ReferenceFeedback:
         self.fade_frames = fade_frames
         self.near_m = near_m
         self.style = "default"
-        self.enabled = True
 
     @classmethod
     def load(cls, path: str | Path, skeleton: str, **kwargs) -> ReferenceFeedback:
@@ -133,7 +125,7 @@ class ReferenceFeedback:
     def apply(self, frames: np.ndarray, weights: np.ndarray) -> np.ndarray:
         """frames (n, D) (any planar frame: the covered features are frame-invariant) -> corrected."""
         m = self.mixture
-        if not self.enabled or m is None or not np.any(weights > 0):
+        if m is None or not np.any(weights > 0):
             return frames
         z = frames[:, m.columns]
         r, d = m.responsibilities(z)

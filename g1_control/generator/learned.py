@@ -17,14 +17,14 @@ import numpy as np
 
 from g1_control.generator import features as F
 from g1_control.generator import skeleton as S
-from g1_control.generator.inbetween import Inbetweener, fill_target, interpolate
+from g1_control.generator.inbetween import MAX_GAP, Inbetweener, fill_target, interpolate
 
 SHIPPED_DIR = Path(__file__).resolve().parents[1] / "policies" / "generator"
 """policies/generator/: the shipped model (trained on every skeleton)."""
 MODEL_FORMAT = 2
 PATCH = 2
-MAX_GAP_FRAMES = 30
-PADDED_GAP = MAX_GAP_FRAMES + (MAX_GAP_FRAMES % PATCH)
+"""Frames per token of the backbone (training/backbone.py)."""
+PADDED_GAP = -(-MAX_GAP // PATCH) * PATCH
 """The exported graph's fixed gap length (frames); shorter gaps are masked inside it."""
 
 

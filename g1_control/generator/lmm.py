@@ -25,14 +25,15 @@ are blended out across the gap.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
 from g1_control.generator import features as F
 from g1_control.generator.inbetween import Inbetweener, fill_target
+from g1_control.generator.learned import model_info
 from g1_control.generator.styles import STYLES
+from g1_control.rotations import wrap_angle
 
 SHIPPED_LMM_DIR = Path(__file__).resolve().parents[1] / "policies" / "generator" / "lmm"
 FPS = 30.0
@@ -100,11 +101,11 @@ def clip_database(feats: np.ndarray, style: int) -> tuple[np.ndarray, np.ndarray
 
 def pose_features(cur: np.ndarray, nxt: np.ndarray) -> np.ndarray:
     """Frames (N, D) and their successors -> poses y (N, Y_DIM) in each frame's heading frame."""
-    yaw = _yaw(cur)
+    rot = F.rot6d_to_matrix(cur[:, F.ROOT_ROT])
+    yaw = F.yaw_of_matrix(rot)
     n = cur.shape[0]
     y = np.zeros((n, Y_DIM))
     y[:, 0] = cur[:, 2]
-    rot = F.rot6d_to_matrix(cur[:, F.ROOT_ROT])
     local = np.einsum("nji,njk->nik", F.rot_z(yaw), rot)
     y[:, 1:4], y[:, 4:7] = local[:, :, 0], local[:, :, 1]
     y[:, 7:50] = cur[:, F.JOINT_SLOTS]
@@ -113,7 +114,7 @@ def pose_features(cur: np.ndarray, nxt: np.ndarray) -> np.ndarray:
     v = (nxt[:, F.ROOT_POS] - cur[:, F.ROOT_POS]) * FPS
     v[:, :2] = _rot2(v[:, :2], yaw)
     y[:, 65:68] = v
-    y[:, 68] = ((_yaw(nxt) - yaw + np.pi) % (2 * np.pi) - np.pi) * FPS
+    y[:, 68] = wrap_angle(_yaw(nxt) - yaw) * FPS
     return y
 
 
@@ -126,8 +127,8 @@ def query_features(context: np.ndarray, target_full: np.ndarray, target_mask: np
     cur, prev = context[:, -1], context[:, -2]
     zero = np.zeros(b)
     q = np.zeros((b, X_DIM))
-    q[:, 0:6] = _local_points(cur[:, FOOT_COLS].reshape(b, 2, 3), cur[:, F.ROOT_POS], _yaw(cur)).reshape(b, 6)
     y0 = _yaw(cur)
+    q[:, 0:6] = _local_points(cur[:, FOOT_COLS].reshape(b, 2, 3), cur[:, F.ROOT_POS], y0).reshape(b, 6)
     dv = (cur[:, FOOT_COLS] - prev[:, FOOT_COLS]).reshape(b, 2, 3) * FPS
     dv[..., :2] = _rot2(dv[..., :2], y0[:, None])
     q[:, 6:12] = dv.reshape(b, 6)
@@ -137,7 +138,7 @@ def query_features(context: np.ndarray, target_full: np.ndarray, target_mask: np
     root_given = target_mask[:, 0] & target_mask[:, 1]
     end_xy = np.where(root_given[:, None], target_full[:, 0:2], cur[:, 0:2])
     end_yaw = np.where(target_mask[:, 3], _yaw(target_full), y0)
-    dyaw_end = (end_yaw - y0 + np.pi) % (2 * np.pi) - np.pi
+    dyaw_end = wrap_angle(end_yaw - y0)
     for k, off in enumerate(TRAJ_OFFSETS):
         a = min(1.0, off / (gap + 1))
         p = cur[:, 0:2] + a * (end_xy - cur[:, 0:2])
@@ -185,8 +186,7 @@ class LearnedMotionMatchingInbetweener(Inbetweener):
         path = folder / "lmm.onnx"
         if not path.is_file():
             raise FileNotFoundError(f"{path}: no learned-motion-matching model; train one with `g1 train lmm`")
-        info = json.loads((folder / "model.json").read_text()) if (folder / "model.json").is_file() else {}
-        trained = info.get("skeletons", ["g1_29dof"])
+        trained = model_info(path).get("skeletons", ["g1_29dof"])
         if skeleton not in trained:
             from g1_control.generator.skeleton import SkeletonError
 
@@ -216,6 +216,5 @@ class LearnedMotionMatchingInbetweener(Inbetweener):
         # the heading offset as a rotation of the root path about the start, not a 6D blend
         alpha = (np.arange(1, gap + 1) / (gap + 1))[None, :, None]
         out = frames[:, 1:gap + 1] + (1 - alpha) * start_off[:, None] + alpha * end_off[:, None]
-        rot = F.rot6d_to_matrix(out[..., F.ROOT_ROT])
-        out[..., 3:6], out[..., 6:9] = rot[..., :, 0], rot[..., :, 1]
+        F.orthonormalize_rot6d(out)
         return out

@@ -55,7 +55,7 @@ def spring_root_trajectory(start: RootState, v_cmd_heading: np.ndarray, wz_cmd: 
     """
     n = max(1, round(horizon_s / dt_s))
     decay = math.exp(-LN2 / cfg.velocity_halflife_s * dt_s)
-    weights, powers, _k, t = _spring_weights(n, decay, dt_s)
+    weights, powers, t = _spring_weights(n, decay, dt_s)
     vx = min(max(float(v_cmd_heading[0]), -cfg.max_vx_mps), cfg.max_vx_mps)
     vy = min(max(float(v_cmd_heading[1]), -cfg.max_vy_mps), cfg.max_vy_mps)
     wz_cmd = min(max(float(wz_cmd), -cfg.max_wz_radps), cfg.max_wz_radps)
@@ -81,16 +81,16 @@ def spring_root_trajectory(start: RootState, v_cmd_heading: np.ndarray, wz_cmd: 
 
 @functools.lru_cache(maxsize=16)
 def _spring_weights(n: int, decay: float, dt_s: float) -> tuple[np.ndarray, ...]:
-    """The velocity spring's (n, n) lower-triangular weights, decay^k, k and t = k dt (cached: the
+    """The velocity spring's (n, n) lower-triangular weights, decay^k and t = k dt (cached: the
     same for every replan of a horizon)."""
     k = np.arange(1, n + 1)
     lag = k[:, None] - k[None, :]
     weights = np.where(lag >= 0, (1 - decay) * decay ** np.maximum(lag, 0), 0.0)
     powers = decay ** k
     t = k * dt_s
-    for a in (weights, powers, k, t):
+    for a in (weights, powers, t):
         a.setflags(write=False)
-    return weights, powers, k, t
+    return weights, powers, t
 
 
 def root_features(pos_xy: np.ndarray, height: float, yaw: float, tilt_rot: np.ndarray | None = None) -> np.ndarray:

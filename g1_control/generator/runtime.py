@@ -77,6 +77,15 @@ def hand_forward_m(goal_z: float, pelvis_z: float, most: float = 0.22) -> float:
     return float(np.clip(math.sqrt(max(0.0, ARM_REACH_M ** 2 - dz * dz)) - 0.03, 0.05, most))
 
 
+def _effector_fk(frame: np.ndarray, name: str) -> np.ndarray:
+    """An effector's position in a world-frame feature frame by forward kinematics of its root and
+    joints (the model's own pose, not its effector columns)."""
+    from g1_control.motion.kinematics import default_body_names
+
+    pos, rot = F.bodies_of(frame)
+    return F.effectors_from_bodies(pos, rot, default_body_names())[F.EFFECTOR_BODIES.index(name)]
+
+
 @dataclass
 class RuntimeConfig:
     fps: float = 30.0
@@ -148,8 +157,6 @@ class InbetweeningGenerator(Generator):
         self.skeleton = S.skeleton(skeleton)
         self.present = F.present_mask(self.skeleton.present)
         self.feedback = feedback
-        self._q_lo = np.where(self.skeleton.present, self.skeleton.q_min, 0.0)
-        self._q_hi = np.where(self.skeleton.present, self.skeleton.q_max, 0.0)
         self._reach: dict[str, list] = {}
         self._goal_offset: dict[str, tuple] = {}
         self._gap_goals: list[tuple] = []  # (frame, columns, value given, goal name, goal point)
@@ -277,8 +284,8 @@ class InbetweeningGenerator(Generator):
             if obj is None and not self._goal_active(name, values):
                 continue
             if name in ("left_wrist_yaw_link", "right_wrist_yaw_link"):  # the goal's arm is free of the style pose
-                side = 15 if name.startswith("left") else 22
-                given[9 + side:9 + side + 7] = False
+                arm = g1.ARM_JOINTS[:7] if name.startswith("left") else g1.ARM_JOINTS[7:]
+                given[[F.JOINTS.start + j for j in arm]] = False
             frame = gap - 1
             if name == g1.BASE_BODY:
                 cols = np.r_[0:3]
@@ -288,7 +295,7 @@ class InbetweeningGenerator(Generator):
                 given_point = point + self._goal_offset_for(name, point)
                 # a goal close by is reached at hand speed, not at the plan's end (replanning comes
                 # after replan_low_frames: a goal on the last frame would never be executed)
-                dist = float(np.linalg.norm(self._effector_now(name) - point))
+                dist = float(np.linalg.norm(_effector_fk(self.history[-1], name) - point))
                 frame = int(np.clip(math.ceil(dist / cfg.effector_speed_mps * cfg.fps), cfg.min_goal_frame, gap - 1))
             values[cols] = given_point
             given[cols] = True
@@ -346,13 +353,6 @@ class InbetweeningGenerator(Generator):
         prev = self._goal_offset.get(name)
         return prev[1] if prev is not None and prev[0] == tuple(np.round(point, 3)) else np.zeros(3)
 
-    def _effector_now(self, name: str) -> np.ndarray:
-        """An effector's position in the last executed frame, by FK (the model's own output)."""
-        from g1_control.motion.kinematics import default_body_names
-
-        pos, rot = F.bodies_of(self.history[-1])
-        return F.effectors_from_bodies(pos, rot, default_body_names())[F.EFFECTOR_BODIES.index(name)]
-
     def _update_goal_errors(self, frames: np.ndarray) -> None:
         """After a plan: for each effector goal, the error of the planned frame that was to reach it
         (FK of the model's joints) feeds the offset given with that goal next time (an integrator on
@@ -360,14 +360,10 @@ class InbetweeningGenerator(Generator):
         cfg = self.config
         if cfg.goal_error_gain <= 0:
             return
-        from g1_control.motion.kinematics import default_body_names
-
         for frame, _, _, name, point in self._gap_goals:
             if name is None or name == g1.BASE_BODY or frame >= len(frames):
                 continue
-            pos, rot = F.bodies_of(frames[frame])
-            reached = F.effectors_from_bodies(pos, rot, default_body_names())[F.EFFECTOR_BODIES.index(name)]
-            error = point - reached
+            error = point - _effector_fk(frames[frame], name)
             offset = self._goal_offset_for(name, point)
             if float(np.linalg.norm(error)) < cfg.goal_error_near_m:
                 offset = offset + cfg.goal_error_gain * error
@@ -433,7 +429,7 @@ class InbetweeningGenerator(Generator):
             weights = self.feedback.frame_weights(len(frames), goal_frames, key.gap if goal_frames else None,
                                                   frames, eff)
             frames = self.feedback.apply(frames, weights)
-        frames[:, F.JOINT_SLOTS] = np.clip(frames[:, F.JOINT_SLOTS], self._q_lo, self._q_hi)
+        frames[:, F.JOINT_SLOTS] = np.clip(frames[:, F.JOINT_SLOTS], self.skeleton.q_min, self.skeleton.q_max)
         frames[:, _WAIST_LEAN] = np.clip(frames[:, _WAIST_LEAN], -cfg.max_waist_lean_rad, cfg.max_waist_lean_rad)
         lo, _, hi = self._style_stats(key.style).pelvis_height_m
         floor = min(lo, key.values[2]) - cfg.height_margin_m

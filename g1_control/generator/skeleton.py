@@ -52,10 +52,6 @@ class Skeleton:
     """(NUM_SLOTS,) joint limits; absent slots (0, 0)."""
 
     @property
-    def body_present(self) -> np.ndarray:
-        return self.present[:NUM_BODY]
-
-    @property
     def has_fingers(self) -> bool:
         return bool(self.present[NUM_BODY:].any())
 

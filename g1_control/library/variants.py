@@ -82,8 +82,8 @@ def retarget_locked(clip: MotionClip, dropped: list[int], warmup: int = 10) -> t
 
     ik = _locked_ik(clip, dropped)
     names = clip.body_names
-    targets = [b for b in (*g1.HAND_BODIES, *g1.FOOT_BODIES, "left_elbow_link", "right_elbow_link",
-                           "left_knee_link", "right_knee_link", g1.TORSO_BODY)]
+    targets = [*g1.HAND_BODIES, *g1.FOOT_BODIES, "left_elbow_link", "right_elbow_link", "left_knee_link",
+               "right_knee_link", g1.TORSO_BODY]
     idx = [names.index(b) for b in targets]
     q_post = clip.joint_pos_rad.copy()
     q_post[:, dropped] = 0.0
@@ -111,8 +111,9 @@ def retarget_locked(clip: MotionClip, dropped: list[int], warmup: int = 10) -> t
                                            body_names=default_body_names(), object=clip.object, scene=tuple(clip.scene))
     hand = [out.body_names.index(b) for b in g1.HAND_BODIES]
     foot = [out.body_names.index(b) for b in g1.FOOT_BODIES]
-    err = {"hand_mean_m": float(np.linalg.norm(out.body_pos_w_m[:, hand] - clip.body_pos_w_m[:, [names.index(b) for b in g1.HAND_BODIES]], axis=-1).mean()),
-           "foot_mean_m": float(np.linalg.norm(out.body_pos_w_m[:, foot] - clip.body_pos_w_m[:, [names.index(b) for b in g1.FOOT_BODIES]], axis=-1).mean())}
+    # idx[:2] / idx[2:4]: the clip's hand and foot bodies (targets' order)
+    err = {"hand_mean_m": float(np.linalg.norm(out.body_pos_w_m[:, hand] - clip.body_pos_w_m[:, idx[:2]], axis=-1).mean()),
+           "foot_mean_m": float(np.linalg.norm(out.body_pos_w_m[:, foot] - clip.body_pos_w_m[:, idx[2:4]], axis=-1).mean())}
     return out, err
 
 

@@ -34,13 +34,11 @@ from torch import nn
 
 from g1_control.generator import features as F
 from g1_control.generator import skeleton as S
-from g1_control.generator.inbetween import CONTEXT_FRAMES, MAX_GAP
+from g1_control.generator.inbetween import CONTEXT_FRAMES
+from g1_control.generator.learned import PADDED_GAP, PATCH
 
-PATCH = 2
-"""Frames per token."""
 CONTEXT_TOKENS = CONTEXT_FRAMES // PATCH
-GAP_TOKENS = (MAX_GAP + PATCH - 1) // PATCH
-PADDED_GAP = GAP_TOKENS * PATCH
+GAP_TOKENS = PADDED_GAP // PATCH
 MAX_TOKENS = CONTEXT_TOKENS + GAP_TOKENS + 1
 
 

@@ -43,10 +43,8 @@ PELVIS_MASK = np.zeros(F.DIM, dtype=bool)
 PELVIS_MASK[F.ROOT_POS] = True
 MASK_KINDS = ("full", "root", "root+upper", "subset")
 MASK_PROBS = (0.35, 0.15, 0.15, 0.35)
-ARM_SLOTS = {"left": [g1.JOINT_INDEX[f"left_{n}_joint"] for n in ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow",
-                                                                  "wrist_roll", "wrist_pitch", "wrist_yaw")],
-             "right": [g1.JOINT_INDEX[f"right_{n}_joint"] for n in ("shoulder_pitch", "shoulder_roll", "shoulder_yaw",
-                                                                    "elbow", "wrist_roll", "wrist_pitch", "wrist_yaw")]}
+ARM_SLOTS = {"left": list(g1.ARM_JOINTS[:7]), "right": list(g1.ARM_JOINTS[7:])}
+"""Per arm: shoulder pitch, roll, yaw, elbow, wrist roll, pitch, yaw (g1.JOINT_NAMES order)."""
 ARM_RANGE = ((-2.3, 0.4), (-0.2, 1.3), (-0.9, 0.9), (-0.5, 1.7), (-0.8, 0.8), (-0.6, 0.6), (-0.6, 0.6))
 """Random reach configurations per arm joint (left arm; the right arm's roll/yaw angles mirrored)."""
 WAIST_RANGE = {"waist_yaw_joint": (-0.6, 0.6), "waist_roll_joint": (-0.15, 0.15), "waist_pitch_joint": (-0.05, 0.45)}
@@ -156,12 +154,8 @@ class WindowSampler:
             wins[i][:, cols] = (1 - a[:, None]) * wins[i][:, cols] + a[:, None] * target_a[None]
             out.append((int(i), arms, end - CONTEXT_FRAMES if end < length - 1 else -1))
         idx = [r[0] for r in out]
-        wins[idx] = F.fix_effectors(wins[idx]) * self.present_full(present[idx])
+        wins[idx] = F.fix_effectors(wins[idx]) * present[idx][:, None, :].astype(float)
         return out
-
-    @staticmethod
-    def present_full(present: np.ndarray) -> np.ndarray:
-        return present[:, None, :].astype(float)
 
     def sample(self, batch: int, gap: int | None = None) -> dict[str, np.ndarray]:
         gap = gap or int(self.rng.integers(self.min_gap, MAX_GAP + 1))

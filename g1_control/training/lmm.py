@@ -75,15 +75,14 @@ def build_database(library_root, skeleton: str):
     return np.concatenate(xs), np.concatenate(ys), starts
 
 
-def _pose_fk_torch(y, y_mean, y_std):
+def _pose_fk_torch(y):
     """Body positions (N, 30, 3) of poses y (raw units) in their heading frame (root xy at 0)."""
     import torch
 
     from g1_control.generator.fk import fk_torch
     from g1_control.training.train import _rot6d_torch
 
-    root = torch.zeros(y.shape[0], 3, dtype=y.dtype)
-    root = torch.cat([root[:, :2], y[:, 0:1]], dim=-1)
+    root = torch.cat([torch.zeros(y.shape[0], 2, dtype=y.dtype), y[:, 0:1]], dim=-1)
     pos, _ = fk_torch(root, _rot6d_torch(y[:, 1:7]), y[:, 7:36])
     return pos
 
@@ -170,7 +169,7 @@ def train_lmm(out_dir: str | Path, config: LmmTrainConfig, library_root=None, pr
         rec = (y_i - Y[i]).abs().mean() + (y_j - Y[j]).abs().mean()
         vel = ((y_j - y_i) - (Y[j] - Y[i])).abs().mean()
         raw_p, raw_t = y_i * ys + ym, Y[i] * ys + ym
-        fk = (_pose_fk_torch(raw_p, ym, ys) - _pose_fk_torch(raw_t, ym, ys)).abs().mean() * 10.0
+        fk = (_pose_fk_torch(raw_p) - _pose_fk_torch(raw_t)).abs().mean() * 10.0
         reg = 0.01 * (z_i ** 2).mean()
         return rec + vel + fk + reg, {"rec": rec.item(), "fk": fk.item()}
 

@@ -20,6 +20,7 @@ import numpy as np
 
 from g1_control.errors import G1ControlError
 from g1_control.generator import features as F
+from g1_control.generator.data import load_split
 
 
 @dataclass
@@ -184,13 +185,6 @@ def check_splits(library_root: str | Path | dict | None) -> None:
         if max(e.num_frames for e in entries) < need:
             raise LibraryError(f"{lib.root}: no clip of the '{split}' ({what}) split has the {need} frames a "
                                "training window needs")
-
-
-def load_split(library_root: str | Path | None, split: str, variant: str | None = None):
-    """(features per clip, style ids) of a library split (generator/data.py)."""
-    from g1_control.generator.data import load_split as load
-
-    return load(library_root, split, variant)
 
 
 def load_skeletons(skeletons, split: str, library_roots: dict | None = None):
