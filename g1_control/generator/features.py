@@ -90,6 +90,11 @@ def orthonormalize_rot6d(frames: np.ndarray) -> None:
     frames[..., 6], frames[..., 7], frames[..., 8] = y0, y1, y2
 
 
+def heading(frames: np.ndarray) -> np.ndarray:
+    """Yaw of the pelvis x axis of feature frames (...,)."""
+    return np.arctan2(frames[..., 4], frames[..., 3])
+
+
 def world_features(root_pos: np.ndarray, root_rot: np.ndarray, joints: np.ndarray,
                    effectors: np.ndarray, fingers: np.ndarray | None = None) -> np.ndarray:
     """(T, 3), (T, 3, 3), (T, 29), (T, NUM_EFFECTORS, 3)[, (T, 14)] world quantities -> (T, D)
