@@ -62,7 +62,8 @@ def register(subparsers) -> None:
     parser.add_argument("--no-release-motion-service", dest="release", action="store_false", default=None,
                         help="do not release the robot's built-in motion service (robot already in debug mode "
                         "via the remote)")
-    parser.add_argument("--interface", help="override backend.interface (e.g. lo for g1 sim-robot)")
+    parser.add_argument("--interface", help="override backend.interface (e.g. lo for g1 sim-robot; auto: the one NIC on "
+                        "192.168.123.0/24; g1 doctor checks the way to the robot first)")
     parser.add_argument("--domain", type=int, help="override backend.domain (robot 0, simulation 1)")
     parser.add_argument("--partition", help="override backend.partition (isolates concurrent runs on one host)")
     parser.add_argument("--duration", type=float, help="length of the control phase in seconds, then damping "
