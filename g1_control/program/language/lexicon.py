@@ -12,7 +12,10 @@ import math
 from dataclasses import dataclass
 
 FILLERS = frozenset(["please", "kindly", "the", "your", "you", "yourself", "robot", "now", "just", "ok", "okay", "hey", "also", "again", "carefully", "still", "can", "could", "would", "my", "its",
-                     "here", "there", "me", "us", "little", "some"])
+                     "here", "there", "me", "us", "little", "some",
+                     # issue 27's everyday set: hedges and spoken fillers
+                     "about", "roughly", "approximately", "like", "um", "uh", "erm", "so",
+                     "alright", "real", "really"])
 """Dropped before anything else ("please", "the", "robot", ...)."""
 
 ARTICLES = frozenset({"a", "an"})
@@ -43,7 +46,11 @@ at same time | simultaneously | in parallel | at once while | together => SAMETI
 square => SHAPE:square
 # locomotion
 walk | walking | walks | go | going | goes | move | moving | moves | head | travel | proceed | come | coming
-    | step | stepping | stroll | march | sidestep | side step | strafe | shuffle => WALK
+    | step | stepping | march | marching | sidestep | side step | strafe | shuffle | shuffling | advance
+    | advancing | scoot | scooting => WALK
+jog | jogging | run | running | hurry | hurrying | rush | rushing | dash => WALK SPEED:fast
+stroll | strolling | amble | ambling | saunter | sauntering => WALK SPEED:slow
+retreat | retreating => WALK backward
 return | returning | go back | come back | head back | walk back to | get back | move back => WALK back
 approach | approaching => WALK to
 back up | backing up | reverse => WALK backward
@@ -73,12 +80,13 @@ quickly | quick | fast | faster | rapidly | briskly | swiftly | fast pace | quic
     | fast speed => SPEED:fast
 within | in under | in less than | at most | no more than | no longer than => WITHIN
 wait | waiting | pause | pausing | stay | staying | rest | resting | stop | stopping | halt | hold | stand
-    | standing | stand still | stay still | hold still | keep still | remain | stay put | freeze | wait there => WAIT
+    | standing | stand still | stay still | hold still | keep still | remain | stay put | freeze | wait there
+    | hang on | hold on | chill => WAIT
 # styles
 wave | waving | waves | wave hand | wave hands | waving hand | wave hello | wave goodbye | say hello
     | wave your hand => STYLE:wave
 dance | dancing | dances => STYLE:dance
-look around | looking around | looks around => STYLE:look_around
+look around | looking around | looks around | glance around | glancing around => STYLE:look_around
 swing arms | swinging arms | arm swing | arms swinging | swing arm | swinging arm => STYLE:arm_swing
 arms out | arms spread | spread arms | spreading arms | stretch arms out | stretch out arms | hold arms out
     | holding arms out | put arms out | with arms out | arms outstretched | outstretched arms
@@ -89,16 +97,16 @@ reach up | reaching up | raise arms | raising arms | raise hands | raising hands
     | put hands up | put arms up | lift arms | with hands up | with arms up | arms raised | with arms raised
     | raised arms | with raised arms | hold arms up | hold hands up | arms in air | hands in air => STYLE:reach_up
 arms down | lower arms | relax arms | put arms down | normal style | default style | default => STYLE:default
-carry | carrying | carries | bring | bringing | deliver | delivering => CARRY
+carry | carrying | carries | bring | bringing | deliver | delivering | haul | hauling => CARRY
 lift | lifting => LIFT
 climb | climbing => CLIMB
-style | pose | mode | posture => STYLEWORD
+style | pose | mode | posture | stance => STYLEWORD
 use | using style | switch to | change to | switch into | change into | set style to | set style | adopt
     | assume | switch | go into | get into => SELECT
 # height
 crouch | crouching | crouched | squat | squatting | duck | ducking | get down | crouch down | squat down
     | go low | get low | bend knees | bend down | crouch low | crouch down low | squat low | squat down low
-    | get down low => HEIGHT:crouch
+    | get down low | duck down => HEIGHT:crouch
 stand up | get up | rise | straighten up | normal height | get back up | stand back up | come back up
     | get up again | stand up again => HEIGHT:normal
 stand tall | stand up tall | stand up straight | stand straight | standing tall | stand at full height
