@@ -71,6 +71,12 @@ class _Slots:
     counts: list = field(default_factory=list)
     body: list = field(default_factory=list)
     shapes: list = field(default_factory=list)
+    circle: list = field(default_factory=list)
+    """An angle that came from "circle" ("walk in a circle": a path; "spin a full circle": a turn)."""
+    sizes: list = field(default_factory=list)
+    """RADIUS / DIAMETER: what the clause's length measures ("a circle with a radius of 2 m")."""
+    out: list = field(default_factory=list)
+    """"reach out": forward unless a direction is named."""
     other: list = field(default_factory=list)
 
 
@@ -175,6 +181,7 @@ class StepBuilder:
             pending = None if v not in ("HEADING", "WITHIN", "in") else v
             if v in MAIN_VERBS:
                 s.verbs.append((v, t))
+                prep = None  # "use both hands to pick up the box": the 'to' was the verb's, not the box's
             elif v.startswith("STYLE:"):
                 s.styles.append((v[6:], t))
             elif v.startswith("HEIGHT:"):
@@ -200,6 +207,12 @@ class StepBuilder:
                 s.body.append((v, t))
             elif v.startswith("SHAPE:"):
                 s.shapes.append((v[6:], t))
+            elif v == "CIRCLE":
+                s.circle.append((v, t))
+            elif v in ("RADIUS", "DIAMETER"):
+                s.sizes.append((v, t))
+            elif v == "OUT":
+                s.out.append((v, t))
             elif v in ("STYLEWORD", "HEADING", "WITHIN"):
                 pass
             else:
@@ -239,6 +252,12 @@ class StepBuilder:
         def timeout() -> float | None:
             return one("timeouts", "time limit")
 
+        if len(s.verbs) > 1 and s.verbs[0][0] == "SELECT" and s.hands:  # "use your left hand to touch the cup"
+            s.verbs = s.verbs[1:]
+            verb = _main_verb(s)
+        if verb is None and s.hands and not (s.styles or s.heights or s.places or s.lengths or s.directions):
+            state.pending_hand = one("hands", "hand")  # "with your left hand, reach out to the left"
+            return []
         if verb is None:
             if s.styles and not s.heights:
                 verb = "STYLE"
@@ -263,17 +282,36 @@ class StepBuilder:
         if verb == "WALK" and any(prep is None for (prep, _), _t in s.places) and \
                 any(prep in TARGET_PREPS for (prep, _), _t in s.places):
             steps = self._manipulate(s, "CARRY", where, state, one, place, timeout, take)  # "move the box to X"
+        elif verb == "WALK" and s.circle:
+            steps = [self._circle(s, where, one, take)]
         elif verb == "WALK" and s.shapes:
-            steps = [self._shape(s, where, one, take)]
+            steps = self._shape(s, where, one, take)
+        elif verb == "WALK" and _moves_an_object(s):  # "move the box 1 meter to the right"
+            obj = state.resolve(s.places[0][0][1], s.places[0][1])
+            s.places = []
+            steps = [] if state.held == obj else [Pick(obj)]
+            steps += [self._walk(s, where, state, one, place, timeout, take), Place(obj)]
+            state.held = None
         elif verb == "WALK":
             steps = [self._walk(s, where, state, one, place, timeout, take)]
         elif verb in ("TURN", "FACE"):
             steps = [self._turn(s, verb, where, state, one, place, timeout, take)]
+        elif verb == "WAIT" and s.places and all(prep is None for (prep, _), _t in s.places):  # "hold the box"
+            steps = self._manipulate(s, "PICK", where, state, one, place, timeout, take)
         elif verb == "WAIT":
             d = one("durations", "duration")
             if d is None:
                 d = one("numbers", "number")
             steps = [Stand(d if d is not None else c.wait_s)]
+        elif verb in ("STYLE", "SELECT", "HEIGHTSET") and s.hands and not s.body and \
+                (verb == "HEIGHTSET" or s.styles[0][0] in ("reach_up", "lift")):
+            # "reach up with the right hand", "raise your left hand", "lift your right hand 20 cm": that hand
+            hand = one("hands", "hand")
+            lowered = verb == "HEIGHTSET" and state.text(s.verbs[0][1]).startswith("lower")
+            dist = one("lengths", "distance")
+            dist = c.reach_m if dist is None else dist
+            steps = [Reach(hand, None, (0.0, 0.0, -dist if lowered else dist), timeout())]
+            s.styles = []
         elif verb in ("STYLE", "SELECT"):
             if s.hands:
                 raise InstructionError(f"\"{where}\": a style is a whole upper-body pose; \"{state.text(s.hands[0][1])}\" "
@@ -301,11 +339,15 @@ class StepBuilder:
             steps = [Height(h, None if h is not None else posture, d)]
             s.heights = []
         elif verb == "REACH":
-            hand = one("hands", "hand") or "right"
+            hand = one("hands", "hand") or state.pending_hand or "right"
+            state.pending_hand = None
             targets = place()
             if len(targets) > 1:
                 raise InstructionError(f"\"{where}\": reach for one place at a time")
+            take("out")
             d = one("directions", "direction")
+            if d is None and s.out:
+                d = "forward"
             length = one("lengths", "distance")
             offset: tuple[float, float, float] | None = None
             if d is not None or length is not None:
@@ -319,6 +361,24 @@ class StepBuilder:
                 raise InstructionError(f"\"{where}\": reach for what? a place (\"the cup\") or a direction "
                                        "(\"forward 20 cm\")")
             steps = [Reach(hand, targets[0] if targets else None, offset, timeout())]
+        elif verb == "PLACE" and s.hands and state.held is None and s.places and \
+                all(prep in TARGET_PREPS for (prep, _), _t in s.places):
+            # "put your right hand on the table": nothing in hand, a hand named: a reach to the place
+            hand = one("hands", "hand")
+            targets = place()
+            steps = [Reach(hand, targets[0], None, timeout())]
+        elif verb in ("PICK", "LIFT", "CARRY", "PLACE") and (s.lengths or s.durations) and \
+                any(d in ("forward", "backward", "left", "right") for d, _ in s.directions):
+            # "carry the box forward 3 meters", "take it 2 meters to the left": pick (unless held), walk
+            walk_slots = _Slots(directions=s.directions, lengths=s.lengths, durations=s.durations,
+                                speed_words=s.speed_words, speeds=s.speeds)
+            s.directions, s.lengths, s.durations, s.speed_words, s.speeds = [], [], [], [], []
+            held = state.held
+            steps = self._manipulate(s, "PICK", where, state, one, place, timeout, take)
+            if len(steps) == 1 and isinstance(steps[0], Pick) and steps[0].object == held:
+                steps = []  # already in hand: just walk with it
+            steps.append(self._walk(walk_slots, where, state, _one_of(walk_slots, where, state), lambda *_: [],
+                                    lambda: None, lambda *_: None))
         elif verb in ("PICK", "LIFT", "CARRY", "PLACE"):
             steps = self._manipulate(s, verb, where, state, one, place, timeout, take)
         elif verb in ("STEPUP", "CLIMB"):
@@ -345,7 +405,7 @@ class StepBuilder:
             take("styles", "heights")
         for name in ("select", "directions", "back", "around", "sideways", "places", "hands", "speed_words",
                      "lengths", "angles", "headings", "durations", "timeouts", "speeds", "rates", "numbers", "body",
-                     "shapes"):
+                     "shapes", "circle", "sizes", "out"):
             items = getattr(s, name)
             if items and name not in used:
                 raise InstructionError(f"could not use \"{state.text(items[0][1])}\" in \"{where}\"")
@@ -358,6 +418,8 @@ class StepBuilder:
 
     def _walk(self, s: _Slots, where, state, one, place, timeout, take) -> Walk:
         c = self.conv
+        if state.held is not None:  # "walk backward 1 meter with it": the held box comes along
+            s.places = [p for p in s.places if not (p[0][0] == "with" and p[0][1] in ("IT", state.held))]
         targets = place()
         if len(targets) > 1:
             raise InstructionError(f"\"{where}\": walk to one place at a time")
@@ -393,22 +455,53 @@ class StepBuilder:
             speed = c.slow_mps if word == "slow" else c.fast_mps
         return Walk(distance, duration, target, direction or "forward", heading, speed, timeout())
 
-    def _shape(self, s: _Slots, where, one, take) -> Repeat:
-        """'walk a square of 2 meters (to the right)': 4 x (walk the side, turn 90 degrees that way)."""
-        one("shapes", "shape")
-        side = one("lengths", "side length")
-        if side is None:
-            side = one("numbers", "number")
-        if side is None:
-            raise InstructionError(f"\"{where}\": how long are the sides? e.g. \"walk a square of 1 meter\"")
-        turn = one("directions", "direction") or "left"
-        if turn not in ("left", "right"):
-            raise InstructionError(f"\"{where}\": a square turns left or right, not {turn}")
+    def _speed(self, one) -> float | None:
         speed = one("speeds", "speed")
         word = one("speed_words", "speed")
         if speed is None and word is not None:
             speed = self.conv.slow_mps if word == "slow" else self.conv.fast_mps
-        return Repeat(4, [Walk(side, speed_mps=speed), Turn(math.pi / 2, turn)])
+        return speed
+
+    def _shape(self, s: _Slots, where, one, take) -> list[Step]:
+        """'walk a square of 2 meters (to the right)': 4 x (walk the side, turn 90 degrees that way); a
+        triangle 3 x (side, 120 degrees); 'a rectangle 2 by 1 meters' 2 x (long, 90, short, 90); 'back and
+        forth 2 meters': the distance forward, then backward (facing the same way)."""
+        shape = one("shapes", "shape")
+        take("lengths", "numbers")
+        sides = [v for v, t in sorted(s.lengths + s.numbers, key=lambda vt: vt[1].i0)]  # as said: "3 by 2 meters"
+        if not sides or len(sides) > (2 if shape == "rectangle" else 1):
+            example = {"rectangle": "a rectangle 2 meters by 1 meter", "back_and_forth": "back and forth 2 meters"}
+            raise InstructionError(f"\"{where}\": how long are the sides? e.g. \"walk "
+                                   f"{example.get(shape, f'a {shape} of 1 meter')}\"")
+        speed = self._speed(one)
+        if shape == "back_and_forth":
+            return [Walk(sides[0], speed_mps=speed), Walk(sides[0], direction="backward", speed_mps=speed)]
+        turn = one("directions", "direction") or "left"
+        if turn not in ("left", "right"):
+            raise InstructionError(f"\"{where}\": a {shape} turns left or right, not {turn}")
+        if shape == "rectangle":
+            long, short = sides if len(sides) == 2 else (sides[0], sides[0])
+            return [Repeat(2, [Walk(long, speed_mps=speed), Turn(math.pi / 2, turn), Walk(short, speed_mps=speed),
+                               Turn(math.pi / 2, turn)])]
+        corners = {"square": 4, "triangle": 3}[shape]
+        return [Repeat(corners, [Walk(sides[0], speed_mps=speed), Turn(2 * math.pi / corners, turn)])]
+
+    def _circle(self, s: _Slots, where, one, take) -> Repeat:
+        """'walk in a circle (with a radius of 2 m) (to the right)': a regular octagon around it, 8 x (walk
+        2 pi r / 8, turn 45 degrees that way); a half circle is 4 of those, a quarter 2."""
+        take("circle", "sizes")
+        arc = one("angles", "circle")
+        size = one("lengths", "radius")
+        if size is None:
+            size = one("numbers", "number")
+        radius = 1.0 if size is None else size / 2 if any(v == "DIAMETER" for v, _ in s.sizes) else size
+        if radius <= 0:
+            raise InstructionError(f"\"{where}\": a circle needs a radius above zero")
+        turn = one("directions", "direction") or "left"
+        if turn not in ("left", "right"):
+            raise InstructionError(f"\"{where}\": a circle turns left or right, not {turn}")
+        segments = max(1, round(8 * arc / (2 * math.pi)))
+        return Repeat(segments, [Walk(2 * math.pi * radius / 8, speed_mps=self._speed(one)), Turn(math.pi / 4, turn)])
 
     def _turn(self, s: _Slots, verb, where, state, one, place, timeout, take) -> Turn:
         c = self.conv
@@ -425,7 +518,7 @@ class StepBuilder:
             n = one("numbers", "number")  # "turn left 90": degrees
             if n is not None:
                 angle = math.radians(n)
-        take("around", "back")
+        take("around", "back", "circle")
         if (s.around or s.back) and angle is None:
             angle = c.around_rad
         if verb == "FACE" and angle is not None and direction is None and target is None and not s.around:
@@ -506,6 +599,8 @@ class BuildState:
         self.last_place: str | None = None
         self.held: str | None = None
         self.last_sentence = (0, 0)
+        self.pending_hand: str | None = None
+        """A hand named in a clause of its own ("with your left hand, reach ..."), for the next reach."""
 
     def text(self, t: Tok) -> str:
         return join_words(self.words[t.i0:t.i1])
@@ -524,3 +619,20 @@ class BuildState:
 
 def _main_verb(s: _Slots) -> str | None:
     return s.verbs[0][0] if s.verbs else None
+
+
+def _moves_an_object(s: _Slots) -> bool:
+    """'move the box 1 meter to the right': one object (no preposition), a distance or time, no target."""
+    return (len(s.places) == 1 and s.places[0][0][0] is None and bool(s.lengths or s.durations)
+            and any(d in ("forward", "backward", "left", "right") for d, _ in s.directions))
+
+
+def _one_of(s: _Slots, where: str, state: BuildState):
+    """The `one(slot, what)` reader of _build for a slot set of its own."""
+    def one(name: str, what: str):
+        items = getattr(s, name)
+        if len(items) > 1:
+            raise InstructionError(f"\"{where}\": more than one {what} "
+                                   f"(\"{state.text(items[0][1])}\" and \"{state.text(items[1][1])}\")")
+        return items[0][0] if items else None
+    return one

@@ -63,7 +63,7 @@ class Grammar:
             cands.sort(key=lambda wr: -len(wr[0]))
         known = set(L.FILLERS) | set(L.ARTICLES) | set(L.NUMBER_WORDS) | set(L.TENS_WORDS)
         known |= set(L.FRACTION_WORDS) | set(L.NUMBER_GLUE) | set(L.UNITS) | set(L.PER_WORDS)
-        known |= {"couple", "pair", "of"} | set(SENTENCE_ENDS) | {","}
+        known |= {"couple", "pair", "few", "of"} | set(SENTENCE_ENDS) | {","}
         for words, _ in table:
             known.update(words)
         self._known = frozenset(known)
@@ -218,6 +218,9 @@ class Grammar:
                 if verb is not None and verb.value == "WALK":  # "walk to the table, then (to) the shelf"
                     out.append([verb] + ([] if c[0].kind == "w" else [Tok("w", "to", c[0].i0, c[0].i0)]) + c)
                     continue
+            if not has_verb and out and _another_leg(c, out[-1]):  # "walk 2 m, then sideways to the right 1 m"
+                out.append([next(t for t in out[-1] if t.kind == "w" and t.value == "WALK")] + c)
+                continue
             if not has_verb and out:
                 out[-1].extend(c)  # "turn left, twice": words without a verb go on with the clause before
             else:
@@ -261,6 +264,16 @@ def join_words(words: list[str]) -> str:
     return out
 
 
+def _another_leg(clause: list[Tok], before: list[Tok]) -> bool:
+    """A verbless clause with its own direction and distance or time, after a walk with both: a walk of its own."""
+    def leg(c: list[Tok]) -> bool:
+        moves = any(t.kind == "qty" and t.value[1] in ("length", "time") for t in c)
+        return moves and any(t.kind == "w" and (t.value in DIRECTIONS or t.value == "SIDEWAYS") for t in c)
+
+    walks = any(t.kind == "w" and t.value == "WALK" for t in before)
+    return walks and leg(clause) and leg(before)
+
+
 def _is_verb(t: Tok) -> bool:
     if t.kind != "w":
         return False
@@ -284,6 +297,8 @@ def _read_number(words: list[str], i: int) -> tuple[float, int] | None:
         nxt = at(k)
         if nxt in ("couple", "pair"):
             return 2.0, k + 2 if at(k + 1) == "of" else k + 1
+        if nxt == "few" and w in L.ARTICLES:  # "a few seconds": three
+            return 3.0, k + 1
         if nxt == "hundred":
             value, j = 100.0, k + 1
             if at(j) == "and" and (at(j + 1) in L.NUMBER_WORDS or at(j + 1) in L.TENS_WORDS):
