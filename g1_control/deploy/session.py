@@ -25,6 +25,7 @@ from g1_control.deploy.preflight import CHECKS, FAIL, Preflight
 from g1_control.deploy.state_machine import DeployState, DeployTracker, OperatorButtons, Transition
 from g1_control.errors import G1ControlError, LaunchFileError
 from g1_control.hardware.links.network import LOOPBACK
+from g1_control.interfaces import InputDevice
 from g1_control.launch.run_folder import RunFolder
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.priority import frozen_heap, realtime
@@ -343,7 +344,7 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
         for sig, handler in previous.items():
             signal.signal(sig, handler)
     log = folder.close_log(loop)
-    _fill_report(report, log, loop, tracker, backend, safety, t_loop0)
+    _fill_report(report, log, loop, tracker, backend, safety, t_loop0, device)
     folder.write_npz(log)
     status = ("error" if error is not None else "fault" if report.fault
               else "interrupted" if report.end_reason.startswith("SIG") else "completed")
@@ -354,7 +355,9 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
 
 
 def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTracker, backend, safety,
-                 t_loop0: float) -> None:
+                 t_loop0: float, program: InputDevice) -> None:
+    """`program`: the operator's device inside OperatorButtons (a ProgramInput when a behaviour
+    program drove the robot: its step records go into the report)."""
     from g1_control.launch.runner import upper_body_rms_by_style
 
     report.sequence = tracker.sequence
@@ -382,8 +385,7 @@ def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTr
                           "upper_body_vs_plan": upper_body_rms_by_style(log_arrays, (t_mono >= start) & (t_mono < end))}
     from g1_control.program.device import ProgramInput, record_dict
 
-    program = next((d for d in (loop.input, getattr(loop.input, "inner", None)) if isinstance(d, ProgramInput)), None)
-    if program is not None:
+    if isinstance(program, ProgramInput):
         report.control["program"] = {"steps": [record_dict(r) for r in program.records],
                                      "finished": program.done and not program.runner.stopped}
     late = loop.scheduler.lateness.summary()

@@ -21,7 +21,7 @@ from g1_control.program.exceptions import InstructionError, ProgramError
 from g1_control.program.language.parser import InstructionParser
 from g1_control.program.program import Program
 from g1_control.program.world import World
-from g1_control.types import Button, Command
+from g1_control.types import Button, Command, ExecutionFeedback
 
 _CANCELLING = frozenset({Button.STOP, Button.DAMP, Button.ESTOP})
 _YES = ("y", "yes")
@@ -46,7 +46,7 @@ class InstructedInput(InputDevice):
         self.pending: Program | None = None
         """A parsed program waiting for the operator's "y" (confirm)."""
         self.finished: list[ProgramInput] = []
-        self._loop = None
+        self._feedback: ExecutionFeedback | None = None
 
     # -- the operator device, passed through -------------------------------------------------
     @property
@@ -68,8 +68,12 @@ class InstructedInput(InputDevice):
     def close(self) -> None:
         self.inner.close()
 
-    def attach(self, loop) -> None:
-        self._loop = loop
+    def observe(self, feedback: ExecutionFeedback) -> None:
+        """The loop's feedback record: passed to the operator's device and to each program run."""
+        self._feedback = feedback
+        self.inner.observe(feedback)
+        if self.active is not None:
+            self.active.observe(feedback)
 
     # -- the tick ------------------------------------------------------------------------------
     def poll(self, now_s: float) -> Command:
@@ -122,8 +126,8 @@ class InstructedInput(InputDevice):
 
     def _start(self, program: Program) -> None:
         device = ProgramInput(program, self.world, pose=self.pose, start_delay_s=0.0, on_record=self._record)
-        if self._loop is not None:
-            device.attach(self._loop)
+        if self._feedback is not None:
+            device.observe(self._feedback)
         self.active = device
 
     def _record(self, record: StepRecord) -> None:
