@@ -111,8 +111,34 @@ class InputDevice(ABC):
         """True once the device is gone for good (the loop then stops the robot, then damps it)."""
         return False
 
+    @property
+    def lost_reason(self) -> str | None:
+        """Why the device was lost (None while it is not, or when it cannot tell)."""
+        return None
+
+    def button_chords(self, action: str) -> list[str]:
+        """The operator's buttons or keys bound to `action` ("estop", "start", ...), one 'a+b' chord
+        each; [] for a device that maps no buttons (scripts, programs without an operator)."""
+        return []
+
     def close(self) -> None:
         """Release the device."""
+
+    def describe(self) -> str:
+        """A short name for the device (video overlay, summaries)."""
+        return type(self).__name__
+
+
+class LineInput(InputDevice):
+    """An input device that also takes typed lines (a terminal keyboard): instructions in English
+    (g1_control/program/instructed.py)."""
+
+    @abstractmethod
+    def take_line(self) -> str | None:
+        """The oldest line the operator submitted, or None."""
+
+    def begin_line(self, prompt: str = "> ") -> None:
+        """Open a line now, as if the operator had pressed the instruction key (to ask a question)."""
 
 
 class Generator(ABC):

@@ -292,16 +292,14 @@ class Preflight:
                                    "operator e-stop; Ctrl-C or SIGTERM damps")
             return self.record("estop_input", FAIL, f"input.type {kind} has no operator e-stop; a robot needs "
                                "unitree_remote, gamepad or keyboard")
-        mapper = getattr(device, "mapper", None)
-        bound = [("+".join(sorted(chord))) for chord, action in mapper.config.buttons.items()
-                 if action == "estop"] if mapper is not None else []
+        bound = device.button_chords("estop")
         deadline = time.monotonic() + launch.deploy.input_check_s
         while time.monotonic() < deadline and not device.lost:
             device.poll(time.monotonic())
             time.sleep(0.02)
         device.poll(time.monotonic())
         if device.lost:
-            return self.record("estop_input", FAIL, f"{kind} lost: {getattr(device, 'lost_reason', '?')}; reconnect it "
+            return self.record("estop_input", FAIL, f"{kind} lost: {device.lost_reason or '?'}; reconnect it "
                                "and start again", overridable=False)
         if not bound:
             return self.record("estop_input", FAIL, f"{kind} mapping binds no button to estop; bind one in "

@@ -90,11 +90,8 @@ def _say(text: str) -> None:
     print(text, flush=True)
 
 
-def _keys_for(device, action: str) -> str:
-    mapper = getattr(device, "mapper", None)
-    if mapper is None:
-        return ""
-    return " or ".join("+".join(sorted(chord)) for chord, a in mapper.config.buttons.items() if a == action)
+def _keys_for(device: InputDevice, action: str) -> str:
+    return " or ".join(device.button_chords(action))
 
 
 def _apply_cli(launch: LaunchFile, options: DeployOptions) -> None:

@@ -74,6 +74,13 @@ class OperatorButtons(InputDevice):
     def lost(self) -> bool:
         return self.inner.lost
 
+    @property
+    def lost_reason(self) -> str | None:
+        return self.inner.lost_reason
+
+    def button_chords(self, action: str) -> list[str]:
+        return self.inner.button_chords(action)
+
     def observe(self, feedback: ExecutionFeedback) -> None:
         self.inner.observe(feedback)
 

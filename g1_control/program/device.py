@@ -124,9 +124,12 @@ class ProgramInput(InputDevice):
         return self.operator.lost if self.operator is not None else False
 
     @property
-    def mapper(self):
-        """The operator device's button mapping (g1 deploy names its keys), if any."""
-        return getattr(self.operator, "mapper", None)
+    def lost_reason(self) -> str | None:
+        return self.operator.lost_reason if self.operator is not None else None
+
+    def button_chords(self, action: str) -> list[str]:
+        """The operator device's (g1 deploy names its keys); [] without one."""
+        return self.operator.button_chords(action) if self.operator is not None else []
 
     def close(self) -> None:
         if self.operator is not None:

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from g1_control.interfaces import InputDevice
+from g1_control.interfaces import InputDevice, LineInput
 from g1_control.program.device import ProgramInput, StepRecord, describe_record
 from g1_control.program.exceptions import InstructionError, ProgramError
 from g1_control.program.language.parser import InstructionParser
@@ -32,9 +32,9 @@ def _print(text: str) -> None:
 
 
 class InstructedInput(InputDevice):
-    """See the module docstring. `inner` needs take_line() (and begin_line() for `confirm`)."""
+    """See the module docstring. `inner`: the operator's keyboard (lines typed, begin_line for `confirm`)."""
 
-    def __init__(self, inner: InputDevice, world: World | None = None, *, pose: str = "estimator",
+    def __init__(self, inner: LineInput, world: World | None = None, *, pose: str = "estimator",
                  confirm: bool = False, say: Callable[[str], None] = _print) -> None:
         self.inner = inner
         self.world = world or World()
@@ -54,16 +54,11 @@ class InstructedInput(InputDevice):
         return self.inner.lost
 
     @property
-    def lost_reason(self):
-        return getattr(self.inner, "lost_reason", None)
+    def lost_reason(self) -> str | None:
+        return self.inner.lost_reason
 
-    @property
-    def mapper(self):
-        return getattr(self.inner, "mapper", None)
-
-    @property
-    def stats(self):
-        return getattr(self.inner, "stats", None)
+    def button_chords(self, action: str) -> list[str]:
+        return self.inner.button_chords(action)
 
     def close(self) -> None:
         self.inner.close()
@@ -78,7 +73,7 @@ class InstructedInput(InputDevice):
     # -- the tick ------------------------------------------------------------------------------
     def poll(self, now_s: float) -> Command:
         op = self.inner.poll(now_s)
-        line = getattr(self.inner, "take_line", lambda: None)()
+        line = self.inner.take_line()
         if line is not None:
             self._line(line.strip())
         if self.active is None:
@@ -118,9 +113,7 @@ class InstructedInput(InputDevice):
         if self.confirm:
             self.pending = program
             self.say('run it on the robot? type y and Enter (anything else: no)')
-            begin = getattr(self.inner, "begin_line", None)
-            if begin is not None:
-                begin("y/n> ")
+            self.inner.begin_line("y/n> ")
             return
         self._start(program)
 

@@ -1,12 +1,12 @@
 """Typed instructions (InstructedInput) over a stand-in operator device and loop."""
 
-from g1_control.interfaces import InputDevice
+from g1_control.interfaces import LineInput
 from g1_control.program.instructed import InstructedInput
 from g1_control.types import Command
 from tests.program.test_program_device import FakeLoop
 
 
-class Operator(InputDevice):
+class Operator(LineInput):
     """Stands in for the keyboard: lines to hand over, a command to report, begin_line recorded."""
 
     lost = False
