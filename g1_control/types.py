@@ -265,6 +265,8 @@ class RobotState:
     mode_machine: int = 5
     tick: int = 0
     wireless_remote: bytes = b""
+    battery_v: float | None = None
+    """Battery voltage, where the link reports one (None: the G1's LowState_ carries none)."""
     # Ground truth, present only in simulation (None on the robot): for tests and logs.
     base_pos_w_m: np.ndarray | None = None
     base_linvel_w_mps: np.ndarray | None = None

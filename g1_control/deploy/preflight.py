@@ -250,7 +250,7 @@ class Preflight:
             self.record("temperatures", PASS, f"hottest {g1.JOINT_NAMES[j]} at {temps[j]:.0f} °C "
                         f"(limit {cfg.max_start_temperature_c:.0f} °C)")
 
-        battery = getattr(state, "battery_v", None)
+        battery = state.battery_v
         if battery is None:
             self.record("battery", SKIP, "not reported: the G1's LowState_ carries no battery voltage (its BMS "
                         "publishes on its own topic); check the charge on the robot's display")
@@ -262,10 +262,9 @@ class Preflight:
 
     def check_peers(self, backend) -> bool:
         """One publisher of the robot's state, no other writer of its commands (where the link can tell)."""
-        refresh = getattr(backend, "refresh_peers", None)
-        if refresh is None:
+        if not backend.sees_peers:
             return self.record("peers", SKIP, "this backend cannot see its peers")
-        refresh()
+        backend.refresh_peers()
         senders, writers, command_writers = backend.peers()
         where = backend.link.describe()
         if writers is None and senders == 0:

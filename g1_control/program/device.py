@@ -232,8 +232,7 @@ def record_dict(record: StepRecord) -> dict:
     o = record.outcome
     out: dict = {"label": o.label, "kind": o.kind, "description": o.description, "status": o.status,
                  "started_s": o.started_s, "ended_s": o.ended_s, "measured": dict(o.measured)}
-    for name in ("truth_start", "truth_end"):
-        pose = getattr(record, name)
+    for name, pose in (("truth_start", record.truth_start), ("truth_end", record.truth_end)):
         out[name] = None if pose is None else [pose.x_m, pose.y_m, pose.yaw_rad, pose.pelvis_height_m]
     out["truth_turned_rad"] = record.truth_turned_rad
     if record.goal_id is not None:
