@@ -64,7 +64,7 @@ def program_world(launch: LaunchFile):
 
 def make_program_input(launch: LaunchFile, program=None, **kwargs):
     """A ProgramInput for `program` (default: the launch file's input.program / instruction) against
-    the launch file's places; steering by input.pose. build_loop attaches it to the loop."""
+    the launch file's places; steering by input.pose. The loop feeds it back before every poll (InputDevice.observe)."""
     from g1_control.program.device import ProgramInput
 
     cfg = launch.input

@@ -24,7 +24,7 @@ def overlay_lines(loop: ControlLoop) -> tuple[str, str]:
         f"{est[0]:+.2f} {est[1]:+.2f} {est[2]:+.2f}",
         c.style,
         state,
-        getattr(loop.input, "name", type(loop.input).__name__),
+        loop.input.describe(),
         f"{tick['p99_us'] / 1000:.2f} ms / {loop.scheduler.deadline_misses}",
     ])
     return labels, values

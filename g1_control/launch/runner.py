@@ -36,6 +36,7 @@ from g1_control.robot import g1
 from g1_control.teleop.scripted import Segment
 
 if TYPE_CHECKING:
+    from g1_control.launch.outcomes import GoalWatcher
     from g1_control.sim.mujoco_backend import MujocoBackend
 
 STEADY_STATE_SKIP_S = 2.0
@@ -206,8 +207,7 @@ def _run_loop(launch: LaunchFile, sim: MujocoBackend, loop: ControlLoop, segment
     if launch.tracker.type == "layer":  # goals: judged from ground truth (g1_control/launch/outcomes.py)
         from g1_control.launch.outcomes import GoalWatcher
 
-        watcher = GoalWatcher(loop)
-        loop.goal_watcher = watcher  # type: ignore[attr-defined]  # the run folder saves what it saw
+        watcher = GoalWatcher(loop)  # the run folder saves what it saw
     view = _open_viewer(sim) if viewer else None
     web = _open_web(sim, web_port, launch.name) if web_port is not None else None
 
@@ -269,7 +269,7 @@ def _run_loop(launch: LaunchFile, sim: MujocoBackend, loop: ControlLoop, segment
                                    "finished": program.done and not program.runner.stopped,
                                    "pose": program.pose_source}
     if folder is not None:
-        write_run_folder(result, launch, loop, folder, log, video, interrupted)
+        write_run_folder(result, launch, loop, folder, log, video, interrupted, watcher)
     if interrupted is not None:
         raise interrupted
     return result
@@ -335,14 +335,14 @@ def _result(launch: LaunchFile, loop: ControlLoop, segments: list[Segment], wall
 
 def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, folder: RunFolder,
                      log: dict[str, np.ndarray], video: bool | None,
-                     interrupted: KeyboardInterrupt | None = None) -> Path:
-    """Close `folder`: log.npz, the plot, the video (not after a signal), summary.json with the end reason."""
+                     interrupted: KeyboardInterrupt | None = None, watcher: GoalWatcher | None = None) -> Path:
+    """Close `folder`: log.npz, the plot, the video (not after a signal), summary.json with the end reason;
+    with a goal watcher (launch/outcomes.py), truth.npz and the scene's boxes in the video."""
     run_dir = folder.run_dir
     result.run_dir = run_dir
     folder.write_npz(log)
-    watcher = getattr(loop, "goal_watcher", None)
     if watcher is not None:  # ground truth of the goals: hand points, soles, boxes (launch/outcomes.py)
-        np.savez_compressed(run_dir / "truth.npz", **watcher.arrays())
+        np.savez_compressed(run_dir / "truth.npz", **watcher.arrays())  # type: ignore[arg-type]
     if launch.output.plot:
         from g1_control.launch.plots import plot_run
 
@@ -354,7 +354,7 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, f
 
         overlay = run_overlay_rows(log, result.events, [dataclasses.asdict(s) for s in result.segments])
         backend = render_video(run_dir / "log.npz", run_dir / "video.mp4", launch.output.video_fps,
-                               launch.output.video_size, overlay=overlay, extra=_scene_arrays(launch, loop))
+                               launch.output.video_size, overlay=overlay, extra=_scene_arrays(launch, watcher))
         result.video = str(run_dir / "video.mp4") if backend else None
         result.extra["render_backend"] = backend
     trip = next((e for e in result.events if "damping" in e["detail"]), None)
@@ -368,9 +368,8 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, f
     return run_dir
 
 
-def _scene_arrays(launch: LaunchFile, loop: ControlLoop) -> dict | None:
+def _scene_arrays(launch: LaunchFile, watcher: GoalWatcher | None) -> dict | None:
     """The scene and where its boxes were (ground truth), for the video; None without a scene."""
-    watcher = getattr(loop, "goal_watcher", None)
     if launch.scene.empty or watcher is None:
         return None
     truth = watcher.arrays()

@@ -14,15 +14,11 @@ and timed walks by having run their time.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
+from g1_control.program.records import PlanarPose, StepRecord, Verdict
 from g1_control.program.runner import COMPLETED, RunnerConfig, wrap_angle
 from g1_control.program.steps import Height, Parallel, Stand, Style, Turn, Walk
 from g1_control.program.world import START, World
-
-if TYPE_CHECKING:
-    from g1_control.program.device import PlanarPose, StepRecord
 
 DISTANCE_TOLERANCE = 0.10
 """Relative: a walk's distance (or the way to a place) within this fraction."""
@@ -30,13 +26,6 @@ MIN_PLACE_TOLERANCE_M = 0.05
 HEADING_TOLERANCE_RAD = math.radians(10.0)
 HEIGHT_TOLERANCE_M = 0.05
 _REL = {"forward": 0.0, "left": math.pi / 2, "backward": math.pi, "right": -math.pi / 2}
-
-
-@dataclass
-class Verdict:
-    ok: bool
-    text: str
-    values: dict[str, float] = field(default_factory=dict)
 
 
 def judge(record: StepRecord, world: World, program_start: PlanarPose | None,
