@@ -141,11 +141,12 @@ def _check_motion_service(pf: Preflight, launch: LaunchFile, backend) -> bool:
     """Ask the motion-switcher service which built-in controller runs (CheckMode only; nothing released)."""
     from g1_control.hardware.unitree.motion_service import MotionServiceClient
 
+    from g1_control.hardware.links.dds import DdsLink
+
     b = launch.backend
-    participant = getattr(backend.link, "_participant", None)
-    if participant is None:
+    if not isinstance(backend.link, DdsLink):
         return pf.record("motion_service", SKIP, f"{backend.link.describe()} has no DDS participant to ask")
-    client = MotionServiceClient(participant, b.partition, timeout_s=1.0)
+    client = MotionServiceClient(backend.link.participant, b.partition, timeout_s=1.0)
     t0 = time.monotonic()
     try:
         name = client.check_mode()

@@ -180,7 +180,7 @@ class GoalGenerator(Generator):
         ctx = self.ctx
         gid = goal.goal_id
         ctx.note(f"goal {gid}: {goal.describe()}")
-        ctx.info = self.goal_info.setdefault(gid, {"kind": goal.kind, "describe": goal.describe(), "start_s": ctx.t})
+        ctx.info = ctx.goal_info.setdefault(gid, {"kind": goal.kind, "describe": goal.describe(), "start_s": ctx.t})
         try:
             ctx.world_pose()  # goals in world coordinates need one: GoalFailed without
             run = SKILLS[goal.kind]
