@@ -412,6 +412,9 @@ class ExecutionFeedback:
     """The loop's clock at the fill (simulated time in lockstep, monotonic on the robot)."""
     estimate: EstimatedState = field(default_factory=EstimatedState)
     """The state estimator's latest output (IMU yaw, leg-odometry velocity, pelvis height)."""
+    state: RobotState | None = None
+    """The robot's latest state as the backend reported it (joints, IMU: what a robot has; its base pose,
+    where a simulator fills one, is for `truth` alone). None before the first read."""
     truth: RobotState | None = None
     """The latest robot state when the backend gives ground truth (its base_pos_w_m is set: a
     simulator); None on a robot. For judging outcomes, never for steering."""

@@ -285,7 +285,7 @@ class Preflight:
         if open_error is not None:
             return self.record("estop_input", FAIL, open_error, overridable=False)
         kind = launch.input.type
-        if kind in ("scripted", "random", "gamepad_script", "program"):
+        if kind in ("scripted", "random", "gamepad_script", "program", "ros2"):
             if launch.backend.type == "unitree_dds" and launch.backend.interface == "lo":
                 return self.record("estop_input", PASS, f"{kind} input against the emulator on lo (sim2sim): no "
                                    "operator e-stop; Ctrl-C or SIGTERM damps")

@@ -19,6 +19,10 @@ def make_input(launch: LaunchFile, segments: list[Segment], limits: CommandLimit
         return ScriptedInput(segments)
     if cfg.type == "program":
         return make_program_input(launch)
+    if cfg.type == "ros2":
+        from g1_control.teleop.ros2 import Ros2Bridge, ros2_settings
+
+        return Ros2Bridge(**ros2_settings(cfg.device), limits=limits)
     from g1_control.teleop.factory import make_input_device
 
     if cfg.type == "gamepad_script":

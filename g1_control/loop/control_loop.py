@@ -215,6 +215,7 @@ class ControlLoop:
         fb, s, g = self.feedback, self.state, self.generator
         fb.t_s = now
         fb.estimate = self.estimator.estimate
+        fb.state = s
         fb.truth = s if s.base_pos_w_m is not None else None
         fb.goal_status, fb.goal_messages, fb.phase = g.goal_status, g.goal_messages, g.phase
         self.input.observe(fb)

@@ -33,7 +33,7 @@ import numpy as np
 from g1_control.errors import LaunchFileError
 from g1_control.interfaces import InputDevice
 from g1_control.robot import g1
-from g1_control.types import Command, CommandLimits, EstimatedState, RobotState
+from g1_control.types import Command, CommandLimits, EstimatedState, ExecutionFeedback, RobotState
 
 log = logging.getLogger(__name__)
 
@@ -121,6 +121,14 @@ class Ros2Bridge(InputDevice):
         return Command(vx_mps=vx, vy_mps=vy, wz_radps=wz)
 
     # -- out ------------------------------------------------------------------------------------------
+    def observe(self, feedback: ExecutionFeedback) -> None:
+        """The loop's record before every poll: publish what the robot reports and its own estimate."""
+        if feedback.state is not None:
+            self.publish(feedback.t_s, feedback.state, feedback.estimate)
+
+    def describe(self) -> str:
+        return "ros2 (Twist on cmd_vel)"
+
     def publish(self, t_s: float, state: RobotState, estimate: EstimatedState | None) -> bool:
         """Publish joint_states, odom and tf for time `t_s` at most at publish_hz; True when it did."""
         if estimate is not None:

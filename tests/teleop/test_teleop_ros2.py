@@ -17,6 +17,7 @@ from g1_control.errors import LaunchFileError
 from g1_control.robot import g1
 from g1_control.teleop.ros2 import Ros2Bridge, ros2_settings
 from g1_control.types import CommandLimits, EstimatedState, RobotState
+from tests.paths import LAUNCH_DIR
 
 DOMAIN = 7
 
@@ -37,9 +38,10 @@ class Peer:
         group = Qos(Policy.Partition([partition]))
         self.twist = DataWriter(Publisher(dp, qos=group), Topic(dp, "rt/cmd_vel", m.Twist_))
         sub = Subscriber(dp, qos=group)
-        self.joints = DataReader(sub, Topic(dp, "rt/joint_states", m.JointState_))
-        self.odom = DataReader(sub, Topic(dp, "rt/odom", m.Odometry_))
-        self.tf = DataReader(sub, Topic(dp, "rt/tf", m.TFMessage_))
+        keep = Qos(Policy.History.KeepLast(256))  # every sample between two reads, to count the rate
+        self.joints = DataReader(sub, Topic(dp, "rt/joint_states", m.JointState_), qos=keep)
+        self.odom = DataReader(sub, Topic(dp, "rt/odom", m.Odometry_), qos=keep)
+        self.tf = DataReader(sub, Topic(dp, "rt/tf", m.TFMessage_), qos=keep)
         self.m = m
 
     def send(self, vx, vy, wz):
@@ -144,3 +146,48 @@ def test_bad_settings_are_refused_by_name(device, message):
     with pytest.raises(LaunchFileError) as info:
         ros2_settings(device)
     assert str(info.value).startswith(message)
+
+
+def test_a_ros2_peer_walks_the_simulated_robot_and_reads_its_odometry(tmp_path):
+    """launch/sim_ros2.yaml (MuJoCo, paced to real time): the peer publishes Twist vx 0.4 at 20 Hz from 1.5 s
+    on; the robot walks (ground truth) and the peer reads joint_states and odom at about their 50 Hz."""
+    import threading
+
+    from g1_control.launch.runner import run
+    from g1_control.launch.schema import load_launch
+
+    partition = f"g1ros2-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+    launch = load_launch(LAUNCH_DIR / "sim_ros2.yaml", overrides=[
+        "duration_s=7", f"input.device.domain={DOMAIN}", f"input.device.partition={partition}", "viewer=false"])
+    peer = Peer(partition)
+    stop = threading.Event()
+
+    def drive():
+        t0 = time.monotonic()
+        while not stop.wait(0.05):
+            if time.monotonic() - t0 > 1.5:
+                peer.send(0.4, 0.0, 0.0)
+
+    joints, odoms = [], []
+
+    def listen():
+        while not stop.wait(0.05):
+            joints.extend(s for s in peer.joints.take(100) if hasattr(s, "name"))
+            odoms.extend(s for s in peer.odom.take(100) if hasattr(s, "pose"))
+
+    threads = [threading.Thread(target=drive, daemon=True), threading.Thread(target=listen, daemon=True)]
+    for t in threads:
+        t.start()
+    try:
+        result = run(launch, progress=False)
+    finally:
+        stop.set()
+        for t in threads:
+            t.join()
+    assert not result.fell
+    walking = [s for s in result.segments if s.commanded[0] > 0.3]
+    assert walking, [s.commanded for s in result.segments]
+    assert walking[-1].achieved[0] > 0.25  # from the simulator's ground truth
+    assert len(joints) > 0.5 * 50 * result.duration_s  # ~50 Hz, discovery and load allowing
+    assert odoms[-1].pose.pose.position.x > 0.5  # the robot's own dead reckoning saw it walk
+    assert odoms[-1].twist.twist.linear.x > 0.2
