@@ -36,6 +36,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("library",),
     ("launch",),
     ("program",),
+    ("report",),
     ("generator", "trackers", "teleop", "retarget"),
     ("ik", "loop"),
     ("motion", "safety", "estimation"),

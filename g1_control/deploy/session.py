@@ -25,9 +25,9 @@ from g1_control.deploy.preflight import CHECKS, FAIL, Preflight
 from g1_control.deploy.state_machine import DeployState, DeployTracker, OperatorButtons, Transition
 from g1_control.errors import G1ControlError, LaunchFileError
 from g1_control.hardware.links.network import LOOPBACK
-from g1_control.launch.run_folder import RunFolder
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.priority import frozen_heap, realtime
+from g1_control.report.run_folder import RunFolder
 from g1_control.robot import g1
 
 log = logging.getLogger("g1_control.deploy")
@@ -355,7 +355,7 @@ def _control(launch: LaunchFile, pf: Preflight, backend, device, options: Deploy
 
 def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTracker, backend, safety,
                  t_loop0: float) -> None:
-    from g1_control.launch.runner import upper_body_rms_by_style
+    from g1_control.report.results import upper_body_rms_by_style
 
     report.sequence = tracker.sequence
     report.transitions = [{"t_s": t.t_s, "from": t.source.value, "to": t.target.value, "reason": t.reason}

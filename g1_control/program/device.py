@@ -36,7 +36,7 @@ from g1_control.types import PHASE_LOCOMOTION, Command, RobotState
 
 if TYPE_CHECKING:
     from g1_control.estimation.estimator import StateEstimator
-    from g1_control.program.judge import Verdict
+    from g1_control.report.verdict import Verdict
 
 POSE_SOURCES = ("estimator", "ground_truth")
 HAND_BACK_SETTLE_S = 0.5
