@@ -156,7 +156,7 @@ class Generator(ABC):
     """goal_id -> why the goal failed."""
     goal_info: Mapping[str, Mapping[str, Any]] = NO_GOALS
     """goal_id -> what the generator recorded about the goal (kind, timing, status), for judging
-    it after the run (g1_control/launch/outcomes.py)."""
+    it after the run (g1_control/report/outcomes.py)."""
 
     @abstractmethod
     def update(self, command: Command, state: RobotState) -> KinematicReference: ...

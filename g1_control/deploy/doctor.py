@@ -139,9 +139,8 @@ def _no_robot(pf: Preflight, launch: LaunchFile, options: DoctorOptions, say) ->
 
 def _check_motion_service(pf: Preflight, launch: LaunchFile, backend) -> bool:
     """Ask the motion-switcher service which built-in controller runs (CheckMode only; nothing released)."""
-    from g1_control.hardware.unitree.motion_service import MotionServiceClient
-
     from g1_control.hardware.links.dds import DdsLink
+    from g1_control.hardware.unitree.motion_service import MotionServiceClient
 
     b = launch.backend
     if not isinstance(backend.link, DdsLink):

@@ -25,7 +25,7 @@ from g1_control.robot import g1
 from g1_control.rotations import tilt_rad
 
 if TYPE_CHECKING:
-    from g1_control.launch.runner import RunResult
+    from g1_control.report.results import RunResult
 
 log = logging.getLogger("g1_control.deploy")
 

@@ -26,9 +26,9 @@ from g1_control.deploy.state_machine import DeployState, DeployTracker, Operator
 from g1_control.errors import G1ControlError, LaunchFileError
 from g1_control.hardware.links.network import LOOPBACK
 from g1_control.interfaces import InputDevice, Tracker
-from g1_control.launch.run_folder import RunFolder
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.priority import frozen_heap, realtime
+from g1_control.report.run_folder import RunFolder
 from g1_control.robot import g1
 from g1_control.safety import SafetyFilter
 
@@ -413,7 +413,7 @@ def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTr
                  t_loop0: float, program: InputDevice) -> None:
     """`program`: the operator's device inside OperatorButtons (a ProgramInput when a behaviour
     program drove the robot: its step records go into the report)."""
-    from g1_control.launch.runner import upper_body_rms_by_style
+    from g1_control.report.results import upper_body_rms_by_style
 
     report.sequence = tracker.sequence
     report.transitions = [{"t_s": t.t_s, "from": t.source.value, "to": t.target.value, "reason": t.reason}

@@ -6,10 +6,11 @@ Plain data shared by the program input (device.py), which fills the records, and
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from g1_control.program.runner import StepOutcome
 from g1_control.program.steps import Step
+from g1_control.report.verdict import Verdict
 
 
 @dataclass(frozen=True)
@@ -18,13 +19,6 @@ class PlanarPose:
     y_m: float
     yaw_rad: float
     pelvis_height_m: float | None = None
-
-
-@dataclass
-class Verdict:
-    ok: bool
-    text: str
-    values: dict[str, float] = field(default_factory=dict)
 
 
 @dataclass

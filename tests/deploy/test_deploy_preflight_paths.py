@@ -15,8 +15,8 @@ from g1_control.deploy import preflight as pf_module
 from g1_control.deploy.preflight import FAIL, NOT_RUN, PASS, CheckResult, Preflight, dry_run_launch, format_table
 from g1_control.errors import G1ControlError
 from g1_control.interfaces import InputDevice
-from g1_control.launch.runner import RunResult, SegmentResult
 from g1_control.launch.schema import DeployConfig, InputConfig, load_launch
+from g1_control.report.results import RunResult, SegmentResult
 from g1_control.safety.config import SafetyConfig
 from g1_control.trackers.policy_spec import load_spec
 from g1_control.types import Command

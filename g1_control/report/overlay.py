@@ -53,7 +53,7 @@ def run_overlay_rows(log: dict, events: list[dict], segments: list[dict] | None 
     velocity (ground truth, or the estimate on a robot, averaged over one gait cycle) and the safety state."""
     import numpy as np
 
-    from g1_control.launch.plots import window_mean
+    from g1_control.report.plots import window_mean
 
     t = log["t_s"]
     truth = log["velocity_true"]
