@@ -13,8 +13,9 @@ The first whole-body reference after walking starts at the measured configuratio
 where they are), so the hand-over does not jump; each later one starts where the previous ended.
 Where the robot must be is planned from the scene (task knowledge: where the boxes, tables and
 platforms are) and the robot's world pose: the simulator's ground truth in simulation (a stand-in
-for a localisation system: on the robot, goals in world coordinates need one; without a world
-pose a goal fails with that message).
+for a localisation system). Goals that need no world (a reach relative to the robot, heights) are
+planned in the frame of the stance the robot stands in and run without one; a goal that does need
+one fails at its start, before anything moves, saying why (world_pose_needed).
 
 Per goal: planned (`plan_cpu_s`), then `goal_status[goal_id]` = "reached" or "failed" with
 `goal_messages[goal_id]` saying why. After a goal the robot stays under the whole-body
@@ -82,6 +83,22 @@ GRAVITY = 9.81
 
 class GoalFailed(RuntimeError):
     """A goal that cannot be done (the message says why)."""
+
+
+def world_pose_needed(goal: TaskGoal) -> str | None:
+    """Why `goal` needs the robot's pose in the world, or None where it runs without one.
+
+    A reach given relative to the robot (offset_h_m) is planned in the frame of the stance the
+    robot stands in, and so are heights (Command.pelvis_height_m); everything placed in the scene
+    (world points, boxes, tables, platforms) is found only from where the robot is in the world."""
+    if goal.kind == "reach":
+        if goal.pos_w_m is None:
+            return None
+        return "a reach to a world point (pos_w_m) needs to know where the robot is; give it relative to the robot (offset_h_m)"
+    what = {"pick": "a pick finds its box in the scene", "place": "a place finds where the box goes in the scene",
+            "step_up": "a step up finds its platform in the scene",
+            "step_down": "a step down finds the floor behind the platform in the scene"}[goal.kind]
+    return f"{what}, which needs to know where the robot is"
 
 
 @dataclass
@@ -259,9 +276,10 @@ class GoalGenerator(Generator):
         self._note(f"goal {gid}: {goal.describe()}")
         self._info = self.goal_info.setdefault(gid, {"kind": goal.kind, "describe": goal.describe(), "start_s": self._t})
         try:
-            if self._state is None or self._state.base_pos_w_m is None:
-                raise GoalFailed("no world pose for the robot (goals in world coordinates need localisation; "
-                                 "the simulator gives it)")
+            why = world_pose_needed(goal)
+            if why is not None and not self._localised:
+                raise GoalFailed(f"no world pose for the robot: {why} (a robot reports none; in simulation the "
+                                 "simulator gives it); nothing moved for this goal")
             run = {"reach": self._reach, "pick": self._pick, "place": self._place, "step_up": self._step_up,
                    "step_down": self._step_down}[goal.kind]
             yield from run(goal)
@@ -334,12 +352,19 @@ class GoalGenerator(Generator):
         self.inner.reset(self._state)
 
     # -- phases -------------------------------------------------------------------------------------
+    @property
+    def _localised(self) -> bool:
+        """Whether the robot's world pose is known (the simulator's ground truth; a robot has none)."""
+        return self._state is not None and self._state.base_pos_w_m is not None
+
     def _measured_q(self) -> np.ndarray:
-        """The robot's configuration now (pinocchio q): joints, IMU orientation, world position."""
+        """The robot's configuration now (pinocchio q): joints, IMU orientation, world position (without
+        a world pose: the origin; goals that run then need no world: world_pose_needed)."""
         s = self._state
-        assert s is not None and s.base_pos_w_m is not None
+        assert s is not None
         w, x, y, z = s.imu_quat_wxyz
-        return np.concatenate([s.base_pos_w_m, [x, y, z, w], s.q_rad])
+        pos = s.base_pos_w_m if s.base_pos_w_m is not None else np.array([0.0, 0.0, self.poses.nominal_pelvis_m])
+        return np.concatenate([pos, [x, y, z, w], s.q_rad])
 
     def _hold_q(self) -> np.ndarray:
         """Where the whole-body reference is now (the end of the current plan)."""
@@ -353,10 +378,10 @@ class GoalGenerator(Generator):
 
     def _offset(self) -> np.ndarray:
         """Plan frame minus world (xy): the tracker's odometry drift, measured against the world pose."""
-        if self.phase != PHASE_WHOLE_BODY or self._plan is None or self._state is None:
+        if self.phase != PHASE_WHOLE_BODY or self._plan is None or not self._localised:
             return np.zeros(2)
         j = self._plan.sample(min(self._t - self._plan_t0, self._plan.duration_s))
-        assert self._state.base_pos_w_m is not None
+        assert self._state is not None and self._state.base_pos_w_m is not None
         return j.root_pos_w_m[:2] - self._state.base_pos_w_m[:2]
 
     def _run(self, traj: WholeBodyTrajectory, keep: bool = False) -> Iterator[None]:
@@ -371,7 +396,8 @@ class GoalGenerator(Generator):
         """From walking: a reference from the measured pose to a clean standing one."""
         q = self._measured_q()
         soles = flat_soles(self.ik, q)
-        ground = [self.scene.ground_height(p[:2]) for p, _ in soles]
+        # without a world pose the scene cannot be placed under the feet: the robot stands on the floor
+        ground = [self.scene.ground_height(p[:2]) if self._localised else 0.0 for p, _ in soles]
         lift = min(p[2] - g for (p, _), g in zip(soles, ground))
         q[2] -= lift  # the lower sole exactly on its ground
         soles = [(np.array([p[0], p[1], g]), r) for (p, r), g in zip(soles, ground)]
@@ -511,7 +537,7 @@ class GoalGenerator(Generator):
         self._note(f"reach: {res.mode}, hand {res.residual_m * 100:.1f} cm from the point in the plan")
         move = cfg.move_s * max(1.0, float(np.abs(res.q[7:] - q0[7:]).max()) / 1.5)
         self._info.update(hand=goal.hand, target_w_m=(target - off).tolist(), mode=res.mode,
-                          plan_residual_m=res.residual_m, hold_s=(self._t + move, self._t + move + cfg.reach_hold_s))
+                          frame="world" if self._localised else "stance", plan_residual_m=res.residual_m, hold_s=(self._t + move, self._t + move + cfg.reach_hold_s))
         yield from self._run(keyframe_trajectory("reach", [(0.0, q0), (move, res.q), (move + cfg.reach_hold_s, res.q)]),
                              keep=True)
 
@@ -818,4 +844,4 @@ class GoalRetargeter(Retargeter):
         return out
 
 
-__all__ = ["FAILED", "REACHED", "GoalConfig", "GoalFailed", "GoalGenerator", "GoalRetargeter"]
+__all__ = ["FAILED", "REACHED", "GoalConfig", "GoalFailed", "GoalGenerator", "GoalRetargeter", "world_pose_needed"]
