@@ -169,23 +169,28 @@ class Preflight:
         try:
             state = backend.wait_for_state(launch.backend.connect_timeout_s)
         except RobotNotConnectedError as exc:
-            self.record("state_stream", FAIL, str(exc), overridable=False)
+            self.record("state_stream", FAIL, str(exc) + _simulator_hint(backend, launch), overridable=False)
             self.not_run(("variant", "peers", "imu_upright", "joint_limits", "temperatures", "battery"),
                          "no robot state")
             return None
         # Rate and CRC health over a window, from the transport's own counters.
+        tick0 = backend.read_state().tick
         before, t0 = backend.stats(), time.monotonic()
         time.sleep(cfg.state_window_s)
         after, elapsed = backend.stats(), time.monotonic() - t0
+        min_rate = _min_state_rate_hz(backend, launch)
         rate = (after.states_received - before.states_received) / elapsed
         bad, malformed = after.bad_crc - before.bad_crc, after.malformed - before.malformed
         bad_frames = after.bad_frames - before.bad_frames
         where = backend.link.describe()
         detail = (f"{rate:.0f} Hz over {elapsed:.1f} s, {bad} bad CRC, {malformed} malformed"
                   + (f", {bad_frames} bad frames" if bad_frames else ""))
-        if rate < cfg.min_state_rate_hz:
-            self.record("state_stream", FAIL, f"{detail}; need >= {cfg.min_state_rate_hz:.0f} Hz on {where}: check the "
+        frozen = _tick_frozen(backend, tick0, after.states_received - before.states_received, elapsed)
+        if rate < min_rate:
+            self.record("state_stream", FAIL, f"{detail}; need >= {min_rate:.0f} Hz on {where}: check the "
                         "cable/switch and that nothing else loads this host")
+        elif frozen:
+            self.record("state_stream", FAIL, f"{detail}; {frozen}{_simulator_hint(backend, launch)}")
         elif bad or malformed or bad_frames:
             self.record("state_stream", FAIL, f"{detail}; corrupted samples on {where}: check the cable, the switch "
                         "and that only one robot publishes on this domain")
@@ -197,14 +202,14 @@ class Preflight:
                             f"{', '.join(invalid[:4])}{' ...' if len(invalid) > 4 else ''}: a sensor or its decoding "
                             "is broken", overridable=False)
             else:
-                self.record("state_stream", PASS, detail)
+                self.record("state_stream", PASS, detail + _simulator_filled(backend, launch))
         state = backend.read_state()
         self.check_peers(backend)
 
         try:
             variant = variant_of(state.mode_machine)
         except VariantMismatchError as exc:
-            self.record("variant", FAIL, str(exc), overridable=False)
+            self.record("variant", FAIL, str(exc) + _simulator_hint(backend, launch), overridable=False)
             variant = None
         if variant is not None:
             if variant.name != launch.backend.expected_variant:
@@ -213,7 +218,8 @@ class Preflight:
                             + (f" and the policy is for {policy_variant}" if policy_variant else "")
                             + "; use a launch file and policy made for this robot", overridable=False)
             else:
-                self.record("variant", PASS, f"mode_machine {state.mode_machine} ({variant.name}, {variant.num_dof} DoF)")
+                self.record("variant", PASS, f"mode_machine {state.mode_machine} ({variant.name}, {variant.num_dof} DoF)"
+                            + _mode_machine_filled(backend))
         active = variant.active_mask if variant is not None else np.ones(g1.NUM_JOINTS, dtype=bool)
 
         tilt = tilt_rad(state.imu_quat_wxyz) if np.all(np.isfinite(state.imu_quat_wxyz)) else float("nan")
@@ -357,6 +363,59 @@ class Preflight:
 
     def as_dict(self) -> list[dict]:
         return [dataclasses.asdict(r) for r in self.results.values()]
+
+
+# -- Unitree's simulators (backend.simulator; g1_control/hardware/unitree/simulators.py) ------------------
+def _min_state_rate_hz(backend, launch: LaunchFile) -> float:
+    from g1_control.hardware.unitree.simulators import min_state_rate_hz
+
+    unset = getattr(backend, "unset_fields", None)
+    return min_state_rate_hz(unset.profile if unset is not None else None, launch.deploy.min_state_rate_hz)
+
+
+def _tick_frozen(backend, tick0: int, received: int, elapsed_s: float) -> str:
+    """Why the stream is frozen ('' when it is not): samples kept arriving over the window but their
+    tick never advanced (a stuck publisher resending one sample; the loop would trip on it at once)."""
+    tick = backend.read_state().tick
+    if received < 2 or tick != tick0:
+        return ""
+    return (f"tick frozen: {received} samples arrived in {elapsed_s:.1f} s, every one with tick {tick}: the "
+            "robot's state publisher is stuck (the control loop would trip on 'tick frozen' at once)")
+
+
+def _simulator_hint(backend, launch: LaunchFile) -> str:
+    """The hint that the stream looks like Unitree's simulator ('' when not, or when it is configured)."""
+    from g1_control.hardware.links.network import LOOPBACK
+    from g1_control.hardware.unitree.simulators import simulator_hint
+
+    if launch.backend.simulator is not None:
+        return ""
+    loopback = launch.backend.type == "unitree_dds" and launch.backend.interface == LOOPBACK
+    sample = getattr(backend, "rejected_sample", None)
+    if sample is not None:
+        return simulator_hint(sample, loopback=loopback)
+    try:
+        state = backend.read_state()
+    except G1ControlError:
+        return ""
+    return simulator_hint(None, tick=state.tick, mode_machine=state.mode_machine, loopback=loopback)
+
+
+def _simulator_filled(backend, launch: LaunchFile) -> str:
+    """'; simulator unitree_mujoco: crc 0 accepted unchecked, ...' for the state_stream row ('' for a robot)."""
+    unset = getattr(backend, "unset_fields", None)
+    if unset is None:
+        return ""
+    filled = unset.describe_filled()
+    return (f"; backend.simulator {unset.profile.name} ({unset.profile.state_rate_hz:.0f} Hz, robot needs "
+            f"{launch.deploy.min_state_rate_hz:.0f}): " + (filled or "every field set, checked as a robot's"))
+
+
+def _mode_machine_filled(backend) -> str:
+    unset = getattr(backend, "unset_fields", None)
+    if unset is None or "mode_machine" not in unset.filled:
+        return ""
+    return f" (left 0 by {unset.profile.name}: the launch file's expected_variant assumed)"
 
 
 def format_table(results: list[CheckResult]) -> str:
