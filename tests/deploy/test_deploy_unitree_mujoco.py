@@ -108,3 +108,47 @@ def test_the_profile_is_for_loopback_only_and_must_be_known(tmp_path):
     with pytest.raises(LaunchFileError, match="backend.simulator: 'gazebo' is not a simulator profile; known: "
                        "unitree_mujoco"):
         load_launch(write_launch(tmp_path, {"backend": {"simulator": "gazebo"}}))
+
+
+def test_deploy_walks_against_the_emulator_playing_unitree_mujoco(tmp_path, partition):
+    """`g1 sim-robot --mode unitree_mujoco` and `g1 deploy launch/sim2sim_unitree_mujoco.yaml --yes` as two
+    processes: the preflight table names the simulator's traits, then the robot walks (ground truth:
+    the emulator's base position) and ends in damping."""
+    import json
+
+    from test_deploy_sim2sim import Emulator
+
+    from g1_control.tools.soak import G1Process
+    from tests.paths import LAUNCH_DIR
+
+    robot = Emulator(partition, "--mode", "unitree_mujoco", "--lower-gantry-on-policy")
+    host = None
+    try:
+        report_path = tmp_path / "deploy.json"
+        host = G1Process("deploy", str(LAUNCH_DIR / "sim2sim_unitree_mujoco.yaml"), "--yes", "--partition", partition,
+                         "--duration", "6", "--json", str(report_path), "--out", str(tmp_path))
+        host.wait_for(r"zero torque: the robot is limp", 120)
+        table = "\n".join(host.seen)
+        assert "backend.simulator unitree_mujoco (200 Hz, robot needs 400): crc 0 accepted unchecked, tick 0 " \
+               "counted by the host, mode_machine 0 read as 5" in table
+        assert "no motion service: nothing is released" in table
+        assert "releasing the robot's built-in motion service" not in table
+        host.wait_for(r"control -> damping: control time over", 60)
+        assert host.proc.wait(timeout=30) == 0, host.stderr
+        report = json.loads(report_path.read_text())
+        wire = robot.ask("report")
+    finally:
+        if host is not None:
+            host.kill()
+        robot.close()
+    assert report["sequence"] == ["zero_torque", "ramp", "hold", "control", "damping"] and not report["fault"]
+    assert report["released_modes"] == []
+    lowered, damped = wire["gantry_lowered_base_pos_w_m"], wire["first_damping_base_pos_w_m"]
+    walked_m = damped[0] - lowered[0]
+    control_s = wire["first_damping_time_s"] - wire["gantry_lowered_at_s"]
+    print(f"\nunitree_mujoco sim2sim: walked {walked_m:.2f} m in {control_s:.2f} s of control (1 s stand, then vx "
+          f"0.5 m/s); LowState_ sent {wire['states_sent']}, host estimate vx "
+          f"{report['control']['velocity_est_mean'][0]:+.2f} m/s; pelvis at {damped[2]:.2f} m when damped")
+    assert walked_m > 1.0, "forward progress under the policy"
+    assert damped[2] > 0.6, "still standing when control ended"
+    assert wire["last_command_is_damping"] is True and wire["bad_crc"] == 0
