@@ -324,7 +324,7 @@ class Preflight:
         except G1ControlError as exc:
             return self.record("dry_run", FAIL, f"the simulated dry run could not run: {exc}")
         self.dry_run = result
-        moved = ", ".join(f"{s.label} {s.achieved[0]:+.2f} m/s" for s in result.segments if abs(s.commanded[0]) > 0)
+        moved = ", ".join(_segment_speed(s, result.duration_s) for s in result.segments if abs(s.commanded[0]) > 0)
         what = (f"{result.duration_s:.1f} s lockstep MuJoCo of policy {launch.tracker.policy} at the launch "
                 f"file's rates ({result.wall_s:.1f} s wall)" + (f"; {moved}" if moved else ""))
         if result.fell:
@@ -363,6 +363,13 @@ class Preflight:
 
     def as_dict(self) -> list[dict]:
         return [dataclasses.asdict(r) for r in self.results.values()]
+
+
+def _segment_speed(segment, run_s: float) -> str:
+    """'walk +0.42 m/s', or, for a segment the dry run did not reach (no samples: no speed), why not."""
+    if np.isfinite(segment.achieved[0]):
+        return f"{segment.label} {segment.achieved[0]:+.2f} m/s"
+    return f"{segment.label} not reached (starts at {segment.start_s:.1f} s, the dry run ran {run_s:.1f} s)"
 
 
 # -- Unitree's simulators (backend.simulator; g1_control/hardware/unitree/simulators.py) ------------------
