@@ -43,6 +43,7 @@ examples:
   g1 deploy launch/robot.yaml --override temperatures  # a check you verified yourself (logged)
   g1 deploy launch/robot.yaml --program square.yaml    # a behaviour program drives once you press run
   g1 deploy launch/sim2sim.yaml --yes --say "walk forward 1 m and turn left"   # shown; y asked on a robot
+  g1 deploy launch/sim2sim_unitree_mujoco.yaml --yes   # Unitree's unitree_mujoco simulator (backend.simulator)
 """
 
 
