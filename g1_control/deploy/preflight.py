@@ -124,7 +124,8 @@ class Preflight:
             self.record("launch_file", FAIL, f"{path}: backend.type is mujoco; g1 deploy drives a robot link "
                         "(unitree_dds, can, serial). Simulate with `g1 launch`", overridable=False)
             return None
-        self.record("launch_file", PASS, f"{path}: {launch.name} ({launch.backend.type}, input {launch.input.type})")
+        self.record("launch_file", PASS, f"{path}: {launch.name} ({launch.backend.type}, input {launch.input.type})"
+                    + _goals_without_world_pose(launch))
         return launch
 
     def check_policy(self, launch: LaunchFile):
@@ -365,6 +366,18 @@ class Preflight:
         return [dataclasses.asdict(r) for r in self.results.values()]
 
 
+def _goals_without_world_pose(launch: LaunchFile) -> str:
+    """'; note: goal seg2.0 (...) will fail at its start: ...' for the launch file's goals that need a
+    world pose, which a robot does not report ('' when none does)."""
+    from g1_control.generator.goals.executor import world_pose_needed
+    from g1_control.launch.builder import timeline_of
+    from g1_control.teleop.scripted import timeline_goals
+
+    failing = [(g, why) for g in timeline_goals(timeline_of(launch)) if (why := world_pose_needed(g)) is not None]
+    return "".join(f"; note: goal {g.goal_id} ({g.describe()}) will fail at its start: the robot reports no world "
+                   f"pose and {why}" for g, why in failing)
+
+
 def _segment_speed(segment, run_s: float) -> str:
     """'walk +0.42 m/s', or, for a segment the dry run did not reach (no samples: no speed), why not."""
     if np.isfinite(segment.achieved[0]):
@@ -409,7 +422,8 @@ def _simulator_hint(backend, launch: LaunchFile) -> str:
 
 
 def _simulator_filled(backend, launch: LaunchFile) -> str:
-    """'; simulator unitree_mujoco: crc 0 accepted unchecked, ...' for the state_stream row ('' for a robot)."""
+    """'; backend.simulator unitree_mujoco (200 Hz, ...): crc 0 accepted unchecked, ...' for the state_stream
+    row ('' for a robot)."""
     unset = getattr(backend, "unset_fields", None)
     if unset is None:
         return ""

@@ -62,6 +62,10 @@ def test_every_goal_is_reported_on_the_robot_path_and_the_relative_reach_runs(tm
             host.kill()
         robot.close()
     console = "\n".join(host.seen)
+    # said before anything moved: the preflight table's launch_file row
+    assert ("; note: goal seg2.0 (reach left hand at (0.40, 0.20, 0.95)) will fail at its start: the robot reports no "
+            "world pose and a reach to a world point (pos_w_m) needs to know where the robot is") in console
+    assert console.index("will fail at its start") < console.index("zero torque: the robot is limp")
     assert "goals (the execution layer's own verdicts; a robot has no ground truth):" in console
     assert "  goal seg1.0 (reach right hand): reached" in console
     assert f"  goal seg2.0 (reach left hand at (0.40, 0.20, 0.95)): failed ({NO_WORLD_POSE}" in console
