@@ -13,7 +13,7 @@ declared here; defaults are what a stage without that capability should report.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -157,6 +157,8 @@ class Generator(ABC):
     goal_info: Mapping[str, Mapping[str, Any]] = NO_GOALS
     """goal_id -> what the generator recorded about the goal (kind, timing, status), for judging
     it after the run (g1_control/report/outcomes.py)."""
+    goal_log: Sequence[tuple[float, str]] = ()
+    """(t_s, text) notes of the execution layer as they came (goal started, failed and why), for reports."""
 
     @abstractmethod
     def update(self, command: Command, state: RobotState) -> KinematicReference: ...

@@ -23,6 +23,9 @@ BENCHMARKS = {
                 "10 %, heading 10 deg), falls; --only 1,5 picks instructions"),
     "parser": ("g1_control.program.language.bench:bench_main",
                "instruction parser latency (30-word instructions): CPU and wall p50/p99, interleaved with a baseline"),
+    "odometry": ("g1_control.tools.bench_odometry:main",
+                 "world pose drift vs ground truth over 10 seeded random timelines: leg odometry (IMU + contact-aided "
+                 "legs) vs velocity integration; cm per metre and per 90 deg (--seconds each, default 40)"),
     "envelope": ("g1_control.tools.bench_envelope:main",
                  "the walking tracker's achievable velocity per axis and style; --write ships it as the command limits"),
 }

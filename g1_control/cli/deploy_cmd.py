@@ -43,6 +43,7 @@ examples:
   g1 deploy launch/robot.yaml --override temperatures  # a check you verified yourself (logged)
   g1 deploy launch/robot.yaml --program square.yaml    # a behaviour program drives once you press run
   g1 deploy launch/sim2sim.yaml --yes --say "walk forward 1 m and turn left"   # shown; y asked on a robot
+  g1 deploy launch/sim2sim_unitree_mujoco.yaml --yes   # Unitree's unitree_mujoco simulator (backend.simulator)
 """
 
 
@@ -84,8 +85,7 @@ def register(subparsers) -> None:
 
 
 def _run(args) -> int:
-    from g1_control.deploy.preflight import PreflightRefused
-    from g1_control.deploy.session import DeployOptions, deploy, write_report
+    from g1_control.deploy.session import DeployOptions, DeployReport, deploy, write_report
 
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     args.file = _launch_path(args.file)
@@ -94,14 +94,15 @@ def _run(args) -> int:
                             interface=args.interface, domain=args.domain, partition=args.partition,
                             duration_s=args.duration, preflight_only=args.preflight_only, program=program,
                             program_text=text, out_root=args.out)
+    report = DeployReport(launch=str(args.file))
     try:
-        report = deploy(args.file, options)
-    except PreflightRefused as exc:
-        if args.json and exc.report is not None:
-            write_report(exc.report, args.json)
+        deploy(args.file, options, report=report)
+    except BaseException as exc:  # the report says how far it got, whatever ended it
+        report.error = f"{type(exc).__name__}: {exc}"
         raise
-    if args.json:
-        write_report(report, args.json)
+    finally:
+        if args.json:
+            write_report(report, args.json)
     return 3 if report.sequence and report.fault else 0
 
 

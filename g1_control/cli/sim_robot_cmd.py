@@ -38,6 +38,10 @@ def register(subparsers) -> None:
                         help="hang the robot on the gantry (as --gantry) and lower it when the policy takes over: "
                         "when stiff leg targets held still for 0.3 s (the deploy's hold) start to move. For sim2sim "
                         "with `g1 deploy`, whose zero-torque/ramp/hold phases need the gantry")
+    parser.add_argument("--mode", choices=("robot", "unitree_mujoco"), default="robot",
+                        help="robot: the G1's protocol (default); unitree_mujoco: play Unitree's MuJoCo simulator "
+                        "(LowState_ with crc, tick and mode_machine 0 at 200 Hz, PD torque computed when a LowCmd_ "
+                        "arrives and held, no motion service), for g1 deploy with backend.simulator: unitree_mujoco")
     parser.add_argument("--mode-machine", type=int, default=5, help="variant to report with --physics mock (4/5/6)")
     parser.add_argument("--no-builtin", action="store_true",
                         help="start with no built-in controller (as after debug mode on the remote)")
@@ -60,7 +64,13 @@ def _run(args) -> int:
     if args.physics == "mujoco":
         from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
 
-        physics = mujoco = MujocoBackend(MujocoConfig(lockstep=True))
+        mujoco: MujocoBackend
+        if args.mode == "unitree_mujoco":
+            from g1_control.sim.unitree_mujoco import PHYSICS_DT_S, HeldTorqueMujoco
+
+            physics = mujoco = HeldTorqueMujoco(MujocoConfig(lockstep=True, physics_dt_s=PHYSICS_DT_S))
+        else:
+            physics = mujoco = MujocoBackend(MujocoConfig(lockstep=True))
         if args.gantry or args.lower_gantry_on_policy:
             from g1_control.sim.emulator import Gantry
 
@@ -71,7 +81,7 @@ def _run(args) -> int:
 
         physics = MockG1(mode_machine=args.mode_machine)
     emulator = RobotEmulator(physics, args.interface, args.domain, partition=args.partition,
-                             builtin_mode="" if args.no_builtin else "ai").start()
+                             builtin_mode="" if args.no_builtin else "ai", mode=args.mode).start()
     stop = {"now": False}
 
     def _stop(signum, frame):
@@ -79,7 +89,8 @@ def _run(args) -> int:
 
     signal.signal(signal.SIGTERM, _stop)
     with frozen_heap():  # the 500 Hz robot loop never waits for a full collection of the startup heap
-        print(f"g1 sim-robot: emulating a G1 ({args.physics}) on interface {args.interface}, domain {args.domain}"
+        played = ", as Unitree's unitree_mujoco" if args.mode == "unitree_mujoco" else ""
+        print(f"g1 sim-robot: emulating a G1 ({args.physics}{played}) on interface {args.interface}, domain {args.domain}"
               + (f", partition {args.partition}" if args.partition else ""), file=sys.stderr, flush=True)
         print("ready", flush=True)
         try:

@@ -20,6 +20,7 @@ from g1_control.robot import g1
 
 if TYPE_CHECKING:
     from g1_control.hardware.link_backend import LinkBackend
+    from g1_control.hardware.unitree.simulators import SimulatorProfile
 
 
 class _HostOptions(TypedDict):
@@ -36,6 +37,13 @@ def expected_mode_machine(config: BackendConfig) -> int:
     return next(v.mode_machine for v in g1.VARIANTS.values() if v.name == config.expected_variant)
 
 
+def simulator_profile(config: BackendConfig) -> SimulatorProfile | None:
+    """The backend.simulator profile (None: a robot); BackendConfig.validate has checked the name."""
+    from g1_control.hardware.unitree.simulators import SIMULATORS
+
+    return SIMULATORS[config.simulator] if config.simulator is not None else None
+
+
 def check_link_endpoint(config: BackendConfig) -> str:
     """Raise TransportError unless the link's interface/port exists (and is up); say what was found.
 
@@ -46,6 +54,11 @@ def check_link_endpoint(config: BackendConfig) -> str:
             name, address = robot_interface()
             config.interface, chosen = name, f" (auto: the one NIC on {ROBOT_SUBNET}, {address})"
         check_interface(config.interface or "")
+        profile = simulator_profile(config)
+        if profile is not None:
+            return (f"interface {config.interface} exists and is up (loopback: simulation); backend.simulator "
+                    f"{profile.name}: {profile.describe}"
+                    + ("" if profile.motion_service else ", no motion service: nothing is released"))
         return f"interface {config.interface} exists and is up{chosen}" + (" (loopback: simulation)" if
                                                                             config.interface == LOOPBACK else "")
     if config.type == "can":
@@ -87,8 +100,11 @@ def open_robot_backend(config: BackendConfig, *, damping_kd: float = 2.0,
         if not config.interface:  # BackendConfig.validate refuses this in a launch file
             raise TransportError("backend.interface: a unitree_dds backend must name its network interface")
         release = config.release_motion_service if release_motion_service is None else release_motion_service
+        profile = simulator_profile(config)
+        if profile is not None and not profile.motion_service:
+            release = False  # nothing to release: the simulator runs none
         return UnitreeDDSBackend(config.interface, config.domain, partition=config.partition,
-                                 release_motion_service=release, **common)
+                                 release_motion_service=release, simulator=profile, **common)
     from g1_control.hardware.link_backend import LinkBackend
 
     if config.type == "can":

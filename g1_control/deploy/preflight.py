@@ -124,7 +124,8 @@ class Preflight:
             self.record("launch_file", FAIL, f"{path}: backend.type is mujoco; g1 deploy drives a robot link "
                         "(unitree_dds, can, serial). Simulate with `g1 launch`", overridable=False)
             return None
-        self.record("launch_file", PASS, f"{path}: {launch.name} ({launch.backend.type}, input {launch.input.type})")
+        self.record("launch_file", PASS, f"{path}: {launch.name} ({launch.backend.type}, input {launch.input.type})"
+                    + _goals_without_world_pose(launch))
         return launch
 
     def check_policy(self, launch: LaunchFile):
@@ -169,23 +170,28 @@ class Preflight:
         try:
             state = backend.wait_for_state(launch.backend.connect_timeout_s)
         except RobotNotConnectedError as exc:
-            self.record("state_stream", FAIL, str(exc), overridable=False)
+            self.record("state_stream", FAIL, str(exc) + _simulator_hint(backend, launch), overridable=False)
             self.not_run(("variant", "peers", "imu_upright", "joint_limits", "temperatures", "battery"),
                          "no robot state")
             return None
         # Rate and CRC health over a window, from the transport's own counters.
+        tick0 = backend.read_state().tick
         before, t0 = backend.stats(), time.monotonic()
         time.sleep(cfg.state_window_s)
         after, elapsed = backend.stats(), time.monotonic() - t0
+        min_rate = _min_state_rate_hz(backend, launch)
         rate = (after.states_received - before.states_received) / elapsed
         bad, malformed = after.bad_crc - before.bad_crc, after.malformed - before.malformed
         bad_frames = after.bad_frames - before.bad_frames
         where = backend.link.describe()
         detail = (f"{rate:.0f} Hz over {elapsed:.1f} s, {bad} bad CRC, {malformed} malformed"
                   + (f", {bad_frames} bad frames" if bad_frames else ""))
-        if rate < cfg.min_state_rate_hz:
-            self.record("state_stream", FAIL, f"{detail}; need >= {cfg.min_state_rate_hz:.0f} Hz on {where}: check the "
+        frozen = _tick_frozen(backend, tick0, after.states_received - before.states_received, elapsed)
+        if rate < min_rate:
+            self.record("state_stream", FAIL, f"{detail}; need >= {min_rate:.0f} Hz on {where}: check the "
                         "cable/switch and that nothing else loads this host")
+        elif frozen:
+            self.record("state_stream", FAIL, f"{detail}; {frozen}{_simulator_hint(backend, launch)}")
         elif bad or malformed or bad_frames:
             self.record("state_stream", FAIL, f"{detail}; corrupted samples on {where}: check the cable, the switch "
                         "and that only one robot publishes on this domain")
@@ -197,14 +203,14 @@ class Preflight:
                             f"{', '.join(invalid[:4])}{' ...' if len(invalid) > 4 else ''}: a sensor or its decoding "
                             "is broken", overridable=False)
             else:
-                self.record("state_stream", PASS, detail)
+                self.record("state_stream", PASS, detail + _simulator_filled(backend, launch))
         state = backend.read_state()
         self.check_peers(backend)
 
         try:
             variant = variant_of(state.mode_machine)
         except VariantMismatchError as exc:
-            self.record("variant", FAIL, str(exc), overridable=False)
+            self.record("variant", FAIL, str(exc) + _simulator_hint(backend, launch), overridable=False)
             variant = None
         if variant is not None:
             if variant.name != launch.backend.expected_variant:
@@ -213,7 +219,8 @@ class Preflight:
                             + (f" and the policy is for {policy_variant}" if policy_variant else "")
                             + "; use a launch file and policy made for this robot", overridable=False)
             else:
-                self.record("variant", PASS, f"mode_machine {state.mode_machine} ({variant.name}, {variant.num_dof} DoF)")
+                self.record("variant", PASS, f"mode_machine {state.mode_machine} ({variant.name}, {variant.num_dof} DoF)"
+                            + _mode_machine_filled(backend))
         active = variant.active_mask if variant is not None else np.ones(g1.NUM_JOINTS, dtype=bool)
 
         tilt = tilt_rad(state.imu_quat_wxyz) if np.all(np.isfinite(state.imu_quat_wxyz)) else float("nan")
@@ -315,7 +322,7 @@ class Preflight:
         except G1ControlError as exc:
             return self.record("dry_run", FAIL, f"the simulated dry run could not run: {exc}")
         self.dry_run = result
-        moved = ", ".join(f"{s.label} {s.achieved[0]:+.2f} m/s" for s in result.segments if abs(s.commanded[0]) > 0)
+        moved = ", ".join(_segment_speed(s, result.duration_s) for s in result.segments if abs(s.commanded[0]) > 0)
         what = (f"{result.duration_s:.1f} s lockstep MuJoCo of policy {launch.tracker.policy} at the launch "
                 f"file's rates ({result.wall_s:.1f} s wall)" + (f"; {moved}" if moved else ""))
         if result.fell:
@@ -354,6 +361,79 @@ class Preflight:
 
     def as_dict(self) -> list[dict]:
         return [dataclasses.asdict(r) for r in self.results.values()]
+
+
+def _goals_without_world_pose(launch: LaunchFile) -> str:
+    """'; note: goal seg2.0 (...) will fail at its start: ...' for the launch file's goals that need a
+    world pose, which a robot does not report ('' when none does)."""
+    from g1_control.generator.goals.executor import world_pose_needed
+    from g1_control.launch.builder import timeline_of
+    from g1_control.teleop.scripted import timeline_goals
+
+    failing = [(g, why) for g in timeline_goals(timeline_of(launch)) if (why := world_pose_needed(g)) is not None]
+    return "".join(f"; note: goal {g.goal_id} ({g.describe()}) will fail at its start: the robot reports no world "
+                   f"pose and {why}" for g, why in failing)
+
+
+def _segment_speed(segment, run_s: float) -> str:
+    """'walk +0.42 m/s', or, for a segment the dry run did not reach (no samples: no speed), why not."""
+    if np.isfinite(segment.achieved[0]):
+        return f"{segment.label} {segment.achieved[0]:+.2f} m/s"
+    return f"{segment.label} not reached (starts at {segment.start_s:.1f} s, the dry run ran {run_s:.1f} s)"
+
+
+# -- Unitree's simulators (backend.simulator; g1_control/hardware/unitree/simulators.py) ------------------
+def _min_state_rate_hz(backend, launch: LaunchFile) -> float:
+    from g1_control.hardware.unitree.simulators import min_state_rate_hz
+
+    unset = getattr(backend, "unset_fields", None)
+    return min_state_rate_hz(unset.profile if unset is not None else None, launch.deploy.min_state_rate_hz)
+
+
+def _tick_frozen(backend, tick0: int, received: int, elapsed_s: float) -> str:
+    """Why the stream is frozen ('' when it is not): samples kept arriving over the window but their
+    tick never advanced (a stuck publisher resending one sample; the loop would trip on it at once)."""
+    tick = backend.read_state().tick
+    if received < 2 or tick != tick0:
+        return ""
+    return (f"tick frozen: {received} samples arrived in {elapsed_s:.1f} s, every one with tick {tick}: the "
+            "robot's state publisher is stuck (the control loop would trip on 'tick frozen' at once)")
+
+
+def _simulator_hint(backend, launch: LaunchFile) -> str:
+    """The hint that the stream looks like Unitree's simulator ('' when not, or when it is configured)."""
+    from g1_control.hardware.links.network import LOOPBACK
+    from g1_control.hardware.unitree.simulators import simulator_hint
+
+    if launch.backend.simulator is not None:
+        return ""
+    loopback = launch.backend.type == "unitree_dds" and launch.backend.interface == LOOPBACK
+    sample = getattr(backend, "rejected_sample", None)
+    if sample is not None:
+        return simulator_hint(sample, loopback=loopback)
+    try:
+        state = backend.read_state()
+    except G1ControlError:
+        return ""
+    return simulator_hint(None, tick=state.tick, mode_machine=state.mode_machine, loopback=loopback)
+
+
+def _simulator_filled(backend, launch: LaunchFile) -> str:
+    """'; backend.simulator unitree_mujoco (200 Hz, ...): crc 0 accepted unchecked, ...' for the state_stream
+    row ('' for a robot)."""
+    unset = getattr(backend, "unset_fields", None)
+    if unset is None:
+        return ""
+    filled = unset.describe_filled()
+    return (f"; backend.simulator {unset.profile.name} ({unset.profile.state_rate_hz:.0f} Hz, robot needs "
+            f"{launch.deploy.min_state_rate_hz:.0f}): " + (filled or "every field set, checked as a robot's"))
+
+
+def _mode_machine_filled(backend) -> str:
+    unset = getattr(backend, "unset_fields", None)
+    if unset is None or "mode_machine" not in unset.filled:
+        return ""
+    return f" (left 0 by {unset.profile.name}: the launch file's expected_variant assumed)"
 
 
 def format_table(results: list[CheckResult]) -> str:

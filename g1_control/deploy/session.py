@@ -85,6 +85,11 @@ class DeployReport:
     dry_run_chain: dict = field(default_factory=dict)
     run_dir: str | None = None
     """The run folder (per-tick log, events, summary), written as the deploy went."""
+    goals: list[dict] = field(default_factory=list)
+    """Every goal's status and message, as the execution layer reports them (report/outcomes.py
+    goal_reports: no ground truth on a robot), including the launch file's goals that never started."""
+    error: str = ""
+    """The error that ended the deploy, if one did (set by `g1 deploy`, which writes --json whatever happened)."""
 
     def to_json(self) -> str:
         return json.dumps(dataclasses.asdict(self), indent=2, default=float)
@@ -156,10 +161,11 @@ def _confirm_program(launch: LaunchFile, options: DeployOptions, say, ask) -> bo
 
 
 def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say,
-           ask: Callable[[str], str] = input) -> DeployReport:
+           ask: Callable[[str], str] = input, report: DeployReport | None = None) -> DeployReport:
     """Run one deploy session; raise PreflightRefused (after printing the table) when refused.
-    `ask`: the operator's answer to a question (confirming a program typed in English)."""
-    report = DeployReport(launch=str(path))
+    `ask`: the operator's answer to a question (confirming a program typed in English).
+    `report`: filled as the deploy goes (so a caller holds what was done even when it raises)."""
+    report = report if report is not None else DeployReport(launch=str(path))
     pf = Preflight(frozenset(options.overrides))
     launch = pf.check_launch_file(path)
     if launch is not None:
@@ -400,6 +406,7 @@ class _RobotControl:
         assert folder is not None  # open_run_folder ran
         log = folder.close_log(self.loop)
         _fill_report(report, log, self.loop, self.tracker, self.backend, self.safety, self.t_loop0, self.device)
+        _report_goals(report, self.loop, self.launch, folder)
         folder.write_npz(log)
         status = ("error" if error is not None else "fault" if report.fault
                   else "interrupted" if report.end_reason.startswith("SIG") else "completed")
@@ -451,6 +458,22 @@ def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTr
                    "clamped_commands": safety.clamps.commands}
 
 
+def _report_goals(report: DeployReport, loop, launch: LaunchFile, folder: RunFolder) -> None:
+    """Every goal's status and message (the execution layer's verdicts) into the report and the run
+    folder's events, with the execution layer's notes (goal started, failed and why, ...) as they came."""
+    from g1_control.launch.builder import timeline_of
+    from g1_control.report.outcomes import goal_reports
+    from g1_control.teleop.scripted import timeline_goals
+
+    if launch.tracker.type != "layer":  # only the tracking layer executes goals
+        return
+    for t_s, text in loop.generator.goal_log:
+        folder.event({"type": "goal_note", "t_s": t_s, "text": text})
+    report.goals = goal_reports(loop.generator, timeline_goals(timeline_of(launch)))
+    for goal in report.goals:
+        folder.event({"type": "goal", **goal})
+
+
 def _print_summary(report: DeployReport, say) -> None:
     link = report.link
     say(f"deploy ended in damping: {report.end_reason}" + (" (FAULT)" if report.fault else ""))
@@ -467,6 +490,12 @@ def _print_summary(report: DeployReport, say) -> None:
             f"wz {v[2]:+.2f} (commanded {c[0]:+.2f}, {c[1]:+.2f}, {c[2]:+.2f})")
     for style, fig in (report.control.get("upper_body_vs_plan") or {}).items():
         say(f"upper body vs plan, style {style}: RMS {fig['rms_rad']:.3f} rad over {fig['seconds']:.1f} s")
+    if report.goals:
+        from g1_control.report.outcomes import outcome_line
+
+        say("goals (the execution layer's own verdicts; a robot has no ground truth):")
+        for goal in report.goals:
+            say("  " + outcome_line(goal))
     say(f"loop: {report.loop['ticks']} ticks, {report.loop['deadline_misses']} deadline misses (worst "
         f"{report.loop['lateness_max_ms']:.1f} ms late, p99 {report.loop['lateness_p99_ms']:.1f} ms), "
         f"{report.loop['clamped_commands']} commands clamped by the safety layer")

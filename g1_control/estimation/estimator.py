@@ -69,6 +69,11 @@ class StateEstimator:
         self.estimate = EstimatedState()
         self._last_t = None
 
+    def sole_offsets_w_m(self) -> np.ndarray:
+        """(2, 3) left and right sole centres minus the base position, world axes (the IMU's
+        orientation), as the last update() computed them."""
+        return np.array([self.data.oMf[f].translation for f in self._soles])
+
     def update(self, state: RobotState, contacts: np.ndarray | None = None) -> EstimatedState:
         """contacts: (left, right) feet known to be in stance (a controller's contact schedule);
         None: the lower foot is taken as the stance foot. Known contacts matter on uneven ground:

@@ -35,7 +35,8 @@ from g1_control.hardware.unitree.conversions import (
     motor_command_to_lowcmd,
     variant_of,
 )
-from g1_control.hardware.unitree.messages import LOWCMD_TOPIC, LOWSTATE_TOPIC
+from g1_control.hardware.unitree.messages import LOWCMD_TOPIC, LOWSTATE_TOPIC, LowState
+from g1_control.hardware.unitree.simulators import RejectedSample, SimulatorProfile, UnsetFields
 from g1_control.interfaces import Backend
 from g1_control.robot import g1
 from g1_control.types import MotorCommand, RobotState
@@ -79,7 +80,9 @@ class LinkBackend(Backend):
 
     def __init__(self, link: Link, *, command_rate_hz: float = 500.0, mode_pr: int = 0,
                  expected_mode_machine: int | None = None, connect_timeout_s: float = 2.0,
-                 close_damping_s: float = 0.2, damping_kd: float = 2.0):
+                 close_damping_s: float = 0.2, damping_kd: float = 2.0, simulator: SimulatorProfile | None = None):
+        """simulator: one of Unitree's simulators (hardware/unitree/simulators.py), whose LowState_
+        leaves fields unset that a robot fills: those are filled in here (needs expected_mode_machine)."""
         if link.side != "host":
             raise ValueError("LinkBackend needs the host side of a link")
         if not command_rate_hz > 0:
@@ -110,6 +113,12 @@ class LinkBackend(Backend):
         self._stop = threading.Event()
         self._threads: list[threading.Thread] = []
         self._closed = False
+        if simulator is not None and expected_mode_machine is None:
+            raise ValueError(f"simulator {simulator.name}: needs expected_mode_machine (what a mode_machine of 0 means)")
+        self.unset_fields = None if simulator is None else UnsetFields(simulator, int(expected_mode_machine or 0))
+        """The simulator's unset LowState_ fields, filled (None: a robot, every field checked)."""
+        self.rejected_sample: RejectedSample | None = None
+        """The latest LowState_ dropped for its CRC, decoded unchecked (for the preflight's hints)."""
         self._start()
 
     # -- Backend ---------------------------------------------------------------------------------
@@ -259,7 +268,7 @@ class LinkBackend(Backend):
                 self.refresh_peers()
             for payload, sender in self.link.receive_tagged(0.05):
                 try:
-                    msg = self.link.decode_state(payload)
+                    msg = self._decode_state(payload)
                 except CrcMismatchError:
                     with self._lock:
                         self._bad_crc += 1
@@ -277,6 +286,16 @@ class LinkBackend(Backend):
                         self._senders[sender] = now
                     self._state_times.append(now)
                 self._state_event.set()
+
+    def _decode_state(self, payload: bytes) -> LowState:
+        try:
+            if self.unset_fields is not None:
+                return self.unset_fields.decode(self.link, payload)
+            return self.link.decode_state(payload)
+        except CrcMismatchError:
+            msg = self.link.decode_state(payload, verify=False)
+            self.rejected_sample = RejectedSample(int(msg.crc), int(msg.tick), int(msg.mode_machine))
+            raise
 
     def _write_loop(self) -> None:
         next_t = time.monotonic()

@@ -44,7 +44,10 @@ class BackendConfig:
     `domain` (0 on the robot, 1 in simulation); `partition` only isolates concurrent runs on one
     host. can needs `can_interface` + `channel` (python-can: socketcan/can0, virtual/NAME); serial
     needs `port` (+ `baudrate`). `expected_variant` is the G1 the launch file is written for: a
-    robot reporting another mode_machine is refused.
+    robot reporting another mode_machine is refused. `simulator` names one of Unitree's own
+    simulators behind a unitree_dds link on loopback (g1_control/hardware/unitree/simulators.py:
+    unitree_mujoco): the host then accepts what that simulator leaves unset in LowState_ (crc,
+    tick, mode_machine at 0, a 200 Hz stream, no motion service), and the preflight says so.
     """
 
     type: Literal["mujoco", "unitree_dds", "can", "serial"] = "mujoco"
@@ -66,8 +69,11 @@ class BackendConfig:
     can_fd: bool = True
     port: str | None = None
     baudrate: int = 921600
+    simulator: str | None = None
+    """None: a robot (or g1 sim-robot), every LowState_ field checked; unitree_mujoco: Unitree's simulator."""
 
     def validate(self, where: str) -> None:
+        self._validate_simulator(where)
         if not 0.0005 <= self.physics_dt_s <= 0.005:
             raise LaunchFileError(f"{where}.physics_dt_s: {self.physics_dt_s} is outside [0.0005, 0.005] s "
                                   "(physics must run at 200 Hz or faster)")
@@ -92,6 +98,20 @@ class BackendConfig:
                                   "(the robot expects a steady stream; Unitree's examples use 500)")
         if self.connect_timeout_s <= 0:
             raise LaunchFileError(f"{where}.connect_timeout_s: must be > 0, got {self.connect_timeout_s}")
+
+    def _validate_simulator(self, where: str) -> None:
+        from g1_control.hardware.links.network import LOOPBACK
+        from g1_control.hardware.unitree.simulators import SIMULATORS
+
+        if self.simulator is None:
+            return
+        if self.simulator not in SIMULATORS:
+            raise LaunchFileError(f"{where}.simulator: '{self.simulator}' is not a simulator profile; known: "
+                                  f"{', '.join(SIMULATORS)} (leave it out for a robot)")
+        if self.type != "unitree_dds" or self.interface != LOOPBACK:
+            raise LaunchFileError(f"{where}.simulator: {self.simulator} is allowed on loopback only (type unitree_dds, "
+                                  f"interface {LOOPBACK}); got type {self.type}, interface {self.interface}: a robot "
+                                  "must fill crc, tick and mode_machine, and is checked for them")
 
 
 @dataclass

@@ -18,6 +18,7 @@ Figures per goal kind:
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -26,7 +27,9 @@ from g1_control.robot import g1
 from g1_control.robot.dynamics import HAND_OFFSET_M, SOLE_OFFSET_M
 
 if TYPE_CHECKING:
+    from g1_control.interfaces import Generator
     from g1_control.loop.control_loop import ControlLoop
+    from g1_control.types import TaskGoal
 
 REACH_TOLERANCE_M = 0.03
 DROP_M = 0.05
@@ -135,6 +138,20 @@ def judge_goal(goal_id: str, info: dict, a: dict[str, np.ndarray]) -> dict:
     return out
 
 
+def goal_reports(generator: Generator, planned: Sequence[TaskGoal] = ()) -> list[dict]:
+    """Every goal's status and message as the execution layer (GoalGenerator) reports them, without
+    ground truth (the robot path): the goals that started, in order, then those `planned` (a launch
+    file's timeline) that never started, as 'not started'. Each dict as judge_goal's, plus message."""
+    info, messages = generator.goal_info, generator.goal_messages
+    out = [dict(judge_goal(gid, dict(i), {"t_s": np.zeros(0)}), message=messages.get(gid)) for gid, i in info.items()]
+    for goal in planned:
+        if goal.goal_id not in info:
+            out.append({"goal_id": goal.goal_id, "kind": goal.kind, "describe": goal.describe(),
+                        "status": "not started", "start_s": None, "end_s": None,
+                        "message": "control ended before the goal's turn came"})
+    return out
+
+
 def outcome_line(o: dict) -> str:
     """One line per goal for a run summary."""
     text = f"goal {o['goal_id']} ({o.get('describe')}): {o['status']}"
@@ -157,4 +174,4 @@ def outcome_line(o: dict) -> str:
     return text
 
 
-__all__ = ["GoalWatcher", "judge_goal", "outcome_line"]
+__all__ = ["GoalWatcher", "goal_reports", "judge_goal", "outcome_line"]

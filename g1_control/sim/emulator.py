@@ -44,6 +44,8 @@ REMOTE_COMMANDS = {
     "stick NAME VALUE": "set a remote stick: lx, ly (forward +), rx, ry, l2 in [-1, 1]",
 }
 REMOTE_PRESS_S = 0.15
+EMULATOR_MODES = ("robot", "unitree_mujoco")
+"""What the emulator plays: the G1 itself, or Unitree's MuJoCo simulator (g1_control/sim/unitree_mujoco.py)."""
 
 
 class FaultyPhysics(Backend):
@@ -192,15 +194,25 @@ class Gantry(Backend):
 
 class RobotEmulator:
     def __init__(self, physics: Backend, interface: str = LOOPBACK, domain_id: int = 1,
-                 partition: str | None = None, rate_hz: float = 500.0, builtin_mode: str = "ai"):
+                 partition: str | None = None, rate_hz: float = 500.0, builtin_mode: str = "ai",
+                 mode: str = "robot"):
+        """mode: robot (the G1's protocol), or unitree_mujoco (that simulator's traits: LowState_ with
+        crc/tick/mode_machine 0 at 200 Hz, no motion service; its held-torque motor law is the physics'
+        own: g1_control/sim/unitree_mujoco.py)."""
+        if mode not in EMULATOR_MODES:
+            raise ValueError(f"emulator mode '{mode}' is not one of {', '.join(EMULATOR_MODES)}")
         if interface != LOOPBACK:
             raise NetworkInterfaceError(
                 f"the robot emulator runs on loopback only (interface '{LOOPBACK}'); got '{interface}'. "
                 "Point the host at the emulator with the same interface and domain")
         self.physics = FaultyPhysics(physics)
         self.state0 = self.physics.reset()
+        self.mode = mode
+        if mode == "unitree_mujoco":
+            rate_hz, builtin_mode = self._unitree_mujoco_traits()
         self.link = DdsLink("robot", interface, domain_id, partition=partition)
         self.endpoint = RobotEndpoint(self.link, self.physics, rate_hz=rate_hz)
+        self.endpoint.unset_state_fields = mode == "unitree_mujoco"
         # Until released, the built-in controller "holds" the robot: physics paused at the standing
         # pose, host commands ignored. Released with no host command yet, the motors damp, as in
         # the remote's debug mode.
@@ -208,8 +220,15 @@ class RobotEmulator:
         if not builtin_mode:
             self.physics.write_command(MotorCommand.damping(g1.KD_DEFAULT))
         self.service = MotionServiceEmulator(self.link._participant, partition, active_mode=builtin_mode,
-                                             on_change=self._on_mode_change)
+                                             on_change=self._on_mode_change) if mode == "robot" else None
         self._lock = threading.Lock()
+
+    @staticmethod
+    def _unitree_mujoco_traits() -> tuple[float, str]:
+        """(LowState_ rate, built-in controller) of Unitree's MuJoCo simulator: 200 Hz, none."""
+        from g1_control.sim.unitree_mujoco import PROFILE
+
+        return PROFILE.state_rate_hz, ""
 
     def _on_mode_change(self, mode: str) -> None:
         self.endpoint.builtin_active = bool(mode)
@@ -268,7 +287,8 @@ class RobotEmulator:
 
     def close(self) -> None:
         self.endpoint.stop()
-        self.service.close()
+        if self.service is not None:
+            self.service.close()
         self.link.close()
         self.physics.close()
 
@@ -277,7 +297,8 @@ class RobotEmulator:
 
         out = asdict(self.endpoint.counters)
         out["first_damping_time_s"] = self.endpoint.first_damping_time_s
-        out["builtin_mode"] = self.service.active_mode
+        out["builtin_mode"] = self.service.active_mode if self.service is not None else None
+        out["mode"] = self.mode
         out.update(self.endpoint.command_wire_stats())
         out.update(self.endpoint.whole_run_period_stats())
         state = self.physics.read_state()

@@ -73,6 +73,9 @@ class RobotEndpoint:
         self.publish = True
         self.freeze_state = False
         self.corrupt_state_crc = False
+        self.unset_state_fields = False
+        """As Unitree's MuJoCo simulator (g1_control/sim/unitree_mujoco.py): LowState_ with crc, tick and
+        mode_machine left at 0, and every LowCmd_ taken whatever its CRC and mode_machine."""
         self._frozen: bytes | None = None
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -112,7 +115,7 @@ class RobotEndpoint:
     def _apply_commands(self, payloads: list[bytes]) -> None:
         for payload in payloads:
             try:
-                msg = self.link.decode_command(payload)
+                msg = self.link.decode_command(payload, verify=not self.unset_state_fields)
             except CrcMismatchError:
                 self.counters.bad_crc += 1
                 continue
@@ -121,7 +124,7 @@ class RobotEndpoint:
                 continue
             self._record_command_time(time.monotonic())
             state = self.physics.read_state()
-            if msg.mode_machine != state.mode_machine:
+            if msg.mode_machine != state.mode_machine and not self.unset_state_fields:
                 self.counters.wrong_mode_machine += 1
                 continue
             if self.builtin_active:
@@ -194,7 +197,11 @@ class RobotEndpoint:
             state = self.physics.read_state()
             state.tick = self._tick
             msg = robot_state_to_lowstate(state)
+            if self.unset_state_fields:
+                msg.tick = msg.mode_machine = 0
             payload = self.link.encode(msg)
+            if self.unset_state_fields:
+                payload = payload[:-4] + bytes(4)  # the CRC word ends both wire forms: crc 0
             if self.corrupt_state_crc:
                 # Flip one bit of the last byte, which lies inside the CRC word on both wire forms.
                 payload = payload[:-1] + bytes([payload[-1] ^ 0x01])

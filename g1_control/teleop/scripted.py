@@ -81,6 +81,16 @@ class RandomTimelineConfig:
     """Upper-body style of every segment."""
 
 
+def segment_goal_id(segment: int, goal: int) -> str:
+    """The goal_id ScriptedInput gives goal `goal` of timeline segment `segment`."""
+    return f"seg{segment}.{goal}"
+
+
+def timeline_goals(segments: Sequence[Segment]) -> list[TaskGoal]:
+    """Every task goal of a timeline, in order, with the goal_ids ScriptedInput gives them."""
+    return [g.to_goal(segment_goal_id(i, j)) for i, s in enumerate(segments) for j, g in enumerate(s.goals)]
+
+
 class ScriptedInput(InputDevice):
     """Plays `segments` back to back from `start_s` on the poll's clock; after the last one (and
     before `start_s`), commands zero velocity."""
@@ -94,7 +104,7 @@ class ScriptedInput(InputDevice):
         self._commands = [
             Command(vx_mps=s.vx_mps, vy_mps=s.vy_mps, wz_radps=s.wz_radps, style=s.style,
                     pelvis_height_m=s.pelvis_height_m,
-                    tasks=[g.to_goal(f"seg{i}.{j}") for j, g in enumerate(s.goals)]).validate()
+                    tasks=[g.to_goal(segment_goal_id(i, j)) for j, g in enumerate(s.goals)]).validate()
             for i, s in enumerate(self.segments)
         ] + [Command()]
 

@@ -36,6 +36,7 @@ class FakeBackend:
         return self.state
 
     def read_state(self):
+        self.state.tick += 1  # a robot's tick advances with every sample (a frozen one fails the preflight)
         return self.state
 
     def stats(self):

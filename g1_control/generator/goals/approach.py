@@ -27,7 +27,8 @@ def enter_whole_body(ctx: GoalContext) -> Iterator[None]:
     """From walking: a reference from the measured pose to a clean standing one."""
     q = ctx.measured_q()
     soles = flat_soles(ctx.ik, q)
-    ground = [ctx.scene.ground_height(p[:2]) for p, _ in soles]
+    # without a world pose the scene cannot be placed under the feet: the robot stands on the floor
+    ground = [ctx.scene.ground_height(p[:2]) if ctx.localised else 0.0 for p, _ in soles]
     lift = min(p[2] - g for (p, _), g in zip(soles, ground))
     q[2] -= lift  # the lower sole exactly on its ground
     soles = [(np.array([p[0], p[1], g]), r) for (p, r), g in zip(soles, ground)]

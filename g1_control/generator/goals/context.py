@@ -35,6 +35,22 @@ class GoalFailed(RuntimeError):
     """A goal that cannot be done (the message says why)."""
 
 
+def world_pose_needed(goal: TaskGoal) -> str | None:
+    """Why `goal` needs the robot's pose in the world, or None where it runs without one.
+
+    A reach given relative to the robot (offset_h_m) is planned in the frame of the stance the
+    robot stands in, and so are heights (Command.pelvis_height_m); everything placed in the scene
+    (world points, boxes, tables, platforms) is found only from where the robot is in the world."""
+    if goal.kind == "reach":
+        if goal.pos_w_m is None:
+            return None
+        return "a reach to a world point (pos_w_m) needs to know where the robot is; give it relative to the robot (offset_h_m)"
+    what = {"pick": "a pick finds its box in the scene", "place": "a place finds where the box goes in the scene",
+            "step_up": "a step up finds its platform in the scene",
+            "step_down": "a step down finds the floor behind the platform in the scene"}[goal.kind]
+    return f"{what}, which needs to know where the robot is"
+
+
 @dataclass
 class GoalConfig:
     walk_speed_mps: float = 0.4
@@ -143,6 +159,18 @@ class GoalContext:
         self.log.append((self.t, text))
 
     # -- where the robot is -------------------------------------------------------------------------
+    @property
+    def localised(self) -> bool:
+        """Whether the robot's world pose is known (the simulator's ground truth; a robot has none)."""
+        return self.state is not None and self.state.base_pos_w_m is not None
+
+    def require_world_pose(self, goal: TaskGoal) -> None:
+        """GoalFailed, before anything moves, when `goal` needs a world pose and there is none."""
+        why = world_pose_needed(goal)
+        if why is not None and not self.localised:
+            raise GoalFailed(f"no world pose for the robot: {why} (a robot reports none; in simulation the "
+                             "simulator gives it); nothing moved for this goal")
+
     def world_pose(self) -> tuple[RobotState, np.ndarray]:
         """This tick's state and the robot's world position; goals in world coordinates need one."""
         s = self.state
@@ -152,10 +180,13 @@ class GoalContext:
         return s, s.base_pos_w_m
 
     def measured_q(self) -> np.ndarray:
-        """The robot's configuration now (pinocchio q): joints, IMU orientation, world position."""
-        s, pos_w = self.world_pose()
+        """The robot's configuration now (pinocchio q): joints, IMU orientation, world position (without
+        a world pose: the origin; goals that run then need no world: world_pose_needed)."""
+        s = self.state
+        assert s is not None
         w, x, y, z = s.imu_quat_wxyz
-        return np.concatenate([pos_w, [x, y, z, w], s.q_rad])
+        pos = s.base_pos_w_m if s.base_pos_w_m is not None else np.array([0.0, 0.0, self.poses.nominal_pelvis_m])
+        return np.concatenate([pos, [x, y, z, w], s.q_rad])
 
     def hold_q(self) -> np.ndarray:
         """Where the whole-body reference is now (the end of the current plan)."""
@@ -169,7 +200,7 @@ class GoalContext:
 
     def offset(self) -> np.ndarray:
         """Plan frame minus world (xy): the tracker's odometry drift, measured against the world pose."""
-        if self.phase != PHASE_WHOLE_BODY or self.plan is None or self.state is None:
+        if self.phase != PHASE_WHOLE_BODY or self.plan is None or not self.localised:
             return np.zeros(2)
         j = self.plan.sample(min(self.t - self.plan_t0, self.plan.duration_s))
         _, pos_w = self.world_pose()

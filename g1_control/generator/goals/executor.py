@@ -13,8 +13,9 @@ The first whole-body reference after walking starts at the measured configuratio
 where they are), so the hand-over does not jump; each later one starts where the previous ended.
 Where the robot must be is planned from the scene (task knowledge: where the boxes, tables and
 platforms are) and the robot's world pose: the simulator's ground truth in simulation (a stand-in
-for a localisation system: on the robot, goals in world coordinates need one; without a world
-pose a goal fails with that message).
+for a localisation system). Goals that need no world (a reach relative to the robot, heights) are
+planned in the frame of the stance the robot stands in and run without one; a goal that does need
+one fails at its start, before anything moves, saying why (context.world_pose_needed).
 
 Per goal: planned (`plan_cpu_s`), then `goal_status[goal_id]` = "reached" or "failed" with
 `goal_messages[goal_id]` saying why. After a goal the robot stays under the whole-body
@@ -35,7 +36,7 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from g1_control.generator.goals.approach import enter_whole_body
-from g1_control.generator.goals.context import ARMS, GoalConfig, GoalContext, GoalFailed
+from g1_control.generator.goals.context import ARMS, GoalConfig, GoalContext, GoalFailed, world_pose_needed
 from g1_control.generator.goals.handling import pick, place
 from g1_control.generator.goals.platform import step_down, step_up
 from g1_control.generator.goals.poses import ReachRefused, flat_soles
@@ -80,7 +81,7 @@ class GoalGenerator(Generator):
         self.goal_info = self.ctx.goal_info
         """Per goal, for judging it from outside: kind, start/end time, the hold window of a reach,
         its target in the world (reach point, box, where the box goes, platform)."""
-        self.log = self.ctx.log
+        self.log = self.goal_log = self.ctx.log
         self._ref = KinematicReference()
         self._joint = JointReference()
         self.reset_state()
@@ -182,7 +183,7 @@ class GoalGenerator(Generator):
         ctx.note(f"goal {gid}: {goal.describe()}")
         ctx.info = ctx.goal_info.setdefault(gid, {"kind": goal.kind, "describe": goal.describe(), "start_s": ctx.t})
         try:
-            ctx.world_pose()  # goals in world coordinates need one: GoalFailed without
+            ctx.require_world_pose(goal)  # goals placed in the world need one: GoalFailed without
             run = SKILLS[goal.kind]
             yield from run(ctx, goal)
             if goal.kind in HAND_BACK_AFTER and ctx.on_platform is None:
@@ -273,4 +274,4 @@ class GoalRetargeter(Retargeter):
         return out
 
 
-__all__ = ["FAILED", "REACHED", "GoalConfig", "GoalFailed", "GoalGenerator", "GoalRetargeter"]
+__all__ = ["FAILED", "REACHED", "GoalConfig", "GoalFailed", "GoalGenerator", "GoalRetargeter", "world_pose_needed"]

@@ -48,6 +48,7 @@ def reach(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     ctx.note(f"reach: {res.mode}, hand {res.residual_m * 100:.1f} cm from the point in the plan")
     move = cfg.move_s * max(1.0, float(np.abs(res.q[7:] - q0[7:]).max()) / 1.5)
     ctx.info.update(hand=goal.hand, target_w_m=(target - off).tolist(), mode=res.mode,
+                    frame="world" if ctx.localised else "stance",
                     plan_residual_m=res.residual_m, hold_s=(ctx.t + move, ctx.t + move + cfg.reach_hold_s))
     yield from ctx.run(keyframe_trajectory("reach", [(0.0, q0), (move, res.q), (move + cfg.reach_hold_s, res.q)]),
                        keep=True)

@@ -1,0 +1,152 @@
+"""`g1 bench odometry`: drift of the world pose estimates against the simulator's ground truth over
+10 seeded random command timelines (launch/sim_random.yaml: stands, walks, turns, sidesteps,
+mixes; the walking policy in lockstep MuJoCo), in the run's start frame.
+
+Two estimates from the same robot state (no ground truth given to either):
+  leg odometry   estimation/pose.py: IMU + contact-aided leg kinematics (stance feet anchored)
+  velocity       program/device.py Odometry: the estimator's velocity integrated (the baseline)
+
+Drift is attributed per command segment: the growth of the position error vector over a segment,
+against the metres walked and the degrees turned in it (ground truth), fitted as
+|growth| = a * metres + b * (degrees / 90) by non-negative least squares over every segment of
+every timeline. Also printed: final error / path length per timeline. Heading: the simulated IMU
+reports the true orientation, so yaw drift is not measured here (a real IMU's yaw drifts).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import time
+
+import numpy as np
+
+TIMELINES = 10
+
+
+def _start_frame(yaw0: float) -> np.ndarray:
+    c, s = math.cos(-yaw0), math.sin(-yaw0)
+    return np.array([[c, -s], [s, c]])
+
+
+def run_timeline(seed: int, seconds: float) -> dict:
+    """One seeded random timeline: per estimator tick the truth and both estimates (start frame)."""
+    from g1_control.estimation.pose import LegOdometry
+    from g1_control.launch.builder import build_loop, make_sim_backend, timeline_of
+    from g1_control.launch.schema import load_launch
+    from g1_control.program.device import Odometry
+    from g1_control.resources import resolve_launch
+    from g1_control.rotations import yaw_of
+
+    launch = load_launch(resolve_launch("sim_random")[0])
+    launch.input.random.seed = seed
+    launch.duration_s = seconds
+    launch.output.video = False
+    segments = timeline_of(launch)
+    loop = build_loop(launch, backend=make_sim_backend(launch))
+    state = loop.reset()
+    assert state.base_pos_w_m is not None  # MuJoCo: ground truth, for judging only
+    blind = dataclasses.replace(state, base_pos_w_m=None, base_linvel_w_mps=None)
+    legs = LegOdometry()
+    legs.reset(blind)
+    velocity = Odometry()
+    velocity.pose(legs.estimator.estimate)
+    p0, yaw0, rot0 = state.base_pos_w_m[:2].copy(), yaw_of(state.imu_quat_wxyz), _start_frame(yaw_of(state.imu_quat_wxyz))
+    every = max(1, round(loop.rates.lowlevel_hz / loop.rates.estimator_hz))
+    rows: list[list[float]] = []
+
+    def tick(i: int) -> None:
+        if i % every:
+            return
+        s = loop.state
+        assert s.base_pos_w_m is not None
+        pose = legs.update(dataclasses.replace(s, base_pos_w_m=None, base_linvel_w_mps=None))
+        v = velocity.pose(legs.estimator.estimate)
+        vxy = rot0 @ np.array([v.x_m, v.y_m])
+        truth = rot0 @ (s.base_pos_w_m[:2] - p0)
+        rows.append([s.t_s, *truth, yaw_of(s.imu_quat_wxyz) - yaw0, pose.x_m, pose.y_m, *vxy])
+
+    loop.run(seconds, progress=tick)
+    a = np.array(rows)
+    return {"seed": seed, "t_s": a[:, 0], "truth": a[:, 1:3], "yaw": np.unwrap(a[:, 3]), "legs": a[:, 4:6],
+            "velocity": a[:, 6:8], "fell": loop.fell,
+            "segment_ends_s": np.cumsum([s.duration_s for s in segments]).tolist()}
+
+
+SWAY_S = 0.5
+"""Path length and turning are summed over steps this long (the pelvis' gait sway, ~1 Hz, left out)."""
+
+
+def walked_and_turned(run: dict) -> tuple[np.ndarray, np.ndarray]:
+    """Cumulative metres walked and radians turned (ground truth) at every sample, over SWAY_S steps."""
+    t, truth, yaw = run["t_s"], run["truth"], run["yaw"]
+    dt = float(np.median(np.diff(t)))
+    k = max(1, round(SWAY_S / dt))
+    idx = np.unique(np.append(np.arange(0, len(t), k), len(t) - 1))
+    path_k = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(truth[idx], axis=0), axis=1))])
+    turn_k = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(yaw[idx])))])
+    return np.interp(t, t[idx], path_k), np.interp(t, t[idx], turn_k)
+
+
+def segment_growth(run: dict, key: str) -> list[tuple[float, float, float]]:
+    """(metres walked, degrees turned / 90, |error growth|) per command segment."""
+    t, truth = run["t_s"], run["truth"]
+    err = run[key] - truth
+    path, turned = walked_and_turned(run)
+    out, start = [], 0
+    for end_s in run["segment_ends_s"]:
+        end = int(np.searchsorted(t, end_s + t[0]))
+        end = min(end, len(t) - 1)
+        if end > start:
+            out.append((float(path[end] - path[start]), float(np.degrees(turned[end] - turned[start]) / 90.0),
+                        float(np.linalg.norm(err[end] - err[start]))))
+        start = end
+    return out
+
+
+def fit_drift(samples: list[tuple[float, float, float]]) -> tuple[float, float]:
+    """(m per m walked, m per 90 deg turned): non-negative least squares of growth on (metres, turns)."""
+    from scipy.optimize import nnls
+
+    a = np.array([[m, q] for m, q, _ in samples])
+    b = np.array([g for _, _, g in samples])
+    coef, _ = nnls(a, b)
+    return float(coef[0]), float(coef[1])
+
+
+def main(args) -> int:
+    seconds = float(args.seconds) if args.seconds and args.seconds != 20.0 else 40.0
+    first = int(getattr(args, "seed", 0) or 0)
+    t0 = time.perf_counter()
+    runs = [run_timeline(first + k, seconds) for k in range(TIMELINES)]
+    wall = time.perf_counter() - t0
+    figures: dict = {"timelines": TIMELINES, "seconds_each": seconds, "seeds": [r["seed"] for r in runs],
+                     "falls": sum(bool(r["fell"]) for r in runs), "wall_s": wall, "per_timeline": []}
+    print(f"odometry drift vs ground truth: {TIMELINES} seeded random timelines x {seconds:.0f} s "
+          f"(seeds {first}..{first + TIMELINES - 1}; {wall:.0f} s wall; falls: {figures['falls']})")
+    print(f"{'seed':>4} {'walked m':>9} {'turned deg':>10} {'legs end err m':>15} {'velocity end err m':>19}")
+    for r in runs:
+        walked, turns = walked_and_turned(r)
+        path, turned = float(walked[-1]), float(np.degrees(turns[-1]))
+        e_legs = float(np.linalg.norm(r["legs"][-1] - r["truth"][-1]))
+        e_vel = float(np.linalg.norm(r["velocity"][-1] - r["truth"][-1]))
+        figures["per_timeline"].append({"seed": r["seed"], "walked_m": path, "turned_deg": turned,
+                                        "legs_end_error_m": e_legs, "velocity_end_error_m": e_vel})
+        print(f"{r['seed']:>4} {path:9.2f} {turned:10.0f} {e_legs:15.3f} {e_vel:19.3f}")
+    for key, name in (("legs", "leg odometry (IMU + contact-aided leg kinematics)"),
+                      ("velocity", "velocity integration (baseline)")):
+        samples = [g for r in runs for g in segment_growth(r, key)]
+        per_m, per_90 = fit_drift(samples)
+        rows = figures["per_timeline"]
+        ratio = np.array([p[f"{key}_end_error_m"] / max(p["walked_m"], 1e-6) for p in rows])
+        figures[key] = {"drift_m_per_m": per_m, "drift_m_per_90deg": per_90,
+                        "end_error_per_path_mean": float(ratio.mean()), "end_error_per_path_max": float(ratio.max())}
+        print(f"{name}: drift {per_m * 100:.1f} cm per metre walked, {per_90 * 100:.1f} cm per 90 deg turned "
+              f"(segment fit over {len(samples)} segments); end error / path length mean {ratio.mean() * 100:.1f} %, "
+              f"max {ratio.max() * 100:.1f} %")
+    print("heading: the simulated IMU reports the true orientation, so yaw drift is not measured here")
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(figures, fh, indent=2)
+    return 0
