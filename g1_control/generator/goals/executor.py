@@ -52,7 +52,7 @@ from g1_control.generator.goals.stepping import (
 )
 from g1_control.generator.styles import ROLLOUT_STYLES
 from g1_control.generator.whole_body import WholeBodyTrajectory, keyframe_trajectory, smoothstep
-from g1_control.interfaces import Generator, Retargeter
+from g1_control.interfaces import Generator
 from g1_control.robot import g1
 from g1_control.rotations import wrap_angle, yaw_of
 from g1_control.scene import Block, Box, SceneConfig
@@ -801,21 +801,4 @@ class GoalGenerator(Generator):
         yield from self._step_to(back, stance.heading, cfg.steps, name="clear of the platform", first_back_m=back_m)
 
 
-class GoalRetargeter(Retargeter):
-    """Whole-body phases: the plan's own joint reference (feasible by construction, with exact joint
-    velocities and the hand forces); locomotion: the inner generator's retargeter."""
-
-    def __init__(self, generator: GoalGenerator, inner: Retargeter):
-        self.generator = generator
-        self.inner = inner
-
-    def solve(self, reference: KinematicReference, q_prev: np.ndarray) -> JointReference:
-        if reference.phase == PHASE_WHOLE_BODY:
-            return self.generator.joint_reference(reference.t_s)
-        out = self.inner.solve(reference, q_prev)
-        out.phase = PHASE_LOCOMOTION
-        out.hand_forces_w_n[:] = 0.0
-        return out
-
-
-__all__ = ["FAILED", "REACHED", "GoalConfig", "GoalFailed", "GoalGenerator", "GoalRetargeter"]
+__all__ = ["FAILED", "REACHED", "GoalConfig", "GoalFailed", "GoalGenerator"]
