@@ -31,11 +31,11 @@ from g1_control.errors import G1ControlError
 from g1_control.ik.retargeter import IKConfig, IKRetargeter
 from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, Tracker
 from g1_control.launch.builder import build_loop
-from g1_control.launch.runner import RunResult
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.human import HumanMotion
+from g1_control.report.results import RunResult
 from g1_control.robot import g1
 from g1_control.types import Command, EstimatedState, JointReference, KinematicReference, MotorCommand, RobotState
 

@@ -1,6 +1,6 @@
 """The small interfaces every stage of the loop implements: the loop's whole contract with a stage.
 
-operator -> InputDevice.poll(now_s) -> Command
+operator -> InputDevice.observe(ExecutionFeedback); InputDevice.poll(now_s) -> Command
          -> Generator.update(Command, RobotState) -> KinematicReference
          -> Retargeter.solve(KinematicReference, q_prev) -> JointReference
          -> Tracker.observe(EstimatedState); Tracker.act(JointReference, RobotState) -> MotorCommand
@@ -13,13 +13,18 @@ declared here; defaults are what a stage without that capability should report.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
 from g1_control.types import (
+    NO_GOALS,
+    PHASE_LOCOMOTION,
     Command,
     CommandLimits,
     EstimatedState,
+    ExecutionFeedback,
     JointReference,
     KinematicReference,
     MotorCommand,
@@ -95,16 +100,64 @@ class InputDevice(ABC):
     @abstractmethod
     def poll(self, now_s: float) -> Command: ...
 
+    def observe(self, feedback: ExecutionFeedback) -> None:
+        """The loop's feedback record (estimate, ground truth where there is one, goal verdicts,
+        phase), given before every poll; the same instance each time, filled in place. Devices
+        that steer by execution (a behaviour program) keep it; a device wrapping another passes
+        it on."""
+
     @property
     def lost(self) -> bool:
         """True once the device is gone for good (the loop then stops the robot, then damps it)."""
         return False
 
+    @property
+    def lost_reason(self) -> str | None:
+        """Why the device was lost (None while it is not, or when it cannot tell)."""
+        return None
+
+    def button_chords(self, action: str) -> list[str]:
+        """The operator's buttons or keys bound to `action` ("estop", "start", ...), one 'a+b' chord
+        each; [] for a device that maps no buttons (scripts, programs without an operator)."""
+        return []
+
     def close(self) -> None:
         """Release the device."""
 
+    def describe(self) -> str:
+        """A short name for the device (video overlay, summaries)."""
+        return type(self).__name__
+
+
+class LineInput(InputDevice):
+    """An input device that also takes typed lines (a terminal keyboard): instructions in English
+    (g1_control/program/instructed.py)."""
+
+    @abstractmethod
+    def take_line(self) -> str | None:
+        """The oldest line the operator submitted, or None."""
+
+    def begin_line(self, prompt: str = "> ") -> None:
+        """Open a line now, as if the operator had pressed the instruction key (to ask a question)."""
+
 
 class Generator(ABC):
+    """Operator intent -> the whole-body plan for this tick. A generator that executes task goals
+    (Command.tasks: g1_control/generator/goals/) reports on them through the attributes below,
+    which the loop passes back to the input (ExecutionFeedback); the defaults are a generator
+    without goals, always in the walking phase."""
+
+    phase: str = PHASE_LOCOMOTION
+    """PHASE_WHOLE_BODY while the generator holds the robot in a whole-body plan (a reach, a carry,
+    a step), else PHASE_LOCOMOTION."""
+    goal_status: Mapping[str, str] = NO_GOALS
+    """goal_id -> "reached" | "failed", for each task goal finished so far (live: updated in place)."""
+    goal_messages: Mapping[str, str] = NO_GOALS
+    """goal_id -> why the goal failed."""
+    goal_info: Mapping[str, Mapping[str, Any]] = NO_GOALS
+    """goal_id -> what the generator recorded about the goal (kind, timing, status), for judging
+    it after the run (g1_control/report/outcomes.py)."""
+
     @abstractmethod
     def update(self, command: Command, state: RobotState) -> KinematicReference: ...
 

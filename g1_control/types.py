@@ -13,6 +13,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import Enum
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -264,6 +265,8 @@ class RobotState:
     mode_machine: int = 5
     tick: int = 0
     wireless_remote: bytes = b""
+    battery_v: float | None = None
+    """Battery voltage, where the link reports one (None: the G1's LowState_ carries none)."""
     # Ground truth, present only in simulation (None on the robot): for tests and logs.
     base_pos_w_m: np.ndarray | None = None
     base_linvel_w_mps: np.ndarray | None = None
@@ -397,6 +400,37 @@ class EstimatedState:
     """(vx, vy, wz): base linear velocity in the heading frame and the yaw rate."""
     pelvis_height_m: float | None = None
     """Pelvis height above the lower foot's sole (leg kinematics: the ground under a standing foot)."""
+
+
+NO_GOALS: Mapping[str, Any] = MappingProxyType({})
+"""An empty, read-only goal table: what a generator without task goals reports."""
+
+
+@dataclass(eq=False)
+class ExecutionFeedback:
+    """What execution reports back to the operator input: one record per loop, filled in place
+    by the ControlLoop before every input poll (InputDevice.observe) and readable as
+    `loop.feedback` (g1 deploy, run reports). Nothing here is copied per tick: the fields are
+    the loop's own objects, valid until the next fill; keep a copy to keep a value.
+
+    Only `truth` is the simulator's ground truth; everything else is what a robot has too."""
+
+    t_s: float = 0.0
+    """The loop's clock at the fill (simulated time in lockstep, monotonic on the robot)."""
+    estimate: EstimatedState = field(default_factory=EstimatedState)
+    """The state estimator's latest output (IMU yaw, leg-odometry velocity, pelvis height)."""
+    state: RobotState | None = None
+    """The robot's latest state as the backend reported it (joints, IMU: what a robot has; its base pose,
+    where a simulator fills one, is for `truth` alone). None before the first read."""
+    truth: RobotState | None = None
+    """The latest robot state when the backend gives ground truth (its base_pos_w_m is set: a
+    simulator); None on a robot. For judging outcomes, never for steering."""
+    goal_status: Mapping[str, str] = field(default_factory=lambda: NO_GOALS)
+    """goal_id -> "reached" | "failed" for the task goals the generator finished (Generator.goal_status)."""
+    goal_messages: Mapping[str, str] = field(default_factory=lambda: NO_GOALS)
+    """goal_id -> why the goal failed (Generator.goal_messages)."""
+    phase: str = PHASE_LOCOMOTION
+    """The generator's phase now (Generator.phase): PHASE_WHOLE_BODY while the execution layer holds the robot."""
 
 
 @dataclass

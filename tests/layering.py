@@ -257,3 +257,39 @@ def import_cycles(package_dir: Path, *, by_unit: bool, runtime_only: bool = True
         out.append(f"{'package' if by_unit else 'module'} import cycle: " + " -> ".join(cycle) + "; "
                    + ", ".join(steps))
     return out
+
+
+# -- the layer list in the docs ----------------------------------------------------------------------
+
+DOC_BEGIN = "<!-- layers: generated from LAYERS and NOTES in tests/test_layers.py; rewrite: python3 -m tests.test_layers --write -->"
+DOC_END = "<!-- /layers -->"
+
+
+def layer_list(layers: Sequence[Sequence[str]], notes: dict[str, str], data_units: Iterable[str] = ()) -> str:
+    """The layers as the docs print them: a fenced block, one line per unit, top to bottom, the layer's
+    number on its first unit (units under one number are independent siblings), each with its note."""
+    data = list(data_units)
+    width = max(len(u) for u in [*itertools.chain.from_iterable(layers), *data]) + 2
+    digits = len(str(len(layers)))
+    lines = []
+    for i, layer in enumerate(layers):
+        for k, unit in enumerate(layer):
+            number = str(i + 1).rjust(digits) if k == 0 else " " * digits
+            lines.append(f"{number}  {unit:<{width}}{notes.get(unit, '')}".rstrip())
+    for unit in data:
+        lines.append(f"{'-' * digits}  {unit:<{width}}{notes.get(unit, '')}".rstrip())
+    return "\n".join(["```text", *lines, "```"])
+
+
+def generated_span(text: str, where: str) -> tuple[int, int]:
+    """(start, end) of what stands between DOC_BEGIN and DOC_END in `text` (the markers excluded)."""
+    begin, end = text.find(DOC_BEGIN), text.find(DOC_END)
+    if begin < 0 or end < begin or text.count(DOC_BEGIN) != 1:
+        raise ValueError(f"{where}: expected one `{DOC_BEGIN}` line followed by a `{DOC_END}` line")
+    return begin + len(DOC_BEGIN), end
+
+
+def with_layer_list(text: str, block: str, where: str) -> str:
+    """`text` with the part between the markers replaced by `block` (on lines of its own)."""
+    start, end = generated_span(text, where)
+    return text[:start] + "\n" + block + "\n" + text[end:]

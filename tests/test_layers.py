@@ -6,24 +6,35 @@ Contracts, checked on the source with `ast` (imports at any depth, type-only one
 - every unit is in exactly one layer (a new package is placed here deliberately), and every name
   in the list is a unit;
 - data packages hold no imports of g1_control; the package root imports nothing of it;
-- no import cycle between units, and none between modules (imports that run; type-only ones never do).
+- no import cycle between units, and none between modules (type-only imports included: two modules
+  that need each other's types share a lower module);
+- the layer list in README.md and docs/architecture.md is the one printed from LAYERS and NOTES here
+  (`python3 -m tests.test_layers --write` rewrites it), and the README's folder table follows it.
 """
 
 from __future__ import annotations
 
+import itertools
+import re
 import shutil
+import sys
 import textwrap
 from pathlib import Path
 
 import pytest
 
 from tests.layering import (
+    DOC_BEGIN,
+    DOC_END,
     collect_imports,
+    generated_span,
     import_cycles,
+    layer_list,
     layer_of,
     layer_violations,
     unassigned_units,
     unknown_layer_units,
+    with_layer_list,
 )
 from tests.paths import REPO
 
@@ -36,6 +47,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("library",),
     ("launch",),
     ("program",),
+    ("report",),
     ("generator", "trackers", "teleop", "retarget"),
     ("ik", "loop"),
     ("motion", "safety", "estimation"),
@@ -55,6 +67,43 @@ DATA_UNITS = ("policies",)
 ROOT_IMPORTS = ("api",)
 """What g1_control/__init__.py may import: the public API it re-exports (lazily)."""
 
+NOTES: dict[str, str] = {
+    "cli": "one module per `g1` subcommand",
+    "api": "the public Python API (docs/api.md)",
+    "tools": "benches, fault suite, evaluations",
+    "deploy": "g1 deploy (preflight, state machine, session)",
+    "training": "generator training (torch; never imported by the runtime)",
+    "library": "motion-library builder (physics rollouts, dance, retargeted mocap)",
+    "launch": "launch-file schema, the loop builder, the runner",
+    "program": "behaviour programs and the English instruction parser",
+    "report": "what a run leaves: run folder, figures and summary, goal outcomes, Verdict, plots, overlay, replay",
+    "generator": "motion generators: velocity, in-betweening, goals, scripted references",
+    "trackers": "walking policy, whole-body controller (wbc/), the tracking layer",
+    "teleop": "input devices and their mappings",
+    "retarget": "offline mocap retargeting, clip quality metrics",
+    "ik": "whole-body differential IK on pinocchio (tasks/, limits/, QP)",
+    "loop": "the control loop, the multi-rate scheduler, rates",
+    "motion": "MotionClip, its file formats and edits, the library on disk",
+    "safety": "limits, watchdogs, falls, the one-way switch to damping",
+    "estimation": "base velocity from IMU + stance-leg kinematics",
+    "sim": "MuJoCo backend, viewer, headless render, browser view, robot emulator",
+    "hardware": "unitree/ (messages, CRC, IDL, remote bytes) and links/ (DDS, CAN, serial)",
+    "interfaces": "the stages' abstract bases: the loop's whole contract with a stage",
+    "types": "the plain dataclasses passed between stages",
+    "scene": "tables, platforms, boxes (no MuJoCo)",
+    "robot": "g1.py (every G1 fact), description.py (pinocchio + MuJoCo models), dynamics.py",
+    "config": "the typed config loader (dataclasses are the schema)",
+    "assets": "pinned registry wheels fetched into the user cache",
+    "rotations": "the one quaternion / yaw module",
+    "resources": "launch files and docs that ship with the package",
+    "errors": "named errors",
+    "policies": "data, read by any layer: policy specs, the shipped generator models",
+}
+"""One line per unit for the printed layer list (docs); a unit without a note is listed bare."""
+
+LAYER_DOCS = (REPO / "README.md", REPO / "docs" / "architecture.md")
+"""Where the layer list is printed (between the DOC_BEGIN and DOC_END markers of tests/layering.py)."""
+
 
 def _report(messages: list[str]) -> str:
     return f"{len(messages)} problem(s):\n  " + "\n  ".join(messages)
@@ -72,6 +121,7 @@ def test_every_package_has_exactly_one_layer():
     assert not unknown_layer_units(PACKAGE, LAYERS, DATA_UNITS), "LAYERS names units that do not exist"
     named = [u for layer in LAYERS for u in layer] + list(DATA_UNITS)
     assert len(named) == len(set(named)), "a unit is listed twice"
+    assert set(NOTES) <= set(named), f"NOTES for units in no layer: {sorted(set(NOTES) - set(named))}"
 
 
 def test_imports_go_down_the_layers_only(imports):
@@ -88,6 +138,78 @@ def test_no_import_cycle_between_packages(imports):
 def test_no_import_cycle_between_modules(imports):
     cycles = import_cycles(PACKAGE, by_unit=False, imports=imports)
     assert not cycles, _report(cycles)
+
+
+def test_no_import_cycle_between_modules_even_through_type_only_imports(imports):
+    # Two modules that need each other's types share a lower module instead (issue 22: program/
+    # device.py and judge.py both import records.py).
+    cycles = import_cycles(PACKAGE, by_unit=False, runtime_only=False, imports=imports)
+    assert not cycles, _report(cycles)
+
+
+@pytest.mark.parametrize("doc", LAYER_DOCS, ids=lambda p: p.name)
+def test_the_docs_print_the_layer_list_of_this_test(doc):
+    text = doc.read_text(encoding="utf-8")
+    start, end = generated_span(text, doc.name)
+    expected = layer_list(LAYERS, NOTES, DATA_UNITS)
+    assert text[start:end].strip("\n") == expected, (
+        f"{doc.relative_to(REPO)}: its layer list differs from LAYERS/NOTES in tests/test_layers.py; "
+        f"rewrite it with `python3 -m tests.test_layers --write`. Expected:\n{expected}")
+
+
+README_FOLDERS = "| folder (`g1_control/...`) | contents |"
+
+
+def test_the_readme_folder_table_follows_the_layers():
+    """Its rows name every unit, in layer order (a row may name several units of one or more layers)."""
+    text = (REPO / "README.md").read_text(encoding="utf-8")
+    assert README_FOLDERS in text, f"README.md: no table headed {README_FOLDERS!r}"
+    rows = text.split(README_FOLDERS, 1)[1].split("\n\n", 1)[0].strip().splitlines()[1:]
+    rank = layer_of([*LAYERS, DATA_UNITS])
+    order: list[str] = []
+    for row in rows:
+        first = row.split("|")[1]
+        order += [name.strip("/").removesuffix(".py") for name in re.findall(r"`([^`]+)`", first)]
+    assert sorted(order) == sorted(rank), (
+        f"README.md folder table: missing {sorted(set(rank) - set(order))}, unknown {sorted(set(order) - set(rank))}")
+    out_of_order = [f"{b} (layer {rank[b] + 1}) listed after {a} (layer {rank[a] + 1})"
+                    for a, b in itertools.pairwise(order) if rank[a] > rank[b]]
+    assert not out_of_order, f"README.md folder table is not in layer order: {out_of_order}"
+
+
+def test_layer_list_text_and_markers():
+    notes = {"top": "the top", "mid_b": "beside mid_a", "data": "shipped data"}
+    block = layer_list(TOY_LAYERS, notes, ["data"])
+    assert block.splitlines() == [
+        "```text",
+        "1  top    the top",
+        "2  mid_a",
+        "   mid_b  beside mid_a",
+        "3  low",
+        "-  data   shipped data",
+        "```"]
+    doc = f"intro\n{DOC_BEGIN}\nold list\n{DOC_END}\nafter\n"
+    new = with_layer_list(doc, block, "doc.md")
+    assert new == f"intro\n{DOC_BEGIN}\n{block}\n{DOC_END}\nafter\n"
+    start, end = generated_span(new, "doc.md")
+    assert new[start:end].strip("\n") == block
+    with pytest.raises(ValueError, match="doc.md: expected one"):
+        generated_span("no markers here", "doc.md")
+    with pytest.raises(ValueError, match="doc.md: expected one"):
+        generated_span(f"{DOC_END}\n{DOC_BEGIN}\n", "doc.md")
+
+
+def write_layer_docs() -> list[str]:
+    """Rewrite the layer list in LAYER_DOCS; the names of the files that changed."""
+    changed = []
+    block = layer_list(LAYERS, NOTES, DATA_UNITS)
+    for doc in LAYER_DOCS:
+        text = doc.read_text(encoding="utf-8")
+        new = with_layer_list(text, block, doc.name)
+        if new != text:
+            doc.write_text(new, encoding="utf-8")
+            changed.append(str(doc.relative_to(REPO)))
+    return changed
 
 
 # -- the checker itself, on small package trees --------------------------------------------------
@@ -212,3 +334,10 @@ def test_a_deliberate_violation_in_a_copy_of_g1_control_fails(tmp_path):
         f"g1_control/rotations.py:{len(lines) + 4}: g1_control.rotations imports g1_control.launch.builder: upward, "
         f"from rotations (layer {rank['rotations'] + 1}: config | assets | rotations | resources) to launch "
         f"(layer {rank['launch'] + 1}: launch, above it)"]
+
+
+if __name__ == "__main__":
+    if sys.argv[1:] != ["--write"]:
+        sys.exit("usage: python3 -m tests.test_layers --write   (rewrites the layer list in README.md and "
+                 "docs/architecture.md from LAYERS and NOTES)")
+    print("\n".join(f"rewrote the layer list in {name}" for name in write_layer_docs()) or "the docs are up to date")

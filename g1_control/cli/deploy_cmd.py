@@ -38,7 +38,7 @@ examples:
   g1 sim-robot --lower-gantry-on-policy &              # the emulator on lo, domain 1
   g1 deploy launch/sim2sim.yaml --yes                  # sim2sim: preflight, ramp, walk, damping
   g1 deploy launch/robot.yaml                          # the robot: operator drives with the remote
-  g1 deploy launch/robot.yaml --preflight-only         # checklist only; nothing is sent
+  g1 deploy robot --preflight-only                     # checklist only; nothing is sent (a shipped file by name)
   g1 deploy launch/robot.yaml --no-release-motion-service   # robot already in debug mode
   g1 deploy launch/robot.yaml --override temperatures  # a check you verified yourself (logged)
   g1 deploy launch/robot.yaml --program square.yaml    # a behaviour program drives once you press run
@@ -53,7 +53,8 @@ def register(subparsers) -> None:
         "deploy", help="preflight-check a robot, then run a launch file on it (real G1 or g1 sim-robot)",
         description=_DESCRIPTION + ", ".join(CHECKS) + ".", epilog=_EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("file", type=Path, help="launch file with a robot backend (unitree_dds, can or serial)")
+    parser.add_argument("file", type=Path, help="launch file with a robot backend (unitree_dds, can or serial): a path, "
+                        "or a shipped launch file's name (robot, sim2sim; g1 launch --list)")
     parser.add_argument("--yes", action="store_true",
                         help="answer start and run automatically once the preflight passed (sim2sim on lo only)")
     parser.add_argument("--override", action="append", default=[], metavar="CHECK", choices=list(CHECKS),
@@ -61,7 +62,8 @@ def register(subparsers) -> None:
     parser.add_argument("--no-release-motion-service", dest="release", action="store_false", default=None,
                         help="do not release the robot's built-in motion service (robot already in debug mode "
                         "via the remote)")
-    parser.add_argument("--interface", help="override backend.interface (e.g. lo for g1 sim-robot)")
+    parser.add_argument("--interface", help="override backend.interface (e.g. lo for g1 sim-robot; auto: the one NIC on "
+                        "192.168.123.0/24; g1 doctor checks the way to the robot first)")
     parser.add_argument("--domain", type=int, help="override backend.domain (robot 0, simulation 1)")
     parser.add_argument("--partition", help="override backend.partition (isolates concurrent runs on one host)")
     parser.add_argument("--duration", type=float, help="length of the control phase in seconds, then damping "
@@ -86,6 +88,7 @@ def _run(args) -> int:
     from g1_control.deploy.session import DeployOptions, deploy, write_report
 
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    args.file = _launch_path(args.file)
     program, text = _program(args)
     options = DeployOptions(yes=args.yes, overrides=frozenset(args.override), release_motion_service=args.release,
                             interface=args.interface, domain=args.domain, partition=args.partition,
@@ -100,6 +103,21 @@ def _run(args) -> int:
     if args.json:
         write_report(report, args.json)
     return 3 if report.sequence and report.fault else 0
+
+
+def _launch_path(arg: Path) -> Path:
+    """A shipped launch file found by name (`g1 deploy robot`), as `g1 launch` finds one; any other path
+    as given, so a missing file is refused by the preflight's launch-file check and lands in its report."""
+    from g1_control.errors import LaunchFileError
+    from g1_control.resources import resolve_launch
+
+    try:
+        path, shipped = resolve_launch(arg)
+    except LaunchFileError:
+        return arg
+    if shipped:
+        print(f"launch file: {path}")
+    return path
 
 
 def _program(args):

@@ -86,7 +86,8 @@ def _run(args) -> int:
         print(f"{args.file}: OK ({launch.name}: {launch.backend.type} {launch.backend.mode}, "
               f"policy {spec.name}, {launch.total_duration_s:.1f} s, input {launch.input.type})")
         return 0
-    from g1_control.launch.runner import format_summary, run
+    from g1_control.launch.runner import run
+    from g1_control.report.results import format_summary
 
     setting = {"on": True, "off": False, "auto": "auto"}[args.viewer] if args.viewer else launch.viewer
     viewer = setting is True or (setting == "auto" and bool(os.environ.get("DISPLAY")))

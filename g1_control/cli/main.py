@@ -29,6 +29,7 @@ SUBCOMMAND_MODULES = (
     "g1_control.cli.retarget_cmd",
     "g1_control.cli.check_cmd",
     "g1_control.cli.deploy_cmd",
+    "g1_control.cli.doctor_cmd",
     "g1_control.cli.library_cmd",
     "g1_control.cli.train_cmd",
     "g1_control.cli.soak_cmd",

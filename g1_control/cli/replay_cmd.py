@@ -24,7 +24,7 @@ def add_output_options(parser) -> None:
 
 def show(pb, args, default_out: Path, stem: str) -> int:
     """Send playback `pb` where the options say: PNG, MP4, browser, or the MuJoCo viewer."""
-    from g1_control.launch import replay
+    from g1_control.report import replay
 
     if args.frame is not None:
         out = args.out or default_out / f"{stem}-{args.frame:g}s.png"
@@ -66,7 +66,7 @@ def register(subparsers) -> None:
 
 
 def _run(args) -> int:
-    from g1_control.launch.replay import from_run
+    from g1_control.report.replay import from_run
 
     pb = from_run(args.run)
     folder = args.run if args.run.is_dir() else args.run.parent

@@ -98,8 +98,9 @@ def _run(args) -> int:
     if args.pose:
         launch.input.pose = args.pose
     from g1_control.launch.inputs import make_program_input
-    from g1_control.launch.runner import fall_text, program_summary, run
+    from g1_control.launch.runner import run
     from g1_control.program.device import describe_record
+    from g1_control.report.results import fall_text, program_summary
 
     device = make_program_input(launch, program, on_record=lambda r: print("  " + describe_record(r), flush=True))
     viewer = args.viewer == "on" or (args.viewer == "auto" and bool(os.environ.get("DISPLAY")))

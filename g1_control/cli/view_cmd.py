@@ -26,7 +26,7 @@ def register(subparsers) -> None:
 
 
 def _run(args) -> int:
-    from g1_control.launch.replay import from_clip
+    from g1_control.report.replay import from_clip
 
     pb = from_clip(args.clip)
     return show(pb, args, args.clip.parent, args.clip.stem)

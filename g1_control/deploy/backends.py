@@ -11,12 +11,15 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import TypedDict
+from typing import TYPE_CHECKING, TypedDict
 
 from g1_control.errors import NetworkInterfaceError, TransportError
-from g1_control.hardware.links.network import LOOPBACK, check_interface
+from g1_control.hardware.links.network import AUTO, LOOPBACK, ROBOT_SUBNET, check_interface, robot_interface
 from g1_control.launch.schema import BackendConfig
 from g1_control.robot import g1
+
+if TYPE_CHECKING:
+    from g1_control.hardware.link_backend import LinkBackend
 
 
 class _HostOptions(TypedDict):
@@ -34,11 +37,17 @@ def expected_mode_machine(config: BackendConfig) -> int:
 
 
 def check_link_endpoint(config: BackendConfig) -> str:
-    """Raise TransportError unless the link's interface/port exists (and is up); say what was found."""
+    """Raise TransportError unless the link's interface/port exists (and is up); say what was found.
+
+    `interface: auto` (unitree_dds) is resolved in `config` to the one NIC on the robot's network."""
     if config.type == "unitree_dds":
+        chosen = ""
+        if config.interface == AUTO:  # resolved here, once, for everything after the check
+            name, address = robot_interface()
+            config.interface, chosen = name, f" (auto: the one NIC on {ROBOT_SUBNET}, {address})"
         check_interface(config.interface or "")
-        return f"interface {config.interface} exists and is up" + (" (loopback: simulation)" if
-                                                                    config.interface == LOOPBACK else "")
+        return f"interface {config.interface} exists and is up{chosen}" + (" (loopback: simulation)" if
+                                                                            config.interface == LOOPBACK else "")
     if config.type == "can":
         if config.can_interface != "socketcan":
             return f"{config.can_interface} bus '{config.channel}' (no network interface to check)"
@@ -65,7 +74,8 @@ def _serial_ports() -> list[str]:
     return sorted(str(p) for pattern in ("ttyUSB*", "ttyACM*") for p in Path("/dev").glob(pattern))
 
 
-def open_robot_backend(config: BackendConfig, *, damping_kd: float = 2.0, release_motion_service: bool | None = None):
+def open_robot_backend(config: BackendConfig, *, damping_kd: float = 2.0,
+                       release_motion_service: bool | None = None) -> LinkBackend:
     """The host side of the robot link `config` describes (a LinkBackend; threads running, silent)."""
     common: _HostOptions = {
         "command_rate_hz": config.command_rate_hz, "mode_pr": config.mode_pr,

@@ -25,7 +25,7 @@ from g1_control.robot import g1
 from g1_control.rotations import tilt_rad
 
 if TYPE_CHECKING:
-    from g1_control.launch.runner import RunResult
+    from g1_control.report.results import RunResult
 
 log = logging.getLogger("g1_control.deploy")
 
@@ -250,7 +250,7 @@ class Preflight:
             self.record("temperatures", PASS, f"hottest {g1.JOINT_NAMES[j]} at {temps[j]:.0f} °C "
                         f"(limit {cfg.max_start_temperature_c:.0f} °C)")
 
-        battery = getattr(state, "battery_v", None)
+        battery = state.battery_v
         if battery is None:
             self.record("battery", SKIP, "not reported: the G1's LowState_ carries no battery voltage (its BMS "
                         "publishes on its own topic); check the charge on the robot's display")
@@ -262,10 +262,9 @@ class Preflight:
 
     def check_peers(self, backend) -> bool:
         """One publisher of the robot's state, no other writer of its commands (where the link can tell)."""
-        refresh = getattr(backend, "refresh_peers", None)
-        if refresh is None:
+        if not backend.sees_peers:
             return self.record("peers", SKIP, "this backend cannot see its peers")
-        refresh()
+        backend.refresh_peers()
         senders, writers, command_writers = backend.peers()
         where = backend.link.describe()
         if writers is None and senders == 0:
@@ -286,22 +285,20 @@ class Preflight:
         if open_error is not None:
             return self.record("estop_input", FAIL, open_error, overridable=False)
         kind = launch.input.type
-        if kind in ("scripted", "random", "gamepad_script", "program"):
+        if kind in ("scripted", "random", "gamepad_script", "program", "ros2"):
             if launch.backend.type == "unitree_dds" and launch.backend.interface == "lo":
                 return self.record("estop_input", PASS, f"{kind} input against the emulator on lo (sim2sim): no "
                                    "operator e-stop; Ctrl-C or SIGTERM damps")
             return self.record("estop_input", FAIL, f"input.type {kind} has no operator e-stop; a robot needs "
                                "unitree_remote, gamepad or keyboard")
-        mapper = getattr(device, "mapper", None)
-        bound = [("+".join(sorted(chord))) for chord, action in mapper.config.buttons.items()
-                 if action == "estop"] if mapper is not None else []
+        bound = device.button_chords("estop")
         deadline = time.monotonic() + launch.deploy.input_check_s
         while time.monotonic() < deadline and not device.lost:
             device.poll(time.monotonic())
             time.sleep(0.02)
         device.poll(time.monotonic())
         if device.lost:
-            return self.record("estop_input", FAIL, f"{kind} lost: {getattr(device, 'lost_reason', '?')}; reconnect it "
+            return self.record("estop_input", FAIL, f"{kind} lost: {device.lost_reason or '?'}; reconnect it "
                                "and start again", overridable=False)
         if not bound:
             return self.record("estop_input", FAIL, f"{kind} mapping binds no button to estop; bind one in "

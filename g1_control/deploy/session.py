@@ -19,16 +19,21 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from g1_control.deploy.preflight import CHECKS, FAIL, Preflight
 from g1_control.deploy.state_machine import DeployState, DeployTracker, OperatorButtons, Transition
 from g1_control.errors import G1ControlError, LaunchFileError
 from g1_control.hardware.links.network import LOOPBACK
-from g1_control.launch.run_folder import RunFolder
+from g1_control.interfaces import InputDevice, Tracker
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.priority import frozen_heap, realtime
+from g1_control.report.run_folder import RunFolder
 from g1_control.robot import g1
+from g1_control.safety import SafetyFilter
+
+if TYPE_CHECKING:
+    from g1_control.hardware.link_backend import LinkBackend
 
 log = logging.getLogger("g1_control.deploy")
 
@@ -89,11 +94,8 @@ def _say(text: str) -> None:
     print(text, flush=True)
 
 
-def _keys_for(device, action: str) -> str:
-    mapper = getattr(device, "mapper", None)
-    if mapper is None:
-        return ""
-    return " or ".join("+".join(sorted(chord)) for chord, a in mapper.config.buttons.items() if a == action)
+def _keys_for(device: InputDevice, action: str) -> str:
+    return " or ".join(device.button_chords(action))
 
 
 def _apply_cli(launch: LaunchFile, options: DeployOptions) -> None:
@@ -225,6 +227,8 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
         if options.preflight_only:
             say("preflight passed (--preflight-only): nothing was sent to the robot")
             return report
+        # a link that did not open and a device that did not open fail checks no override passes
+        assert backend is not None and device is not None
         _control(launch, pf, backend, device, options, report, say)
         return report
     finally:
@@ -244,118 +248,172 @@ def _refuse(pf: Preflight, report: DeployReport, say) -> DeployReport:
     raise refusal
 
 
-def _control(launch: LaunchFile, pf: Preflight, backend, device, options: DeployOptions, report: DeployReport,
-             say) -> None:
-    from g1_control.launch.builder import CHAIN_STAGES, build_loop
+def _control(launch: LaunchFile, pf: Preflight, backend: LinkBackend, device: InputDevice, options: DeployOptions,
+             report: DeployReport, say) -> None:
+    """The robot under the loop, from zero torque to damping, in the steps of _RobotControl."""
+    control = _RobotControl(launch, backend, device, options, report, say)
+    control.build_loop()
+    control.check_chain(pf)
+    control.open_run_folder()
+    error = control.run()
+    control.finish(error)
 
-    buttons = OperatorButtons(device)
-    t_start = time.monotonic()
 
-    folder: RunFolder | None = None
+class _RobotControl:
+    """One deploy's control phase: the loop built around the deploy state machine, checked against
+    the dry run, logged into a run folder, run until the state machine has damped long enough, and
+    reported. Each method is one step of _control, in order."""
 
-    def on_transition(t: Transition) -> None:
-        say(f"[{t.t_s - t_start:7.2f} s] {t}")
-        if folder is not None:
-            folder.event({"type": "transition", "t_s": t.t_s, "from": t.source.value, "to": t.target.value,
-                          "reason": t.reason})
-        if t.target == DeployState.HOLD and not options.yes:
-            say(f"holding the default pose: press {_keys_for(device, 'run') or 'run'} to start the policy")
+    def __init__(self, launch: LaunchFile, backend: LinkBackend, device: InputDevice, options: DeployOptions,
+                 report: DeployReport, say) -> None:
+        self.launch, self.backend, self.device = launch, backend, device
+        self.options, self.report, self.say = options, report, say
+        self.buttons = OperatorButtons(device)
+        self.t_start = time.monotonic()
+        self.folder: RunFolder | None = None
+        self.control_s = options.duration_s if options.duration_s is not None else launch.duration_s
+        self._wrapped: list[DeployTracker] = []
+        self.t_loop0 = time.monotonic()
 
-    control_s = options.duration_s if options.duration_s is not None else launch.duration_s
-    wrapped: list[DeployTracker] = []
+    # -- the deploy state machine ----------------------------------------------------------------
+    def _on_transition(self, t: Transition) -> None:
+        self.say(f"[{t.t_s - self.t_start:7.2f} s] {t}")
+        if self.folder is not None:
+            self.folder.event({"type": "transition", "t_s": t.t_s, "from": t.source.value, "to": t.target.value,
+                               "reason": t.reason})
+        if t.target == DeployState.HOLD and not self.options.yes:
+            self.say(f"holding the default pose: press {_keys_for(self.device, 'run') or 'run'} to start the policy")
 
-    def deploy_state_machine(inner, safety):
+    def _state_machine(self, inner: Tracker, safety: SafetyFilter) -> DeployTracker:
+        """build_loop's wrap_tracker: the DeployTracker around the launch file's tracker."""
+        from g1_control.trackers.locomotion import LocomotionPolicyTracker
+
         # The pose and gains of the ramp: the walking policy's own when it has them, else the robot's defaults.
-        spec = getattr(inner, "spec", None)
+        spec = inner.spec if isinstance(inner, LocomotionPolicyTracker) else None
         pose = spec.default_q_rad if spec is not None else g1.DEFAULT_Q_RAD
         kp, kd = (spec.kp, spec.kd) if spec is not None else (g1.KP_DEFAULT, g1.KD_DEFAULT)
-        tracker = DeployTracker(inner, pose, kp, kd, safety, time.monotonic, launch.deploy, buttons=buttons,
-                                auto=options.yes, control_s=control_s, on_transition=on_transition)
-        wrapped.append(tracker)
+        tracker = DeployTracker(inner, pose, kp, kd, safety, time.monotonic, self.launch.deploy, buttons=self.buttons,
+                                auto=self.options.yes, control_s=self.control_s, on_transition=self._on_transition)
+        self._wrapped.append(tracker)
         return tracker
 
-    # The per-tick log streams into the run folder (attached below): the loop keeps one chunk only.
-    loop = build_loop(launch, backend=backend, input_device=buttons, wrap_tracker=deploy_state_machine,
-                      wallclock=True, log_capacity=1)
-    tracker, safety = wrapped[0], loop.safety
-    # The variant the preflight accepted: a state reporting another mode_machine trips, and is never echoed.
-    if getattr(backend, "expected_mode_machine", None) is not None:
-        safety.expect_mode_machine(backend.expected_mode_machine)
-    # A scripted timeline starts when control starts; so does a behaviour program (its own clock:
-    # the operator device keeps the loop's).
-    buttons.timeline_clock = tracker.control_elapsed_s
-    from g1_control.program.device import ProgramInput
+    # -- the steps -------------------------------------------------------------------------------
+    def build_loop(self) -> None:
+        """The launch file's loop on the robot link, the state machine around its tracker."""
+        from g1_control.launch.builder import build_loop
+        from g1_control.program.device import ProgramInput
 
-    if isinstance(device, ProgramInput):
-        device.program_clock = tracker.control_elapsed_s
-    report.chain = dict(loop.chain)
-    dry = pf.dry_run.chain if pf.dry_run is not None else {}
-    report.dry_run_chain = dict(dry)
-    differs = [k for k in CHAIN_STAGES if dry.get(k) != loop.chain.get(k)]
-    if dry and differs:
-        raise G1ControlError("the robot's loop differs from the one the dry run checked: " + "; ".join(
-            f"{k}: dry run {dry.get(k)!r}, robot {loop.chain.get(k)!r}" for k in differs))
-    folder = RunFolder.create(Path(options.out_root or launch.output.dir), launch)
-    folder.attach(loop)
-    report.run_dir = str(folder.run_dir)
-    say(f"run folder: {folder.run_dir} (log, events and summary written as the deploy goes)")
-    say("control chain (as checked by the dry run): " + " -> ".join(loop.chain[k] for k in ("generator", "retargeter",
-                                                                                            "tracker")))
+        # The per-tick log streams into the run folder (attached later): the loop keeps one chunk only.
+        self.loop = build_loop(self.launch, backend=self.backend, input_device=self.buttons,
+                               wrap_tracker=self._state_machine, wallclock=True, log_capacity=1)
+        self.tracker, self.safety = self._wrapped[0], self.loop.safety
+        # The variant the preflight accepted: a state reporting another mode_machine trips, and is never echoed.
+        if self.backend.expected_mode_machine is not None:
+            self.safety.expect_mode_machine(self.backend.expected_mode_machine)
+        # A scripted timeline starts when control starts; so does a behaviour program (its own clock:
+        # the operator device keeps the loop's).
+        self.buttons.timeline_clock = self.tracker.control_elapsed_s
+        if isinstance(self.device, ProgramInput):
+            self.device.program_clock = self.tracker.control_elapsed_s
 
-    def on_signal(signum, frame):
-        safety.estop(f"{signal.Signals(signum).name} received", time.monotonic(), planned=True)
-        backend.damp()  # damping on the wire now, not at the next tick
+    def check_chain(self, pf: Preflight) -> None:
+        """The robot's loop must be the one the dry run checked (G1ControlError otherwise)."""
+        from g1_control.launch.builder import CHAIN_STAGES
+
+        chain = self.loop.chain
+        self.report.chain = dict(chain)
+        dry = pf.dry_run.chain if pf.dry_run is not None else {}
+        self.report.dry_run_chain = dict(dry)
+        differs = [k for k in CHAIN_STAGES if dry.get(k) != chain.get(k)]
+        if dry and differs:
+            raise G1ControlError("the robot's loop differs from the one the dry run checked: " + "; ".join(
+                f"{k}: dry run {dry.get(k)!r}, robot {chain.get(k)!r}" for k in differs))
+
+    def open_run_folder(self) -> None:
+        folder = self.folder = RunFolder.create(Path(self.options.out_root or self.launch.output.dir), self.launch)
+        folder.attach(self.loop)
+        self.report.run_dir = str(folder.run_dir)
+        self.say(f"run folder: {folder.run_dir} (log, events and summary written as the deploy goes)")
+        self.say("control chain (as checked by the dry run): " + " -> ".join(
+            self.loop.chain[k] for k in ("generator", "retargeter", "tracker")))
+
+    def run(self) -> G1ControlError | None:
+        """Zero torque, then the loop until the state machine has damped for exit_damping_s; every way
+        out (operator, signal, error) ends in damping. Returns the error that ended it, if one did."""
+        previous = {sig: signal.signal(sig, self._on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
+        error: G1ControlError | None = None
+        self.t_loop0 = time.monotonic()
+        try:
+            self._start()
+            self._loop()
+        except KeyboardInterrupt:
+            pass
+        except G1ControlError as exc:
+            error = exc
+            self.safety.estop(f"error: {exc}", time.monotonic())
+        finally:
+            self._end_in_damping()
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
+        return error
+
+    def _on_signal(self, signum, frame) -> None:
+        self.safety.estop(f"{signal.Signals(signum).name} received", time.monotonic(), planned=True)
+        self.backend.damp()  # damping on the wire now, not at the next tick
         raise KeyboardInterrupt
 
-    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
-    error: BaseException | None = None
-    t_loop0 = time.monotonic()
-    try:
-        if getattr(backend, "release_motion_service", False):
-            say("releasing the robot's built-in motion service ...")
-        loop.reset()
-        report.released_modes = list(getattr(backend, "released_modes", []))
-        say(f"zero torque: the robot is limp. Press {_keys_for(device, 'start') or 'start'} to ramp to the default "
-            f"pose over {launch.deploy.ramp_s:.1f} s"
-            + (f"; e-stop: {_keys_for(device, 'estop')}" if _keys_for(device, "estop") else "")
-            + (f"; stop (damping): {_keys_for(device, 'stop')}" if _keys_for(device, "stop") else "")
-            + (" (--yes: answered automatically)" if options.yes else ""))
-        exit_s = launch.deploy.exit_damping_s
+    def _start(self) -> None:
+        """Release the motion service (if asked), reset the loop: the robot is limp; say what starts it."""
+        backend, device, launch = self.backend, self.device, self.launch
+        if backend.release_motion_service:
+            self.say("releasing the robot's built-in motion service ...")
+        self.loop.reset()
+        self.report.released_modes = list(backend.released_modes)
+        self.say(f"zero torque: the robot is limp. Press {_keys_for(device, 'start') or 'start'} to ramp to the "
+                 f"default pose over {launch.deploy.ramp_s:.1f} s"
+                 + (f"; e-stop: {_keys_for(device, 'estop')}" if _keys_for(device, "estop") else "")
+                 + (f"; stop (damping): {_keys_for(device, 'stop')}" if _keys_for(device, "stop") else "")
+                 + (" (--yes: answered automatically)" if self.options.yes else ""))
+
+    def _loop(self) -> None:
+        tracker, exit_s = self.tracker, self.launch.deploy.exit_damping_s
 
         def finished() -> bool:
             now = time.monotonic()
             return tracker.observe_safety(now) and tracker.time_in_state_s(now) >= exit_s
 
-        t_loop0 = time.monotonic()
+        self.t_loop0 = time.monotonic()
         with frozen_heap():  # no full garbage collection of the whole heap inside the loop
-            loop.scheduler.run(1 << 40, stop=finished)
-    except KeyboardInterrupt:
-        pass
-    except G1ControlError as exc:
-        error = exc
-        safety.estop(f"error: {exc}", time.monotonic())
-    finally:
-        backend.damp()
+            self.loop.scheduler.run(1 << 40, stop=finished)
+
+    def _end_in_damping(self) -> None:
+        self.backend.damp()
+        tracker = self.tracker
         if tracker.state != DeployState.DAMPING:
-            trip = safety.trip_event
+            trip = self.safety.trip_event
             tracker._go(DeployState.DAMPING, f"{trip.kind.value}: {trip.detail}" if trip else "exit", time.monotonic())
-            time.sleep(launch.deploy.exit_damping_s)  # damping keeps streaming before the link closes
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-    log = folder.close_log(loop)
-    _fill_report(report, log, loop, tracker, backend, safety, t_loop0)
-    folder.write_npz(log)
-    status = ("error" if error is not None else "fault" if report.fault
-              else "interrupted" if report.end_reason.startswith("SIG") else "completed")
-    folder.finish(status, report.end_reason, dataclasses.asdict(report))
-    _print_summary(report, say)
-    if error is not None:
-        raise error
+            time.sleep(self.launch.deploy.exit_damping_s)  # damping keeps streaming before the link closes
+
+    def finish(self, error: G1ControlError | None) -> None:
+        """The log, the report and the run folder's summary; then the error that ended the run, if any."""
+        folder, report = self.folder, self.report
+        assert folder is not None  # open_run_folder ran
+        log = folder.close_log(self.loop)
+        _fill_report(report, log, self.loop, self.tracker, self.backend, self.safety, self.t_loop0, self.device)
+        folder.write_npz(log)
+        status = ("error" if error is not None else "fault" if report.fault
+                  else "interrupted" if report.end_reason.startswith("SIG") else "completed")
+        folder.finish(status, report.end_reason, dataclasses.asdict(report))
+        _print_summary(report, self.say)
+        if error is not None:
+            raise error
 
 
 def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTracker, backend, safety,
-                 t_loop0: float) -> None:
-    from g1_control.launch.runner import upper_body_rms_by_style
+                 t_loop0: float, program: InputDevice) -> None:
+    """`program`: the operator's device inside OperatorButtons (a ProgramInput when a behaviour
+    program drove the robot: its step records go into the report)."""
+    from g1_control.report.results import upper_body_rms_by_style
 
     report.sequence = tracker.sequence
     report.transitions = [{"t_s": t.t_s, "from": t.source.value, "to": t.target.value, "reason": t.reason}
@@ -382,8 +440,7 @@ def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTr
                           "upper_body_vs_plan": upper_body_rms_by_style(log_arrays, (t_mono >= start) & (t_mono < end))}
     from g1_control.program.device import ProgramInput, record_dict
 
-    program = next((d for d in (loop.input, getattr(loop.input, "inner", None)) if isinstance(d, ProgramInput)), None)
-    if program is not None:
+    if isinstance(program, ProgramInput):
         report.control["program"] = {"steps": [record_dict(r) for r in program.records],
                                      "finished": program.done and not program.runner.stopped}
     late = loop.scheduler.lateness.summary()

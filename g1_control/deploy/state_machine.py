@@ -24,7 +24,16 @@ from g1_control.launch.schema import DeployConfig
 from g1_control.safety import SafetyFilter
 from g1_control.teleop.gamepad_script import ScriptedGamepad
 from g1_control.teleop.scripted import ScriptedInput
-from g1_control.types import Button, Command, CommandLimits, EstimatedState, JointReference, MotorCommand, RobotState
+from g1_control.types import (
+    Button,
+    Command,
+    CommandLimits,
+    EstimatedState,
+    ExecutionFeedback,
+    JointReference,
+    MotorCommand,
+    RobotState,
+)
 
 log = logging.getLogger("g1_control.deploy")
 
@@ -64,6 +73,16 @@ class OperatorButtons(InputDevice):
     @property
     def lost(self) -> bool:
         return self.inner.lost
+
+    @property
+    def lost_reason(self) -> str | None:
+        return self.inner.lost_reason
+
+    def button_chords(self, action: str) -> list[str]:
+        return self.inner.button_chords(action)
+
+    def observe(self, feedback: ExecutionFeedback) -> None:
+        self.inner.observe(feedback)
 
     def poll(self, now_s: float) -> Command:
         if self._scripted and self.timeline_clock is not None:

@@ -13,7 +13,7 @@ feedback.py      reference-guided feedback toward per-style Gaussian mixtures of
 skeleton.py      the G1 variants (29-DoF, 23-DoF, with Dex3 hands) over one set of joint slots
 data.py          a built library as generator features (any variant)
 features.py, fk.py   the 67-D frame representation and batched forward kinematics
-evaluation.py, bench.py   Harvey et al. protocol (L2P, L2Q, NPSS) and `g1 bench generator`
+evaluation.py    Harvey et al. protocol (L2P, L2Q, NPSS); `g1 bench generator` is tools/bench_generator.py
 factory.py       generators by name for launch files (the IK stage is built apart: g1_control/ik/stage.py)
 scripted.py, whole_body.py   scripted whole-body references; WholeBodyTrajectory (feasible plans)
 """

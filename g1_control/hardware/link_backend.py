@@ -17,6 +17,7 @@ import logging
 import threading
 import time
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -69,6 +70,12 @@ class LinkBackend(Backend):
     """Wall-clock backend speaking LowCmd_/LowState_ over `link` (host side)."""
 
     lockstep = False
+    release_motion_service: bool = False
+    """Opening the link releases the robot's built-in motion service first (UnitreeDDSBackend)."""
+    released_modes: Sequence[str] = ()
+    """The motion-service modes that were released (UnitreeDDSBackend), for the deploy report."""
+    sees_peers: bool = True
+    """The link can tell its peers (peers(), refresh_peers()): the deploy preflight checks them."""
 
     def __init__(self, link: Link, *, command_rate_hz: float = 500.0, mode_pr: int = 0,
                  expected_mode_machine: int | None = None, connect_timeout_s: float = 2.0,

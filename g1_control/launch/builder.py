@@ -196,17 +196,4 @@ def build_loop(launch: LaunchFile, *, backend: Backend | None = None, input_devi
     chain["input"] = type(input_device).__name__
     chain["backend"] = backend.describe()
     loop.chain = chain
-    attach_program(loop)
     return loop
-
-
-def attach_program(loop: ControlLoop) -> None:
-    """A program input or a keyboard taking typed instructions (itself, or inside g1 deploy's
-    OperatorButtons) reads the loop's estimator, state and goal verdicts (g1_control/program/)."""
-    from g1_control.program.device import ProgramInput
-    from g1_control.program.instructed import InstructedInput
-
-    device = loop.input
-    for candidate in (device, getattr(device, "inner", None)):
-        if isinstance(candidate, (ProgramInput, InstructedInput)):
-            candidate.attach(loop)

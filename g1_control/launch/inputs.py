@@ -19,6 +19,10 @@ def make_input(launch: LaunchFile, segments: list[Segment], limits: CommandLimit
         return ScriptedInput(segments)
     if cfg.type == "program":
         return make_program_input(launch)
+    if cfg.type == "ros2":
+        from g1_control.teleop.ros2 import Ros2Bridge, ros2_settings
+
+        return Ros2Bridge(**ros2_settings(cfg.device), limits=limits)
     from g1_control.teleop.factory import make_input_device
 
     if cfg.type == "gamepad_script":
@@ -64,7 +68,7 @@ def program_world(launch: LaunchFile):
 
 def make_program_input(launch: LaunchFile, program=None, **kwargs):
     """A ProgramInput for `program` (default: the launch file's input.program / instruction) against
-    the launch file's places; steering by input.pose. build_loop attaches it to the loop."""
+    the launch file's places; steering by input.pose. The loop feeds it back before every poll (InputDevice.observe)."""
     from g1_control.program.device import ProgramInput
 
     cfg = launch.input

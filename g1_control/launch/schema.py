@@ -267,7 +267,7 @@ class InputConfig:
     """
 
     type: Literal["scripted", "random", "gamepad", "keyboard", "unitree_remote", "gamepad_script",
-                  "program"] = "scripted"
+                  "program", "ros2"] = "scripted"
     timeline: list[Segment] = field(default_factory=list)
     random: RandomTimelineConfig = field(default_factory=RandomTimelineConfig)
     device: dict[str, Any] = field(default_factory=dict)
@@ -297,6 +297,10 @@ class InputConfig:
                                   f"runs a program (got type {self.type})")
         if self.start_delay_s < 0:
             raise LaunchFileError(f"{where}.start_delay_s: must be >= 0, got {self.start_delay_s}")
+        if self.type == "ros2":
+            from g1_control.teleop.ros2 import ros2_settings
+
+            ros2_settings(self.device, f"{where}.device")
         if self.type == "gamepad_script":
             from g1_control.teleop.gamepad_script import parse_gamepad_script
 

@@ -17,10 +17,10 @@ import numpy as np
 
 from g1_control.generator.styles import ROLLOUT_STYLES, UpperBodyStyle
 from g1_control.launch.builder import build_loop, timeline_of
-from g1_control.launch.runner import upper_body_rms
 from g1_control.launch.schema import LaunchFile
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.interpolation import interpolate_positions, interpolate_quaternions
+from g1_control.report.results import upper_body_rms
 from g1_control.robot import g1
 from g1_control.teleop.scripted import RandomTimelineConfig
 

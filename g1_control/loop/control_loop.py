@@ -19,7 +19,7 @@ from g1_control.robot import g1
 from g1_control.rotations import quat_to_rot_rows, tilt_rad, yaw_of
 from g1_control.safety import SafetyConfig, SafetyFilter
 from g1_control.safety.fall import Fall, FallMonitor
-from g1_control.types import Button, Command, JointReference, KinematicReference, RobotState
+from g1_control.types import Button, Command, ExecutionFeedback, JointReference, KinematicReference, RobotState
 
 
 @dataclass
@@ -122,6 +122,9 @@ class ControlLoop:
         self.chain: dict[str, str] = {}
         """What each stage is (set by g1_control/launch/builder.py): the same in a deploy's dry run and on the robot."""
         self.log = RunLog(max(1, log_capacity))
+        self.feedback = ExecutionFeedback()
+        """What execution reports back to the input (estimate, ground truth, goal verdicts, phase):
+        one record, filled in place before every input poll and given to InputDevice.observe."""
         r = self.rates
         stages = [
             Stage("input", r.input_hz, self._input),
@@ -187,6 +190,7 @@ class ControlLoop:
     # -- stages --------------------------------------------------------------------------------------
     def _input(self) -> None:
         now = self.now_s()
+        self._feed_back(now)
         command = self.input.poll(now)
         if self.input.lost:
             # A lost device is no input at all: the safety layer stops the robot, then damps it.
@@ -204,6 +208,17 @@ class ControlLoop:
         if Button.DAMP in command.buttons:
             self.safety.estop("damp pressed on the operator input", now)
         self.command = self.safety.vet_input(command, now)
+
+    def _feed_back(self, now: float) -> None:
+        """Fill the feedback record from the latest state, estimate and generator report (no
+        allocation: references to the loop's own objects) and hand it to the input."""
+        fb, s, g = self.feedback, self.state, self.generator
+        fb.t_s = now
+        fb.estimate = self.estimator.estimate
+        fb.state = s
+        fb.truth = s if s.base_pos_w_m is not None else None
+        fb.goal_status, fb.goal_messages, fb.phase = g.goal_status, g.goal_messages, g.phase
+        self.input.observe(fb)
 
     def _read_state(self) -> RobotState | None:
         """The robot's state for this tick (read once per tick, shared by the stages)."""

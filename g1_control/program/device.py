@@ -1,7 +1,7 @@
 """A behaviour program as the control loop's input: an InputDevice that steps a ProgramRunner.
 
     device = ProgramInput(program, world)              # pose from the robot's own estimate
-    loop = build_loop(launch, input_device=device)     # the builder attaches it to the loop
+    loop = build_loop(launch, input_device=device)     # the loop feeds it back (observe) before each poll
     ... loop runs; device.records: one StepRecord per step, judged against ground truth
 
 What the runner steers by is what the robot itself has (pose="estimator", the default): the
@@ -13,8 +13,9 @@ step is also *judged* from ground truth (StepRecord.truth_*, g1_control/program/
 runner's own verdict ("completed") says only that odometry thinks it is there.
 
 Goal steps (reach, pick, place, step up/down) are handed to the execution layer through
-Command.tasks (GoalRequest.to_task_goal, the one mapping); their status comes back from the
-generator's `goal_status` (the GoalGenerator's verdicts) when the loop has one.
+Command.tasks (GoalRequest.to_task_goal, the one mapping); their status comes back through the
+loop's feedback record (ExecutionFeedback: the generator's goal_status, goal_messages and phase,
+the estimate, ground truth), which the loop gives the device before every poll (observe).
 
 With an `operator` device (g1 deploy: the remote or keyboard with the e-stop), buttons and loss
 come from the operator and motion from the program.
@@ -22,34 +23,22 @@ come from the operator and motion from the program.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 from g1_control.interfaces import InputDevice
+from g1_control.program.judge import judge
 from g1_control.program.program import Program
-from g1_control.program.runner import ProgramProgress, ProgramRunner, RunnerConfig, StepOutcome, wrap_angle
-from g1_control.program.steps import Step
+from g1_control.program.records import PlanarPose, StepRecord
+from g1_control.program.runner import ProgramProgress, ProgramRunner, RunnerConfig, wrap_angle
 from g1_control.program.world import World
 from g1_control.rotations import yaw_of
-from g1_control.types import PHASE_LOCOMOTION, Command, RobotState
-
-if TYPE_CHECKING:
-    from g1_control.estimation.estimator import StateEstimator
-    from g1_control.program.judge import Verdict
+from g1_control.types import PHASE_LOCOMOTION, Command, EstimatedState, ExecutionFeedback, RobotState
 
 POSE_SOURCES = ("estimator", "ground_truth")
 HAND_BACK_SETTLE_S = 0.5
 """After the execution layer hands the robot back to the walking policy (its 0.3 s blend), a
 locomotion step that was waiting for it starts this much later."""
-
-
-@dataclass(frozen=True)
-class PlanarPose:
-    x_m: float
-    y_m: float
-    yaw_rad: float
-    pelvis_height_m: float | None = None
 
 
 def truth_pose(state: RobotState) -> PlanarPose | None:
@@ -65,13 +54,12 @@ class Odometry:
     estimator's world-frame base velocity (leg kinematics + accelerometer) over its own time
     stamps. Starts at (0, 0): the robot's start, which is also the world origin of a scene."""
 
-    def __init__(self, estimator: StateEstimator, x_m: float = 0.0, y_m: float = 0.0) -> None:
-        self.estimator = estimator
+    def __init__(self, x_m: float = 0.0, y_m: float = 0.0) -> None:
         self.x_m, self.y_m = x_m, y_m
         self._last_t: float | None = None
 
-    def pose(self) -> PlanarPose:
-        est = self.estimator.estimate
+    def pose(self, est: EstimatedState) -> PlanarPose:
+        """The pose after `est` (the estimator's latest output; an estimate seen before adds nothing)."""
         if self._last_t is not None and est.t_s > self._last_t:
             dt = est.t_s - self._last_t
             vx, vy, _ = est.base_linvel_w_mps.tolist()
@@ -79,23 +67,6 @@ class Odometry:
             self.y_m += vy * dt
         self._last_t = est.t_s
         return PlanarPose(self.x_m, self.y_m, est.yaw_rad, est.pelvis_height_m)
-
-
-@dataclass
-class StepRecord:
-    """One finished step: the runner's outcome (from the pose it steers by) and, in simulation,
-    ground truth at its start and end and the yaw it turned by ground truth."""
-
-    outcome: StepOutcome
-    step: Step
-    truth_start: PlanarPose | None = None
-    truth_end: PlanarPose | None = None
-    truth_turned_rad: float | None = None
-    goal_id: str | None = None
-    message: str | None = None
-    """Why the execution layer failed the step's goal (GoalGenerator.goal_messages), if it did."""
-    verdict: Verdict | None = None
-    """Set by the judge (g1_control/program/judge.py) when ground truth exists."""
 
 
 @dataclass
@@ -128,11 +99,8 @@ class ProgramInput(InputDevice):
         self.truth_start: PlanarPose | None = None
         self.started_s: float | None = None
         self.ended_s: float | None = None
-        self._odometry: Odometry | None = None
-        self._truth: Callable[[], PlanarPose | None] = lambda: None
-        self._goal_status: Mapping[str, str] = {}
-        self._goal_messages: Mapping[str, str] = {}
-        self._phase: Callable[[], str] = lambda: PHASE_LOCOMOTION
+        self._feedback: ExecutionFeedback | None = None
+        self._odometry = Odometry()
         self._handed_back_s: float | None = None
         self._restart_label: str | None = None
         self._open: dict[str, _Open] = {}
@@ -140,17 +108,12 @@ class ProgramInput(InputDevice):
         self._t0: float | None = None
 
     # -- wiring ---------------------------------------------------------------------------------
-    def attach(self, loop) -> None:
-        """Read the loop's estimator (odometry), its latest robot state (ground truth, where the
-        backend gives it) and its generator's goal verdicts. Called by launch/builder.py."""
-        self._odometry = Odometry(loop.estimator)
-        self._truth = lambda: truth_pose(loop.state)
-        status = getattr(loop.generator, "goal_status", None)
-        self._goal_status = status if isinstance(status, Mapping) else {}
-        messages = getattr(loop.generator, "goal_messages", None)
-        self._goal_messages = messages if isinstance(messages, Mapping) else {}
-        generator = loop.generator
-        self._phase = lambda: getattr(generator, "phase", PHASE_LOCOMOTION)
+    def observe(self, feedback: ExecutionFeedback) -> None:
+        """The loop's feedback record (the same instance every tick): the estimate it steers by,
+        ground truth where the backend gives it, the generator's goal verdicts and phase."""
+        self._feedback = feedback
+        if self.operator is not None:
+            self.operator.observe(feedback)
 
     @property
     def done(self) -> bool:
@@ -161,23 +124,31 @@ class ProgramInput(InputDevice):
         return self.operator.lost if self.operator is not None else False
 
     @property
-    def mapper(self):
-        """The operator device's button mapping (g1 deploy names its keys), if any."""
-        return getattr(self.operator, "mapper", None)
+    def lost_reason(self) -> str | None:
+        return self.operator.lost_reason if self.operator is not None else None
+
+    def button_chords(self, action: str) -> list[str]:
+        """The operator device's (g1 deploy names its keys); [] without one."""
+        return self.operator.button_chords(action) if self.operator is not None else []
 
     def close(self) -> None:
         if self.operator is not None:
             self.operator.close()
 
     # -- the tick -------------------------------------------------------------------------------
+    def _truth(self) -> PlanarPose | None:
+        fb = self._feedback
+        return truth_pose(fb.truth) if fb is not None and fb.truth is not None else None
+
     def _pose(self, truth: PlanarPose | None) -> PlanarPose:
         if self.pose_source == "ground_truth":
             if truth is None:
                 raise RuntimeError("pose 'ground_truth' needs a simulator (the robot's state has no base position)")
             return truth
-        if self._odometry is None:
-            raise RuntimeError("ProgramInput is not attached to a loop (launch/builder.py:build_loop attaches it)")
-        return self._odometry.pose()
+        if self._feedback is None:
+            raise RuntimeError("ProgramInput is not attached to a loop: it steers by the loop's feedback "
+                               "(ControlLoop gives it before every poll, InputDevice.observe)")
+        return self._odometry.pose(self._feedback.estimate)
 
     def poll(self, now_s: float) -> Command:
         op = self.operator.poll(now_s) if self.operator is not None else None
@@ -206,7 +177,9 @@ class ProgramInput(InputDevice):
         runner = self.runner
         n = len(runner.outcomes)
         goals = runner.active_goals
-        status = {g.goal_id: self._goal_status[g.goal_id] for g in goals if g.goal_id in self._goal_status}
+        fb = self._feedback
+        verdicts = fb.goal_status if fb is not None else {}
+        status = {g.goal_id: verdicts[g.goal_id] for g in goals if g.goal_id in verdicts}
         progress = ProgramProgress(pose.x_m, pose.y_m, pose.yaw_rad, status, pose.pelvis_height_m)
         self._after_hand_back(now_s, progress, truth)
         command = runner.update(now_s, progress)
@@ -214,10 +187,8 @@ class ProgramInput(InputDevice):
             opened = self._open.pop(outcome.label, None) or _Open(truth)
             record = StepRecord(outcome, runner.step_of(outcome.label), opened.truth_start, truth,
                                 opened.turned if truth is not None else None, opened.goal_id,
-                                self._goal_messages.get(opened.goal_id) if opened.goal_id else None)
+                                fb.goal_messages.get(opened.goal_id) if opened.goal_id and fb is not None else None)
             if truth is not None:
-                from g1_control.program.judge import judge
-
                 record.verdict = judge(record, self.world, self.truth_start)
             self.records.append(record)
             if self.on_record is not None:
@@ -239,7 +210,8 @@ class ProgramInput(InputDevice):
         if label is None or not self.runner.active_is_locomotion:
             self._restart_label = None
             return
-        if self._phase() != PHASE_LOCOMOTION:
+        phase = self._feedback.phase if self._feedback is not None else PHASE_LOCOMOTION
+        if phase != PHASE_LOCOMOTION:
             self._restart_label, self._handed_back_s = label, None
             return
         if self._restart_label != label:
@@ -260,8 +232,7 @@ def record_dict(record: StepRecord) -> dict:
     o = record.outcome
     out: dict = {"label": o.label, "kind": o.kind, "description": o.description, "status": o.status,
                  "started_s": o.started_s, "ended_s": o.ended_s, "measured": dict(o.measured)}
-    for name in ("truth_start", "truth_end"):
-        pose = getattr(record, name)
+    for name, pose in (("truth_start", record.truth_start), ("truth_end", record.truth_end)):
         out[name] = None if pose is None else [pose.x_m, pose.y_m, pose.yaw_rad, pose.pelvis_height_m]
     out["truth_turned_rad"] = record.truth_turned_rad
     if record.goal_id is not None:

@@ -15,13 +15,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from g1_control.interfaces import InputDevice
+from g1_control.interfaces import InputDevice, LineInput
 from g1_control.program.device import ProgramInput, StepRecord, describe_record
 from g1_control.program.exceptions import InstructionError, ProgramError
 from g1_control.program.language.parser import InstructionParser
 from g1_control.program.program import Program
 from g1_control.program.world import World
-from g1_control.types import Button, Command
+from g1_control.types import Button, Command, ExecutionFeedback
 
 _CANCELLING = frozenset({Button.STOP, Button.DAMP, Button.ESTOP})
 _YES = ("y", "yes")
@@ -32,9 +32,9 @@ def _print(text: str) -> None:
 
 
 class InstructedInput(InputDevice):
-    """See the module docstring. `inner` needs take_line() (and begin_line() for `confirm`)."""
+    """See the module docstring. `inner`: the operator's keyboard (lines typed, begin_line for `confirm`)."""
 
-    def __init__(self, inner: InputDevice, world: World | None = None, *, pose: str = "estimator",
+    def __init__(self, inner: LineInput, world: World | None = None, *, pose: str = "estimator",
                  confirm: bool = False, say: Callable[[str], None] = _print) -> None:
         self.inner = inner
         self.world = world or World()
@@ -46,7 +46,7 @@ class InstructedInput(InputDevice):
         self.pending: Program | None = None
         """A parsed program waiting for the operator's "y" (confirm)."""
         self.finished: list[ProgramInput] = []
-        self._loop = None
+        self._feedback: ExecutionFeedback | None = None
 
     # -- the operator device, passed through -------------------------------------------------
     @property
@@ -54,27 +54,26 @@ class InstructedInput(InputDevice):
         return self.inner.lost
 
     @property
-    def lost_reason(self):
-        return getattr(self.inner, "lost_reason", None)
+    def lost_reason(self) -> str | None:
+        return self.inner.lost_reason
 
-    @property
-    def mapper(self):
-        return getattr(self.inner, "mapper", None)
-
-    @property
-    def stats(self):
-        return getattr(self.inner, "stats", None)
+    def button_chords(self, action: str) -> list[str]:
+        return self.inner.button_chords(action)
 
     def close(self) -> None:
         self.inner.close()
 
-    def attach(self, loop) -> None:
-        self._loop = loop
+    def observe(self, feedback: ExecutionFeedback) -> None:
+        """The loop's feedback record: passed to the operator's device and to each program run."""
+        self._feedback = feedback
+        self.inner.observe(feedback)
+        if self.active is not None:
+            self.active.observe(feedback)
 
     # -- the tick ------------------------------------------------------------------------------
     def poll(self, now_s: float) -> Command:
         op = self.inner.poll(now_s)
-        line = getattr(self.inner, "take_line", lambda: None)()
+        line = self.inner.take_line()
         if line is not None:
             self._line(line.strip())
         if self.active is None:
@@ -114,16 +113,14 @@ class InstructedInput(InputDevice):
         if self.confirm:
             self.pending = program
             self.say('run it on the robot? type y and Enter (anything else: no)')
-            begin = getattr(self.inner, "begin_line", None)
-            if begin is not None:
-                begin("y/n> ")
+            self.inner.begin_line("y/n> ")
             return
         self._start(program)
 
     def _start(self, program: Program) -> None:
         device = ProgramInput(program, self.world, pose=self.pose, start_delay_s=0.0, on_record=self._record)
-        if self._loop is not None:
-            device.attach(self._loop)
+        if self._feedback is not None:
+            device.observe(self._feedback)
         self.active = device
 
     def _record(self, record: StepRecord) -> None:

@@ -7,22 +7,19 @@ so 360-degree turns count); a walk to a place within 10 % of the way there (at l
 its stop point; a turn to a heading or a place within 10 degrees of it; a height step within
 5 cm of the height asked for (posture "normal": the walking policy's own, not judged); a goal
 step (reach, pick, place, step) by the execution layer's ground-truth figures (goal_verdict, from
-g1_control/launch/outcomes.py: where the hand, the box and the feet really were); stands, styles
+g1_control/report/outcomes.py: where the hand, the box and the feet really were); stands, styles
 and timed walks by having run their time.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
+from g1_control.program.records import PlanarPose, StepRecord
 from g1_control.program.runner import COMPLETED, RunnerConfig, wrap_angle
 from g1_control.program.steps import Height, Parallel, Stand, Style, Turn, Walk
 from g1_control.program.world import START, World
-
-if TYPE_CHECKING:
-    from g1_control.program.device import PlanarPose, StepRecord
+from g1_control.report.verdict import Verdict
 
 DISTANCE_TOLERANCE = 0.10
 """Relative: a walk's distance (or the way to a place) within this fraction."""
@@ -30,13 +27,6 @@ MIN_PLACE_TOLERANCE_M = 0.05
 HEADING_TOLERANCE_RAD = math.radians(10.0)
 HEIGHT_TOLERANCE_M = 0.05
 _REL = {"forward": 0.0, "left": math.pi / 2, "backward": math.pi, "right": -math.pi / 2}
-
-
-@dataclass
-class Verdict:
-    ok: bool
-    text: str
-    values: dict[str, float] = field(default_factory=dict)
 
 
 def judge(record: StepRecord, world: World, program_start: PlanarPose | None,
@@ -131,7 +121,7 @@ PICK_MIN_RISE_M = 0.05
 
 
 def goal_verdict(outcome: dict) -> Verdict:
-    """A goal step judged from the execution layer's ground-truth figures (g1_control/launch/outcomes.py:
+    """A goal step judged from the execution layer's ground-truth figures (g1_control/report/outcomes.py:
     judge_goal): reach: mean hand error within 3 cm over the hold; pick: box lifted >= 5 cm and not
     dropped; place: box within 5 cm of where it was to go, tilted under 10 degrees, not dropped;
     step up: both feet on the platform at the end; step down: both on the floor. A goal the layer
@@ -163,4 +153,4 @@ def goal_verdict(outcome: dict) -> Verdict:
     return Verdict(reached, f"execution layer: {status} (no ground-truth figures for this goal)" + why)
 
 
-__all__ = ["DISTANCE_TOLERANCE", "HEADING_TOLERANCE_RAD", "HEIGHT_TOLERANCE_M", "Verdict", "goal_verdict", "judge"]
+__all__ = ["DISTANCE_TOLERANCE", "HEADING_TOLERANCE_RAD", "HEIGHT_TOLERANCE_M", "goal_verdict", "judge"]

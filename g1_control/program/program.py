@@ -24,7 +24,7 @@ class Program:
         if not self.steps:
             raise ProgramError("program: has no steps")
         for i, step in enumerate(self.steps):
-            where = f"step {i + 1} ({getattr(step, 'kind', '?')})"
+            where = f"step {i + 1} ({step.kind if isinstance(step, Step) else '?'})"
             if not isinstance(step, Step):
                 raise ProgramError(f"{where}: not a step; got {type(step).__name__}")
             step.validate(where)

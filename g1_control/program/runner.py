@@ -25,6 +25,7 @@ import numpy as np
 
 from g1_control.program.program import Program
 from g1_control.program.steps import (
+    TIMED_STEPS,
     Height,
     Parallel,
     Pick,
@@ -200,7 +201,7 @@ def time_budget_s(program: Program, config: RunnerConfig | None = None) -> float
     def budget(step: Step) -> float:
         if isinstance(step, Parallel):
             return budget(step.main)
-        timeout = getattr(step, "timeout_s", None)
+        timeout = step.timeout_s if isinstance(step, TIMED_STEPS) else None
         if timeout is not None:
             return timeout
         if isinstance(step, Walk):
@@ -407,8 +408,8 @@ class ProgramRunner:
     def _goal(self, step: Step, p: ProgramProgress, where: str) -> GoalRequest:
         self._goal_counter += 1
         gid = f"g{self._goal_counter}"
-        name = getattr(step, "target", None) if isinstance(step, (Reach, Place)) else \
-            getattr(step, "object", None) if isinstance(step, Pick) else getattr(step, "platform", None)
+        name = step.target if isinstance(step, (Reach, Place)) else step.object if isinstance(step, Pick) else \
+            step.platform if isinstance(step, (StepUp, StepDown)) else None
         target_w = None
         if name is not None:
             if name == START:
@@ -427,7 +428,7 @@ class ProgramRunner:
         kind = None if name is None else "point" if name == START else self.world.get(name, where).kind
         return GoalRequest(
             gid, step.kind,
-            hand=getattr(step, "hand", None) or getattr(step, "hands", None),
+            hand=step.hand if isinstance(step, Reach) else step.hands if isinstance(step, Pick) else None,
             object=step.object if isinstance(step, (Pick, Place)) else None,
             target=name if not isinstance(step, Pick) else None,
             target_w_m=target_w, offset_b_m=offset_b, target_kind=kind)

@@ -468,6 +468,11 @@ class StepDown(Step):
         return "step down" + (f" from {self.platform}" if self.platform else "") + _timeout_text(self.timeout_s)
 
 
+def _kind_of(value: object) -> str:
+    """A step's kind, or the type of what stands where a step should (bad input)."""
+    return value.kind if isinstance(value, Step) else type(value).__name__
+
+
 LOCOMOTION = (Walk, Turn, Stand)
 ALONGSIDE = (Style, Height, Reach)
 
@@ -483,17 +488,15 @@ class Parallel(Step):
 
     def _check(self, where: str) -> None:
         if not isinstance(self.main, LOCOMOTION):
-            raise ProgramError(f"{where}.main: must be a walk, turn or stand step; got "
-                               f"{getattr(self.main, 'kind', type(self.main).__name__)!r}")
+            raise ProgramError(f"{where}.main: must be a walk, turn or stand step; got {_kind_of(self.main)!r}")
         self.main._check(f"{where}.main ({self.main.kind})")
         if not self.alongside:
             raise ProgramError(f"{where}.alongside: needs at least one style, height or reach step")
         for i, s in enumerate(self.alongside):
-            w = f"{where}.alongside[{i}] ({getattr(s, 'kind', '?')})"
+            w = f"{where}.alongside[{i}] ({s.kind if isinstance(s, Step) else '?'})"
             if not isinstance(s, ALONGSIDE):
-                raise ProgramError(f"{w}: only style, height and reach steps run alongside; got "
-                                   f"{getattr(s, 'kind', type(s).__name__)!r}")
-            if getattr(s, "duration_s", None) is not None:
+                raise ProgramError(f"{w}: only style, height and reach steps run alongside; got {_kind_of(s)!r}")
+            if isinstance(s, (Style, Height)) and s.duration_s is not None:
                 raise ProgramError(f"{w}.duration_s: a step alongside lasts as long as the main step; leave it out")
             s._check(w)
 
@@ -539,8 +542,10 @@ STEP_TYPES: dict[str, type[Step]] = {c.kind: c for c in (
 
 def iter_named_places(step: Step):
     """Yield (field path, name) of every object/place name a step refers to."""
-    for attr in ("target", "object", "platform"):
-        value = getattr(step, attr, None)
+    target = step.target if isinstance(step, (Walk, Turn, Reach, Place)) else None
+    obj = step.object if isinstance(step, (Pick, Place)) else None
+    platform = step.platform if isinstance(step, (StepUp, StepDown)) else None
+    for attr, value in (("target", target), ("object", obj), ("platform", platform)):
         if value:
             yield attr, value
     if isinstance(step, Parallel):
@@ -553,6 +558,8 @@ def iter_named_places(step: Step):
 
 
 GOAL_STEPS = (Reach, Pick, Place, StepUp, StepDown)
+TIMED_STEPS = (Walk, Turn, Reach, Pick, Place, StepUp, StepDown)
+"""Steps with a `timeout_s` of their own."""
 """Steps the execution layer carries out (task goals)."""
 
 

@@ -48,6 +48,12 @@ class TeleopDevice(InputDevice):
     def lost(self) -> bool:
         return self._lost_reason is not None
 
+    def describe(self) -> str:
+        return self.name
+
+    def button_chords(self, action: str) -> list[str]:
+        return ["+".join(sorted(chord)) for chord, a in self.mapper.config.buttons.items() if a == action]
+
     @property
     def lost_reason(self) -> str | None:
         return self._lost_reason

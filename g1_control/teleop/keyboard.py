@@ -29,6 +29,7 @@ from collections import deque
 from collections.abc import Callable
 
 from g1_control.errors import InputDeviceError
+from g1_control.interfaces import LineInput
 from g1_control.teleop.device import DeviceLost, TeleopDevice
 from g1_control.teleop.mapping import LINE_ACTION, MappingConfig
 from g1_control.teleop.snapshot import InputSnapshot
@@ -79,7 +80,7 @@ def decode_keys(text: str) -> tuple[list[str], int]:
     return keys, unknown
 
 
-class TerminalKeyboard(TeleopDevice):
+class TerminalKeyboard(TeleopDevice, LineInput):
     kind = "keyboard"
 
     def __init__(self, mapping: MappingConfig | None = None, limits: CommandLimits | None = None, *,

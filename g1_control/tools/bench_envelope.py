@@ -53,11 +53,13 @@ def probe(style: str, axis: int, value: float, log: list) -> bool:
     result = run_trial(Trial(f"envelope {style} {value:+.2f}@{axis}", walk_timeline(style, command_t),
                              policy=POLICY, envelope_limits=False))
     verdict = judge_walk(command_t)(result)
-    log.append({"style": style, "command": command, "met": verdict.success, "error_pct": verdict.velocity_error_pct,
-                "drift": verdict.drift, "upper_body_rms_rad": verdict.upper_body_rms_rad, "note": verdict.note})
-    print(f"  {style:<12} {['vx', 'vy', 'wz'][axis]} {value:+.2f}: {'ok  ' if verdict.success else 'miss'} "
-          f"{verdict.note}", flush=True)
-    return verdict.success
+    figures = verdict.values
+    log.append({"style": style, "command": command, "met": verdict.ok, "error_pct": figures.get("velocity_error_pct"),
+                "drift": figures.get("drift"), "upper_body_rms_rad": figures.get("upper_body_rms_rad"),
+                "note": verdict.text})
+    print(f"  {style:<12} {['vx', 'vy', 'wz'][axis]} {value:+.2f}: {'ok  ' if verdict.ok else 'miss'} "
+          f"{verdict.text}", flush=True)
+    return verdict.ok
 
 
 def direction_limit(style: str, axis: int, ladder: tuple[float, ...], log: list) -> float:
@@ -82,10 +84,10 @@ def height_limit(log: list) -> float:
         result = run_trial(Trial(f"envelope height {height}", walk_timeline("default", command, pelvis_height_m=height),
                                  policy=POLICY, envelope_limits=False))
         verdict = judge_walk(command, height, HEIGHT_TOLERANCE_M)(result)
-        log.append({"style": "default", "pelvis_height_m": height, "met": verdict.success, "note": verdict.note})
-        print(f"  pelvis {height:.2f} m at vx {HEIGHT_SPEED_MPS}: {'ok  ' if verdict.success else 'miss'} {verdict.note}",
+        log.append({"style": "default", "pelvis_height_m": height, "met": verdict.ok, "note": verdict.text})
+        print(f"  pelvis {height:.2f} m at vx {HEIGHT_SPEED_MPS}: {'ok  ' if verdict.ok else 'miss'} {verdict.text}",
               flush=True)
-        if not verdict.success:
+        if not verdict.ok:
             break
         lowest = height
     return lowest if lowest is not None else CommandLimits().pelvis_height_m[1]

@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from g1_control.generator.styles import ROLLOUT_STYLES
+from g1_control.report.verdict import Verdict, figures
 from g1_control.teleop.scripted import Segment
 from g1_control.tools.physics_trials import Push, Trial, TrialResult, run_trial, walk_timeline
 
@@ -52,22 +53,6 @@ PUSH_DIRECTIONS = {"front": (-1.0, 0.0), "back": (1.0, 0.0), "left": (0.0, -1.0)
 PUSH_PHASES = 5
 """Pushes per direction, at seeded times spread over one gait cycle."""
 TICK_S = 0.02
-
-
-@dataclass
-class Verdict:
-    success: bool
-    velocity_error_pct: float | None = None
-    drift: float | None = None
-    upper_body_rms_rad: float | None = None
-    hand_error_m: float | None = None
-    object_error_m: float | None = None
-    note: str = ""
-    count: int = 1
-    """How many goals the trial judged (a sequence of reaches, of heights); 1 for one behaviour."""
-    successes: int | None = None
-    """Of those, how many met the goal (None: the trial's `success`)."""
-    height_error_m: float | None = None
 
 
 @dataclass
@@ -112,7 +97,7 @@ def judge_walk(command: tuple[float, float, float], height_m: float | None = Non
                height_tolerance_m: float = HEIGHT_TOLERANCE_M) -> Callable[[TrialResult], Verdict]:
     def judge(result: TrialResult) -> Verdict:
         if result.fell:
-            return Verdict(False, note=f"fell: {result.fall}")
+            return Verdict(False, f"fell: {result.fall}")
         err, drift = velocity_figures(result, 1, command)
         ub = result.upper_body_rms(1)
         ok = err <= SPEED_TOLERANCE_PCT and drift <= DRIFT_TOLERANCE and ub <= UPPER_BODY_TOLERANCE_RAD
@@ -122,12 +107,12 @@ def judge_walk(command: tuple[float, float, float], height_m: float | None = Non
             z = result.pelvis_height(1)
             ok = ok and abs(z - height_m) <= height_tolerance_m
             note += f", pelvis {z:.3f} m (asked {height_m:.2f})"
-        return Verdict(bool(ok), float(err), float(drift), ub, note=note)
+        return Verdict(bool(ok), note, figures(velocity_error_pct=err, drift=drift, upper_body_rms_rad=ub))
     return judge
 
 
 def judge_survive(result: TrialResult) -> Verdict:
-    return Verdict(not result.fell, note=f"fell: {result.fall}" if result.fell else "")
+    return Verdict(not result.fell, f"fell: {result.fall}" if result.fell else "")
 
 
 # -- the suite ---------------------------------------------------------------------------------------
@@ -174,7 +159,7 @@ def behaviours() -> list[Behaviour]:
                           "no fall in >= 90 %", lambda seed: push_trials(True, seed), judge_survive, min_success=0.9))
     from g1_control.tools.execution_goals import goal_behaviours
 
-    rows += goal_behaviours(Behaviour, Verdict)
+    rows += goal_behaviours(Behaviour)
     return rows
 
 
@@ -206,14 +191,17 @@ def run_behaviour(behaviour: Behaviour, seed: int = 0, video_dir: Path | None = 
 
             out = log_path.with_suffix(".mp4")
             video = str(out) if render_video(log_path, out, fps=15, size=(480, 360), quiet=True) else None
-    successes = sum(int(v.success) if v.successes is None else v.successes for v in verdicts)
+    successes = sum(v.met() for v in verdicts)
     count = sum(v.count for v in verdicts)
-    notes = [f"{t.name}: {v.note}" for t, v in zip(trials, verdicts) if v.note and (not v.success or len(trials) == 1)]
+    notes = [f"{t.name}: {v.text}" for t, v in zip(trials, verdicts) if v.text and (not v.ok or len(trials) == 1)]
+
+    def worst(name: str) -> float | None:
+        return _worst([v.values.get(name) for v in verdicts])
+
     return Row(
         behaviour.name, behaviour.goal, count, successes, falls,
-        _worst([v.velocity_error_pct for v in verdicts]), _worst([v.drift for v in verdicts]),
-        _worst([v.upper_body_rms_rad for v in verdicts]), _worst([v.hand_error_m for v in verdicts]),
-        _worst([v.object_error_m for v in verdicts]), sim_s / wall_s if wall_s > 0 else math.inf,
+        worst("velocity_error_pct"), worst("drift"), worst("upper_body_rms_rad"), worst("hand_error_m"),
+        worst("object_error_m"), sim_s / wall_s if wall_s > 0 else math.inf,
         successes >= math.ceil(behaviour.min_success * count - 1e-9), notes, video)
 
 

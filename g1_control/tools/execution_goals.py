@@ -1,7 +1,7 @@
 """Goal rows of `g1 bench execution` (issue 17 part 2): reaching, standing heights, the box, the
 step. Every trial runs the tracking layer (walking policy + WBC, launch tracker.type layer) in
 MuJoCo through the one loop builder, with seeded scenes and goals; every figure comes from the
-simulator's ground truth (g1_control/launch/outcomes.py), not from the goal generator's status.
+simulator's ground truth (g1_control/report/outcomes.py), not from the goal generator's status.
 
   reach.left / reach.right   20 seeded points in the hand's workspace, reached one after another
                              while standing: hand within 3 cm for >= 90 % of each 1.5 s hold
@@ -27,6 +27,7 @@ from collections.abc import Callable
 import numpy as np
 
 from g1_control.generator.styles import ROLLOUT_STYLES
+from g1_control.report.verdict import Verdict, figures
 from g1_control.scene import Box, Platform, SceneConfig, Table
 from g1_control.teleop.scripted import GoalEntry, Segment
 from g1_control.tools.physics_trials import Trial, TrialResult
@@ -238,9 +239,9 @@ __all__ = ["box_layout", "box_outcome", "box_trials", "height_figures", "height_
 
 
 # -- rows --------------------------------------------------------------------------------------------
-def goal_behaviours(Behaviour, Verdict) -> list:
-    """The rows above as bench_execution.Behaviour entries (its Behaviour and Verdict classes are
-    passed in: bench_execution imports this module)."""
+def goal_behaviours(Behaviour) -> list:
+    """The rows above as bench_execution.Behaviour entries (its Behaviour class is passed in:
+    bench_execution imports this module)."""
 
     def judge_reach(result: TrialResult) -> Verdict:
         reaches = [o for o in result.goals if o.get("kind") == "reach"]
@@ -252,7 +253,7 @@ def goal_behaviours(Behaviour, Verdict) -> list:
         success = not result.fell and sum(ok) >= math.ceil(REACH_HOLD_FRACTION * n - 1e-9)
         note = (f"fell: {result.fall}; " if result.fell else "") + f"{sum(ok)}/{n} points" + \
             (f"; missed {'; '.join(missed)}" if missed else "")
-        return Verdict(success, hand_error_m=float(np.mean(errors)) if errors else None, note=note, count=n,
+        return Verdict(success, note, figures(hand_error_m=float(np.mean(errors)) if errors else None), count=n,
                        successes=sum(ok))
 
     def judge_height(result: TrialResult) -> Verdict:
@@ -260,16 +261,15 @@ def goal_behaviours(Behaviour, Verdict) -> list:
         ok = [not result.fell and abs(z - h) <= HEIGHT_TOLERANCE_M for h, z in figs]
         note = ", ".join(f"{h:.2f}->{z:.3f}" for h, z in figs) + (f"; fell: {result.fall}" if result.fell else "")
         worst = max((abs(z - h) for h, z in figs if np.isfinite(z)), default=None)
-        return Verdict(all(ok), note=note, count=len(figs), successes=sum(ok),
-                       hand_error_m=None, object_error_m=None, height_error_m=worst)
+        return Verdict(all(ok), note, figures(height_error_m=worst), count=len(figs), successes=sum(ok))
 
     def judge_box(result: TrialResult) -> Verdict:
         ok, err, note = box_outcome(result)
-        return Verdict(ok, object_error_m=err, note=note)
+        return Verdict(ok, note, figures(object_error_m=err))
 
     def judge_step(result: TrialResult) -> Verdict:
         ok, note = step_outcome(result)
-        return Verdict(ok, note=note)
+        return Verdict(ok, note)
 
     rows = [Behaviour(f"reach.{hand}", f"{REACH_POINTS} seeded points: hand within {REACH_TOLERANCE_M * 100:.0f} cm "
                       f"for >= {REACH_HOLD_FRACTION:.0%} of each hold on >= 90 % of them, no fall",

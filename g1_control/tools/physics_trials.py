@@ -64,7 +64,7 @@ class TrialResult:
     tracker_us: tuple[float, float]
     """The tracker stage's p50 and p99 (us) in this run."""
     goals: list[dict] = field(default_factory=list)
-    """Goal outcomes from ground truth (g1_control/launch/outcomes.py), tracker 'layer' only."""
+    """Goal outcomes from ground truth (g1_control/report/outcomes.py), tracker 'layer' only."""
     layer_cpu: tuple[np.ndarray, np.ndarray] | None = None
     """The tracking layer's act() thread CPU time (s) and what ran (0 policy, 1 WBC, 2 both)."""
 
@@ -96,7 +96,7 @@ class TrialResult:
 
     def upper_body_rms(self, index: int) -> float:
         """RMS (rad) over waist and arm joints of measured minus the tracker's reference posture."""
-        from g1_control.launch.runner import upper_body_rms
+        from g1_control.report.results import upper_body_rms
 
         rms = upper_body_rms(self.log, self.window(index))
         return float("nan") if rms is None else rms
@@ -151,7 +151,7 @@ def run_trial(trial: Trial, *, log_path: Path | None = None, stop_on_fall: bool 
     loop.reset()
     watcher = None
     if trial.tracker == "layer":
-        from g1_control.launch.outcomes import GoalWatcher
+        from g1_control.report.outcomes import GoalWatcher
 
         watcher = GoalWatcher(loop)
     duration = launch.total_duration_s

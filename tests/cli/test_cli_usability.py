@@ -1,6 +1,7 @@
 """The command line a new user meets: --version, descriptions, launch files by name, init, docs."""
 
 import argparse
+from pathlib import Path
 
 import pytest
 
@@ -97,3 +98,36 @@ def test_code_cites_only_files_in_this_repository():
                 text = path.read_text(errors="replace")
                 offenders += [f"{path.relative_to(REPO)}: {name}" for name in outside if name in text]
     assert not offenders, offenders
+
+
+
+@pytest.fixture
+def deploy_paths(tmp_path, monkeypatch):
+    """The launch-file paths `g1 deploy` hands to the deploy session, which stops there (nothing reaches a robot)."""
+    from g1_control.deploy import session
+
+    monkeypatch.chdir(tmp_path)  # no launch/ folder here
+    given: list[Path] = []
+
+    def fake_deploy(path, options):
+        given.append(path)
+        raise SystemExit(7)
+
+    monkeypatch.setattr(session, "deploy", fake_deploy)
+    return given
+
+
+@pytest.mark.parametrize("name", ["robot", "sim2sim.yaml", "launch/robot.yaml"])
+def test_deploy_takes_a_shipped_launch_file_by_name(name, deploy_paths, capsys):
+    """`g1 deploy robot` runs the shipped robot.yaml (it said "robot.yaml: no such launch file")."""
+    with pytest.raises(SystemExit):
+        main(["deploy", name, "--preflight-only"])
+    path = LAUNCH_DIR / (name.rsplit("/", 1)[-1].removesuffix(".yaml") + ".yaml")
+    assert deploy_paths == [path]
+    assert f"launch file: {path}" in capsys.readouterr().out
+
+
+def test_deploy_leaves_a_missing_launch_file_to_the_preflight(deploy_paths):
+    with pytest.raises(SystemExit):
+        main(["deploy", "robto", "--preflight-only"])
+    assert deploy_paths == [Path("robto")]  # refused by the preflight's launch_file check, into its report

@@ -225,13 +225,20 @@ def test_a_dry_run_that_falls_refuses(tmp_path):
     assert pf.dry_run.fell
 
 
-def test_robot_launch_file_names_no_interface_until_the_operator_does(tmp_path, partition, mock_robot):
-    """launch/robot.yaml refuses to guess a NIC; pointed at an emulated robot on lo it passes."""
+def test_robot_launch_file_takes_the_one_nic_on_the_robot_network(tmp_path, partition, mock_robot, monkeypatch):
+    """launch/robot.yaml's `interface: auto` never guesses: with no NIC on 192.168.123.0/24 it refuses and says
+    how to add one; pointed at an emulated robot on lo it passes."""
+    import ipaddress
+
     from deploy_test_helpers import ROOT
 
+    from g1_control.hardware.links import network
+
+    monkeypatch.setattr(network, "interface_table", lambda: {"lo": ipaddress.IPv4Interface("127.0.0.1/8")})
     report, refused, _ = preflight_only(ROOT / "launch" / "robot.yaml", partition)
     assert refused is not None
-    assert "network interface 'CHANGE_ME' does not exist" in _reason(report, "interface")
+    assert _reason(report, "interface").startswith("--interface auto: no interface here has an address on the "
+                                                   "robot's network 192.168.123.0/24 (interfaces: lo 127.0.0.1/8)")
     mock_robot().start()
     fast = write_launch(tmp_path, FAST, base=ROOT / "launch" / "robot.yaml")
     report, refused, text = preflight_only(fast, partition, interface="lo", domain=1)

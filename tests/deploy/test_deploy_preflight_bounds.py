@@ -30,8 +30,10 @@ class _Robot:
         self._peers = peers
         self.link = SimpleNamespace(describe=lambda: "stand-in link")
         self.timeouts: list = []
-        if can_see_peers:
-            self.refresh_peers = lambda: None
+        self.sees_peers = can_see_peers
+
+    def refresh_peers(self):
+        assert self.sees_peers, "refresh_peers on a link that cannot see its peers"
 
     def wait_for_state(self, timeout_s):
         self.timeouts.append(timeout_s)

@@ -24,6 +24,8 @@ class _Link:
 class FakeBackend:
     """A robot reporting `state` at 500 Hz with clean CRCs; `peers` as LinkBackend.peers() says."""
 
+    sees_peers = True
+
     def __init__(self, state: RobotState, peers=(1, 1, 0), battery_v=None):
         self.state, self._peers, self.link = state, peers, _Link()
         if battery_v is not None:

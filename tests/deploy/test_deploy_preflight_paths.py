@@ -14,10 +14,12 @@ from deploy_test_helpers import write_launch
 from g1_control.deploy import preflight as pf_module
 from g1_control.deploy.preflight import FAIL, NOT_RUN, PASS, CheckResult, Preflight, dry_run_launch, format_table
 from g1_control.errors import G1ControlError
-from g1_control.launch.runner import RunResult, SegmentResult
+from g1_control.interfaces import InputDevice
 from g1_control.launch.schema import DeployConfig, InputConfig, load_launch
+from g1_control.report.results import RunResult, SegmentResult
 from g1_control.safety.config import SafetyConfig
 from g1_control.trackers.policy_spec import load_spec
+from g1_control.types import Command
 from tests.paths import LAUNCH_DIR
 
 
@@ -123,21 +125,28 @@ def test_the_interface_check(launch):
 
 
 # -- operator input --------------------------------------------------------------------------------------
-class _Device:
+class _Device(InputDevice):
     """A stand-in input device: `lost` after `lose_after` polls (None: never), e-stop chords as given."""
 
     def __init__(self, chords=(("LB", "RB"),), lose_after=None, reason="unplugged"):
-        buttons = {frozenset(c): "estop" for c in chords}
-        buttons[frozenset({"A"})] = "run"
-        self.mapper = SimpleNamespace(config=SimpleNamespace(buttons=buttons))
-        self.polls, self.lose_after, self.lost_reason = 0, lose_after, reason
+        self.buttons = {frozenset(c): "estop" for c in chords}
+        self.buttons[frozenset({"A"})] = "run"
+        self.polls, self.lose_after, self.reason = 0, lose_after, reason
 
     @property
     def lost(self) -> bool:
         return self.lose_after is not None and self.polls >= self.lose_after
 
+    @property
+    def lost_reason(self):
+        return self.reason if self.lost else None
+
+    def button_chords(self, action):
+        return ["+".join(sorted(chord)) for chord, a in self.buttons.items() if a == action]
+
     def poll(self, now_s):
         self.polls += 1
+        return Command()
 
 
 def _teleop(launch, kind="gamepad", **backend):
@@ -183,8 +192,12 @@ def test_a_device_without_an_estop_fails_and_may_be_overridden(launch):
     r = _only(pf, "estop_input")
     assert r.status == FAIL and r.overridden and not r.blocks
     assert r.reason == "keyboard mapping binds no button to estop; bind one in input.device.mapping.buttons"
+    class Unmapped(InputDevice):  # maps no buttons at all (InputDevice.button_chords' default)
+        def poll(self, now_s):
+            return Command()
+
     pf = Preflight()
-    assert not pf.check_input(SimpleNamespace(lost=False, poll=lambda now: None), _teleop(launch))
+    assert not pf.check_input(Unmapped(), _teleop(launch))
     assert "binds no button to estop" in pf.results["estop_input"].reason
 
 
@@ -385,8 +398,10 @@ def test_the_device_is_polled_throughout_the_window_with_the_time(launch, monkey
 
 
 def test_a_lost_device_without_a_reason_says_so(launch):
-    device = SimpleNamespace(lost=True, poll=lambda now: None,
-                             mapper=SimpleNamespace(config=SimpleNamespace(buttons={frozenset({"B"}): "estop"})))
+    class Lost(_Device):
+        lost_reason = None
+
+    device = Lost(chords=(("B",),), lose_after=0)
     pf = Preflight()
     assert not pf.check_input(device, _teleop(launch))
     assert pf.results["estop_input"].reason == "gamepad lost: ?; reconnect it and start again"

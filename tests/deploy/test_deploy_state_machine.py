@@ -12,7 +12,7 @@ from g1_control.launch.schema import DeployConfig
 from g1_control.robot import g1
 from g1_control.safety import SafetyEventKind, SafetyFilter
 from g1_control.teleop.unitree_remote import UnitreeRemote, encode_wireless_remote
-from g1_control.types import Command, JointReference, MotorCommand, RobotState
+from g1_control.types import Command, ExecutionFeedback, JointReference, MotorCommand, RobotState
 
 
 class Clock:
@@ -232,3 +232,14 @@ def test_a_trip_the_loop_handled_alone_is_observed_without_act():
     assert tracker.observe_safety(clock.t + 0.01)
     assert tracker.state == DeployState.DAMPING
     assert tracker.transitions[-1].reason == "estop: e-stop pressed on the operator input"
+
+
+def test_operator_buttons_pass_the_loops_feedback_to_the_device_inside():
+    class Steering(Buttons):
+        def observe(self, feedback):
+            self.feedback = feedback
+
+    device = Steering()
+    feedback = ExecutionFeedback(phase="whole_body")
+    OperatorButtons(device).observe(feedback)
+    assert device.feedback is feedback

@@ -77,9 +77,9 @@ def test_two_step_program_reaches_its_targets_in_mujoco(tmp_path):
 def test_steps_the_robot_fell_in_are_missed_and_goal_steps_take_ground_truth():
     from g1_control.launch.runner import finish_program_verdicts
     from g1_control.program.device import StepRecord
-    from g1_control.program.judge import Verdict
     from g1_control.program.runner import StepOutcome
     from g1_control.program.steps import Pick, Stand, Turn
+    from g1_control.report.verdict import Verdict
 
     def rec(step, t0, t1, goal_id=None):
         return StepRecord(StepOutcome("1", step.kind, step.describe(), "completed", t0, t1), step, goal_id=goal_id,

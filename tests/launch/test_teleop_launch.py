@@ -9,8 +9,8 @@ import pytest
 from g1_control.errors import LaunchFileError
 from g1_control.launch import runner
 from g1_control.launch.builder import build_loop, command_limits, make_tracker
-from g1_control.launch.overlay import overlay_lines
 from g1_control.launch.schema import load_launch, parse_launch
+from g1_control.report.overlay import overlay_lines
 
 REPO = Path(__file__).resolve().parents[2]
 

@@ -13,7 +13,7 @@ from g1_control.robot import g1
 from g1_control.sim.mujoco_backend import MujocoBackend
 from g1_control.trackers.locomotion import LocomotionPolicyTracker
 from g1_control.trackers.policy_spec import load_spec
-from g1_control.types import Command, JointReference, KinematicReference
+from g1_control.types import PHASE_LOCOMOTION, PHASE_WHOLE_BODY, Command, JointReference, KinematicReference
 
 
 class SequenceInput(InputDevice):
@@ -110,3 +110,62 @@ def test_other_builtin_policy_walks(policy):
     log = loop.log.arrays()
     assert not loop.fell
     assert log["velocity_true"][-100:, 0].mean() > 0.3
+
+
+class GoalReportingGenerator(VelocityReferenceGenerator):
+    """Reports one goal reached and the whole-body phase from 0.3 s on (as a goal executor would)."""
+
+    def __init__(self):
+        super().__init__()
+        self.goal_status: dict[str, str] = {}
+        self.goal_messages = {"g0": "out of reach"}
+
+    def update(self, command, state):
+        if state.t_s >= 0.3:
+            self.goal_status["g1"] = "reached"
+            self.phase = PHASE_WHOLE_BODY
+        return super().update(command, state)
+
+
+class FeedbackRecorder(SequenceInput):
+    def __init__(self):
+        super().__init__([])
+        self.seen = []
+        self.loop = None
+
+    def observe(self, feedback):
+        self.feedback = feedback
+        self.seen.append((feedback.t_s, feedback.phase, dict(feedback.goal_status), feedback.truth is not None))
+        if self.loop is not None:  # the loop's own latest state and estimate, not copies
+            assert feedback.truth is self.loop.state and feedback.estimate is self.loop.estimator.estimate
+
+    def poll(self, now_s):
+        assert self.seen[-1][0] == now_s, "the record is filled for this poll, before it"
+        return super().poll(now_s)
+
+
+def test_the_loop_feeds_one_record_back_to_the_input_before_every_poll():
+    device = FeedbackRecorder()
+    generator = GoalReportingGenerator()
+    loop = make_loop(device, generator)
+    device.loop = loop
+    loop.run(0.5)
+    fb = loop.feedback
+    assert device.feedback is fb and len(device.seen) == 50, "one record, given before each of the 50 polls (100 Hz)"
+    assert fb.goal_status is generator.goal_status and fb.goal_messages["g0"] == "out of reach"
+    early = [s for s in device.seen if s[0] < 0.25]
+    late = [s for s in device.seen if s[0] > 0.35]
+    assert all(p == PHASE_LOCOMOTION and g == {} for _, p, g, _ in early)
+    assert all(p == PHASE_WHOLE_BODY and g == {"g1": "reached"} for _, p, g, _ in late)
+    assert all(truth for *_, truth in device.seen), "MuJoCo gives ground truth"
+
+
+def test_a_generator_without_goals_reports_none_and_a_robot_gives_no_truth():
+    device = FeedbackRecorder()
+    loop = make_loop(device)
+    loop.state.base_pos_w_m = None  # what a robot's state looks like
+    loop._feed_back(0.0)
+    fb = device.feedback
+    assert fb.truth is None and fb.phase == PHASE_LOCOMOTION and dict(fb.goal_status) == {}
+    with pytest.raises(TypeError):
+        fb.goal_status["g1"] = "reached"  # the shared empty table is read-only

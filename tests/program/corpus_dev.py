@@ -4,6 +4,8 @@
 Each entry: (instruction, expected program steps as dicts, exactly as Program.to_dict() writes them).
 """
 
+import math
+
 from tests.program.corpus_steps import deg, down, height, par, pick, place, reach, rep, stand, style, turn, up, walk
 
 DEV = [
@@ -358,6 +360,35 @@ DEV = [
     ("turn to face the shelf, walk to it, and set the cup on it",
      [turn(target="shelf"), walk(target="shelf"), place("cup", "shelf")]),
     ("wave with your right hand", None),  # the wave is the right hand's; a hand named with a style is refused
+    # part 3 (issue 27, after the everyday set's blind run): its constructs in other sentences
+    ("go in a circle clockwise slowly",
+     [rep(8, walk(distance_m=math.pi / 4, speed_mps=0.25), turn(angle_rad=deg(45), direction="right"))]),
+    ("walk a quarter circle with a radius of 4 meters",
+     [rep(2, walk(distance_m=math.pi), turn(angle_rad=deg(45)))]),
+    ("move in a semicircle 2 meters across", [rep(4, walk(distance_m=math.pi / 4), turn(angle_rad=deg(45)))]),
+    ("walk a triangle of 1.5 meters to the right",
+     [rep(3, walk(distance_m=1.5), turn(angle_rad=deg(120), direction="right"))]),
+    ("walk in a rectangle of 3 by 2 meters",
+     [rep(2, walk(distance_m=3.0), turn(angle_rad=deg(90)), walk(distance_m=2.0), turn(angle_rad=deg(90)))]),
+    ("walk to and fro 50 cm twice", [rep(2, walk(distance_m=0.5), walk(distance_m=0.5, direction="backward"))]),
+    ("spin a full circle, then walk in a circle", [turn(angle_rad=deg(360)),
+                                                   rep(8, walk(distance_m=math.pi / 4), turn(angle_rad=deg(45)))]),
+    ("raise your right hand 10 cm", [reach(offset_m=[0.0, 0.0, 0.1])]),
+    ("lower your left hand", [reach(hand="left", offset_m=[0.0, 0.0, -0.3])]),
+    ("reach up with both hands", [reach(hand="both", offset_m=[0.0, 0.0, 0.3])]),
+    ("extend your left arm to the left 20 cm", [reach(hand="left", offset_m=[0.0, 0.2, 0.0])]),
+    ("using your right hand, touch the door", [reach(target="door")]),
+    ("put your left hand on the wall", [reach(hand="left", target="wall")]),
+    ("use both hands to pick up the box", [pick("box")]),
+    ("carry the ball to the left for 3 seconds", [pick("ball"), walk(duration_s=3.0, direction="left")]),
+    ("pick up the cup and walk backward 2 meters with it", [pick("cup"), walk(distance_m=2.0, direction="backward")]),
+    ("move the cup 50 cm to the left", [pick("cup"), walk(distance_m=0.5, direction="left"), place("cup")]),
+    ("hold the ball", [pick("ball")]),
+    ("walk forward 1 m, then left 2 m", [walk(distance_m=1.0), walk(distance_m=2.0, direction="left")]),
+    ("wait for a few seconds", [stand(3)]),
+    ("step back down from the platform", [down("platform")]),
+    ("face the opposite direction", [turn(angle_rad=deg(180))]),
+    ("sprint forward 3 meters", None),  # not a word of ours: faster than the quick walk, refused
     # --- words the parser refuses -----------------------------------------------------------------------
     ("jump forward 1 meter", None),
     ("walk forward 2 parsecs", None),

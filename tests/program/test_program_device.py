@@ -2,17 +2,17 @@
 whose estimator and simulator state come from integrating the commands exactly (kinematic)."""
 
 import math
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+from g1_control.interfaces import InputDevice
 from g1_control.program import COMPLETED, Landmark, Program, World, parse_instruction
 from g1_control.program.device import Odometry, PlanarPose, ProgramInput, StepRecord, record_dict
 from g1_control.program.judge import judge
 from g1_control.program.runner import StepOutcome
 from g1_control.program.steps import Height, Stand, Turn, Walk
-from g1_control.types import Command, EstimatedState, RobotState
+from g1_control.types import Command, EstimatedState, ExecutionFeedback, RobotState
 
 
 def yaw_quat(yaw):
@@ -22,24 +22,27 @@ def yaw_quat(yaw):
 class FakeLoop:
     """Moves exactly as commanded (heading-frame velocity, yaw rate). The estimator's velocity
     is the true one times `odometry_scale` (a leg odometry that under-reads), so the runner's
-    pose and ground truth differ in a known way."""
+    pose and ground truth differ in a known way. Like the ControlLoop, it feeds back through one
+    ExecutionFeedback record, filled in place (tests set its goal_status and phase directly)."""
 
     def __init__(self, odometry_scale=1.0):
         self.x = self.y = self.yaw = 0.0
         self.t = 0.0
         self.scale = odometry_scale
-        self.estimator = SimpleNamespace(estimate=EstimatedState())
-        self.state = RobotState()
-        self.generator = SimpleNamespace(goal_status={})
+        self.feedback = ExecutionFeedback(estimate=EstimatedState(), goal_status={})
         self._publish(np.zeros(3))
 
+    def connect(self, device):
+        device.observe(self.feedback)
+
     def _publish(self, v_w):
-        est = self.estimator.estimate
+        est = self.feedback.estimate
         est.t_s, est.yaw_rad = self.t, self.yaw
         est.base_linvel_w_mps = v_w * self.scale
         est.pelvis_height_m = 0.75
-        self.state = RobotState(t_s=self.t, imu_quat_wxyz=yaw_quat(self.yaw),
-                                base_pos_w_m=np.array([self.x, self.y, 0.75]))
+        self.feedback.t_s = self.t
+        self.feedback.truth = RobotState(t_s=self.t, imu_quat_wxyz=yaw_quat(self.yaw),
+                                         base_pos_w_m=np.array([self.x, self.y, 0.75]))
 
     def step(self, cmd: Command, dt=0.01):
         c, s = math.cos(self.yaw), math.sin(self.yaw)
@@ -52,7 +55,7 @@ class FakeLoop:
 
 
 def drive(device, loop, max_s=120.0, dt=0.01):
-    device.attach(loop)
+    loop.connect(device)
     while not device.done and loop.t < max_s:
         loop.step(device.poll(loop.t), dt)
     return device
@@ -115,7 +118,7 @@ def test_walk_to_a_place_and_back_to_the_start():
 def test_start_delay_holds_and_the_program_clock_replaces_the_loop_clock():
     loop = FakeLoop()
     device = ProgramInput(parse_instruction("walk forward 1 meter"), start_delay_s=1.0)
-    device.attach(loop)
+    loop.connect(device)
     clock = [0.0]
     device.program_clock = lambda: clock[0]
     for k in range(300):  # 3 s of loop time with the program clock stopped (deploy: before control)
@@ -126,11 +129,14 @@ def test_start_delay_holds_and_the_program_clock_replaces_the_loop_clock():
 
 
 def test_operator_buttons_and_loss_pass_through():
-    class Operator:
+    class Operator(InputDevice):
         lost = False
 
         def poll(self, now_s):
             return Command(vx_mps=0.7, buttons=frozenset({"estop"}))
+
+        def observe(self, feedback):
+            self.feedback = feedback
 
         def close(self):
             self.closed = True
@@ -138,7 +144,8 @@ def test_operator_buttons_and_loss_pass_through():
     op = Operator()
     loop = FakeLoop()
     device = ProgramInput(parse_instruction("wait 2 seconds"), operator=op, start_delay_s=0.0)
-    device.attach(loop)
+    loop.connect(device)
+    assert op.feedback is loop.feedback, "the operator's device gets the loop's feedback too"
     cmd = device.poll(0.0)
     assert cmd.buttons == frozenset({"estop"}) and cmd.vx_mps == 0.0, "motion from the program, buttons from the operator"
     op.lost = True
@@ -152,13 +159,13 @@ def test_goal_verdicts_come_from_the_generator():
     loop = FakeLoop()
     device = ProgramInput(Program([parse_instruction("pick up the box", places=world.names()).steps[0]]), world,
                           start_delay_s=0.0)
-    device.attach(loop)
+    loop.connect(device)
     device.poll(0.0)
     (goal,) = device.runner.active_goals
     for k in range(1, 50):
         device.poll(k * 0.01)
     assert not device.done
-    loop.generator.goal_status[goal.goal_id] = "reached"
+    loop.feedback.goal_status[goal.goal_id] = "reached"
     device.poll(0.6)
     assert device.done and device.records[0].outcome.status == COMPLETED
     assert device.records[0].goal_id == goal.goal_id
@@ -179,13 +186,13 @@ def test_without_a_loop_the_estimator_pose_is_refused():
 
 def test_odometry_integrates_the_estimators_velocity_over_its_time_stamps():
     est = EstimatedState()
-    odo = Odometry(SimpleNamespace(estimate=est))
-    odo.pose()
+    odo = Odometry()
+    odo.pose(est)
     for k in range(1, 101):  # 1 s at 0.5 m/s along +y, sampled every 10 ms
         est.t_s = k * 0.01
         est.base_linvel_w_mps = np.array([0.0, 0.5, 0.0])
-        pose = odo.pose()
-        odo.pose()  # polled twice between estimates: counted once
+        pose = odo.pose(est)
+        odo.pose(est)  # polled twice between estimates: counted once
     assert pose.y_m == pytest.approx(0.5) and pose.x_m == 0.0
 
 
@@ -246,15 +253,15 @@ def test_a_walk_after_a_goal_starts_over_once_the_walking_policy_has_the_robot()
     """The execution layer holds the robot in a whole-body phase until the walk's motion makes it
     hand back; what the robot does meanwhile is not the walk's."""
     loop = FakeLoop()
-    loop.generator.phase = "whole_body"
+    loop.feedback.phase = "whole_body"
     device = ProgramInput(parse_instruction("walk forward 1 meter"), start_delay_s=0.0)
-    device.attach(loop)
+    loop.connect(device)
     for _ in range(100):  # 1 s in the whole-body phase: the robot is moved 0.3 m by the hand-over
         cmd = device.poll(loop.t)
         assert cmd.vx_mps > 0, "the walk commands motion, which makes the layer hand back"
         loop.x += 0.003
         loop.step(Command(), 0.01)
-    loop.generator.phase = "locomotion"
+    loop.feedback.phase = "locomotion"
     while not device.done and loop.t < 30:
         loop.step(device.poll(loop.t), 0.01)
     (walk,) = device.records

@@ -1,11 +1,12 @@
 """Typed instructions (InstructedInput) over a stand-in operator device and loop."""
 
+from g1_control.interfaces import LineInput
 from g1_control.program.instructed import InstructedInput
 from g1_control.types import Command
 from tests.program.test_program_device import FakeLoop
 
 
-class Operator:
+class Operator(LineInput):
     """Stands in for the keyboard: lines to hand over, a command to report, begin_line recorded."""
 
     lost = False
@@ -30,7 +31,7 @@ def make(confirm=False):
     said = []
     op, loop = Operator(), FakeLoop()
     device = InstructedInput(op, confirm=confirm, say=said.append)
-    device.attach(loop)
+    loop.connect(device)
     return device, op, loop, said
 
 

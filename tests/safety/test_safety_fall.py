@@ -6,8 +6,9 @@ import pytest
 
 from g1_control.estimation.estimator import StateEstimator
 from g1_control.launch.builder import build_loop
-from g1_control.launch.runner import format_summary, run
+from g1_control.launch.runner import run
 from g1_control.launch.schema import LaunchFile, Segment
+from g1_control.report.results import format_summary
 from g1_control.safety.fall import FallConfig, FallMonitor
 from g1_control.sim.mujoco_backend import MujocoBackend
 from g1_control.types import MotorCommand

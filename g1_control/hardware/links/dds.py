@@ -126,6 +126,11 @@ class DdsLink(Link):
         """Discovered writers on our two topics and partition: instance handle -> (topic, guid)."""
         self._closed = False
 
+    @property
+    def participant(self):
+        """The DDS participant of this link (for RPC on the same domain: the motion service)."""
+        return self._participant
+
     def describe(self) -> str:
         where = f"interface {self.interface}, domain {self.domain_id}"
         return f"DDS ({where}{', partition ' + self.partition if self.partition else ''})"

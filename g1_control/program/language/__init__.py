@@ -1,1 +1,1 @@
-"""English instruction -> behaviour Program (rule-based): lexicon tables, parser, latency bench."""
+"""English instruction -> behaviour Program (rule-based): lexicon tables, grammar, step building, parser, latency bench."""

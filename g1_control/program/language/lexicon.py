@@ -12,7 +12,10 @@ import math
 from dataclasses import dataclass
 
 FILLERS = frozenset(["please", "kindly", "the", "your", "you", "yourself", "robot", "now", "just", "ok", "okay", "hey", "also", "again", "carefully", "still", "can", "could", "would", "my", "its",
-                     "here", "there", "me", "us", "little", "some"])
+                     "here", "there", "me", "us", "little", "some",
+                     # issue 27's everyday set: hedges and spoken fillers
+                     "about", "roughly", "approximately", "like", "um", "uh", "erm", "so",
+                     "alright", "real", "really"])
 """Dropped before anything else ("please", "the", "robot", ...)."""
 
 ARTICLES = frozenset({"a", "an"})
@@ -36,14 +39,23 @@ repeat | repeat that | repeat this | repeat it | do that | do this | do it | do 
 until reach | until reaching | until get to | until arrive at | until arriving at | until at => to
 until face | until facing => toward
 # filler phrases
-i want to | i would like to | i need to | go ahead and | make sure to | try to | start by | let us | lets
+i want to | i would like to | i to | i'd to | i need to | go ahead and | make sure to | try to | start by | let us | lets
     | keep | keep on | with sides of | sides of | sides | side length of | side length | on each side | each side
     | per side | a bit | bit => 
 at same time | simultaneously | in parallel | at once while | together => SAMETIME
 square => SHAPE:square
+triangle => SHAPE:triangle
+rectangle | oblong => SHAPE:rectangle
+back and forth | to and fro | backward and forward | backwards and forwards => SHAPE:back_and_forth
+radius | radius of | with radius of => RADIUS
+diameter | diameter of | with diameter of | across => DIAMETER
 # locomotion
 walk | walking | walks | go | going | goes | move | moving | moves | head | travel | proceed | come | coming
-    | step | stepping | stroll | march | sidestep | side step | strafe | shuffle => WALK
+    | step | stepping | march | marching | sidestep | side step | strafe | shuffle | shuffling | advance
+    | advancing | scoot | scooting | pace | pacing | make way | make way over => WALK
+jog | jogging | run | running | hurry | hurrying | rush | rushing | dash => WALK SPEED:fast
+stroll | strolling | amble | ambling | saunter | sauntering => WALK SPEED:slow
+retreat | retreating => WALK backward
 return | returning | go back | come back | head back | walk back to | get back | move back => WALK back
 approach | approaching => WALK to
 back up | backing up | reverse => WALK backward
@@ -63,22 +75,26 @@ u turn | uturn => ANGLE:180
 down | downward | downwards | below | under | beneath => down
 turn | turning | turns | spin | spinning | rotate | rotating | pivot | pivoting => TURN
 turn to face | turn and face | face | facing | look at | looking at | look towards | look toward => FACE
-quarter turn | quarter of turn | quarter circle => ANGLE:90
-half turn | half circle | half of turn => ANGLE:180
-full turn | full circle | full rotation | complete turn | complete circle | whole turn | full spin | circle
-    | full revolution | complete rotation => ANGLE:360
+face other way | turn other way | look other way | face opposite way | face opposite direction => TURN around
+quarter turn | quarter of turn => ANGLE:90
+half turn | half of turn => ANGLE:180
+full turn | full rotation | complete turn | whole turn | full spin | full revolution | complete rotation => ANGLE:360
+quarter circle => ANGLE:90 CIRCLE
+half circle | semicircle | semi circle => ANGLE:180 CIRCLE
+full circle | complete circle | circle | whole circle => ANGLE:360 CIRCLE
 heading | at heading | to heading | along heading | with heading | heading of => HEADING
 slowly | slow | slower | gently | slow pace | slow speed | leisurely pace | low speed => SPEED:slow
 quickly | quick | fast | faster | rapidly | briskly | swiftly | fast pace | quick pace | brisk pace | high speed
     | fast speed => SPEED:fast
 within | in under | in less than | at most | no more than | no longer than => WITHIN
 wait | waiting | pause | pausing | stay | staying | rest | resting | stop | stopping | halt | hold | stand
-    | standing | stand still | stay still | hold still | keep still | remain | stay put | freeze | wait there => WAIT
+    | standing | stand still | stay still | hold still | keep still | remain | stay put | freeze | wait there
+    | hang on | hold on | chill => WAIT
 # styles
 wave | waving | waves | wave hand | wave hands | waving hand | wave hello | wave goodbye | say hello
     | wave your hand => STYLE:wave
 dance | dancing | dances => STYLE:dance
-look around | looking around | looks around => STYLE:look_around
+look around | looking around | looks around | glance around | glancing around => STYLE:look_around
 swing arms | swinging arms | arm swing | arms swinging | swing arm | swinging arm => STYLE:arm_swing
 arms out | arms spread | spread arms | spreading arms | stretch arms out | stretch out arms | hold arms out
     | holding arms out | put arms out | with arms out | arms outstretched | outstretched arms
@@ -89,16 +105,16 @@ reach up | reaching up | raise arms | raising arms | raise hands | raising hands
     | put hands up | put arms up | lift arms | with hands up | with arms up | arms raised | with arms raised
     | raised arms | with raised arms | hold arms up | hold hands up | arms in air | hands in air => STYLE:reach_up
 arms down | lower arms | relax arms | put arms down | normal style | default style | default => STYLE:default
-carry | carrying | carries | bring | bringing | deliver | delivering => CARRY
+carry | carrying | carries | bring | bringing | deliver | delivering | haul | hauling => CARRY
 lift | lifting => LIFT
 climb | climbing => CLIMB
-style | pose | mode | posture => STYLEWORD
+style | pose | mode | posture | stance => STYLEWORD
 use | using style | switch to | change to | switch into | change into | set style to | set style | adopt
     | assume | switch | go into | get into => SELECT
 # height
 crouch | crouching | crouched | squat | squatting | duck | ducking | get down | crouch down | squat down
     | go low | get low | bend knees | bend down | crouch low | crouch down low | squat low | squat down low
-    | get down low => HEIGHT:crouch
+    | get down low | duck down => HEIGHT:crouch
 stand up | get up | rise | straighten up | normal height | get back up | stand back up | come back up
     | get up again | stand up again => HEIGHT:normal
 stand tall | stand up tall | stand up straight | stand straight | standing tall | stand at full height
@@ -106,8 +122,8 @@ stand tall | stand up tall | stand up straight | stand straight | standing tall 
 lower | raise | set height | set pelvis height | height | set pelvis | change height => HEIGHTSET
 pelvis | body | hips | hip | torso | pelvis height => BODY
 # manipulation and stepping
-reach | reaching | touch | touching => REACH
-reach out | reaching out => REACH forward
+reach | reaching | touch | touching | stretch | stretching | extend | extending => REACH
+reach out | reaching out | stretch out | extend out => REACH OUT
 pick up | picking up | pick | grab | grabbing | grasp | grasping | take | taking | take hold of
     | get hold of | collect | fetch | lift up => PICK
 put | putting | place | placing | set | set down | put down | drop off | leave | deposit | lay | lay down
@@ -116,7 +132,9 @@ step up onto | step up on | step up to | step up | step onto | step on | climb o
     | climb up onto | climb up on | climb up | get on | get onto | get up on | get up onto | go up onto
     | go up on | mount | step on top of | climb on top of => STEPUP
 step down from | step down off | step down | step off | step off of | get off | get off of | get down from
-    | climb down from | climb down off | climb down | climb off | go down from | step down off of => STEPDOWN
+    | climb down from | climb down off | climb down | climb off | go down from | step down off of
+    | get down off | get down off of | step back down | get back down | come back down | climb back down
+    | step down again => STEPDOWN
 left hand | left arm | with left hand | with left arm | using left hand | using left arm => HAND:left
 right hand | right arm | with right hand | with right arm | using right hand | using right arm => HAND:right
 both hands | both arms | two hands | with both hands | with both arms | with two hands | using both hands
@@ -163,7 +181,8 @@ PER_WORDS = frozenset({"per", "a", "/", "every", "each"})
 DEFAULT_PLACES: dict[str, str] = {
     "box": "box", "red box": "red_box", "blue box": "blue_box", "table": "table", "other table": "other_table",
     "platform": "platform", "chair": "chair", "shelf": "shelf", "cup": "cup", "ball": "ball", "door": "door",
-    "wall": "wall", "start": "start", "starting point": "start", "starting position": "start",
+    "wall": "wall", "window": "window", "crate": "crate", "bottle": "bottle", "basket": "basket", "bin": "bin",
+    "desk": "desk", "counter": "counter", "couch": "couch", "stairs": "stairs", "start": "start", "starting point": "start", "starting position": "start",
     "start position": "start", "where started": "start", "beginning": "start",
 }
 """Place phrases -> names when the parser is given no world (a World's names are used instead)."""

@@ -1,8 +1,14 @@
 """Model-based whole-body control on pinocchio: an inverse-dynamics QP with contact wrenches,
 capture-point balance and a Tracker that turns a JointReference into torque + PD targets.
 
-Modules: model (dynamics and frames), contacts (foot wrench constraints), tasks (acceleration
-tasks), qp (the inverse-dynamics QP), capture_point (LIPM balance feedback), zmp_preview (CoM plans
-for references), odometry (floating-base position from the stance feet), tracker (the Tracker),
-references (scripted test references), evaluate and bench (figures).
+    contacts.py        foot wrench constraints
+    tasks.py           acceleration tasks
+    qp.py              the inverse-dynamics QP
+    capture_point.py   LIPM balance feedback
+    odometry.py        floating-base position from the stance feet
+    tracker.py         the Tracker
+
+Elsewhere: the model (dynamics and frames) is robot/dynamics.py; CoM plans for references
+generator/zmp_preview.py; the scripted test references generator/scripted.py; the figures
+tools/wbc_evaluate.py and tools/bench_wbc.py.
 """

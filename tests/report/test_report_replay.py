@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from g1_control.cli.main import main
-from g1_control.launch import replay
-from g1_control.launch.overlay import run_overlay_rows, safety_state_at
-from g1_control.launch.plots import window_mean
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.formats.dispatch import save_clip
+from g1_control.report import replay
+from g1_control.report.overlay import run_overlay_rows, safety_state_at
+from g1_control.report.plots import window_mean
 from g1_control.robot import g1
 
 

@@ -36,15 +36,18 @@ class GoalWatcher:
     """Records ground truth while a loop runs (MuJoCo backends only) and judges its goals."""
 
     def __init__(self, loop: ControlLoop, record_hz: float = 50.0):
-        self.loop = loop
+        from g1_control.sim.mujoco_backend import MujocoBackend
+
         sim = loop.backend
-        self.model, self.data = sim.model, sim.data  # type: ignore[attr-defined]
+        if not isinstance(sim, MujocoBackend):
+            raise TypeError(f"GoalWatcher records MuJoCo's ground truth; the loop's backend is {sim.describe()}")
+        self.loop, self.sim = loop, sim
+        self.model, self.data = sim.model, sim.data
         m = self.model
         self.every = max(1, round(loop.rates.lowlevel_hz / record_hz))
         self.hands = [m.body(n).id for n in g1.HAND_BODIES]
         self.feet = [m.body(n).id for n in g1.FOOT_BODIES]
-        scene = getattr(sim, "scene", None)
-        self.boxes = [b.name for b in scene.boxes] if scene is not None else []
+        self.boxes = [b.name for b in sim.scene.boxes]
         self.t: list[float] = []
         self.hand_w: list[np.ndarray] = []
         self.sole_w: list[np.ndarray] = []
@@ -58,7 +61,7 @@ class GoalWatcher:
         self.hand_w.append(np.array([d.xpos[b] + d.xmat[b].reshape(3, 3) @ HAND_OFFSET_M for b in self.hands]))
         self.sole_w.append(np.array([d.xpos[b] + d.xmat[b].reshape(3, 3) @ SOLE_OFFSET_M for b in self.feet]))
         for name in self.boxes:
-            pos, quat = self.loop.backend.object_pose(name)  # type: ignore[attr-defined]
+            pos, quat = self.sim.object_pose(name)
             self.box_w[name].append(np.concatenate([pos, quat]))
 
     def arrays(self) -> dict[str, np.ndarray]:
@@ -68,9 +71,8 @@ class GoalWatcher:
         return out
 
     def outcomes(self) -> list[dict]:
-        gen = self.loop.generator
-        info = getattr(gen, "goal_info", {})
-        messages = getattr(gen, "goal_messages", {})
+        gen = self.loop.generator  # what it recorded per goal (Generator.goal_info, goal_messages)
+        info, messages = gen.goal_info, gen.goal_messages
         a = self.arrays()
         return [dict(judge_goal(gid, dict(i), a), message=messages.get(gid)) for gid, i in info.items()]
 

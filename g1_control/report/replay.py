@@ -63,7 +63,7 @@ def from_run(path: str | Path) -> Playback:
     summary = {}
     if (folder / "summary.json").is_file():
         summary = json.loads((folder / "summary.json").read_text())
-    from g1_control.launch.overlay import run_overlay_rows
+    from g1_control.report.overlay import run_overlay_rows
 
     rows = run_overlay_rows(log, summary.get("events", []), summary.get("segments", []))
     title = f"run {summary.get('name', folder.name)}"

@@ -24,7 +24,7 @@ def overlay_lines(loop: ControlLoop) -> tuple[str, str]:
         f"{est[0]:+.2f} {est[1]:+.2f} {est[2]:+.2f}",
         c.style,
         state,
-        getattr(loop.input, "name", type(loop.input).__name__),
+        loop.input.describe(),
         f"{tick['p99_us'] / 1000:.2f} ms / {loop.scheduler.deadline_misses}",
     ])
     return labels, values
@@ -53,7 +53,7 @@ def run_overlay_rows(log: dict, events: list[dict], segments: list[dict] | None 
     velocity (ground truth, or the estimate on a robot, averaged over one gait cycle) and the safety state."""
     import numpy as np
 
-    from g1_control.launch.plots import window_mean
+    from g1_control.report.plots import window_mean
 
     t = log["t_s"]
     truth = log["velocity_true"]

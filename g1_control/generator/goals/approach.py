@@ -1,0 +1,117 @@
+"""Approach: from walking to a work stance.
+
+The walking policy walks to a stance short of the work (velocity commands closed on the robot's
+measured world pose) and stands still until it has settled (`walk_to`); the whole-body controller
+takes over from the measured configuration (`enter_whole_body`: the soles where they are, so the
+hand-over does not jump) and steps the rest (`step_to`), correcting the stance against the world
+pose until it is where it should be (`correct_stance`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+
+import numpy as np
+
+from g1_control.generator.goals.box import Approach
+from g1_control.generator.goals.context import GoalContext, GoalFailed
+from g1_control.generator.goals.poses import flat_soles
+from g1_control.generator.goals.stepping import Stance, SteppingConfig, stepping_trajectory, walk_steps
+from g1_control.generator.whole_body import keyframe_trajectory
+from g1_control.robot import g1
+from g1_control.rotations import wrap_angle, yaw_of
+
+
+def enter_whole_body(ctx: GoalContext) -> Iterator[None]:
+    """From walking: a reference from the measured pose to a clean standing one."""
+    q = ctx.measured_q()
+    soles = flat_soles(ctx.ik, q)
+    ground = [ctx.scene.ground_height(p[:2]) for p, _ in soles]
+    lift = min(p[2] - g for (p, _), g in zip(soles, ground))
+    q[2] -= lift  # the lower sole exactly on its ground
+    soles = [(np.array([p[0], p[1], g]), r) for (p, r), g in zip(soles, ground)]
+    q_stand = yield from ctx.compute("stand", lambda: ctx.poses.stand(
+        q, soles, min(ground) + ctx.poses.nominal_pelvis_m, g1.DEFAULT_Q_RAD))
+    ctx.note("hand over to the whole-body controller")
+    yield from ctx.run(keyframe_trajectory("stand", [(0.0, q), (ctx.config.stand_s, q_stand)]))
+
+
+def walk_to(ctx: GoalContext, approach: Approach, *, out_m: float) -> Iterator[None]:
+    """Walk (the policy) to `out_m` short of the approach stance, facing it, then stand still."""
+    cfg = ctx.config
+    fwd = np.array([math.cos(approach.heading), math.sin(approach.heading)])
+    goal_xy = approach.pelvis_xy() - out_m * fwd
+    t0 = ctx.t
+    settled_since: float | None = None
+    while True:
+        s, pos_w = ctx.world_pose()
+        if ctx.t - t0 > cfg.walk_timeout_s:
+            raise GoalFailed(f"did not reach the stance within {cfg.walk_timeout_s:.0f} s")
+        yaw = yaw_of(s.imu_quat_wxyz)
+        d = goal_xy - pos_w[:2]
+        dist = float(np.hypot(*d))
+        yaw_err = float(wrap_angle(approach.heading - yaw))
+        c, sn = math.cos(yaw), math.sin(yaw)
+        d_h = np.array([c * d[0] + sn * d[1], -sn * d[0] + c * d[1]])
+        if dist <= cfg.approach_tolerance_m and abs(yaw_err) <= cfg.approach_heading_tolerance_rad:
+            ctx.walk[:] = 0.0
+            speed = float(np.hypot(*s.base_linvel_w_mps[:2])) if s.base_linvel_w_mps is not None else 0.0
+            settled_since = ctx.t if settled_since is None or speed > cfg.settle_speed_mps else settled_since
+            if ctx.t - settled_since >= cfg.settle_s:
+                return
+            yield
+            continue
+        settled_since = None
+        if dist > 0.5:
+            bearing_err = float(wrap_angle(math.atan2(d[1], d[0]) - yaw))
+            vx = min(cfg.walk_speed_mps, 0.8 * dist) * max(0.0, math.cos(bearing_err)) ** 2
+            ctx.walk[:] = (vx, 0.0, float(np.clip(1.5 * bearing_err, -cfg.turn_rate_radps, cfg.turn_rate_radps)))
+        else:
+            v = np.clip(1.2 * d_h, -0.25, 0.25)
+            v[np.abs(d_h) < 0.02] = 0.0
+            v = np.where((v != 0) & (np.abs(v) < 0.1), np.sign(v) * 0.1, v)
+            wz = float(np.clip(1.5 * yaw_err, -cfg.turn_rate_radps, cfg.turn_rate_radps))
+            if 0 < abs(wz) < 0.15 and abs(yaw_err) > cfg.approach_heading_tolerance_rad * 0.5:
+                wz = math.copysign(0.15, wz)
+            ctx.walk[:] = (v[0], v[1], wz)
+        yield
+
+
+def step_to(ctx: GoalContext, mid_xy: np.ndarray, heading: float, cfg: SteppingConfig, *, posture=None, forces=None,
+            com_shift=None, first_back_m: float = 0.0, name: str = "steps") -> Iterator[None]:
+    q0 = ctx.hold_q()
+    stance = Stance.of(ctx.ik, q0)
+    ground = ctx.scene.ground_height
+    steps = []
+    if first_back_m > 0:
+        back = stance.mid_xy - first_back_m * np.array([math.cos(stance.heading), math.sin(stance.heading)])
+        steps += walk_steps(stance, back, stance.heading, cfg, lambda xy: ground(xy), backward_max_m=1.0)
+        for st in steps:
+            stance = stance.apply(st)
+    steps += walk_steps(stance, mid_xy, heading, cfg, lambda xy: ground(xy), then=steps)
+    if not steps:
+        return
+    plan = yield from ctx.compute(name, lambda: stepping_trajectory(
+        ctx.ik, q0, steps, cfg, posture=posture, hand_forces=forces, com_offset_h_m=com_shift, name=name))
+    ctx.last_steps = plan
+    if plan.sole_error_m > 0.03:
+        raise GoalFailed(f"{name}: the footsteps are out of the legs' reach (plan off by "
+                         f"{plan.sole_error_m * 100:.0f} cm)")
+    yield from ctx.run(plan.trajectory)
+
+
+def correct_stance(ctx: GoalContext, mid_w: np.ndarray, heading: float, cfg: SteppingConfig, *, posture=None,
+                   forces=None, com_shift=None, tolerance_m: float = 0.03, rounds: int = 2) -> Iterator[None]:
+    """Small steps until the stance is where it should be in the world (the tracker's odometry
+    drifts a few cm per metre walked; the world pose says where the robot really is)."""
+    for _ in range(rounds):
+        q0 = ctx.hold_q()
+        stance = Stance.of(ctx.ik, q0)
+        mid_plan = mid_w + ctx.offset()
+        err = float(np.hypot(*(mid_plan - stance.mid_xy)))
+        if err <= tolerance_m and abs(wrap_angle(heading - stance.heading)) <= 0.05:
+            return
+        ctx.note(f"stance {err * 100:.0f} cm off: correcting steps")
+        yield from step_to(ctx, mid_plan, heading, cfg, posture=posture, forces=forces, com_shift=com_shift,
+                           name="correction")

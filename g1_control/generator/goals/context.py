@@ -1,0 +1,206 @@
+"""GoalContext: what the goal skills share with each other and with the executor (executor.py).
+
+The skills (approach.py, reach.py, handling.py, platform.py) are generator functions over one
+context: the scene and the planners, the whole-body plan being followed (and when it started),
+the walking command of an approach, the box held, the platform stood on, where the boxes are, the
+robot's state this tick and the current goal's record. The context's own steps are the ones every
+skill uses: where the reference is (`hold_q`), the drift of the plan frame (`offset`), following a
+plan (`run`), planning (`compute`), and the robot's world pose (`world_pose`, the one place that
+requires it).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Generator, Iterator
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from typing import Any, TypeVar
+
+import numpy as np
+
+from g1_control.generator.goals.poses import PosePlanner
+from g1_control.generator.goals.stepping import SteppingConfig
+from g1_control.generator.styles import UpperBodyStyle
+from g1_control.generator.whole_body import WholeBodyTrajectory
+from g1_control.robot import g1
+from g1_control.scene import Box, SceneConfig
+from g1_control.types import PHASE_LOCOMOTION, PHASE_WHOLE_BODY, RobotState, TaskGoal
+
+ARMS = np.array(g1.ARM_JOINTS)
+T = TypeVar("T")
+
+
+class GoalFailed(RuntimeError):
+    """A goal that cannot be done (the message says why)."""
+
+
+@dataclass
+class GoalConfig:
+    walk_speed_mps: float = 0.4
+    turn_rate_radps: float = 0.6
+    approach_offset_m: float = 0.2
+    """The walking policy stops this much short of a work stance; the whole-body controller steps
+    the rest (the policy stops within ~5-10 cm; footsteps are exact)."""
+    approach_tolerance_m: float = 0.08
+    approach_heading_tolerance_rad: float = 0.12
+    settle_s: float = 1.0
+    """Standing still this long (speed below settle_speed_mps) before a hand-over."""
+    settle_speed_mps: float = 0.05
+    walk_timeout_s: float = 45.0
+    stand_s: float = 1.0
+    """After a hand-over: from the measured pose to a clean standing pose."""
+    move_s: float = 2.0
+    """Joint-space moves of the arms and the body (reach, height)."""
+    reach_hold_s: float = 1.5
+    squeeze_n: float = 20.0
+    """Per hand: twice the Coulomb minimum for a 2 kg box at mu 1 (m g / 2 mu = 9.8 N)."""
+    lift_m: float = 0.10
+    pre_gap_m: float = 0.065
+    press_m: float = 0.01
+    """Hand targets this far inside the box's faces (the squeeze is the known force; this keeps contact)."""
+    force_ramp_s: float = 0.4
+    backup_m: float = 0.3
+    """Steps back from a table before turning with a box."""
+    carry: SteppingConfig = field(default_factory=lambda: SteppingConfig(
+        max_advance_m=0.10, max_turn_rad=0.18, single_support_s=0.6, double_support_s=0.25))
+    steps: SteppingConfig = field(default_factory=lambda: SteppingConfig(
+        max_advance_m=0.08, max_side_m=0.06, single_support_s=0.5, double_support_s=0.2))
+    """Stepping into a work stance (and onto a platform): short, unhurried steps (a 0.24 m diagonal
+    step into a table's stance left the body behind and it fell, measured)."""
+    toe_gap_m: float = 0.055
+    """Stepping up: the toes stop this short of the platform's edge."""
+    past_edge_m: float = 0.12
+    """Stepping up: the sole's centre lands this far past the edge (the heel is 0.085 m behind it)."""
+    clear_of_platform_m: float = 0.30
+    """After stepping down, the stance's mid-point steps back to at least this far from the
+    platform before the hand-back: the step down lands where the step up started (mid-point
+    0.16 m from the edge), and the walking policy turning in place there put a sole centre 4 cm
+    from the edge and the shin on the platform's top edge (measured: program 20 of g1 bench
+    program, a fall). The walking policy knows nothing of the platform."""
+    policy_height_m: tuple[float, float] = (0.63, 0.78)
+    """Pelvis heights the walking policy holds (its envelope); others stand under the WBC."""
+    height_min_m: float = 0.45
+    plan_in_background: bool = False
+    """Plan in a worker thread while the robot holds its current reference (wall-clock runs: a
+    carry's footstep plan takes ~1-2 s of CPU, which would stall the loop). Off in lockstep, where
+    planning inline keeps runs deterministic (simulated time waits for it)."""
+
+
+@dataclass
+class Held:
+    box: Box
+    forces: np.ndarray
+    """(2, 3) hand forces while held (world axes at the time of the grasp's heading)."""
+
+
+class GoalContext:
+    """The state the goal skills and the executor share (module docstring)."""
+
+    def __init__(self, scene: SceneConfig, config: GoalConfig):
+        self.scene = scene
+        self.config = config
+        self.poses = PosePlanner()
+        self.ik = self.poses.ik
+        self.plan_cpu_s: dict[str, float] = {}
+        self.goal_info: dict[str, dict] = {}
+        """Per goal, for judging it from outside: kind, start/end time, the hold window of a reach,
+        its target in the world (reach point, box, where the box goes, platform)."""
+        self.log: list[tuple[float, str]] = []
+        self.info: dict = {}
+        """The current goal's entry of goal_info."""
+        self.last_steps: Any = None
+        """The last footstep plan (stepping.StepPlan), for inspection."""
+        self._pool: ThreadPoolExecutor | None = None
+        if self.config.plan_in_background:
+            import sys
+
+            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="goal-planner")
+            # The planner and the control thread share the GIL: switch often, so a tick waits
+            # at most ~1 ms for the planner's Python (default 5 ms).
+            sys.setswitchinterval(min(sys.getswitchinterval(), 0.001))
+        self.reset()
+
+    def reset(self) -> None:
+        self.phase = PHASE_LOCOMOTION
+        self.goal: TaskGoal | None = None
+        self.plan: WholeBodyTrajectory | None = None
+        self.plan_t0 = 0.0
+        self.walk = np.zeros(3)
+        """The walking command (vx, vy, wz) of an approach (approach.walk_to)."""
+        self.held: Held | None = None
+        self.on_platform: str | None = None
+        self.box_positions: dict[str, np.ndarray | None] = {b.name: self.scene.box_center(b) for b in self.scene.boxes}
+        self.overlay: tuple[UpperBodyStyle, float] | None = None
+        """An upper-body style waving the arms over the plan (style, its start time)."""
+        self.keep = False
+        """Stay under the whole-body controller after the plan ends (a reach holds its point)."""
+        self.step_back = (0.0, 0.0)
+        self.t = 0.0
+        self.state: RobotState | None = None
+
+    def note(self, text: str) -> None:
+        self.log.append((self.t, text))
+
+    # -- where the robot is -------------------------------------------------------------------------
+    def world_pose(self) -> tuple[RobotState, np.ndarray]:
+        """This tick's state and the robot's world position; goals in world coordinates need one."""
+        s = self.state
+        if s is None or s.base_pos_w_m is None:
+            raise GoalFailed("no world pose for the robot (goals in world coordinates need localisation; "
+                             "the simulator gives it)")
+        return s, s.base_pos_w_m
+
+    def measured_q(self) -> np.ndarray:
+        """The robot's configuration now (pinocchio q): joints, IMU orientation, world position."""
+        s, pos_w = self.world_pose()
+        w, x, y, z = s.imu_quat_wxyz
+        return np.concatenate([pos_w, [x, y, z, w], s.q_rad])
+
+    def hold_q(self) -> np.ndarray:
+        """Where the whole-body reference is now (the end of the current plan)."""
+        assert self.plan is not None
+        j = self.plan.sample(min(self.t - self.plan_t0, self.plan.duration_s))
+        w, x, y, z = j.root_quat_wxyz
+        q = np.concatenate([j.root_pos_w_m, [x, y, z, w], j.q_rad])
+        if self.overlay is not None:
+            q[7 + ARMS] = self.overlay[0].pose(self.t - self.overlay[1])[ARMS]
+        return q
+
+    def offset(self) -> np.ndarray:
+        """Plan frame minus world (xy): the tracker's odometry drift, measured against the world pose."""
+        if self.phase != PHASE_WHOLE_BODY or self.plan is None or self.state is None:
+            return np.zeros(2)
+        j = self.plan.sample(min(self.t - self.plan_t0, self.plan.duration_s))
+        _, pos_w = self.world_pose()
+        return j.root_pos_w_m[:2] - pos_w[:2]
+
+    # -- plans --------------------------------------------------------------------------------------
+    def run(self, traj: WholeBodyTrajectory, keep: bool = False) -> Iterator[None]:
+        self.plan, self.plan_t0 = traj, self.t
+        self.overlay = None
+        self.keep = keep
+        self.phase = PHASE_WHOLE_BODY
+        while self.t - self.plan_t0 < traj.duration_s:
+            yield
+
+    def compute(self, what: str, fn: Callable[[], T]) -> Generator[None, None, T]:
+        """fn() inline, or in the planner thread while the loop keeps ticking (the robot holds its
+        reference meanwhile); returns its result (use with `yield from`). Records the planning CPU
+        (inline) or wall time (background) under `what`."""
+        if self._pool is None:
+            t0 = time.process_time()
+            out = fn()
+            self._cpu(what, t0)
+            return out
+        start = time.perf_counter()
+        future = self._pool.submit(fn)
+        while not future.done():
+            yield
+        key = f"{self.goal.goal_id if self.goal else ''} {what} (background, wall)".strip()
+        self.plan_cpu_s[key] = self.plan_cpu_s.get(key, 0.0) + time.perf_counter() - start
+        return future.result()
+
+    def _cpu(self, what: str, t0: float) -> None:
+        key = f"{self.goal.goal_id if self.goal else ''} {what}".strip()
+        self.plan_cpu_s[key] = self.plan_cpu_s.get(key, 0.0) + time.process_time() - t0

@@ -1,0 +1,109 @@
+"""Platforms: step up onto a platform (or a step) from in front of its nearest side, and back down
+to where the step up started, then straight back until the stance is clear of it (the walking
+policy that takes over knows nothing of the platform)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+
+import numpy as np
+
+from g1_control.generator.goals.approach import correct_stance, enter_whole_body, step_to, walk_to
+from g1_control.generator.goals.box import Approach
+from g1_control.generator.goals.context import GoalContext, GoalFailed
+from g1_control.generator.goals.stepping import SOLE_HALF_LENGTH_M, Stance, level_steps, stepping_trajectory
+from g1_control.scene import Block
+from g1_control.types import PHASE_WHOLE_BODY, TaskGoal
+
+
+def find_platform(ctx: GoalContext, name: str | None):
+    if name is not None:
+        block = ctx.scene.block(name)
+        if block is None or block not in ctx.scene.platforms:
+            raise GoalFailed(f"'{name}' is not a platform of the scene")
+        return block
+    _, pos_w = ctx.world_pose()
+    here = pos_w[:2]
+    best = min(ctx.scene.platforms, key=lambda p: p.distance_xy(here), default=None)
+    if best is None or best.distance_xy(here) > 4.0:
+        raise GoalFailed("no platform within 4 m")
+    return best
+
+
+def step_up(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
+    cfg = ctx.config
+    if ctx.on_platform is not None:
+        raise GoalFailed(f"already on '{ctx.on_platform}'")
+    block = find_platform(ctx, goal.target)
+    _, pos_w = ctx.world_pose()
+    # the side facing the robot; the robot squarely in front of it, clear of its corners
+    local = block.local_xy(pos_w[:2])
+    ratios = np.abs(local) / block.half
+    axis = int(np.argmax(ratios))
+    other = 1 - axis
+    n_local = np.zeros(2)
+    n_local[axis] = math.copysign(1.0, local[axis])
+    along = float(np.clip(local[other], -block.half[other] + 0.3, block.half[other] - 0.3))
+    edge_local = np.zeros(2)
+    edge_local[axis] = n_local[axis] * block.half[axis]
+    edge_local[other] = along
+    c, sn = math.cos(block.yaw_rad), math.sin(block.yaw_rad)
+    rot = np.array([[c, -sn], [sn, c]])
+    normal, edge = rot @ n_local, block.center + rot @ edge_local
+    if block.half[axis] * 2 < cfg.past_edge_m + SOLE_HALF_LENGTH_M + 0.05:
+        raise GoalFailed(f"platform '{block.name}' is too shallow to stand on")
+    mid = edge + normal * (SOLE_HALF_LENGTH_M + cfg.toe_gap_m)
+    heading = math.atan2(-normal[1], -normal[0])
+    ctx.info.update(platform=block.name, height_m=block.height_m)
+    approach = Approach(mid, heading)
+    if ctx.phase != PHASE_WHOLE_BODY:
+        yield from walk_to(ctx, approach, out_m=cfg.approach_offset_m)
+        yield from enter_whole_body(ctx)
+    yield from step_to(ctx, mid + ctx.offset(), heading, cfg.steps, name="approach")
+    yield from correct_stance(ctx, mid, heading, cfg.steps, tolerance_m=0.02)
+    q0 = ctx.hold_q()
+    stance = Stance.of(ctx.ik, q0)
+    forward = SOLE_HALF_LENGTH_M + cfg.toe_gap_m + cfg.past_edge_m
+    steps = level_steps(stance, forward, block.height_m, cfg.steps)
+    plan = yield from ctx.compute("step up", lambda: stepping_trajectory(ctx.ik, q0, steps, cfg.steps,
+                                                                        name="step up"))
+    yield from ctx.run(plan.trajectory)
+    ctx.on_platform = block.name
+    ctx.step_back = (forward, 0.0)
+
+
+def step_down(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
+    """Step back down (and clear of the platform); the executor then hands back to the walking policy."""
+    cfg = ctx.config
+    if ctx.on_platform is None:
+        raise GoalFailed("not standing on a platform")
+    ctx.info.update(platform=ctx.on_platform)
+    forward, _ = ctx.step_back
+    q0 = ctx.hold_q()
+    stance = Stance.of(ctx.ik, q0)
+    back = stance.mid_xy - forward * np.array([math.cos(stance.heading), math.sin(stance.heading)])
+    level = ctx.scene.ground_height(back - ctx.offset())
+    if level > 0.0:
+        level = 0.0
+    steps = level_steps(stance, -forward, level, cfg.steps)
+    plan = yield from ctx.compute("step down", lambda: stepping_trajectory(ctx.ik, q0, steps, cfg.steps,
+                                                                          name="step down"))
+    yield from ctx.run(plan.trajectory)
+    block = ctx.scene.block(ctx.on_platform)
+    ctx.on_platform = None
+    if block is not None:
+        yield from clear_of(ctx, block)
+
+
+def clear_of(ctx: GoalContext, block: Block) -> Iterator[None]:
+    """Step straight back until the stance's mid-point is `clear_of_platform_m` from `block`."""
+    cfg = ctx.config
+    stance = Stance.of(ctx.ik, ctx.hold_q())
+    gap = block.distance_xy(stance.mid_xy - ctx.offset())
+    back_m = cfg.clear_of_platform_m - gap
+    if back_m < 0.01:
+        return
+    ctx.note(f"{gap * 100:.0f} cm from '{block.name}': stepping {back_m * 100:.0f} cm back clear of it")
+    back = stance.mid_xy - back_m * np.array([math.cos(stance.heading), math.sin(stance.heading)])
+    yield from step_to(ctx, back, stance.heading, cfg.steps, name="clear of the platform", first_back_m=back_m)
