@@ -2,8 +2,8 @@
 
 Each builder returns a WholeBodyTrajectory (generator/whole_body.py): root pose, joint angles and
 the contact schedule sampled in time, played back through cubic splines. Poses that must keep the
-feet planted or put a hand somewhere come from the whole-body IK (WholeBodyIK, joint limits inside
-its iteration); stepping references take their CoM from ZMP preview control over a footstep plan
+feet planted or put a hand somewhere come from the whole-body IK (ik/whole_body.py: WholeBodyIK,
+joint limits inside its iteration); stepping references take their CoM from ZMP preview control over a footstep plan
 (zmp_preview.py).
 
     stand          the default pose, still
@@ -23,14 +23,10 @@ from collections.abc import Callable
 import numpy as np
 
 from g1_control.errors import WbcConfigError
-from g1_control.generator.whole_body import (
-    WholeBodyIK,
-    WholeBodyTrajectory,
-    smoothstep,
-    trajectory_from_configurations,
-)
+from g1_control.generator.whole_body import WholeBodyTrajectory, smoothstep, trajectory_from_configurations
 from g1_control.generator.zmp_preview import ZmpPreviewController
-from g1_control.interfaces import Generator, Retargeter
+from g1_control.ik.whole_body import WholeBodyIK
+from g1_control.interfaces import Generator
 from g1_control.robot import g1
 from g1_control.robot.dynamics import SOLE_FRAMES
 from g1_control.types import Command, JointReference, KinematicReference, RobotState
@@ -39,7 +35,9 @@ _trajectory = trajectory_from_configurations
 
 
 class TrajectoryGenerator(Generator):
-    """Plays a trajectory as the generator stage (time from the robot state's clock)."""
+    """Plays a trajectory as the generator stage (time from the robot state's clock). The trajectory
+    is feasible by construction: each reference carries its sample (with the exact joint
+    velocities a KinematicReference does not hold) as the feasible plan the IK stage passes on."""
 
     def __init__(self, trajectory: WholeBodyTrajectory):
         self.trajectory = trajectory
@@ -55,18 +53,6 @@ class TrajectoryGenerator(Generator):
         ref = self._ref.set_from(j)
         ref.t_s = state.t_s - self._t0
         return ref
-
-
-class TrajectoryRetargeter(Retargeter):
-    """The trajectory is feasible by construction: sample it (with exact joint velocities, which
-    a KinematicReference does not carry) at the generator's time."""
-
-    def __init__(self, trajectory: WholeBodyTrajectory):
-        self.trajectory = trajectory
-        self._out = JointReference()
-
-    def solve(self, reference: KinematicReference, q_prev: np.ndarray) -> JointReference:
-        return self.trajectory.sample(reference.t_s, self._out)
 
 
 # -- the references ------------------------------------------------------------------------------------------

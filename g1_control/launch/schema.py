@@ -214,6 +214,65 @@ class GeneratorConfig:
     for walk; see the functions in g1_control/generator/scripted.py)."""
 
 
+@dataclass
+class IKSection:
+    """The IK stage between generator and tracker (g1_control/ik/stage.py: IKStage). A reference
+    the generator made feasible by construction (velocity, scripted, a goal's whole-body plan)
+    passes through; any other (backbone and the other learned generators) is solved by the
+    differential-IK QP (g1_control/ik/retargeter.py: IKRetargeter) with these settings, one solve
+    per tracker tick (its time step is 1 / rates.tracker_hz). The names are IKConfig's.
+
+    The defaults are the loop's: the legs belong to the walking policy. Holding stance feet where
+    they touched down or moving the CoM would make the IK bend the arms to reach a generated root
+    the real robot is not at (measured: it swung both arms overhead and tipped the robot over), so
+    contacts are free and the CoM has no cost; what the IK adds is feasibility of the upper body
+    (joint position and velocity limits, smoothness) and effector goals as frame targets.
+    """
+
+    backend: Literal["daqp", "proxqp"] = "daqp"
+    """The QP solver (g1_control/ik/solver.py)."""
+    iterations: int = 1
+    """QP steps per tick (one is enough online: the target moves little per tick)."""
+    root_cost: tuple[float, float] = (10.0, 5.0)
+    """(position 1/m, orientation 1/rad) cost of the pelvis following the reference root pose."""
+    com_cost: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    """Per world axis: the CoM follows the reference posture's CoM (0: free, see above)."""
+    posture_cost: float = 0.3
+    default_frame_cost: tuple[float, float] = (5.0, 1.0)
+    """(position, orientation) cost of a frame target (an effector goal) not in frame_costs."""
+    frame_costs: dict[str, tuple[float, float]] = field(default_factory=dict)
+    """Per frame name (a link of the G1 model): (position, orientation) cost."""
+    damping_cost: float = 1e-3
+    smoothness_cost: float = 0.05
+    velocity_limit_scale: float = 1.0
+    """Fraction of the motors' velocity limits the IK may use, in (0, 1]."""
+    joint_margin_rad: float = 0.0
+    """The IK keeps the joints this far inside their position limits."""
+    hold_contacts: bool = False
+    """Hold stance feet where they touched down (off in the loop, see above)."""
+    enforce_ground: bool = True
+    """Keep the feet above the floor."""
+    self_collision: bool = False
+    """Keep every pair of non-adjacent links apart (the URDF's collision meshes; costs CPU)."""
+
+    def validate(self, where: str) -> None:
+        if self.iterations < 1:
+            raise LaunchFileError(f"{where}.iterations: {self.iterations} must be >= 1 (QP steps per tick)")
+        costs = {"root_cost": self.root_cost, "com_cost": self.com_cost, "posture_cost": (self.posture_cost,),
+                 "default_frame_cost": self.default_frame_cost, "damping_cost": (self.damping_cost,),
+                 "smoothness_cost": (self.smoothness_cost,)}
+        costs.update({f"frame_costs.{name}": cost for name, cost in self.frame_costs.items()})
+        for name, values in costs.items():
+            if any(v < 0 for v in values):
+                shown = values[0] if len(values) == 1 else list(values)
+                raise LaunchFileError(f"{where}.{name}: {shown} has a negative cost (costs are >= 0; 0 disables)")
+        if not 0.0 < self.velocity_limit_scale <= 1.0:
+            raise LaunchFileError(f"{where}.velocity_limit_scale: {self.velocity_limit_scale} is outside (0, 1] "
+                                  "(a fraction of the motors' velocity limits)")
+        if not 0.0 <= self.joint_margin_rad < 0.2:
+            raise LaunchFileError(f"{where}.joint_margin_rad: {self.joint_margin_rad} is outside [0, 0.2) rad")
+
+
 TELEOP_DEVICES = ("gamepad", "keyboard", "unitree_remote")
 
 
@@ -339,6 +398,8 @@ class LaunchFile:
     rates: LoopRates = field(default_factory=LoopRates)
     tracker: TrackerConfig = field(default_factory=TrackerConfig)
     generator: GeneratorConfig = field(default_factory=GeneratorConfig)
+    ik: IKSection = field(default_factory=IKSection)
+    """The IK stage (absent: the loop's defaults, IKSection)."""
     input: InputConfig = field(default_factory=InputConfig)
     limits: LimitsConfig = field(default_factory=LimitsConfig)
     output: OutputConfig = field(default_factory=OutputConfig)
