@@ -340,7 +340,8 @@ class LaunchFile:
                                       f"known: {', '.join(REFERENCES)}")
             import inspect
 
-            accepted = inspect.signature(REFERENCES[self.generator.reference]).parameters
+            # the robot variant is backend.expected_variant's, never a reference parameter
+            accepted = [p for p in inspect.signature(REFERENCES[self.generator.reference]).parameters if p != "variant"]
             unknown = sorted(set(self.generator.reference_params) - set(accepted))
             if unknown:
                 raise LaunchFileError(f"generator.reference_params: {', '.join(unknown)} not a parameter of reference "

@@ -86,8 +86,12 @@ def pinocchio_q(base_pos_w: np.ndarray, base_quat_wxyz: np.ndarray, q_rad: np.nd
     return np.concatenate([base_pos_w, [x, y, z, w], q_rad])
 
 
-def mujoco_spec(floor: bool = True, timestep_s: float = 0.005):
-    """MjSpec of the G1 scene built from the URDF (see module docstring)."""
+def mujoco_spec(floor: bool = True, timestep_s: float = 0.005, variant: g1.Variant = g1.G1_29DOF):
+    """MjSpec of the G1 scene built from the URDF (see module docstring), as `variant` is built:
+    the joints the variant lacks (g1_23dof: waist roll/pitch, wrist pitch/yaw) are removed, so
+    their links are welded to their parents at the joint's zero, as the locked waist and the
+    wrist-less forearm of the real robot are. Its actuators are the variant's joints, in g1.JOINT_NAMES
+    order (nu = variant.num_dof)."""
     import mujoco
 
     xml = urdf_path().read_text()
@@ -111,7 +115,10 @@ def mujoco_spec(floor: bool = True, timestep_s: float = 0.005):
     pelvis.add_freejoint(name="floating_base")
     pelvis.pos = [0.0, 0.0, g1.DEFAULT_PELVIS_HEIGHT_M]
 
-    for i, name in enumerate(g1.JOINT_NAMES):
+    for i in sorted(set(range(g1.NUM_JOINTS)) - set(variant.active_joints)):
+        spec.delete(spec.joint(g1.JOINT_NAMES[i]))
+    for i in variant.active_joints:
+        name = g1.JOINT_NAMES[i]
         joint = spec.joint(name)
         joint.armature = float(g1.ARMATURE_KGM2[i])
         joint.range = [float(g1.Q_MIN_RAD[i]), float(g1.Q_MAX_RAD[i])]

@@ -57,17 +57,51 @@ class FrameTerms:
     """6: (linear m/s, angular rad/s), LOCAL_WORLD_ALIGNED."""
 
 
-class WbcModel:
-    """Evaluates the dynamics terms the QP needs at one state; reuses its buffers."""
+def build_variant_model(variant: g1.Variant):
+    """(full model, the variant's model): build_model(), and the same with the joints `variant`
+    lacks locked at zero (pinocchio's reduced model: their links welded to their parents, the
+    masses and frames kept; None for the 29-DoF G1). The frames keep their ids and names."""
+    import pinocchio as pin
 
-    def __init__(self) -> None:
+    full = build_model()
+    if variant.num_dof == g1.NUM_JOINTS:
+        return full, None
+    locked = [full.getJointId(g1.JOINT_NAMES[i]) for i in range(g1.NUM_JOINTS) if i not in variant.active_joints]
+    return full, pin.buildReducedModel(full, locked, pin.neutral(full))
+
+
+class WbcModel:
+    """Evaluates the dynamics terms the QP needs at one state; reuses its buffers.
+
+    Every array is in the 29-DoF G1's coordinates (nv 35: base, then g1.JOINT_NAMES), whatever the
+    variant, so that the controller and its QP serve every variant unchanged. For a variant without
+    some joints (the 23-DoF G1), the terms are those of the variant's own model (build_variant_model:
+    the joints it lacks locked), scattered into those coordinates: a locked joint's coordinate is
+    decoupled from everything (unit inertia, no bias, no Jacobian column, no contact or gravity
+    term), so the QP can neither use it nor feel it, and the rest is the reduced model's dynamics
+    exactly. `model` stays the 29-DoF kinematic model (for references, whose locked joints are 0 on
+    such a robot); `data` holds the kinematics of the last update() (of the variant's model: frame
+    ids are the same in both).
+    """
+
+    def __init__(self, variant: g1.Variant = g1.G1_29DOF) -> None:
         import pinocchio as pin
 
         self._pin = pin
-        self.model = build_model()
-        self.data = self.model.createData()
+        self.variant = variant
+        self.model, reduced = build_variant_model(variant)
+        self.dynamics_model = self.model if reduced is None else reduced
+        """The variant's own model: the one update() evaluates."""
+        self.data = self.dynamics_model.createData()
         self.nv = self.model.nv
         self.nq = self.model.nq
+        self._reduced = reduced is not None
+        active = np.array(variant.active_joints)
+        self._qi = np.concatenate([np.arange(7), 7 + active])
+        """Indices of the variant model's configuration in the 29-DoF one."""
+        self._vi = np.concatenate([np.arange(6), 6 + active])
+        """Indices of the variant model's velocity coordinates in the 29-DoF ones."""
+        self._locked_v = np.setdiff1d(np.arange(self.nv), self._vi)
         self.mass_kg = float(sum(i.mass for i in self.model.inertias))
         self.sole_ids = tuple(self.model.getFrameId(n) for n in SOLE_FRAMES)
         self.hand_ids = tuple(self.model.getFrameId(n) for n in HAND_FRAMES)
@@ -91,7 +125,11 @@ class WbcModel:
         its torques push back."""
 
     def update(self, q: np.ndarray, v: np.ndarray) -> None:
-        """Compute M, bias (C v + g), CoM terms and the soles' contact Jacobians at (q, v)."""
+        """Compute M, bias (C v + g), CoM terms and the soles' contact Jacobians at (q, v)
+        (the 29-DoF G1's coordinates; a variant's locked joints are read as locked)."""
+        if self._reduced:
+            self._update_reduced(q, v)
+            return
         pin, m, d = self._pin, self.model, self.data
         pin.computeAllTerms(m, d, q, v)  # M (upper triangle), nle, joint Jacobians, CoM, Jcom
         self.mass_matrix[:] = d.M
@@ -117,10 +155,47 @@ class WbcModel:
 
     def frame(self, frame_id: int) -> FrameTerms:
         """Kinematics of one frame at the state of the last update()."""
-        pin, m, d = self._pin, self.model, self.data
+        pin, m, d = self._pin, self.dynamics_model, self.data
         lwa = pin.LOCAL_WORLD_ALIGNED
         placement = d.oMf[frame_id]
-        return FrameTerms(placement.translation.copy(), placement.rotation.copy(),
-                          pin.getFrameJacobian(m, d, frame_id, lwa),
+        jac = pin.getFrameJacobian(m, d, frame_id, lwa)
+        if self._reduced:
+            jac = self._columns(jac)
+        return FrameTerms(placement.translation.copy(), placement.rotation.copy(), jac,
                           pin.getFrameClassicalAcceleration(m, d, frame_id, lwa).vector,
                           pin.getFrameVelocity(m, d, frame_id, lwa).vector)
+
+    # -- a variant with locked joints ------------------------------------------------------------------
+    def _columns(self, jac: np.ndarray) -> np.ndarray:
+        """A Jacobian of the variant's model with the 29-DoF G1's columns (0 for locked joints)."""
+        out = np.zeros((jac.shape[0], self.nv))
+        out[:, self._vi] = jac
+        return out
+
+    def _update_reduced(self, q: np.ndarray, v: np.ndarray) -> None:
+        pin, m, d, vi = self._pin, self.dynamics_model, self.data, self._vi
+        qr, vr = q[self._qi], v[vi]
+        pin.computeAllTerms(m, d, qr, vr)
+        mr = np.triu(d.M) + np.triu(d.M, 1).T
+        self.mass_matrix[:] = 0.0
+        self.mass_matrix[np.ix_(vi, vi)] = mr
+        self.mass_matrix[self._locked_v, self._locked_v] = 1.0
+        self.bias[:] = 0.0
+        self.bias[vi] = d.nle
+        self.com_m[:] = d.com[0]
+        self.com_vel_mps[:] = d.vcom[0]
+        self.com_jac[:] = 0.0
+        self.com_jac[:, vi] = d.Jcom
+        pin.forwardKinematics(m, d, qr, vr, np.zeros(m.nv))
+        pin.updateFramePlacements(m, d)
+        pin.centerOfMass(m, d, qr, vr, np.zeros(m.nv))
+        self.com_drift[:] = d.acom[0]
+        self.contact_jac_local[:] = 0.0
+        for i, fid in enumerate(self.sole_ids):
+            rows = slice(6 * i, 6 * i + 6)
+            self.contact_jac_local[rows, vi] = pin.getFrameJacobian(m, d, fid, pin.LOCAL)
+            self.contact_drift_local[rows] = pin.getFrameAcceleration(m, d, fid, pin.LOCAL).vector
+            self.contact_vel_local[rows] = pin.getFrameVelocity(m, d, fid, pin.LOCAL).vector
+        if self.hand_forces_w_n.any():
+            for fid, force in zip(self.hand_ids, self.hand_forces_w_n):
+                self.bias[vi] -= pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED)[:3].T @ force
