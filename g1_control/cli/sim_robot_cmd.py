@@ -23,7 +23,8 @@ def register(subparsers) -> None:
         epilog="examples:\n  g1 sim-robot                      # lo, domain 1, until Ctrl-C\n"
         "  g1 sim-robot --seconds 30 --physics mock\n"
         "  g1 sim-robot --control-stdin      # faults / remote buttons by name on stdin (test harnesses)\n"
-        "  g1 sim-robot --lower-gantry-on-policy   # sim2sim with g1 deploy launch/sim2sim.yaml --yes",
+        "  g1 sim-robot --lower-gantry-on-policy   # sim2sim with g1 deploy launch/sim2sim.yaml --yes\n"
+        "  g1 sim-robot --mode-machine 4 --lower-gantry-on-policy   # the 23-DoF G1 (g1 deploy launch/sim2sim_23dof.yaml)",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--interface", default="lo", help="network interface; loopback only (default lo)")
@@ -38,7 +39,10 @@ def register(subparsers) -> None:
                         help="hang the robot on the gantry (as --gantry) and lower it when the policy takes over: "
                         "when stiff leg targets held still for 0.3 s (the deploy's hold) start to move. For sim2sim "
                         "with `g1 deploy`, whose zero-torque/ramp/hold phases need the gantry")
-    parser.add_argument("--mode-machine", type=int, default=5, help="variant to report with --physics mock (4/5/6)")
+    parser.add_argument("--mode-machine", type=int, default=5, choices=(4, 5, 6),
+                        help="the G1 variant to emulate and report: 4 = 23-DoF (no waist roll/pitch, no wrist "
+                        "pitch/yaw: MuJoCo builds it without those joints), 5 = 29-DoF (default), 6 = 29-DoF with "
+                        "the waist locked")
     parser.add_argument("--no-builtin", action="store_true",
                         help="start with no built-in controller (as after debug mode on the remote)")
     parser.add_argument("--rt-priority", type=int, default=30, metavar="N",
@@ -58,9 +62,11 @@ def _run(args) -> int:
     realtime(args.rt_priority)
     physics: Backend
     if args.physics == "mujoco":
+        from g1_control.robot import g1
         from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
 
-        physics = mujoco = MujocoBackend(MujocoConfig(lockstep=True))
+        variant = g1.variant_for_mode_machine(args.mode_machine).name
+        physics = mujoco = MujocoBackend(MujocoConfig(lockstep=True, variant=variant))
         if args.gantry or args.lower_gantry_on_policy:
             from g1_control.sim.emulator import Gantry
 
@@ -79,7 +85,7 @@ def _run(args) -> int:
 
     signal.signal(signal.SIGTERM, _stop)
     with frozen_heap():  # the 500 Hz robot loop never waits for a full collection of the startup heap
-        print(f"g1 sim-robot: emulating a G1 ({args.physics}) on interface {args.interface}, domain {args.domain}"
+        print(f"g1 sim-robot: emulating a G1 ({args.physics}, mode_machine {args.mode_machine}) on interface {args.interface}, domain {args.domain}"
               + (f", partition {args.partition}" if args.partition else ""), file=sys.stderr, flush=True)
         print("ready", flush=True)
         try:
