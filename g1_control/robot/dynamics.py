@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from g1_control.errors import RobotDescriptionError
 from g1_control.robot import description, g1
 
 SOLE_OFFSET_M = np.array([0.035, 0.0, -0.035])
@@ -67,7 +68,11 @@ def build_variant_model(variant: g1.Variant):
     if variant.num_dof == g1.NUM_JOINTS:
         return full, None
     locked = [full.getJointId(g1.JOINT_NAMES[i]) for i in range(g1.NUM_JOINTS) if i not in variant.active_joints]
-    return full, pin.buildReducedModel(full, locked, pin.neutral(full))
+    reduced = pin.buildReducedModel(full, locked, pin.neutral(full))
+    if [f.name for f in reduced.frames] != [f.name for f in full.frames]:
+        raise RobotDescriptionError(f"pinocchio's {variant.name} model renumbered the G1's frames; the controller "
+                                    "addresses frames of both models by one id")
+    return full, reduced
 
 
 class WbcModel:
