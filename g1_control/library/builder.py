@@ -16,9 +16,10 @@ from pathlib import Path
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.library import INDEX_NAME, LibraryError, MotionLibrary
 
-BUILD_VERSION = 2
+BUILD_VERSION = 3
 """Bumped when the builder's output changes for the same configuration (invalidates caches).
-2: demo mocap retargeted with the collision-aware IK and the URDF's ankle/waist limits (issue 12)."""
+2: demo mocap retargeted with the collision-aware IK and the URDF's ankle/waist limits (issue 12).
+3: every piece gated on `g1 check`'s acceptance figures; failing pieces are left out (issue 23)."""
 
 LICENSES = {
     "rollout": "generated here (g1-control) with holosoma-inference 0.1.3's loco policy (Apache-2.0 upstream)",
@@ -40,6 +41,10 @@ class LibraryConfig:
     clip_seconds: float = 8.0
     test_every: int = 5
     """Every test_every-th piece of each source (offset 2) is held out."""
+    gate: bool = True
+    """Admit only pieces that meet `g1 check`'s acceptance figures (no limit violation, no link in
+    the floor or the scene, no self-collision, sliding on <= 1 % of stance frames); a piece that
+    misses them is left out with its mirror, and the index says which and why (`gate`)."""
 
     def key(self) -> str:
         blob = json.dumps({"v": BUILD_VERSION, **asdict(self)}, sort_keys=True)
@@ -78,6 +83,13 @@ def cut(clip: MotionClip, seconds: float) -> list[MotionClip]:
     count = max(1, clip.num_frames // n)
     bounds = [i * n for i in range(count)] + [clip.num_frames]
     return [slice_clip(clip, a, b) for a, b in itertools.pairwise(bounds)]
+
+
+def gate_reasons(clip: MotionClip) -> list[str]:
+    """Why `clip` fails `g1 check` (measured on its own scene, as `g1 check` does), [] when it passes."""
+    from g1_control.retarget.metrics import compute_metrics, failures
+
+    return failures(compute_metrics(clip))
 
 
 def build_library(out_dir: str | Path, config: LibraryConfig | None = None, *, force: bool = False,
@@ -139,11 +151,17 @@ def build_library(out_dir: str | Path, config: LibraryConfig | None = None, *, f
         if len(pieces) < 3:
             short.setdefault(source.style, []).append(source.source)
     held_out_sources = {names[1] for names in short.values() if len(names) >= 3}
-    entries = []
-    for source, pieces in tqdm(cut_sources, desc="mirror, write", unit="src", file=sys.stderr, disable=not progress):
+    entries, left_out = [], []
+    for source, pieces in tqdm(cut_sources, desc="check, mirror, write", unit="src", file=sys.stderr,
+                               disable=not progress):
         for k, piece in enumerate(pieces):
             long_held = len(pieces) >= 3 and k % config.test_every == 2
             split = "test" if long_held or source.source in held_out_sources else "train"
+            reasons = gate_reasons(piece) if config.gate else []
+            if reasons:
+                left_out.append({"name": f"{source.source}_{k:02d}", "source": source.source, "style": source.style,
+                                 "split": split, "num_frames": piece.num_frames, "reasons": reasons})
+                continue
             variants = [(piece, False)] + ([(mirror(piece), True)] if config.mirror else [])
             for clip, mirrored in variants:
                 name = f"{source.source}_{k:02d}{'_mirror' if mirrored else ''}"
@@ -153,7 +171,16 @@ def build_library(out_dir: str | Path, config: LibraryConfig | None = None, *, f
                                 "source": source.source, "mirrored": mirrored, "num_frames": clip.num_frames})
     index = {"key": config.key(), "version": BUILD_VERSION, "fps": config.fps, "config": asdict(config),
              "licenses": LICENSES, "rollouts": infos, "build_s": round(time.perf_counter() - started, 1),
-             "clips": entries}
+             "gate": {"checked": config.gate, "left_out": left_out}, "clips": entries}
     index_path.write_text(json.dumps(index, indent=1))
+    if left_out and progress:
+        print(gate_summary(left_out), file=sys.stderr)
     return MotionLibrary(out)
+
+
+def gate_summary(left_out: list[dict]) -> str:
+    """What the gate left out, one line per piece (name, split, why)."""
+    lines = [f"library gate: {len(left_out)} piece(s) left out (and their mirrors): they fail `g1 check`"]
+    lines += [f"  {e['name']} ({e['style']}, {e['split']}): {'; '.join(e['reasons'])}" for e in left_out]
+    return "\n".join(lines)
 
