@@ -63,7 +63,8 @@ def make_tracker(launch: LaunchFile) -> Tracker:
     if cfg.type == "wbc":
         from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
 
-        return WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz), variant=robot_variant(launch))
+        return WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz), variant=robot_variant(launch),
+                                hands=launch.backend.hands)
     if cfg.type == "wbt":
         from g1_control.trackers.wbt import WbtPolicyTracker
 
@@ -76,8 +77,9 @@ def make_tracker(launch: LaunchFile) -> Tracker:
 
         policy = LocomotionPolicyTracker(load_spec(cfg.policy), VelocityCorrectionConfig(enabled=cfg.velocity_correction),
                                          envelope_limits=cfg.envelope_limits)
-        return TrackingLayer(policy, WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz), variant=robot_variant(launch)),
-                             launch.rates.tracker_hz)
+        wbc = WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz), variant=robot_variant(launch),
+                               hands=launch.backend.hands)
+        return TrackingLayer(policy, wbc, launch.rates.tracker_hz)
     raise LaunchFileError(f"tracker.type: unknown tracker '{cfg.type}'")
 
 
@@ -129,7 +131,8 @@ def make_sim_backend(launch: LaunchFile) -> MujocoBackend:
     from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
 
     return MujocoBackend(MujocoConfig(physics_dt_s=launch.backend.physics_dt_s, lockstep=True,
-                                      variant=launch.backend.expected_variant), scene=launch.scene)
+                                      variant=launch.backend.expected_variant, hands=launch.backend.hands),
+                         scene=launch.scene)
 
 
 def describe_chain(launch: LaunchFile, generator: Generator, retargeter: Retargeter, tracker: Tracker) -> dict[str, str]:

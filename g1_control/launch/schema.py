@@ -71,6 +71,9 @@ class BackendConfig:
         if not 0.0005 <= self.physics_dt_s <= 0.005:
             raise LaunchFileError(f"{where}.physics_dt_s: {self.physics_dt_s} is outside [0.0005, 0.005] s "
                                   "(physics must run at 200 Hz or faster)")
+        if self.hands == "dex3" and self.expected_variant != "g1_29dof":
+            raise LaunchFileError(f"{where}.hands: Dex3 hands are modelled on the 29-DoF G1 only; "
+                                  f"expected_variant is {self.expected_variant}")
         if self.type == "mujoco":
             return
         if self.type == "unitree_dds":

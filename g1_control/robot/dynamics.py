@@ -25,11 +25,12 @@ HAND_OFFSET_M = np.array([0.1, 0.0, 0.0])
 """Hand point in the wrist-yaw link: roughly the palm centre (the URDF's rubber hand extends ~0.1 m)."""
 
 
-def build_model():
-    """pinocchio Model of the G1 with armature and the controller's extra frames."""
+def build_model(hands: str = "none"):
+    """pinocchio Model of the G1 (with `hands`: description.pinocchio_model) with armature and the
+    controller's extra frames."""
     import pinocchio as pin
 
-    model = pin.Model(description.pinocchio_model())
+    model = pin.Model(description.pinocchio_model(hands))
     # MuJoCo (and the robot) have reflected rotor inertia on every joint; without it the
     # controller's mass matrix is wrong by up to 30 % on the distal joints.
     model.armature[6:] = g1.ARMATURE_KGM2
@@ -58,13 +59,13 @@ class FrameTerms:
     """6: (linear m/s, angular rad/s), LOCAL_WORLD_ALIGNED."""
 
 
-def build_variant_model(variant: g1.Variant):
+def build_variant_model(variant: g1.Variant, hands: str = "none"):
     """(full model, the variant's model): build_model(), and the same with the joints `variant`
     lacks locked at zero (pinocchio's reduced model: their links welded to their parents, the
     masses and frames kept; None for the 29-DoF G1). The frames keep their ids and names."""
     import pinocchio as pin
 
-    full = build_model()
+    full = build_model(hands)
     if variant.num_dof == g1.NUM_JOINTS:
         return full, None
     locked = [full.getJointId(g1.JOINT_NAMES[i]) for i in range(g1.NUM_JOINTS) if i not in variant.active_joints]
@@ -89,12 +90,13 @@ class WbcModel:
     ids are the same in both).
     """
 
-    def __init__(self, variant: g1.Variant = g1.G1_29DOF) -> None:
+    def __init__(self, variant: g1.Variant = g1.G1_29DOF, hands: str = "none") -> None:
+        """hands 'dex3': the G1 with Dex3-1 hands, fingers locked open (their mass and frames)."""
         import pinocchio as pin
 
         self._pin = pin
         self.variant = variant
-        self.model, reduced = build_variant_model(variant)
+        self.model, reduced = build_variant_model(variant, hands)
         self.dynamics_model = self.model if reduced is None else reduced
         """The variant's own model: the one update() evaluates."""
         self.data = self.dynamics_model.createData()

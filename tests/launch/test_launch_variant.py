@@ -99,3 +99,19 @@ def test_the_23dof_robot_reaches_under_the_wbc():
           f"measured joints), joint RMS {figures.joint_rms_rad:.4f} rad")
     assert not loop.fell and figures.hand_error_m < 0.02
     assert np.isfinite(figures.joint_rms_rad) and figures.joint_rms_rad < 0.05
+
+
+def test_dex3_hands_on_the_23dof_robot_are_refused_in_the_launch_file():
+    with pytest.raises(LaunchFileError, match="backend.hands: Dex3 hands are modelled on the 29-DoF G1 only; "
+                                              "expected_variant is g1_23dof"):
+        load_launch(WALK_23, overrides=["backend.hands=dex3"])
+
+
+def test_the_wbc_walks_the_g1_with_dex3_hands_on_their_model():
+    loop = build_loop(load_launch(LAUNCH_DIR / "sim_wbc_walk.yaml", overrides=["backend.hands=dex3"]))
+    assert loop.backend.model.njnt == 1 + 29 + 14
+    assert loop.tracker.dyn.mass_kg == pytest.approx(34.394, abs=1e-3)  # the hands' mass, not the rubber hands'
+    log = _run(loop, loop.generator.trajectory.duration_s)
+    pos = log["base_pos_m"]
+    print(f"\nDex3 WBC walk: {pos[-1, 0] - pos[0, 0]:.2f} m forward, pelvis min {pos[:, 2].min():.3f} m")
+    assert not loop.fell and pos[-1, 0] - pos[0, 0] > 1.5

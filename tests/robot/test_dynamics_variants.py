@@ -66,3 +66,25 @@ def test_the_variant_models_weigh_the_same_and_share_frames():
     assert a.mass_kg == pytest.approx(b.mass_kg) and b.nv == a.nv == 35
     assert b.dynamics_model.nv == 29
     assert [f.name for f in a.model.frames] == [f.name for f in b.dynamics_model.frames]
+
+
+def test_the_dex3_model_is_mujocos_with_the_fingers_held():
+    """With the fingers at rest, the dynamics of the body's coordinates are the hand robot's with
+    the fingers locked: MuJoCo's mass matrix and bias restricted to those coordinates."""
+    model = WbcModel(hands="dex3")
+    backend = MujocoBackend(MujocoConfig(hands="dex3"))
+    m, d = backend.model, backend.data
+    q, dq = _state(g1.G1_29DOF)
+    body = [m.jnt_dofadr[m.joint(n).id] for n in g1.JOINT_NAMES]
+    d.qpos[:7] = [0.0, 0.0, 0.75, 1.0, 0.0, 0.0, 0.0]
+    d.qpos[[m.jnt_qposadr[m.joint(n).id] for n in g1.JOINT_NAMES]] = q
+    d.qvel[:] = 0.0
+    d.qvel[body] = dq
+    mujoco.mj_forward(m, d)
+    mass = np.zeros((m.nv, m.nv))
+    mujoco.mj_fullM(m, d, mass)
+    kept = np.concatenate([np.arange(6), body])
+    model.update(np.concatenate([[0.0, 0.0, 0.75, 0.0, 0.0, 0.0, 1.0], q]), np.concatenate([np.zeros(6), dq]))
+    np.testing.assert_allclose(model.mass_matrix, mass[np.ix_(kept, kept)], atol=1e-9)
+    np.testing.assert_allclose(model.bias, d.qfrc_bias[kept], atol=1e-9)
+    assert model.mass_kg == pytest.approx(34.394, abs=1e-3) and WbcModel().mass_kg == pytest.approx(33.341, abs=1e-3)

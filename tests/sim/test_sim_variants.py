@@ -84,3 +84,44 @@ def test_the_23dof_robot_stands_under_its_default_pd_for_a_moment():
     backend.step(0.3)
     assert backend.read_state().base_pos_w_m[2] > 0.7
     assert mujoco.mj_name2id(backend.model, mujoco.mjtObj.mjOBJ_ACTUATOR, "waist_roll") == -1
+
+
+# -- backend.hands: dex3 ---------------------------------------------------------------------------------
+def test_dex3_hands_are_built_with_their_fingers_held_open_and_the_same_29_motors():
+    from g1_control.robot import description
+
+    backend = MujocoBackend(MujocoConfig(hands="dex3"))
+    m = backend.model
+    fingers = description.finger_joint_names()
+    assert len(fingers) == 14 and m.nu == 29 and m.njnt == 1 + 29 + 14
+    assert np.sum(m.body_mass) == pytest.approx(34.394, abs=1e-3)  # the hand URDF's mass (rubber hands: 33.34)
+    assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "left_hand_palm_link") >= 0
+    assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "left_rubber_hand") == -1
+    state = backend.reset()
+    elbow = g1.JOINT_INDEX["left_elbow_joint"]
+    cmd = MotorCommand(q_rad=g1.DEFAULT_Q_RAD.copy(), kp=g1.KP_DEFAULT.copy(), kd=g1.KD_DEFAULT.copy())
+    cmd.q_rad[elbow] += 0.4
+    backend.write_command(cmd)
+    backend.step(0.5)
+    state = backend.read_state()
+    adr = m.jnt_qposadr[m.joint("left_elbow_joint").id]
+    assert state.q_rad[elbow] == backend.data.qpos[adr] and state.q_rad[elbow] - g1.DEFAULT_Q_RAD[elbow] > 0.25
+    finger_q = [backend.data.qpos[m.jnt_qposadr[m.joint(f).id]] for f in fingers]
+    assert np.abs(finger_q).max() < 0.2, "the fingers hold the open pose against gravity and the arm's motion"
+
+
+def test_dex3_hands_on_the_23dof_robot_are_refused():
+    with pytest.raises(RobotDescriptionError, match="Dex3 hands are modelled on the 29-DoF G1 only, not on g1_23dof"):
+        MujocoBackend(MujocoConfig(variant="g1_23dof", hands="dex3"))
+
+
+def test_a_scene_with_dex3_hands_builds_without_the_rubber_hand_boxes():
+    from g1_control.scene import Box, SceneConfig
+
+    scene = SceneConfig(boxes=[Box(name="box", xy_m=(0.6, 0.0))])
+    assert scene.hand_collision
+    m = MujocoBackend(MujocoConfig(hands="dex3"), scene=scene).model
+    geoms = {m.geom(i).name for i in range(m.ngeom)}
+    assert "box_geom" in geoms and not any(name.endswith("rubber_hand_collision") for name in geoms)
+    rubber = MujocoBackend(scene=scene).model
+    assert "right_rubber_hand_collision" in {rubber.geom(i).name for i in range(rubber.ngeom)}
