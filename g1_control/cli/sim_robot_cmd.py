@@ -39,10 +39,10 @@ def register(subparsers) -> None:
                         help="hang the robot on the gantry (as --gantry) and lower it when the policy takes over: "
                         "when stiff leg targets held still for 0.3 s (the deploy's hold) start to move. For sim2sim "
                         "with `g1 deploy`, whose zero-torque/ramp/hold phases need the gantry")
-    parser.add_argument("--mode-machine", type=int, default=5, choices=(4, 5, 6),
+    parser.add_argument("--mode-machine", type=int, default=5,
                         help="the G1 variant to emulate and report: 4 = 23-DoF (no waist roll/pitch, no wrist "
                         "pitch/yaw: MuJoCo builds it without those joints), 5 = 29-DoF (default), 6 = 29-DoF with "
-                        "the waist locked")
+                        "the waist locked (--physics mock reports any value)")
     parser.add_argument("--no-builtin", action="store_true",
                         help="start with no built-in controller (as after debug mode on the remote)")
     parser.add_argument("--rt-priority", type=int, default=30, metavar="N",
@@ -56,6 +56,7 @@ def register(subparsers) -> None:
 
 
 def _run(args) -> int:
+    from g1_control.errors import G1ControlError
     from g1_control.loop.priority import frozen_heap, realtime
     from g1_control.sim.emulator import RobotEmulator
 
@@ -65,7 +66,10 @@ def _run(args) -> int:
         from g1_control.robot import g1
         from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
 
-        variant = g1.variant_for_mode_machine(args.mode_machine).name
+        try:
+            variant = g1.variant_for_mode_machine(args.mode_machine).name
+        except ValueError as exc:
+            raise G1ControlError(f"--mode-machine: {exc}") from None
         physics = mujoco = MujocoBackend(MujocoConfig(lockstep=True, variant=variant))
         if args.gantry or args.lower_gantry_on_policy:
             from g1_control.sim.emulator import Gantry

@@ -125,3 +125,11 @@ def test_a_scene_with_dex3_hands_builds_without_the_rubber_hand_boxes():
     assert "box_geom" in geoms and not any(name.endswith("rubber_hand_collision") for name in geoms)
     rubber = MujocoBackend(scene=scene).model
     assert "right_rubber_hand_collision" in {rubber.geom(i).name for i in range(rubber.ngeom)}
+
+
+def test_sim_robot_refuses_a_mode_machine_it_cannot_build(capsys):
+    from g1_control.cli.main import main
+
+    assert main(["sim-robot", "--mode-machine", "9", "--seconds", "0.1", "--rt-priority", "0"]) == 1
+    assert ("--mode-machine: unknown G1 mode_machine 9; known: 4 (g1_23dof), 5 (g1_29dof), 6 (g1_29dof_locked_waist)"
+            in capsys.readouterr().err)
