@@ -177,7 +177,9 @@ def build_library(out_dir: str | Path, config: LibraryConfig | None = None, *, f
         if len(pieces) < 3:
             short.setdefault(source.style, []).append(source.source)
     held_out_sources = {names[1] for names in short.values() if len(names) >= 3}
-    entries, left_out, repaired = [], [], []
+    entries: list[dict] = []
+    left_out: list[dict] = []
+    repaired: list[dict] = []
     for source, pieces in tqdm(cut_sources, desc="check, mirror, write", unit="src", file=sys.stderr,
                                disable=not progress):
         for k, piece in enumerate(pieces):
@@ -199,13 +201,13 @@ def build_library(out_dir: str | Path, config: LibraryConfig | None = None, *, f
                 write_clip_npz(clip, out / "clips" / f"{name}.npz")
                 entries.append({"name": name, "file": f"clips/{name}.npz", "style": clip.style, "split": split,
                                 "source": source.source, "mirrored": mirrored, "num_frames": clip.num_frames})
+    gate = {"checked": config.gate, "repair": config.repair, "repaired": repaired, "left_out": left_out}
     index = {"key": config.key(), "version": BUILD_VERSION, "fps": config.fps, "config": asdict(config),
              "licenses": LICENSES, "rollouts": infos, "build_s": round(time.perf_counter() - started, 1),
-             "gate": {"checked": config.gate, "repair": config.repair, "repaired": repaired, "left_out": left_out},
-             "clips": entries}
+             "gate": gate, "clips": entries}
     index_path.write_text(json.dumps(index, indent=1))
     if (left_out or repaired) and progress:
-        print(gate_summary(index["gate"]), file=sys.stderr)
+        print(gate_summary(gate), file=sys.stderr)
     return MotionLibrary(out)
 
 
