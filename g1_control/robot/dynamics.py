@@ -130,6 +130,14 @@ class WbcModel:
         the hands (its weight share, the squeeze's reaction). update() folds them into `bias`
         (bias - J^T f), so the QP's dynamics, torque limits and foot forces account for them and
         its torques push back."""
+        if self._reduced:
+            nr = self.dynamics_model.nv
+            self._mr = np.zeros((nr, nr))
+            self._mr_lower = np.tril_indices(nr, -1)
+            self._m_flat = (self._vi[:, None] * self.nv + self._vi[None, :]).ravel()
+            """Where the variant model's mass matrix goes in the flattened 29-DoF one."""
+            self._a0r = np.zeros(nr)
+            self.mass_matrix[self._locked_v, self._locked_v] = 1.0
 
     def update(self, q: np.ndarray, v: np.ndarray) -> None:
         """Compute M, bias (C v + g), CoM terms and the soles' contact Jacobians at (q, v)
@@ -180,24 +188,23 @@ class WbcModel:
         return out
 
     def _update_reduced(self, q: np.ndarray, v: np.ndarray) -> None:
+        # Only the variant's rows and columns are written: the locked coordinates' entries keep what
+        # __init__ gave them (unit inertia, zeros) for good.
         pin, m, d, vi = self._pin, self.dynamics_model, self.data, self._vi
         qr, vr = q[self._qi], v[vi]
         pin.computeAllTerms(m, d, qr, vr)
-        mr = np.triu(d.M) + np.triu(d.M, 1).T
-        self.mass_matrix[:] = 0.0
-        self.mass_matrix[np.ix_(vi, vi)] = mr
-        self.mass_matrix[self._locked_v, self._locked_v] = 1.0
-        self.bias[:] = 0.0
+        mr = self._mr
+        mr[:] = d.M  # upper triangle
+        mr[self._mr_lower] = mr.T[self._mr_lower]
+        self.mass_matrix.flat[self._m_flat] = mr.ravel()
         self.bias[vi] = d.nle
         self.com_m[:] = d.com[0]
         self.com_vel_mps[:] = d.vcom[0]
-        self.com_jac[:] = 0.0
         self.com_jac[:, vi] = d.Jcom
-        pin.forwardKinematics(m, d, qr, vr, np.zeros(m.nv))
+        pin.forwardKinematics(m, d, qr, vr, self._a0r)
         pin.updateFramePlacements(m, d)
-        pin.centerOfMass(m, d, qr, vr, np.zeros(m.nv))
+        pin.centerOfMass(m, d, qr, vr, self._a0r)
         self.com_drift[:] = d.acom[0]
-        self.contact_jac_local[:] = 0.0
         for i, fid in enumerate(self.sole_ids):
             rows = slice(6 * i, 6 * i + 6)
             self.contact_jac_local[rows, vi] = pin.getFrameJacobian(m, d, fid, pin.LOCAL)
