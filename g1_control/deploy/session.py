@@ -211,7 +211,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             device = ProgramInput(options.program, launch.program_world(), pose="estimator",
                                   start_delay_s=launch.input.start_delay_s, operator=device,
                                   on_record=lambda r: say("program step " + describe_record(r)))
-        if spec is not None:
+        if spec is not None or (launch.tracker.type == "wbc" and pf.results["policy"].status == "pass"):
             say(f"simulated dry run ({launch.deploy.dry_run_s:.0f} s lockstep MuJoCo"
                 + (", the whole program" if options.program is not None or launch.input.type == "program" else "")
                 + ") ...")

@@ -56,14 +56,15 @@ class TrajectoryGenerator(Generator):
 
 
 # -- the references ------------------------------------------------------------------------------------------
-def stand(duration_s: float = 60.0) -> WholeBodyTrajectory:
-    q0 = WholeBodyIK().nominal()
+def stand(duration_s: float = 60.0, variant: str = "g1_29dof") -> WholeBodyTrajectory:
+    q0 = WholeBodyIK(g1.variant_named(variant)).nominal()
     t = np.array([0.0, duration_s])
     return _trajectory("stand", t, np.array([q0, q0]), np.ones((2, 2), dtype=bool))
 
 
-def arm_wave(duration_s: float = 10.0, frequency_hz: float = 0.5, amplitude_rad: float = 0.6) -> WholeBodyTrajectory:
-    q0 = WholeBodyIK().nominal()
+def arm_wave(duration_s: float = 10.0, frequency_hz: float = 0.5, amplitude_rad: float = 0.6,
+             variant: str = "g1_29dof") -> WholeBodyTrajectory:
+    q0 = WholeBodyIK(g1.variant_named(variant)).nominal()
     t = np.arange(0.0, duration_s + 1e-9, 0.01)
     qs = np.repeat(q0[None], len(t), axis=0)
     ramp = smoothstep(t / 1.0) * smoothstep((duration_s - t) / 1.0)
@@ -80,8 +81,8 @@ def _planted_feet(ik: WholeBodyIK, q0: np.ndarray) -> list[tuple[np.ndarray, np.
     return [ik.frame_pose(q0, name) for name in SOLE_FRAMES]
 
 
-def crouch(depth_m: float = 0.15, down_s: float = 2.0, hold_s: float = 1.5) -> WholeBodyTrajectory:
-    ik = WholeBodyIK()
+def crouch(depth_m: float = 0.15, down_s: float = 2.0, hold_s: float = 1.5, variant: str = "g1_29dof") -> WholeBodyTrajectory:
+    ik = WholeBodyIK(g1.variant_named(variant))
     q0 = ik.nominal()
     soles = _planted_feet(ik, q0)
     com_xy = ik.com(q0)[:2]
@@ -96,10 +97,10 @@ def crouch(depth_m: float = 0.15, down_s: float = 2.0, hold_s: float = 1.5) -> W
 
 
 def lean_reach(ahead_m: float = 0.5, height_m: float = 0.8, side_m: float = -0.2,
-               reach_s: float = 2.5, hold_s: float = 2.0) -> WholeBodyTrajectory:
+               reach_s: float = 2.5, hold_s: float = 2.0, variant: str = "g1_29dof") -> WholeBodyTrajectory:
     """Right hand to (ahead_m, side_m, height_m) in the start pelvis's ground frame, CoM kept over
     the feet (the hips move back as the torso leans), then back to the default pose."""
-    ik = WholeBodyIK()
+    ik = WholeBodyIK(g1.variant_named(variant))
     q0 = ik.nominal()
     soles = _planted_feet(ik, q0)
     com_xy = ik.com(q0)[:2]
@@ -121,11 +122,12 @@ def lean_reach(ahead_m: float = 0.5, height_m: float = 0.8, side_m: float = -0.2
 
 def stepping(footsteps: list[tuple[int, np.ndarray]], *, single_support_s: float = 0.4,
              double_support_s: float = 0.15, lift_m: float = 0.05, start_s: float = 1.0, end_s: float = 1.5,
-             pelvis_drop_m: float = 0.02, name: str = "stepping", dt_s: float = 0.01) -> WholeBodyTrajectory:
+             pelvis_drop_m: float = 0.02, name: str = "stepping", dt_s: float = 0.01,
+             variant: str = "g1_29dof") -> WholeBodyTrajectory:
     """Footsteps (foot index 0 left / 1 right, new sole xy) taken one after another; CoM from
     ZMP preview control, ZMP on the stance sole during single support and moving linearly
     between soles during double support."""
-    ik = WholeBodyIK()
+    ik = WholeBodyIK(g1.variant_named(variant))
     q0 = ik.nominal()
     soles0 = _planted_feet(ik, q0)
     com0 = ik.com(q0)

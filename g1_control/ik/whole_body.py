@@ -32,10 +32,13 @@ LIMIT_MARGIN_RAD = 0.02
 class WholeBodyIK:
     """Damped least squares on the floating-base configuration (module docstring)."""
 
-    def __init__(self):
+    def __init__(self, variant: g1.Variant = g1.G1_29DOF):
+        """variant: the G1 whose poses are solved for; the joints it lacks stay at 0 (locked)."""
         import pinocchio as pin
 
         self.pin = pin
+        self.variant = variant
+        self._locked = np.flatnonzero(~variant.active_mask)
         self.model = build_model()
         self.data = self.model.createData()
         self.sole_ids = [self.model.getFrameId(n) for n in SOLE_FRAMES]
@@ -78,6 +81,9 @@ class WholeBodyIK:
         if posture_weight is None:
             posture_weight = LEG_LIGHT_POSTURE_WEIGHT
         lo, hi = g1.Q_MIN_RAD + margin_rad, g1.Q_MAX_RAD - margin_rad
+        if self._locked.size:  # joints the variant lacks: held at 0, never moved
+            lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
+            lo[self._locked] = hi[self._locked] = 0.0
         q = q0.copy()
         q[7:] = np.clip(q[7:], lo, hi)
         lwa = pin.LOCAL_WORLD_ALIGNED
@@ -125,6 +131,8 @@ class WholeBodyIK:
             errs.append(posture - q[7:])
             weights.append(w_post)
             jac, e, w = np.vstack(rows), np.concatenate(errs), np.concatenate(weights)
+            if self._locked.size:
+                jac[:, 6 + self._locked] = 0.0
             jw = jac.T * w
             h, g = jw @ jac + eye, jw @ e
             dv = np.linalg.solve(h, g)

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 from g1_control.errors import LaunchFileError
 from g1_control.interfaces import Backend, Generator, InputDevice, Tracker
 from g1_control.launch.schema import SKELETON_GENERATORS, LaunchFile
+from g1_control.launch.variant import check_tracker_fits, robot_variant
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.safety import SafetyConfig, SafetyFilter
 from g1_control.safety.fall import FallMonitor
@@ -54,6 +55,7 @@ def timeline_of(launch: LaunchFile) -> list[Segment]:
 
 def make_tracker(launch: LaunchFile) -> Tracker:
     cfg = launch.tracker
+    check_tracker_fits(launch)  # a policy that does not fit the robot variant is refused by name
     if cfg.type == "policy":
         from g1_control.trackers.locomotion import LocomotionPolicyTracker, VelocityCorrectionConfig
         from g1_control.trackers.policy_spec import load_spec
@@ -63,7 +65,8 @@ def make_tracker(launch: LaunchFile) -> Tracker:
     if cfg.type == "wbc":
         from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
 
-        return WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz))
+        return WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz), variant=robot_variant(launch),
+                                hands=launch.backend.hands)
     if cfg.type == "wbt":
         from g1_control.trackers.wbt import WbtPolicyTracker
 
@@ -76,7 +79,9 @@ def make_tracker(launch: LaunchFile) -> Tracker:
 
         policy = LocomotionPolicyTracker(load_spec(cfg.policy), VelocityCorrectionConfig(enabled=cfg.velocity_correction),
                                          envelope_limits=cfg.envelope_limits)
-        return TrackingLayer(policy, WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz)), launch.rates.tracker_hz)
+        wbc = WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz), variant=robot_variant(launch),
+                               hands=launch.backend.hands)
+        return TrackingLayer(policy, wbc, launch.rates.tracker_hz)
     raise LaunchFileError(f"tracker.type: unknown tracker '{cfg.type}'")
 
 
@@ -113,7 +118,8 @@ def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
     if cfg.type == "scripted":
         from g1_control.generator.scripted import TrajectoryGenerator, build_reference
 
-        return TrajectoryGenerator(build_reference(cfg.reference, **cfg.reference_params))
+        return TrajectoryGenerator(build_reference(cfg.reference, variant=launch.backend.expected_variant,
+                                                   **cfg.reference_params))
     from g1_control.generator.factory import make_generator as make_named
 
     skeleton = "g1_29dof"
@@ -141,7 +147,9 @@ def make_sim_backend(launch: LaunchFile) -> MujocoBackend:
                               "run it with `g1 deploy`, which checks the robot before anything moves")
     from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
 
-    return MujocoBackend(MujocoConfig(physics_dt_s=launch.backend.physics_dt_s, lockstep=True), scene=launch.scene)
+    return MujocoBackend(MujocoConfig(physics_dt_s=launch.backend.physics_dt_s, lockstep=True,
+                                      variant=launch.backend.expected_variant, hands=launch.backend.hands),
+                         scene=launch.scene)
 
 
 def describe_chain(launch: LaunchFile, generator: Generator, ik: IKStage, tracker: Tracker) -> dict[str, str]:

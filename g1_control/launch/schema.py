@@ -77,6 +77,9 @@ class BackendConfig:
         if not 0.0005 <= self.physics_dt_s <= 0.005:
             raise LaunchFileError(f"{where}.physics_dt_s: {self.physics_dt_s} is outside [0.0005, 0.005] s "
                                   "(physics must run at 200 Hz or faster)")
+        if self.hands == "dex3" and self.expected_variant != "g1_29dof":
+            raise LaunchFileError(f"{where}.hands: Dex3 hands are modelled on the 29-DoF G1 only; "
+                                  f"expected_variant is {self.expected_variant}")
         if self.type == "mujoco":
             return
         if self.type == "unitree_dds":
@@ -425,7 +428,8 @@ class LaunchFile:
                                       f"known: {', '.join(REFERENCES)}")
             import inspect
 
-            accepted = inspect.signature(REFERENCES[self.generator.reference]).parameters
+            # the robot variant is backend.expected_variant's, never a reference parameter
+            accepted = [p for p in inspect.signature(REFERENCES[self.generator.reference]).parameters if p != "variant"]
             unknown = sorted(set(self.generator.reference_params) - set(accepted))
             if unknown:
                 raise LaunchFileError(f"generator.reference_params: {', '.join(unknown)} not a parameter of reference "

@@ -205,6 +205,19 @@ G1_29DOF_LOCKED_WAIST = Variant(
 VARIANTS = {v.mode_machine: v for v in (G1_23DOF, G1_29DOF, G1_29DOF_LOCKED_WAIST)}
 
 
+def variant_named(name: str) -> Variant:
+    """The variant called `name` (a launch file's backend.expected_variant); raises for an unknown name."""
+    for v in VARIANTS.values():
+        if v.name == name:
+            return v
+    raise ValueError(f"unknown G1 variant '{name}'; known: {', '.join(v.name for v in VARIANTS.values())}")
+
+
+def missing_joints(variant: Variant, joint_names) -> list[str]:
+    """The names in `joint_names` that `variant` has no motor for (a 29-DoF policy on a 23-DoF G1)."""
+    return [n for n in joint_names if n in JOINT_INDEX and JOINT_INDEX[n] not in variant.active_joints]
+
+
 def variant_for_mode_machine(mode_machine: int) -> Variant:
     """The variant a robot reporting `mode_machine` is; raises for an unknown value."""
     try:

@@ -305,8 +305,11 @@ class RobotEmulator:
         out["base_pos_w_m"] = None if state.base_pos_w_m is None else [float(v) for v in state.base_pos_w_m]
         out["first_damping_base_pos_w_m"] = self.endpoint.first_damping_base_pos_w_m
         last = self.endpoint.last_command
+        # damping on every motor the robot has (a 23-DoF G1's empty slots go out disabled, gains 0)
+        motors = g1.VARIANTS.get(int(state.mode_machine), g1.G1_29DOF).active_mask
         out["last_command_is_damping"] = None if last is None else bool(
-            float(np.max(last.motor_kp_nm_per_rad)) == 0.0 and float(np.min(last.motor_kd_nms_per_rad[:g1.NUM_JOINTS])) > 0)
+            float(np.max(last.motor_kp_nm_per_rad)) == 0.0
+            and float(np.min(last.motor_kd_nms_per_rad[:g1.NUM_JOINTS][motors])) > 0)
         gantry = self.physics.inner
         if isinstance(gantry, Gantry):
             out["gantry_lowered_at_s"] = gantry.lowered_at_s
