@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from g1_control.generator.scripted import lean_reach
-from g1_control.generator.whole_body import WholeBodyIK
+from g1_control.ik.whole_body import WholeBodyIK
 from g1_control.robot import g1
 
 DROPPED = ~g1.G1_23DOF.active_mask
