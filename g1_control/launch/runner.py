@@ -31,7 +31,7 @@ from g1_control.launch.builder import build_loop, make_sim_backend, timeline_of
 from g1_control.launch.overlay import overlay_lines
 from g1_control.launch.run_folder import RunFolder, interrupt_on_signals
 from g1_control.launch.schema import LaunchFile
-from g1_control.loop.control_loop import ControlLoop
+from g1_control.loop.control_loop import ControlLoop, first_fault
 from g1_control.robot import g1
 from g1_control.teleop.scripted import Segment
 
@@ -357,7 +357,7 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, f
                                launch.output.video_size, overlay=overlay, extra=_scene_arrays(launch, loop))
         result.video = str(run_dir / "video.mp4") if backend else None
         result.extra["render_backend"] = backend
-    trip = next((e for e in result.events if "damping" in e["detail"]), None)
+    trip = first_fault(result.events)
     if interrupted is not None:
         status, reason = "interrupted", str(interrupted)
     elif trip is not None:
@@ -431,7 +431,7 @@ def format_summary(result: RunResult) -> str:
     if result.estimator_rms_mps is not None:
         lines.append(f"state estimator velocity RMS error vs ground truth: {result.estimator_rms_mps:.3f} m/s")
     for e in result.events:
-        lines.append(f"event at {e['t_s']:.2f} s: {e['kind']}: {e['detail']}")
+        lines.append(f"event at {e['t_s']:.2f} s: {e['kind']}{' (damping)' if e.get('trips') else ''}: {e['detail']}")
     if result.extra.get("goals"):
         from g1_control.launch.outcomes import outcome_line
 
