@@ -42,6 +42,8 @@ from g1_control.program.steps import (
 
 _WORD_RE = re.compile(r"\d+(?:\.\d+)?|\.\d+|[a-z]+(?:'[a-z]+)?|°|/|[,;.!?]|\S")
 _DIGITS_RE = re.compile(r"^(?:\d+(?:\.\d+)?|\.\d+)$")
+_NEGATIVE_RE = re.compile(r"(?<![\w.])[-\u2212]\s*(?:\d+(?:\.\d+)?|\.\d+)(?:\s*(?:°|[a-z]+))?")
+"""A signed number ('-3', '− 2.5 meters'): hyphens are word joints elsewhere ("ninety-degree")."""
 SENTENCE_ENDS = frozenset(";.!?")
 DIRECTIONS = frozenset({"forward", "backward", "left", "right", "up", "down"})
 PREPOSITIONS = frozenset({"to", "toward", "towards", "onto", "on", "into", "in", "at", "from", "off", "of", "for",
@@ -129,6 +131,11 @@ class InstructionParser:
     # ------------------------------------------------------------------------------------------
     def parse(self, text: str) -> Program:
         """The validated Program for an instruction; InstructionError (or UnknownWordError) if none."""
+        negative = _NEGATIVE_RE.search(text.lower())
+        if negative:
+            raise InstructionError(f"\"{negative.group(0)}\": a negative quantity; durations, distances, angles and "
+                                   "counts are sizes; say the direction in words instead, e.g. \"walk backward 2 "
+                                   "meters\", \"turn right 90 degrees\"")
         words = _WORD_RE.findall(text.lower().replace("-", " ").replace("\u2019", "'"))
         if not words:
             raise InstructionError("empty instruction: say what to do, e.g. \"walk forward two meters\"")
