@@ -21,6 +21,7 @@ import numpy as np
 
 from g1_control.errors import G1ControlError, RobotNotConnectedError, VariantMismatchError
 from g1_control.launch.schema import InputConfig, LaunchFile, Segment
+from g1_control.loop.control_loop import first_fault
 from g1_control.robot import g1
 from g1_control.rotations import tilt_rad
 
@@ -344,10 +345,10 @@ class Preflight:
             when = f" at {fall['t_s']:.1f} s ({fall['detail']})" if fall else ""
             return self.record("dry_run", FAIL, f"FELL in simulation{when}: "
                                f"{what}; do not run this policy/launch file on the robot")
-        faults = [e for e in result.events if "damping" in e["detail"]]
-        if faults:
-            return self.record("dry_run", FAIL, f"the safety layer tripped in simulation: {faults[0]['kind']}: "
-                               f"{faults[0]['detail']}")
+        fault = first_fault(result.events)
+        if fault is not None:
+            return self.record("dry_run", FAIL, f"the safety layer tripped in simulation: {fault['kind']}: "
+                               f"{fault['detail']}")
         ran = result.extra.get("program")
         if ran is not None:
             missed = [s["label"] for s in ran["steps"] if not s.get("verdict", {}).get("ok", True)]

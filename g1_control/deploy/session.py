@@ -38,8 +38,6 @@ if TYPE_CHECKING:
 log = logging.getLogger("g1_control.deploy")
 
 ROBOT_CHECKS = ("variant", "state_stream", "peers", "imu_upright", "joint_limits", "temperatures", "battery")
-CLEAN_ENDINGS = ("operator stop", "control time over", "SIGINT received", "SIGTERM received")
-"""Trip details that end a deploy as planned (exit code 0); any other trip is a fault (exit code 3)."""
 
 
 @dataclass
@@ -427,7 +425,8 @@ def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTr
                           for t in tracker.transitions]
     trip = safety.trip_event
     report.end_reason = trip.detail if trip else "exit"
-    report.fault = trip is None or not any(trip.detail.startswith(c) for c in CLEAN_ENDINGS)
+    # A planned ending (operator stop, control time over, a signal) exits 0; any other trip is a fault (exit 3).
+    report.fault = trip is None or not trip.planned
     report.safety_events = [{"t_s": e.t_s, "kind": e.kind.value, "detail": e.detail, "trips": e.trips,
                              "planned": e.planned} for e in safety.events]
     report.link = dataclasses.asdict(backend.stats())

@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -13,6 +14,7 @@ from typing import Any, Literal
 from g1_control.config import apply_overrides, from_dict, read_yaml
 from g1_control.errors import LaunchFileError, SafetyConfigError
 from g1_control.loop.rates import LoopRates
+from g1_control.robot import g1
 from g1_control.safety.config import SafetyConfig
 from g1_control.safety.fall import FallConfig
 from g1_control.scene import FLOOR, SceneConfig
@@ -139,9 +141,11 @@ class DeployConfig:
     joint_limit_tolerance_rad: float = 0.02
     """Measured joints may sit this far outside their limits (encoder noise at an end stop)."""
     max_start_temperature_c: float = 70.0
-    """Every motor must be cooler than this to start (the runtime trip is safety.max_motor_temperature_c)."""
+    """Every motor must be cooler than this to start (the runtime trip is safety.max_motor_temperature_c); at
+    most the motors' rating (robot.g1.MOTOR_MAX_TEMPERATURE_C)."""
     min_battery_v: float = 40.0
-    """Checked when the transport reports a battery voltage (the G1's LowState_ does not)."""
+    """Checked when the transport reports a battery voltage (the G1's LowState_ does not); inside the pack's
+    range (robot.g1.BATTERY_EMPTY_V, BATTERY_FULL_V), where the check can fire."""
     dry_run_s: float = 10.0
     """Lockstep MuJoCo run of the same launch file before the robot moves; it must not fall."""
     input_check_s: float = 0.3
@@ -163,6 +167,16 @@ class DeployConfig:
         if not 0 <= self.realtime_priority <= 99:
             raise LaunchFileError(f"{where}.realtime_priority: {self.realtime_priority} is not a real-time priority "
                                   "(1..99, or 0 for normal scheduling)")
+        if self.max_start_temperature_c > g1.MOTOR_MAX_TEMPERATURE_C:
+            raise LaunchFileError(f"{where}.max_start_temperature_c: {self.max_start_temperature_c} °C is above the "
+                                  f"motors' rating ({g1.MOTOR_MAX_TEMPERATURE_C:g} °C); the start check could never "
+                                  "refuse a motor in time")
+        if not g1.BATTERY_EMPTY_V < self.min_battery_v < g1.BATTERY_FULL_V:
+            never = "fire (the pack is never that low)" if self.min_battery_v <= g1.BATTERY_EMPTY_V else \
+                "pass (the pack is never that high)"
+            raise LaunchFileError(f"{where}.min_battery_v: {self.min_battery_v} V is outside the G1 battery's range "
+                                  f"({g1.BATTERY_EMPTY_V:g} V empty, {g1.BATTERY_FULL_V:g} V full); the check could "
+                                  f"never {never}")
         if self.min_state_rate_hz <= 0 or self.max_start_tilt_rad <= 0 or self.joint_limit_tolerance_rad < 0:
             raise LaunchFileError(f"{where}: min_state_rate_hz and max_start_tilt_rad must be positive, "
                                   "joint_limit_tolerance_rad not negative")
@@ -372,7 +386,7 @@ class LimitsConfig:
     max_vy_mps: float = 0.6
     max_wz_radps: float = 1.0
     max_tilt_rad: float = 1.0
-    """Beyond this pelvis tilt the robot counts as fallen and the loop damps it."""
+    """Beyond this pelvis tilt the robot counts as fallen and the loop damps it (below pi: no tilt exceeds pi)."""
 
     def validate(self, where: str) -> None:
         for name in ("max_vx_mps", "max_vy_mps", "max_wz_radps", "max_tilt_rad"):
@@ -380,6 +394,9 @@ class LimitsConfig:
             if not value > 0:
                 raise LaunchFileError(f"{where}.{name}: {value} must be > 0 (a limit on the magnitude, both "
                                       "directions)")
+        if self.max_tilt_rad >= math.pi:
+            raise LaunchFileError(f"{where}.max_tilt_rad: {self.max_tilt_rad} rad must be below pi ({math.pi:.4f}): "
+                                  "no tilt exceeds pi, so the fall could never be detected")
 
 
 @dataclass
@@ -552,8 +569,8 @@ def parse_launch(data, source: str = "<launch>") -> LaunchFile:
         return from_dict(LaunchFile, data, "")
     except LaunchFileError as exc:
         raise LaunchFileError(f"{source}: {exc}") from None
-    except SafetyConfigError as exc:
-        raise LaunchFileError(f"{source}: safety: {exc}") from None
+    except SafetyConfigError as exc:  # SafetyConfig's own messages, or fall.* (FallConfig, which names its key)
+        raise LaunchFileError(f"{source}: {'safety: ' if str(exc).startswith('SafetyConfig') else ''}{exc}") from None
 
 
 def load_launch(path: str | Path, overrides: Iterable[str] = ()) -> LaunchFile:

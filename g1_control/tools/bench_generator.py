@@ -337,8 +337,8 @@ def _models_table(model_path, lmm_dir, runs_dir, figures: dict) -> None:
     from g1_control.generator import skeleton as S
 
     print("models: training time on this CPU and shipped sizes")
-    rows = [("backbone (shared)", Path(model_path).parent, ("backbone.onnx", "backbone.pt", "feedback.npz")),
-            ("learned motion matching", Path(lmm_dir), ("lmm.onnx", "lmm.pt"))]
+    rows = [("backbone (shared)", Path(model_path).parent, ("backbone.onnx", "feedback.npz")),
+            ("learned motion matching", Path(lmm_dir), ("lmm.onnx",))]
     rows += [(f"backbone {sk} only", Path(runs_dir) / f"gen_{sk}", ("backbone.onnx", "backbone.pt"))
              for sk in S.SKELETONS]
     figures["models"] = {}
