@@ -12,6 +12,7 @@ import pytest
 
 from g1_control.deploy.preflight import FAIL, Preflight
 from g1_control.launch import runner
+from g1_control.report.results import format_summary
 from g1_control.launch.schema import Segment, load_launch
 from tests.paths import LAUNCH_DIR
 
@@ -39,7 +40,7 @@ def test_a_trip_is_recorded_by_its_type_and_the_run_is_a_fault(tripped):
     assert summary["end_reason"] == f"joint_overspeed: {trips[0]['detail']}"
     lines = [json.loads(line) for line in (result.run_dir / "events.jsonl").read_text().splitlines()]
     assert any(r.get("kind") == "joint_overspeed" and r.get("trips") is True for r in lines)
-    assert "s: joint_overspeed (damping): " in runner.format_summary(result)
+    assert "s: joint_overspeed (damping): " in format_summary(result)
 
 
 def test_the_preflight_refuses_a_dry_run_whose_safety_layer_tripped(tripped, monkeypatch):
