@@ -12,8 +12,8 @@ import pytest
 
 from g1_control.deploy.preflight import FAIL, Preflight
 from g1_control.launch import runner
-from g1_control.report.results import format_summary
 from g1_control.launch.schema import Segment, load_launch
+from g1_control.report.results import format_summary
 from tests.paths import LAUNCH_DIR
 
 
