@@ -92,7 +92,7 @@ class RobotEndpoint:
     def stop(self) -> None:
         self._stop.set()
         if self._thread is not None:
-            self._thread.join(timeout=2.0)
+            self._thread.join(timeout=10.0)  # a busy host: the link is closed only after the thread is out
 
     def run(self, seconds: float | None = None) -> EndpointCounters:
         end = time.monotonic() + seconds if seconds is not None else float("inf")
