@@ -401,7 +401,7 @@ def _segment_speed(segment, run_s: float) -> str:
 def _min_state_rate_hz(backend, launch: LaunchFile) -> float:
     from g1_control.hardware.unitree.simulators import min_state_rate_hz
 
-    unset = getattr(backend, "unset_fields", None)
+    unset = backend.unset_fields
     return min_state_rate_hz(unset.profile if unset is not None else None, launch.deploy.min_state_rate_hz)
 
 
@@ -423,7 +423,7 @@ def _simulator_hint(backend, launch: LaunchFile) -> str:
     if launch.backend.simulator is not None:
         return ""
     loopback = launch.backend.type == "unitree_dds" and launch.backend.interface == LOOPBACK
-    sample = getattr(backend, "rejected_sample", None)
+    sample = backend.rejected_sample
     if sample is not None:
         return simulator_hint(sample, loopback=loopback)
     try:
@@ -436,7 +436,7 @@ def _simulator_hint(backend, launch: LaunchFile) -> str:
 def _simulator_filled(backend, launch: LaunchFile) -> str:
     """'; backend.simulator unitree_mujoco (200 Hz, ...): crc 0 accepted unchecked, ...' for the state_stream
     row ('' for a robot)."""
-    unset = getattr(backend, "unset_fields", None)
+    unset = backend.unset_fields
     if unset is None:
         return ""
     filled = unset.describe_filled()
@@ -445,7 +445,7 @@ def _simulator_filled(backend, launch: LaunchFile) -> str:
 
 
 def _mode_machine_filled(backend) -> str:
-    unset = getattr(backend, "unset_fields", None)
+    unset = backend.unset_fields
     if unset is None or "mode_machine" not in unset.filled:
         return ""
     return f" (left 0 by {unset.profile.name}: the launch file's expected_variant assumed)"

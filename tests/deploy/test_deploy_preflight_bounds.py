@@ -31,6 +31,7 @@ class _Robot:
         self.link = SimpleNamespace(describe=lambda: "stand-in link")
         self.timeouts: list = []
         self.sees_peers = can_see_peers
+        self.unset_fields = self.rejected_sample = None  # a robot, not one of Unitree's simulators
 
     def refresh_peers(self):
         assert self.sees_peers, "refresh_peers on a link that cannot see its peers"

@@ -25,6 +25,7 @@ class FakeBackend:
     """A robot reporting `state` at 500 Hz with clean CRCs; `peers` as LinkBackend.peers() says."""
 
     sees_peers = True
+    unset_fields = rejected_sample = None  # a robot, not one of Unitree's simulators
 
     def __init__(self, state: RobotState, peers=(1, 1, 0), battery_v=None):
         self.state, self._peers, self.link = state, peers, _Link()
