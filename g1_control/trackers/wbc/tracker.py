@@ -1,15 +1,17 @@
 """The whole-body controller as a Tracker: act(JointReference, RobotState) -> MotorCommand.
 
-Per tick:
-  1. floating-base state without ground truth: orientation and angular velocity from the IMU,
-     linear velocity from the project's StateEstimator (leg kinematics + accelerometer), position
-     from leg odometry anchored at the stance feet (odometry.py);
-  2. the reference's full configuration (root pose + joints) through forward kinematics gives the
-     task targets: CoM, pelvis and torso orientation, swing-foot poses, hand positions, posture;
-  3. the CoM's horizontal target becomes a CoM acceleration by capture-point feedback clipped to
-     the support polygon (capture_point.py);
-  4. the inverse-dynamics QP (qp.py) returns accelerations, contact wrenches and torques;
-  5. the motor command: feedforward torque plus q/dq targets one tick ahead along the QP's
+Per tick (act() calls one method per step; _contact_state first turns the schedule into contacts):
+  1. _estimate_base: floating-base state without ground truth: orientation and angular velocity
+     from the IMU, linear velocity from the project's StateEstimator (leg kinematics +
+     accelerometer), position from leg odometry anchored at the stance feet (odometry.py);
+  2. _reference_kinematics: the reference's full configuration (root pose + joints) through
+     forward kinematics gives the task targets: CoM, pelvis and torso orientation, swing-foot
+     poses, hand positions, posture;
+  3. _balance_task: the CoM's horizontal target becomes a CoM acceleration by capture-point
+     feedback (capture_point.py);
+  4. _motion_tasks: orientation, swing feet, hands, posture;
+  5. _solve: the inverse-dynamics QP (qp.py) returns accelerations, contact wrenches and torques;
+  6. _motor_command: feedforward torque plus q/dq targets one tick ahead along the QP's
      accelerations, with gains well below the default stiffness (see WbcConfig.kp_scale).
 
 Contact flags come from the reference (JointReference.contacts: the contact schedule). A foot
@@ -116,6 +118,8 @@ class WholeBodyTracker(Tracker):
         self._v = np.zeros(self.dyn.nv)
         self._q_ref = np.zeros(self.dyn.nq)
         self._v_ref = np.zeros(self.dyn.nv)
+        self._sole_pos = np.zeros((2, 3))
+        """This tick's sole positions (world, after the odometry step), left then right."""
         self.reset()
 
     # -- lifecycle ---------------------------------------------------------------------------------
@@ -151,27 +155,46 @@ class WholeBodyTracker(Tracker):
 
     # -- the tick --------------------------------------------------------------------------------------
     def act(self, reference: JointReference, state: RobotState) -> MotorCommand:
-        pin, cfg, dyn = self._pin, self.config, self.dyn
         if not self._started:
             self._start(reference, state)
-        dt = 1.0 / cfg.rate_hz if self._last_t is None else max(1e-4, state.t_s - self._last_t)
+        dt = 1.0 / self.config.rate_hz if self._last_t is None else max(1e-4, state.t_s - self._last_t)
         self._last_t = state.t_s
+        scheduled, stance, load = self._contact_state(reference, state.t_s)
+        shift = self._estimate_base(state, reference, scheduled, stance, dt)
+        com_ref, com_vel_ref = self._reference_kinematics(reference, dt)
+        tasks = [self._balance_task(com_ref, com_vel_ref, stance, shift)]
+        tasks += self._motion_tasks(reference, state, stance, shift, dt)
+        sol = self._solve(tasks, stance, load)
+        if sol is None:
+            return self._command if self.diagnostics.solution is not None else self._hold(state)
+        return self._motor_command(sol, state, dt)
+
+    def _contact_state(self, reference: JointReference, t_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(scheduled, stance, load): the schedule's stance feet; the feet the QP treats as contacts
+        (a foot just lifted stays one while it unloads); each contact's share of its full normal-force
+        allowance (ramped in after touchdown, out after lift-off)."""
+        cfg = self.config
         scheduled = np.asarray(reference.contacts, dtype=bool)
         if not scheduled.any():
             raise WbcConfigError("JointReference.contacts has no foot in contact; the controller needs at "
                                  "least one stance foot (flight phases are not supported)")
         for i in range(2):
             if scheduled[i] and not self._prev_stance[i]:
-                self._stance_since[i] = state.t_s
+                self._stance_since[i] = t_s
             elif not scheduled[i] and self._prev_stance[i]:
-                self._swing_since[i] = state.t_s
+                self._swing_since[i] = t_s
         self._prev_stance[:] = scheduled
-        load = np.clip((state.t_s - self._stance_since) / max(cfg.contact_ramp_s, 1e-6), 0.0, 1.0)
-        unloading = ~scheduled & (state.t_s - self._swing_since < cfg.liftoff_unload_s)
-        load[unloading] = 1.0 - (state.t_s - self._swing_since[unloading]) / max(cfg.liftoff_unload_s, 1e-6)
-        stance = scheduled | unloading
+        load = np.clip((t_s - self._stance_since) / max(cfg.contact_ramp_s, 1e-6), 0.0, 1.0)
+        unloading = ~scheduled & (t_s - self._swing_since < cfg.liftoff_unload_s)
+        load[unloading] = 1.0 - (t_s - self._swing_since[unloading]) / max(cfg.liftoff_unload_s, 1e-6)
+        return scheduled, scheduled | unloading, load
 
-        # 1. floating-base state
+    def _estimate_base(self, state: RobotState, reference: JointReference, scheduled: np.ndarray,
+                       stance: np.ndarray, dt: float) -> np.ndarray:
+        """Step 1, the floating-base state: fills self._q/_v, updates the dynamics (self.dyn) and the
+        odometry; returns the base's shift by this tick's odometry step (positions the dynamics
+        computed before it move with the base). Keeps the soles' positions in self._sole_pos."""
+        dyn = self.dyn
         # Leg-kinematics velocity from the scheduled stance feet (the lower foot is not the stance
         # foot on a step: with it, a trailing foot swinging up read as the body falling, measured).
         est = self.estimator.update(state, scheduled if scheduled.all() or not stance.all() else stance)
@@ -190,10 +213,15 @@ class WholeBodyTracker(Tracker):
         offsets = sole_pos_before - q[:3]
         base_prev = q[:3].copy()
         base = self.odometry.update(dt, est.base_linvel_w_mps, offsets, stance)
-        shift = base - base_prev  # positions computed before the odometry step move with the base
+        shift = base - base_prev
         q[:3] = base
+        self._sole_pos = sole_pos_before + shift
+        return shift
 
-        # 2. reference kinematics
+    def _reference_kinematics(self, reference: JointReference, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Step 2: the reference's full configuration through forward kinematics (into self.ref_data);
+        returns the reference CoM and its velocity, and filters the CoM's reference acceleration."""
+        pin, dyn = self._pin, self.dyn
         qr, vr, rd = self._q_ref, self._v_ref, self.ref_data
         rq = reference.root_quat_wxyz
         qr[:3] = reference.root_pos_w_m
@@ -216,11 +244,15 @@ class WholeBodyTracker(Tracker):
             raw = (com_vel_ref - self._com_vel_ref_prev) / dt
             self._com_acc_ref += min(1.0, dt / 0.02) * (raw - self._com_acc_ref)
         self._com_vel_ref_prev = com_vel_ref
+        return com_ref, com_vel_ref
 
-        # 3. balance: CoM acceleration from capture-point feedback
+    def _balance_task(self, com_ref: np.ndarray, com_vel_ref: np.ndarray, stance: np.ndarray,
+                      shift: np.ndarray) -> AccelerationTask:
+        """Step 3, balance: the CoM task, its horizontal acceleration from capture-point feedback."""
+        cfg, dyn = self.config, self.dyn
         com = dyn.com_m + shift
         com_vel = dyn.com_vel_mps
-        sole_pos = sole_pos_before + shift
+        sole_pos = self._sole_pos
         sole_rot = np.array([dyn.data.oMf[f].rotation for f in dyn.sole_ids])
         ground_z = float(np.mean(sole_pos[stance, 2]))
         omega = cp.lipm_frequency(max(com[2] - ground_z, 0.2))
@@ -234,12 +266,16 @@ class WholeBodyTracker(Tracker):
         a_com = np.empty(3)
         a_com[:2] = omega**2 * (com[:2] - cop)
         a_com[2] = self._com_acc_ref[2] + h.kp * (com_ref[2] - com[2]) + h.kd * (com_vel_ref[2] - com_vel[2])
-        tasks: list[AccelerationTask] = [
-            AccelerationTask("com", dyn.com_jac, a_com - dyn.com_drift,
-                             np.array([cfg.com_xy_weight, cfg.com_xy_weight, h.weight])),
-        ]
+        diag = self.diagnostics
+        diag.com_m, diag.com_ref_m, diag.cop_des_xy_m = com, com_ref, cop
+        return AccelerationTask("com", dyn.com_jac, a_com - dyn.com_drift,
+                                np.array([cfg.com_xy_weight, cfg.com_xy_weight, h.weight]))
 
-        # 4. orientation, swing feet, hands, posture
+    def _motion_tasks(self, reference: JointReference, state: RobotState, stance: np.ndarray,
+                      shift: np.ndarray, dt: float) -> list[AccelerationTask]:
+        """Step 4: pelvis and torso orientation, swing feet, hands, posture, from the reference."""
+        pin, cfg, dyn, rd = self._pin, self.config, self.dyn, self.ref_data
+        tasks: list[AccelerationTask] = []
         lwa = pin.LOCAL_WORLD_ALIGNED
         for fid, gains in ((dyn.pelvis_id, cfg.pelvis_orientation), (dyn.torso_id, cfg.torso_orientation)):
             ft = dyn.frame(fid)
@@ -270,25 +306,30 @@ class WholeBodyTracker(Tracker):
                                            rd.oMf[fid].translation, ref_v, np.zeros(3), cfg.hands))
         tasks.append(posture_task(dyn.nv, state.q_rad, state.dq_radps, reference.q_rad, reference.dq_radps,
                                   cfg.posture))
+        return tasks
 
-        # 5. solve and command
+    def _solve(self, tasks: list[AccelerationTask], stance: np.ndarray, load: np.ndarray) -> IdSolution | None:
+        """Step 5: the inverse-dynamics QP; None when even the relaxed retry fails."""
         diag = self.diagnostics
         diag.ticks += 1
-        diag.base_pos_w_m = base.copy()
-        diag.com_m, diag.com_ref_m, diag.cop_des_xy_m = com, com_ref, cop
+        diag.base_pos_w_m = self._q[:3].copy()
         try:
-            sol = self.qp.solve(dyn, tasks, stance, load)
+            sol = self.qp.solve(self.dyn, tasks, stance, load)
         except WbcSolveError:
             # Seen at touchdown: a foot landing fast cannot be stopped at once within the torque
             # and force limits while its load is still ramping in. Retry with the contact
             # allowed its full load and no velocity damping; failing that, keep the last command.
             diag.solve_failures += 1
             try:
-                sol = self.qp.solve(dyn, tasks, stance, np.ones(2), contact_damping_per_s=0.0)
+                sol = self.qp.solve(self.dyn, tasks, stance, np.ones(2), contact_damping_per_s=0.0)
             except WbcSolveError:
                 diag.unsolved_ticks += 1
-                return self._command if diag.solution is not None else self._hold(state)
+                return None
         diag.solution = sol
+        return sol
+
+    def _motor_command(self, sol: IdSolution, state: RobotState, dt: float) -> MotorCommand:
+        """Step 6: feedforward torque plus q/dq targets one tick ahead along the QP's accelerations."""
         out = self._command
         ddq = sol.ddq[6:]
         out.tau_nm[:] = sol.tau_nm
