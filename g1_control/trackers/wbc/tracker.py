@@ -21,6 +21,7 @@ that touches down takes load gradually (contact_ramp_s), so torques do not jump.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
@@ -29,8 +30,9 @@ from g1_control.estimation.estimator import StateEstimator
 from g1_control.interfaces import Tracker
 from g1_control.robot import g1
 from g1_control.robot.dynamics import WbcModel
-from g1_control.rotations import quat_to_rot, yaw_of
+from g1_control.rotations import quat_to_rot, yaw_of, yaw_of_matrix
 from g1_control.trackers.wbc import capture_point as cp
+from g1_control.trackers.wbc.gait import GaitConfig, VelocityGait, yaw_rotation
 from g1_control.trackers.wbc.odometry import BaseOdometry
 from g1_control.trackers.wbc.qp import IdSolution, InverseDynamicsQP, QpConfig
 from g1_control.trackers.wbc.tasks import (
@@ -72,8 +74,22 @@ class WbcConfig:
     only holds the joints along the QP's one-tick-ahead prediction between controller ticks and
     absorbs model error. At full default stiffness the PD would override the QP's balance torques."""
     qp: QpConfig = field(default_factory=QpConfig)
+    footsteps: Literal["plan", "velocity"] = "plan"
+    """plan: the feet follow the reference's contact schedule and poses (a scripted or goal plan);
+    velocity: the controller walks by its own gait (gait.py) from the reference's root twist (heading
+    frame), taking only the upper body's posture and the pelvis height from the reference."""
+    gait: GaitConfig = field(default_factory=GaitConfig)
+    walking_com_lower_m: float = 0.03
+    """Walking by its own gait, the CoM is held this much below its standing height: bent knees keep
+    the stance leg away from the straight-knee singularity at the end of a long step."""
+    walking_com_weight: tuple[float, float] = (1000.0, 1000.0)
+    """QP weights of the CoM task's horizontal and vertical rows when walking by the gait."""
+    walking_leg_posture_weight: float = 0.05
+    """Walking by its own gait, the legs' posture task is only a regulariser (relative to `posture`)."""
 
     def __post_init__(self) -> None:
+        if self.footsteps not in ("plan", "velocity"):
+            raise WbcConfigError(f"WbcConfig.footsteps must be 'plan' or 'velocity'; got {self.footsteps!r}")
         if self.rate_hz <= 0:
             raise WbcConfigError(f"WbcConfig.rate_hz must be > 0; got {self.rate_hz}")
         for name in ("kp_scale", "kd_scale", "contact_ramp_s", "liftoff_unload_s", "capture_point_gain", "com_xy_weight"):
@@ -120,7 +136,23 @@ class WholeBodyTracker(Tracker):
         self._v_ref = np.zeros(self.dyn.nv)
         self._sole_pos = np.zeros((2, 3))
         """This tick's sole positions (world, after the odometry step), left then right."""
+        self._sole_yaw = np.zeros(2)
+        self._dcm_xy = np.zeros(2)
+        self.gait = VelocityGait(self.config.gait) if self.config.footsteps == "velocity" else None
+        self._com_height_m, self._pelvis_height_m = self._standing_heights()
+        self._posture_weights = np.ones(self.dyn.nv - 6)
+        self._posture_weights[list(g1.LEG_JOINTS)] = self.config.walking_leg_posture_weight
         self.reset()
+
+    def _standing_heights(self) -> tuple[float, float]:
+        """CoM and pelvis heights above the soles in the default pose (the gait's nominal)."""
+        pin, m, d = self._pin, self.dyn.model, self.ref_data
+        q = pin.neutral(m)
+        q[7:] = g1.DEFAULT_Q_RAD
+        pin.framesForwardKinematics(m, d, q)
+        ground = min(d.oMf[f].translation[2] for f in self.dyn.sole_ids)
+        com = pin.centerOfMass(m, d, q)
+        return float(com[2] - ground), float(-ground)
 
     # -- lifecycle ---------------------------------------------------------------------------------
     def reset(self, state: RobotState | None = None) -> None:
@@ -135,6 +167,8 @@ class WholeBodyTracker(Tracker):
         self._com_acc_ref = np.zeros(3)
         self._frame_vel_ref_prev: dict[int, np.ndarray] = {}
         self.diagnostics = WbcDiagnostics()
+        if self.gait is not None:
+            self.gait.reset()
 
     def _start(self, reference: JointReference, state: RobotState) -> None:
         """First tick: the odometry's world frame is the reference's; the robot starts at the
@@ -143,9 +177,20 @@ class WholeBodyTracker(Tracker):
         lowest = offsets[:, 2].min()
         base = np.array([reference.root_pos_w_m[0], reference.root_pos_w_m[1], -lowest])
         self.odometry.reset(base, offsets)
+        self._sole_pos = base + offsets
+        self._sole_yaw = self._yaws(self.ref_data)  # _sole_offsets left the measured pose's kinematics there
+        self._dcm_xy = self._sole_pos[:, :2].mean(axis=0)
         self._stance_since[:] = -np.inf
         self._prev_stance[:] = reference.contacts
         self._started = True
+
+    def _yaws(self, data) -> np.ndarray:
+        """The soles' headings in `data`'s frame placements."""
+        out = self._sole_yaw
+        for i, fid in enumerate(self.dyn.sole_ids):
+            r = data.oMf[fid].rotation
+            out[i] = np.arctan2(r[1, 0], r[0, 0])
+        return out
 
     def _sole_offsets(self, quat_wxyz: np.ndarray, q_rad: np.ndarray) -> np.ndarray:
         pin, m, d = self._pin, self.dyn.model, self.ref_data
@@ -159,22 +204,30 @@ class WholeBodyTracker(Tracker):
             self._start(reference, state)
         dt = 1.0 / self.config.rate_hz if self._last_t is None else max(1e-4, state.t_s - self._last_t)
         self._last_t = state.t_s
-        scheduled, stance, load = self._contact_state(reference, state.t_s)
+        if self.gait is not None:
+            schedule = self.gait.schedule(state.t_s, self._walk_command(reference), self._sole_pos, self._sole_yaw,
+                                          self._dcm_xy)
+        else:
+            schedule = reference.contacts
+        scheduled, stance, load = self._contact_state(schedule, state.t_s)
         shift = self._estimate_base(state, reference, scheduled, stance, dt)
         com_ref, com_vel_ref = self._reference_kinematics(reference, dt)
-        tasks = [self._balance_task(com_ref, com_vel_ref, stance, shift)]
-        tasks += self._motion_tasks(reference, state, stance, shift, dt)
+        if self.gait is None:
+            tasks = [self._balance_task(com_ref, com_vel_ref, stance, shift)]
+            tasks += self._motion_tasks(reference, state, stance, shift, dt)
+        else:
+            tasks = self._walking_tasks(reference, state, stance, shift, dt)
         sol = self._solve(tasks, stance, load)
         if sol is None:
             return self._command if self.diagnostics.solution is not None else self._hold(state)
         return self._motor_command(sol, state, dt)
 
-    def _contact_state(self, reference: JointReference, t_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(scheduled, stance, load): the schedule's stance feet; the feet the QP treats as contacts
+    def _contact_state(self, schedule: np.ndarray, t_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(scheduled, stance, load): the schedule's stance feet (the reference's, or the gait's); the feet the QP treats as contacts
         (a foot just lifted stays one while it unloads); each contact's share of its full normal-force
         allowance (ramped in after touchdown, out after lift-off)."""
         cfg = self.config
-        scheduled = np.asarray(reference.contacts, dtype=bool)
+        scheduled = np.asarray(schedule, dtype=bool)
         if not scheduled.any():
             raise WbcConfigError("JointReference.contacts has no foot in contact; the controller needs at "
                                  "least one stance foot (flight phases are not supported)")
@@ -216,6 +269,7 @@ class WholeBodyTracker(Tracker):
         shift = base - base_prev
         q[:3] = base
         self._sole_pos = sole_pos_before + shift
+        self._yaws(dyn.data)
         return shift
 
     def _reference_kinematics(self, reference: JointReference, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -306,6 +360,59 @@ class WholeBodyTracker(Tracker):
                                            rd.oMf[fid].translation, ref_v, np.zeros(3), cfg.hands))
         tasks.append(posture_task(dyn.nv, state.q_rad, state.dq_radps, reference.q_rad, reference.dq_radps,
                                   cfg.posture))
+        return tasks
+
+    @staticmethod
+    def _walk_command(reference: JointReference) -> np.ndarray:
+        """(vx, vy, wz) in the heading frame: what the gait walks."""
+        lin, ang = reference.root_linvel_h_mps, reference.root_angvel_h_radps
+        return np.array([lin[0], lin[1], ang[2]])
+
+    def _walking_tasks(self, reference: JointReference, state: RobotState, stance: np.ndarray,
+                       shift: np.ndarray, dt: float) -> list[AccelerationTask]:
+        """Steps 3-4 when walking by the gait: the CoM from the gait's CoP (LIPM), the pelvis and
+        torso at the gait's heading (the torso's pose relative to the pelvis from the reference),
+        the swing foot along the gait's path, the reference's posture (legs only regularised)."""
+        cfg, dyn, rd = self.config, self.dyn, self.ref_data
+        assert self.gait is not None
+        com = dyn.com_m + shift
+        com_vel = dyn.com_vel_mps
+        ground_z = float(np.mean(self._sole_pos[stance, 2]))
+        omega = cp.lipm_frequency(max(com[2] - ground_z, 0.2))
+        self._dcm_xy = cp.capture_point(com[:2], com_vel[:2], omega)
+        gt = self.gait.update(state.t_s, dt, self._sole_pos, self._sole_yaw,
+                              self._dcm_xy, omega)
+        h = cfg.com_height
+        height = self._com_height_m - cfg.walking_com_lower_m
+        if reference.pelvis_height_m is not None:
+            height += reference.pelvis_height_m - self._pelvis_height_m
+        a_com = np.empty(3)
+        a_com[:2] = omega**2 * (com[:2] - gt.cop_xy_m)
+        a_com[2] = h.kp * (ground_z + height - com[2]) - h.kd * com_vel[2]
+        diag = self.diagnostics
+        diag.com_m, diag.cop_des_xy_m = com, gt.cop_xy_m.copy()
+        diag.com_ref_m = np.array([*self._dcm_xy, ground_z + height])
+        wxy, wz = cfg.walking_com_weight
+        tasks = [AccelerationTask("com", dyn.com_jac, a_com - dyn.com_drift, np.array([wxy, wxy, wz]))]
+        heading_rot = yaw_rotation(gt.heading_rad)
+        yaw_rate = np.array([0.0, 0.0, gt.yaw_rate_radps])
+        pelvis_ref = rd.oMf[dyn.pelvis_id].rotation
+        for fid, gains in ((dyn.pelvis_id, cfg.pelvis_orientation), (dyn.torso_id, cfg.torso_orientation)):
+            ft = dyn.frame(fid)
+            # the reference's pose relative to its own heading, turned to the gait's heading
+            ref_rot = heading_rot @ yaw_rotation(-float(yaw_of_matrix(pelvis_ref))) @ rd.oMf[fid].rotation
+            tasks.append(orientation_task("orientation", ft.jac_w[3:], ft.drift_w[3:], ft.rot_w, ft.vel_w[3:],
+                                          ref_rot, yaw_rate, gains))
+        f = gt.swing_foot
+        if f >= 0 and not stance[f]:
+            ft = dyn.frame(dyn.sole_ids[f])
+            tasks.append(position_task("swing_foot", ft.jac_w[:3], ft.drift_w[:3], ft.pos_w_m + shift, ft.vel_w[:3],
+                                       gt.swing_pos_m, gt.swing_vel_mps, gt.swing_acc_mps2, cfg.swing_foot))
+            tasks.append(orientation_task("swing_foot_rot", ft.jac_w[3:], ft.drift_w[3:], ft.rot_w, ft.vel_w[3:],
+                                          yaw_rotation(gt.swing_yaw_rad), np.array([0.0, 0.0, gt.swing_yaw_rate_radps]),
+                                          cfg.swing_foot))
+        tasks.append(posture_task(dyn.nv, state.q_rad, state.dq_radps, reference.q_rad, reference.dq_radps,
+                                  cfg.posture, self._posture_weights))
         return tasks
 
     def _solve(self, tasks: list[AccelerationTask], stance: np.ndarray, load: np.ndarray) -> IdSolution | None:
