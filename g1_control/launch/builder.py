@@ -61,7 +61,8 @@ def make_tracker(launch: LaunchFile) -> Tracker:
     if cfg.type == "wbc":
         from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
 
-        return WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz))
+        footsteps = "plan" if launch.generator.type == "scripted" else "velocity"
+        return WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz, footsteps=footsteps))
     if cfg.type == "wbt":
         from g1_control.trackers.wbt import WbtPolicyTracker
 

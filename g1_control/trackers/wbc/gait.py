@@ -59,7 +59,7 @@ class GaitConfig:
     step_width_m: float = 0.22
     """Sole centre to sole centre, side to side, walking straight."""
     min_width_m: float = 0.16
-    max_width_m: float = 0.4
+    max_width_m: float = 0.45
     max_forward_m: float = 0.42
     """Landing sole ahead of the stance sole, at most (heading frame of the step)."""
     max_backward_m: float = 0.32
@@ -92,6 +92,9 @@ class GaitConfig:
     feet's measured touchdowns) is added to the speed the steps are planned for: the pendulum model
     is not the robot, and without it the robot walks ~20 % slow (measured)."""
     max_speed_correction_mps: float = 0.4
+    speed_margin: float = 0.85
+    """The gait walks at most this fraction of the speeds its step limits allow (the rest is left
+    for the step adjustment that balance needs)."""
     stop_tolerance_m: float = 0.05
     """Stopping needs the feet side by side within this (else it steps once more)."""
 
@@ -240,7 +243,7 @@ class VelocityGait:
         walked = self.command_h
         if self.mode == "walk":
             step = np.asarray(cfg.max_accel) * dt
-            walked += np.clip(np.asarray(command_h, dtype=float) - walked, -step, step)
+            walked += np.clip(self.feasible(command_h) - walked, -step, step)
         else:
             walked[:] = 0.0
         command_h = walked
@@ -282,6 +285,18 @@ class VelocityGait:
         self.targets.mode = self.mode
         return contacts
 
+    def feasible(self, command_h: np.ndarray) -> np.ndarray:
+        """`command_h` within what the step limits allow (GaitConfig.speed_margin of them)."""
+        cfg = self.config
+        T, m = cfg.step_s, cfg.speed_margin
+        out = np.array(command_h, dtype=float)
+        out[0] = min(max(out[0], -m * cfg.max_backward_m / T), m * cfg.max_forward_m / T)
+        vy = m * (cfg.max_width_m - cfg.step_width_m) / (2 * T)
+        out[1] = min(max(out[1], -vy), vy)
+        wz = m * cfg.max_relative_yaw_rad / T
+        out[2] = min(max(out[2], -wz), wz)
+        return out
+
     def _correct_speed(self, t_s: float, foot: int, landed_xy: np.ndarray) -> None:
         """A foot has landed: compare the stride since its last touchdown with the command walked."""
         cfg = self.config
@@ -292,6 +307,8 @@ class VelocityGait:
             c = self.speed_correction_h
             c += cfg.speed_feedback_gain * (self.command_h[:2] - v_h)
             np.clip(c, -cfg.max_speed_correction_mps, cfg.max_speed_correction_mps, out=c)
+            # no wind-up: the corrected command stays within the step limits
+            c[:] = self.feasible(np.array([*(self.command_h[:2] + c), 0.0]))[:2] - self.command_h[:2]
         self._td_pos[foot] = landed_xy
         self._td_t[foot] = t_s
 
