@@ -61,8 +61,10 @@ def make_tracker(launch: LaunchFile) -> Tracker:
     if cfg.type == "wbc":
         from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
 
-        footsteps = "plan" if launch.generator.type == "scripted" else "velocity"
-        return WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz, footsteps=footsteps))
+        # a scripted reference plans the feet; any other generator gives a root twist to walk
+        if launch.generator.type == "scripted":
+            return WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz, footsteps="plan"))
+        return WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz, footsteps="velocity"))
     if cfg.type == "wbt":
         from g1_control.trackers.wbt import WbtPolicyTracker
 
