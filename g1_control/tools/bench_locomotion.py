@@ -1,0 +1,230 @@
+"""`g1 bench locomotion`: the model-based controller's walking against holosoma's ppo and fastsac
+walking policies, in one run, one table: per axis and speed, what the robot achieved against
+what was commanded, falls, and the CPU cost of each tracker's act().
+
+Every row is one launch through the one loop builder in lockstep MuJoCo: the velocity generator,
+1 s standing, then the command for --seconds; the WBC (tracker.type wbc, its own gait) at 250 Hz,
+the policies (tracker.type policy, their trained command range, not the shipped envelope) at their
+50 Hz. Figures, all from the simulator's ground truth:
+  achieved   mean heading-frame (vx, vy, wz) over whole gait cycles after the first STEADY_SKIP_S
+             of walking (the WBC's stride is two of its steps; the policies' gait period is 1 s);
+  error      achieved minus commanded on the commanded axis, in % of the command;
+  off-axis   the largest |achieved| of the two uncommanded axes (m/s or rad/s);
+  fell       the loop's fall monitor (pelvis below 0.4 m or tilted), and the lowest pelvis height;
+  act CPU    p50/p99 of the tracker's act() in thread CPU time (not wall time: the machines are
+             shared), beside pinocchio RNEA + CRBA on the WBC's visited states in the same run.
+Exits 1 when any row fell.
+
+    g1 bench locomotion                          # every row (~15 min)
+    g1 bench locomotion --only wbc --seconds 10  # rows whose name starts with a prefix
+    g1 bench locomotion --json out.json
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from g1_control.teleop.scripted import Segment
+
+CONTROLLERS: dict[str, tuple[str, str, float]] = {
+    "wbc": ("wbc", "", 250.0),
+    "ppo": ("policy", "holosoma_loco_ppo", 50.0),
+    "fastsac": ("policy", "holosoma_loco_fastsac", 50.0),
+}
+"""name -> (tracker.type, tracker.policy, tracker rate Hz)."""
+POLICY_GAIT_PERIOD_S = 1.0
+
+
+@dataclass(frozen=True)
+class Case:
+    name: str
+    command: tuple[float, float, float]
+    """(vx m/s, vy m/s, wz rad/s) in the heading frame."""
+    style: str = "default"
+
+
+CASES = (
+    Case("forward_0.5", (0.5, 0.0, 0.0)),
+    Case("forward_1.0", (1.0, 0.0, 0.0)),
+    Case("backward_0.5", (-0.5, 0.0, 0.0)),
+    Case("sideways_0.4", (0.0, 0.4, 0.0)),
+    Case("turning_1.2", (0.0, 0.0, 1.2)),
+)
+STEADY_SKIP_S = 3.0
+
+
+@dataclass
+class Row:
+    controller: str
+    case: str
+    command: list[float]
+    achieved: list[float] = field(default_factory=lambda: [math.nan] * 3)
+    error_pct: float = math.nan
+    off_axis: float = math.nan
+    fell: bool = False
+    fall: str = ""
+    min_pelvis_m: float = math.nan
+    act_cpu_p50_us: float = math.nan
+    act_cpu_p99_us: float = math.nan
+    sim_s: float = 0.0
+    wall_s: float = 0.0
+
+    @property
+    def name(self) -> str:
+        return f"{self.controller}/{self.case}"
+
+
+def steady_velocity(log: dict[str, np.ndarray], t_from_s: float, t_to_s: float, period_s: float) -> np.ndarray:
+    """Mean of the true heading-frame (vx, vy, wz) over whole `period_s` cycles from t_from_s."""
+    cycles = math.floor((t_to_s - t_from_s) / period_s + 1e-9)
+    if cycles < 1:
+        raise ValueError(f"no whole gait cycle of {period_s:.2f} s between {t_from_s:.2f} and {t_to_s:.2f} s")
+    t = log["t_s"]
+    window = (t >= t_from_s - 1e-9) & (t < t_from_s + cycles * period_s - 1e-9)
+    return log["velocity_true"][window].mean(axis=0)
+
+
+def case_launch(controller: str, case: Case, walk_s: float):
+    from g1_control.launch.schema import LaunchFile
+
+    kind, policy, hz = CONTROLLERS[controller]
+    vx, vy, wz = case.command
+    launch = LaunchFile(name=f"locomotion_{controller}_{case.name}")
+    launch.input.timeline = [Segment(1.0, style=case.style, label="stand"),
+                             Segment(walk_s, vx_mps=vx, vy_mps=vy, wz_radps=wz, style=case.style, label="walk")]
+    launch.generator.type = "velocity"
+    launch.tracker.type = kind  # type: ignore[assignment]
+    if policy:
+        launch.tracker.policy = policy
+    launch.tracker.envelope_limits = False
+    launch.rates.tracker_hz = hz
+    launch.limits.max_vx_mps = max(launch.limits.max_vx_mps, abs(vx))
+    launch.limits.max_vy_mps = max(launch.limits.max_vy_mps, abs(vy))
+    launch.limits.max_wz_radps = max(launch.limits.max_wz_radps, abs(wz))
+    launch.validate("locomotion")
+    launch.output.video, launch.output.plot, launch.viewer = False, False, False
+    return launch
+
+
+def run_case(controller: str, case: Case, walk_s: float, states: list | None = None) -> Row:
+    """One row. `states`: gets (q, v) samples of the run appended (the RNEA + CRBA baseline)."""
+    from g1_control.launch.builder import build_loop
+
+    loop = build_loop(case_launch(controller, case, walk_s))
+    loop.reset()
+    tracker = loop.tracker
+    cpu: list[int] = []
+    act = tracker.act
+
+    keep = states is not None and controller == "wbc"
+
+    def timed_act(reference, state):
+        t0 = time.thread_time_ns()
+        out = act(reference, state)
+        cpu.append(time.thread_time_ns() - t0)
+        if keep and len(cpu) % 10 == 0:  # the WBC's own (q, v) this tick: the baseline's inputs
+            states.append((tracker._q.copy(), tracker._v.copy()))  # type: ignore[attr-defined, union-attr]
+        return out
+
+    tracker.act = timed_act  # type: ignore[method-assign]
+    duration = 1.0 + walk_s
+    t0 = time.perf_counter()
+    try:
+        loop.scheduler.run(round(duration * loop.rates.lowlevel_hz), stop=lambda: loop.fell)
+    finally:
+        wall = time.perf_counter() - t0
+        loop.backend.close()
+    log = loop.log.arrays()
+    row = Row(controller, case.name, list(case.command), sim_s=float(loop.time_s), wall_s=wall)
+    row.fell = loop.fell
+    row.fall = str(loop.fall) if loop.fall else ""
+    row.min_pelvis_m = float(log["base_pos_m"][:, 2].min())
+    samples = np.asarray(cpu, dtype=float) / 1e3
+    row.act_cpu_p50_us, row.act_cpu_p99_us = (float(v) for v in np.percentile(samples, [50, 99]))
+    if not row.fell:
+        period = 2 * tracker.config.gait.step_s if controller == "wbc" else POLICY_GAIT_PERIOD_S  # type: ignore[attr-defined]
+        achieved = steady_velocity(log, 1.0 + STEADY_SKIP_S, duration, period)
+        row.achieved = [float(v) for v in achieved]
+        axis = int(np.argmax(np.abs(case.command)))
+        row.error_pct = 100.0 * (achieved[axis] - case.command[axis]) / case.command[axis]
+        row.off_axis = float(max(abs(achieved[k]) for k in range(3) if k != axis))
+    return row
+
+
+def rnea_crba_cpu_us(states: list[tuple[np.ndarray, np.ndarray]]) -> tuple[float, float]:
+    """p50/p99 thread CPU time (us) of pinocchio RNEA + CRBA on `states` (the WBC's model)."""
+    import pinocchio as pin
+
+    from g1_control.robot.dynamics import build_model
+
+    model = build_model()
+    data = model.createData()
+    a0 = np.zeros(model.nv)
+    samples = []
+    for q, v in states:
+        t0 = time.thread_time_ns()
+        pin.rnea(model, data, q, v, a0)
+        pin.crba(model, data, q)
+        samples.append((time.thread_time_ns() - t0) / 1e3)
+    p50, p99 = np.percentile(samples, [50, 99])
+    return float(p50), float(p99)
+
+
+def run_table(controllers: list[str], cases: list[Case], walk_s: float, only: list[str] | None = None,
+              echo=print) -> tuple[list[Row], tuple[float, float]]:
+    """Every (controller, case) row whose name starts with one of `only` (all when None), and the
+    RNEA + CRBA baseline (nan without a WBC row)."""
+    rows: list[Row] = []
+    states: list = []
+    for case in cases:
+        for controller in controllers:
+            name = f"{controller}/{case.name}"
+            if only and not any(name.startswith(p) for p in only):
+                continue
+            row = run_case(controller, case, walk_s, states)
+            rows.append(row)
+            echo(format_row(row))
+    baseline = rnea_crba_cpu_us(states) if states else (math.nan, math.nan)
+    return rows, baseline
+
+
+HEADER = (f"{'controller/case':<24} {'command':>17} {'achieved':>23} {'error %':>8} {'off-axis':>8} {'fell':>5} "
+          f"{'min z m':>7} {'act CPU p50/p99 us':>19}")
+
+
+def format_row(row: Row) -> str:
+    cmd = "({:+.2f} {:+.2f} {:+.2f})".format(*row.command)
+    got = "({:+.3f} {:+.3f} {:+.3f})".format(*row.achieved) if not row.fell else "-"
+    return (f"{row.name:<24} {cmd:>17} {got:>23} {row.error_pct:8.1f} {row.off_axis:8.3f} "
+            f"{'FELL' if row.fell else 'no':>5} {row.min_pelvis_m:7.3f} "
+            f"{row.act_cpu_p50_us:9.0f}/{row.act_cpu_p99_us:<9.0f}")
+
+
+def main(args) -> int:
+    only = [p for p in (args.only or "").split(",") if p] or None
+    walk_s = float(args.seconds)
+    print(f"g1 bench locomotion: {walk_s:.0f} s per row after 1 s standing; achieved = ground-truth mean over whole "
+          f"gait cycles after {STEADY_SKIP_S:.0f} s of walking; act() in thread CPU time")
+    print(HEADER, flush=True)
+    rows, (base50, base99) = run_table(list(CONTROLLERS), list(CASES), walk_s, only,
+                                       echo=lambda line: print(line, flush=True))
+    print(f"baseline, same run: pinocchio RNEA + CRBA on the WBC's visited states: p50 {base50:.0f} us, "
+          f"p99 {base99:.0f} us (thread CPU)")
+    for row in rows:
+        if row.controller == "wbc" and np.isfinite(base50):
+            print(f"  {row.name}: act()/RNEA+CRBA p50 {row.act_cpu_p50_us / base50:.1f}x; p99 {row.act_cpu_p99_us:.0f} us "
+                  f"= {row.act_cpu_p99_us / 4000 * 100:.0f} % of the 4 ms tick at 250 Hz")
+    falls = [row.name for row in rows if row.fell]
+    if falls:
+        print(f"FELL: {', '.join(falls)}")
+    if args.json:
+        Path(args.json).write_text(json.dumps({"walk_s": walk_s, "steady_skip_s": STEADY_SKIP_S,
+                                               "rnea_crba_cpu_p50_us": base50, "rnea_crba_cpu_p99_us": base99,
+                                               "rows": [asdict(r) for r in rows]}, indent=2))
+    return 1 if falls else 0
