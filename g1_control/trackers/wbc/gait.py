@@ -63,14 +63,14 @@ class GaitConfig:
     max_forward_m: float = 0.42
     """Landing sole ahead of the stance sole, at most (heading frame of the step)."""
     max_backward_m: float = 0.32
-    max_relative_yaw_rad: float = 0.5
+    max_relative_yaw_rad: float = 0.7
     swing_height_m: float = 0.07
     swing_rise: float = 0.4
     swing_fall: float = 0.4
     """Fractions of the single support the swing foot takes to rise to its apex and to come down."""
-    swing_hold_s: float = 0.1
+    swing_hold_s: float = 0.05
     """Fraction of the single support the swing foot rises before it moves across."""
-    swing_arrive_early_s: float = 0.04
+    swing_arrive_early_s: float = 0.02
     """The horizontal swing ends this long before touchdown (the foot comes straight down)."""
     freeze_landing_after: float = 0.75
     """Fraction of the single support after which the landing point no longer moves."""
