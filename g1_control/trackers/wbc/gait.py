@@ -87,6 +87,11 @@ class GaitConfig:
     max_accel: tuple[float, float, float] = (0.8, 0.8, 2.0)
     """The command the gait walks follows the operator's at most this fast (m/s^2, m/s^2, rad/s^2):
     a step's length cannot change much from the one before without a large DCM error."""
+    timing_adjust_excess_m: float = 0.03
+    """A landing point this far beyond the step limits makes the step land sooner (step timing)."""
+    min_swing_s: float = 0.2
+    min_remaining_s: float = 0.08
+    """A step made sooner still swings this long in all, and lands no sooner than this from now."""
     speed_feedback_gain: float = 0.3
     """Per stride, this fraction of the error between the command and the stride's speed (from the
     feet's measured touchdowns) is added to the speed the steps are planned for: the pendulum model
@@ -218,6 +223,8 @@ class VelocityGait:
         self._ref = np.zeros((4, 3))
         """Swing reference (x, y, yaw) rows: position, velocity, acceleration; row 3 unused."""
         self._dcm_from = np.zeros(2)
+        self.step_T = self.config.step_s
+        """This step's duration (touchdown to touchdown): shortened when balance needs a step sooner."""
         self._lifted_at = math.nan
         """The _t0 of the step whose swing has started (nan: none)."""
         self.command_h = np.zeros(3)
@@ -264,13 +271,14 @@ class VelocityGait:
             self.mode, self._t0 = "walk", t_s - cfg.double_support_s
             self._lift(soles_m, sole_yaws)
         if self.mode == "walk":
-            if t_s - self._t0 >= cfg.step_s:
+            if t_s - self._t0 >= self.step_T:
                 # touchdown of the swing foot: it becomes the stance foot
                 self.touchdowns.append((t_s, 1 - self.stance, self._landing.copy()))
                 self._correct_speed(t_s, 1 - self.stance, soles_m[1 - self.stance, :2])
                 self.steps += 1
                 self.stance = 1 - self.stance
-                self._t0 += cfg.step_s
+                self._t0 += self.step_T
+                self.step_T = cfg.step_s
                 if not moving and self._side_by_side(soles_m, sole_yaws):
                     self.mode, self._t0 = "stop", t_s
                     self._dcm_from = np.array(dcm_xy, dtype=float)
@@ -311,6 +319,19 @@ class VelocityGait:
             c[:] = self.feasible(np.array([*(self.command_h[:2] + c), 0.0]))[:2] - self.command_h[:2]
         self._td_pos[foot] = landed_xy
         self._td_t[foot] = t_s
+
+    def _landing_for(self, t_r: float, p: np.ndarray, u: np.ndarray, f: int, dcm_xy: np.ndarray, omega: float,
+                     command_h: np.ndarray) -> tuple[float, np.ndarray, float]:
+        """(heading at touchdown, unclipped landing relative to the stance sole in that heading
+        frame, how far (m) it lies beyond the step limits) for a touchdown t_r from now."""
+        cfg = self.config
+        heading_td = self.heading + float(command_h[2]) * t_r
+        xi_td = p + (dcm_xy - p) * math.exp(omega * t_r)
+        b_next = _rot2(heading_td) @ nominal_dcm_offset(cfg, f, command_h[:2], omega)
+        rel = _rot2(heading_td).T @ (xi_td - b_next - u[:2])
+        side_out = _SIDE[f] * rel[1]
+        excess = max(rel[0] - cfg.max_forward_m, -cfg.max_backward_m - rel[0], side_out - cfg.max_width_m, 0.0)
+        return heading_td, rel, float(excess)
 
     def _in_swing(self, t_s: float) -> bool:
         return t_s - self._t0 >= self.config.double_support_s
@@ -372,9 +393,9 @@ class VelocityGait:
             return out
         # walking
         s, f = self.stance, 1 - self.stance
-        T, Tds = cfg.step_s, cfg.double_support_s
+        Tds = cfg.double_support_s
         t_in = t_s - self._t0
-        t_r = max(T - t_in, 0.0)
+        t_r = max(self.step_T - t_in, 0.0)
         u = soles_m[s]
         b_now = _rot2(self.heading - float(command_h[2]) * t_in) @ nominal_dcm_offset(cfg, s, command_h[:2], omega)
         xi_nom = u[:2] + b_now * math.exp(omega * t_in)
@@ -396,13 +417,21 @@ class VelocityGait:
         # where the swing foot lands: the DCM predicted at touchdown less the next stance's offset
         tau = (t_in - Tds) / cfg.single_support_s
         if tau < cfg.freeze_landing_after or not self._swinging:
-            heading_td = self.heading + float(command_h[2]) * t_r
-            xi_td = p + (dcm_xy - p) * math.exp(omega * t_r)
-            b_next = _rot2(heading_td) @ nominal_dcm_offset(cfg, f, command_h[:2], omega)
-            landing = xi_td - b_next
-            rel = _rot2(heading_td).T @ (landing - u[:2])
-            rel[0] = min(max(rel[0], -cfg.max_backward_m), cfg.max_forward_m)
+            heading_td, rel, excess = self._landing_for(t_r, p, u, f, dcm_xy, omega, command_h)
+            if excess > cfg.timing_adjust_excess_m and self._swinging:
+                # step timing: the step cannot reach far enough in time; land sooner, when the
+                # DCM has not yet run as far (the earliest that leaves the swing its minimum)
+                t_sw = t_in - Tds
+                for frac in (0.8, 0.6, 0.45, 0.3):
+                    t_try = max(t_r * frac, cfg.min_swing_s - t_sw, cfg.min_remaining_s)
+                    if t_try >= t_r - 1e-3:
+                        break
+                    heading_td, rel, excess = self._landing_for(t_try, p, u, f, dcm_xy, omega, command_h)
+                    self.step_T = t_in + t_try
+                    if excess <= cfg.timing_adjust_excess_m:
+                        break
             side = _SIDE[f]
+            rel[0] = min(max(rel[0], -cfg.max_backward_m), cfg.max_forward_m)
             rel[1] = side * min(max(side * rel[1], cfg.min_width_m), cfg.max_width_m)
             self._landing[:2] = u[:2] + _rot2(heading_td) @ rel
             self._landing[2] = u[2]
@@ -417,19 +446,21 @@ class VelocityGait:
         # ground, height up early, across, down late (a foot moving forward low trips on its toe)
         out.swing_foot = f
         Tss = cfg.single_support_s
+        Tsw = self.step_T - Tds  # this step's swing (shorter when its timing was adjusted)
         t_sw = t_in - Tds
         ref = self._ref
         if t_sw >= cfg.swing_hold_s * Tss:
             goals = (self._landing[0], self._landing[1],
                      self._swing_yaw_from + float(wrap_angle(self._landing_yaw - self._swing_yaw_from)))
-            h = max(Tss - cfg.swing_arrive_early_s - t_sw, 0.0)
+            h = max(Tsw - cfg.swing_arrive_early_s - t_sw, 0.0)
             for k in range(3):
                 x, v, acc = _min_jerk(ref[0, k], ref[1, k], ref[2, k], goals[k], h + dt_s, dt_s)
                 ref[0, k], ref[1, k], ref[2, k] = x, v, acc
         z0, z1 = self._swing_from[2], self._landing[2]
         apex = max(z0, z1) + cfg.swing_height_m
         up = _smooth(t_sw / (cfg.swing_rise * Tss), cfg.swing_rise * Tss)
-        down = _smooth((t_sw - (1 - cfg.swing_fall) * Tss) / (cfg.swing_fall * Tss), cfg.swing_fall * Tss)
+        fall = min(cfg.swing_fall * Tss, 0.5 * Tsw)
+        down = _smooth((t_sw - (Tsw - fall)) / fall, fall)
         out.swing_pos_m[:] = (ref[0, 0], ref[0, 1], z0 + up[0] * (apex - z0) + down[0] * (z1 - apex))
         out.swing_vel_mps[:] = (ref[1, 0], ref[1, 1], up[1] * (apex - z0) + down[1] * (z1 - apex))
         out.swing_acc_mps2[:] = (ref[2, 0], ref[2, 1], up[2] * (apex - z0) + down[2] * (z1 - apex))

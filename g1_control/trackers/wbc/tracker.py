@@ -217,7 +217,7 @@ class WholeBodyTracker(Tracker):
             tasks += self._motion_tasks(reference, state, stance, shift, dt)
         else:
             tasks = self._walking_tasks(reference, state, stance, shift, dt)
-        sol = self._solve(tasks, stance, load)
+        sol = self._solve(tasks, stance, load, state.dq_radps, dt)
         if sol is None:
             return self._command if self.diagnostics.solution is not None else self._hold(state)
         return self._motor_command(sol, state, dt)
@@ -415,17 +415,20 @@ class WholeBodyTracker(Tracker):
                                   cfg.posture, self._posture_weights))
         return tasks
 
-    def _solve(self, tasks: list[AccelerationTask], stance: np.ndarray, load: np.ndarray) -> IdSolution | None:
-        """Step 5: the inverse-dynamics QP; None when even the relaxed retry fails."""
+    def _solve(self, tasks: list[AccelerationTask], stance: np.ndarray, load: np.ndarray, dq_radps: np.ndarray,
+               dt: float) -> IdSolution | None:
+        """Step 5: the inverse-dynamics QP (joint speeds bounded one tick ahead); None when even the
+        relaxed retry fails."""
         diag = self.diagnostics
         diag.ticks += 1
         diag.base_pos_w_m = self._q[:3].copy()
         try:
-            sol = self.qp.solve(self.dyn, tasks, stance, load)
+            sol = self.qp.solve(self.dyn, tasks, stance, load, joint_velocity_radps=dq_radps, dt_s=dt)
         except WbcSolveError:
             # Seen at touchdown: a foot landing fast cannot be stopped at once within the torque
             # and force limits while its load is still ramping in. Retry with the contact
-            # allowed its full load and no velocity damping; failing that, keep the last command.
+            # allowed its full load, no velocity damping and no joint speed bounds; failing that,
+            # keep the last command.
             diag.solve_failures += 1
             try:
                 sol = self.qp.solve(self.dyn, tasks, stance, np.ones(2), contact_damping_per_s=0.0)
