@@ -50,8 +50,8 @@ _SIDE = (1.0, -1.0)
 
 @dataclass(frozen=True)
 class GaitConfig:
-    single_support_s: float = 0.35
-    double_support_s: float = 0.10
+    single_support_s: float = 0.28
+    double_support_s: float = 0.07
     start_s: float = 0.5
     """Weight shift onto the first stance foot before the first lift-off."""
     stop_s: float = 0.6

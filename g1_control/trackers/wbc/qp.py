@@ -145,8 +145,9 @@ class InverseDynamicsQP:
         vr = self._vel_rows
         if joint_velocity_radps is not None and dt_s > 0:
             C[vr, 6:nv] = np.eye(nv - 6) * dt_s
-            l[vr] = -self.velocity_limit - joint_velocity_radps
-            u[vr] = self.velocity_limit - joint_velocity_radps
+            # a joint already past its bound need only not speed up further (ddq = 0 stays feasible)
+            np.minimum(-self.velocity_limit - joint_velocity_radps, 0.0, out=l[vr])
+            np.maximum(self.velocity_limit - joint_velocity_radps, 0.0, out=u[vr])
         else:
             C[vr] = 0.0
             l[vr], u[vr] = -_FREE, _FREE

@@ -82,6 +82,9 @@ class WbcConfig:
     walking_com_lower_m: float = 0.03
     """Walking by its own gait, the CoM is held this much below its standing height: bent knees keep
     the stance leg away from the straight-knee singularity at the end of a long step."""
+    walking_com_lower_per_mps: float = 0.05
+    """... and further by this per m/s of horizontal speed walked: longer steps need more knee bend (at
+    0.77 m/s the trailing knee straightened in double support, then overspeeds at lift-off, measured)."""
     walking_com_weight: tuple[float, float] = (1000.0, 1000.0)
     """QP weights of the CoM task's horizontal and vertical rows when walking by the gait."""
     walking_leg_posture_weight: float = 0.05
@@ -383,7 +386,8 @@ class WholeBodyTracker(Tracker):
         gt = self.gait.update(state.t_s, dt, self._sole_pos, self._sole_yaw,
                               self._dcm_xy, omega)
         h = cfg.com_height
-        height = self._com_height_m - cfg.walking_com_lower_m
+        speed = float(np.hypot(*self.gait.command_h[:2]))
+        height = self._com_height_m - cfg.walking_com_lower_m - cfg.walking_com_lower_per_mps * speed
         if reference.pelvis_height_m is not None:
             height += reference.pelvis_height_m - self._pelvis_height_m
         a_com = np.empty(3)
@@ -427,14 +431,18 @@ class WholeBodyTracker(Tracker):
         except WbcSolveError:
             # Seen at touchdown: a foot landing fast cannot be stopped at once within the torque
             # and force limits while its load is still ramping in. Retry with the contact
-            # allowed its full load, no velocity damping and no joint speed bounds; failing that,
-            # keep the last command.
+            # allowed its full load and no velocity damping, then also without joint speed
+            # bounds; failing that, keep the last command.
             diag.solve_failures += 1
             try:
-                sol = self.qp.solve(self.dyn, tasks, stance, np.ones(2), contact_damping_per_s=0.0)
+                sol = self.qp.solve(self.dyn, tasks, stance, np.ones(2), contact_damping_per_s=0.0,
+                                    joint_velocity_radps=dq_radps, dt_s=dt)
             except WbcSolveError:
-                diag.unsolved_ticks += 1
-                return None
+                try:
+                    sol = self.qp.solve(self.dyn, tasks, stance, np.ones(2), contact_damping_per_s=0.0)
+                except WbcSolveError:
+                    diag.unsolved_ticks += 1
+                    return None
         diag.solution = sol
         return sol
 
