@@ -294,7 +294,8 @@ class VelocityGait:
         return contacts
 
     def feasible(self, command_h: np.ndarray) -> np.ndarray:
-        """`command_h` within what the step limits allow (GaitConfig.speed_margin of them)."""
+        """`command_h` within what the step limits allow (GaitConfig.speed_margin of them), each axis
+        and together (the three axes' fractions of their limits add up to at most one)."""
         cfg = self.config
         T, m = cfg.step_s, cfg.speed_margin
         out = np.array(command_h, dtype=float)
@@ -303,6 +304,12 @@ class VelocityGait:
         out[1] = min(max(out[1], -vy), vy)
         wz = m * cfg.max_relative_yaw_rad / T
         out[2] = min(max(out[2], -wz), wz)
+        # combined axes share the step's reach: walking fast while turning hard stretched the swing
+        # leg straight to its landing point (a knee overspeed at touchdown, measured)
+        vx = m * (cfg.max_forward_m if out[0] >= 0 else cfg.max_backward_m) / T
+        load = abs(out[0]) / vx + abs(out[1]) / vy + abs(out[2]) / wz
+        if load > 1.0:
+            out /= load
         return out
 
     def _correct_speed(self, t_s: float, foot: int, landed_xy: np.ndarray) -> None:

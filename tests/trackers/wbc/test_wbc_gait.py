@@ -53,12 +53,21 @@ def test_minimum_jerk_segment_arrives_at_rest():
 def test_commands_beyond_the_step_limits_are_walked_at_the_limit():
     gait = VelocityGait()
     cfg = gait.config
-    out = gait.feasible(np.array([3.0, -2.0, 5.0]))
-    T = cfg.step_s
-    assert out[0] == pytest.approx(cfg.speed_margin * cfg.max_forward_m / T)
-    assert out[1] == pytest.approx(-cfg.speed_margin * (cfg.max_width_m - cfg.step_width_m) / (2 * T))
-    assert out[2] == pytest.approx(cfg.speed_margin * cfg.max_relative_yaw_rad / T)
+    T, m = cfg.step_s, cfg.speed_margin
+    limits = (m * cfg.max_forward_m / T, m * (cfg.max_width_m - cfg.step_width_m) / (2 * T),
+              m * cfg.max_relative_yaw_rad / T)
+    for axis, limit in enumerate(limits):
+        command = np.zeros(3)
+        command[axis] = -5.0 if axis == 1 else 5.0
+        out = gait.feasible(command)
+        assert abs(out[axis]) == pytest.approx(limit) and np.sign(out[axis]) == np.sign(command[axis])
+        assert np.count_nonzero(out) == 1
+    assert gait.feasible(np.array([-5.0, 0.0, 0.0]))[0] == pytest.approx(-m * cfg.max_backward_m / T)
     np.testing.assert_allclose(gait.feasible(np.array([0.3, 0.05, 0.2])), [0.3, 0.05, 0.2])
+    # combined axes share the reach: their fractions of the limits add up to one, direction kept
+    out = gait.feasible(np.array([0.8, 0.2, -1.0]))
+    assert sum(abs(out[k]) / limits[k] for k in range(3)) == pytest.approx(1.0)
+    np.testing.assert_allclose(out / np.linalg.norm(out), np.array([0.8, 0.2, -1.0]) / np.linalg.norm([0.8, 0.2, -1.0]))
 
 
 def _feet():
