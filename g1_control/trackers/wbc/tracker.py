@@ -14,8 +14,11 @@ Per tick (act() calls one method per step; _contact_state first turns the schedu
   6. _motor_command: feedforward torque plus q/dq targets one tick ahead along the QP's
      accelerations, with gains well below the default stiffness (see WbcConfig.kp_scale).
 
-Contact flags come from the reference (JointReference.contacts: the contact schedule). A foot
-that touches down takes load gradually (contact_ramp_s), so torques do not jump.
+Contact flags come from the reference (JointReference.contacts: the contact schedule), or, with
+WbcConfig.footsteps "velocity", from the controller's own gait (gait.py), which walks the
+reference's root twist: then steps 3-4 are _walking_tasks (CoM from the gait's CoP, pelvis at the
+gait's heading, the gait's swing foot, the reference's upper-body posture). A foot that touches
+down takes load gradually (contact_ramp_s), so torques do not jump.
 """
 
 from __future__ import annotations
