@@ -82,6 +82,7 @@ class InverseDynamicsQP:
         self.effort_limit = np.asarray(self.config.effort_limit_nm, dtype=float)
         self.velocity_limit = self.config.velocity_limit_fraction * np.asarray(g1.VELOCITY_LIMIT_RADPS, dtype=float)
         self._vel_rows = slice(nv - 6 + 2 * ROWS_PER_FOOT, 2 * (nv - 6) + 2 * ROWS_PER_FOOT)
+        self._vel_diag = (np.arange(self._vel_rows.start, self._vel_rows.stop), np.arange(6, nv))
         self._foot_rows = wrench_constraint_rows(self.config.foot)
         self.H = np.zeros((self.n, self.n))
         self.g = np.zeros(self.n)
@@ -144,7 +145,8 @@ class InverseDynamicsQP:
         u[:nv - 6] = self.effort_limit - h[6:]
         vr = self._vel_rows
         if joint_velocity_radps is not None and dt_s > 0:
-            C[vr, 6:nv] = np.eye(nv - 6) * dt_s
+            C[vr, 6:nv] = 0.0
+            C[self._vel_diag] = dt_s
             # a joint already past its bound need only not speed up further (ddq = 0 stays feasible)
             np.minimum(-self.velocity_limit - joint_velocity_radps, 0.0, out=l[vr])
             np.maximum(self.velocity_limit - joint_velocity_radps, 0.0, out=u[vr])
