@@ -90,9 +90,6 @@ class WbcConfig:
     0.77 m/s the trailing knee straightened in double support, then overspeeds at lift-off, measured)."""
     walking_com_weight: tuple[float, float] = (1000.0, 1000.0)
     """QP weights of the CoM task's horizontal and vertical rows when walking by the gait."""
-    walking_swing_rotation: TaskGains = field(default_factory=lambda: TaskGains(100.0, 20.0, 10.0))
-    """Walking by the gait, the swing sole's orientation is held softly: held as stiffly as its
-    position, the light ankle whipped past its speed limit (the safety layer's damping, measured)."""
     walking_leg_posture_weight: float = 0.05
     """Walking by its own gait, the legs' posture task is only a regulariser (relative to `posture`)."""
 
@@ -420,7 +417,7 @@ class WholeBodyTracker(Tracker):
                                        gt.swing_pos_m, gt.swing_vel_mps, gt.swing_acc_mps2, cfg.swing_foot))
             tasks.append(orientation_task("swing_foot_rot", ft.jac_w[3:], ft.drift_w[3:], ft.rot_w, ft.vel_w[3:],
                                           yaw_rotation(gt.swing_yaw_rad), np.array([0.0, 0.0, gt.swing_yaw_rate_radps]),
-                                          cfg.walking_swing_rotation))
+                                          cfg.swing_foot))
         tasks.append(posture_task(dyn.nv, state.q_rad, state.dq_radps, reference.q_rad, reference.dq_radps,
                                   cfg.posture, self._posture_weights))
         return tasks
