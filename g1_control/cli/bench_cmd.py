@@ -26,6 +26,9 @@ BENCHMARKS = {
     "odometry": ("g1_control.tools.bench_odometry:main",
                  "world pose drift vs ground truth over 10 seeded random timelines: leg odometry (IMU + contact-aided "
                  "legs) vs velocity integration; cm per metre and per 90 deg (--seconds each, default 40)"),
+    "locomotion": ("g1_control.tools.bench_locomotion:main",
+                   "walking from ground truth: model-based WBC vs holosoma ppo and fastsac per axis and speed "
+                   "(achieved vs commanded, off-axis, falls, act() CPU p50/p99 vs RNEA+CRBA); exits 1 on a fall"),
     "envelope": ("g1_control.tools.bench_envelope:main",
                  "the walking tracker's achievable velocity per axis and style; --write ships it as the command limits"),
 }
@@ -42,7 +45,7 @@ def register(subparsers) -> None:
     parser.add_argument("name", choices=sorted(BENCHMARKS), help="which benchmark")
     parser.add_argument("--seconds", type=float, default=20.0, help="simulated/measured duration (default 20)")
     parser.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
-    parser.add_argument("--only", metavar="PREFIXES", help="execution/envelope: only rows (styles) starting with these "
+    parser.add_argument("--only", metavar="PREFIXES", help="execution/envelope/locomotion: only rows (styles, controller/case) starting with these "
                         "comma-separated prefixes; program: instruction numbers (1,5)")
     parser.add_argument("--seed", type=int, default=0, help="execution: the suite's seed (push timing; default 0)")
     parser.add_argument("--video", metavar="DIR", help="execution: a video per behaviour into DIR")

@@ -65,8 +65,11 @@ def make_tracker(launch: LaunchFile) -> Tracker:
     if cfg.type == "wbc":
         from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
 
-        return WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz), variant=robot_variant(launch),
-                                hands=launch.backend.hands)
+        # a scripted reference plans the feet; any other generator gives a root twist to walk
+        config = (WbcConfig(rate_hz=launch.rates.tracker_hz, footsteps="plan") if launch.generator.type == "scripted"
+                  else WbcConfig(rate_hz=launch.rates.tracker_hz, footsteps="velocity"))
+        return WholeBodyTracker(config,
+                                variant=robot_variant(launch), hands=launch.backend.hands)
     if cfg.type == "wbt":
         from g1_control.trackers.wbt import WbtPolicyTracker
 

@@ -188,8 +188,9 @@ class TrackerConfig:
 
     policy: a velocity-command walking policy (`policy`: a built-in spec name or a spec YAML) with
     upper-body override and closed-loop velocity correction; wbc: the model-based whole-body
-    controller (needs rates.tracker_hz >= 100 and a generator with root poses and a contact
-    schedule: generator.type scripted); wbt: holosoma's whole-body-tracking policy (50 Hz), kept as
+    controller (needs rates.tracker_hz >= 100): with generator.type scripted its feet follow the
+    reference's contact schedule, with any other generator it walks by its own gait from the
+    reference's root twist (g1_control/trackers/wbc/gait.py); wbt: holosoma's whole-body-tracking policy (50 Hz), kept as
     a comparison baseline for the WBC; layer: the tracking layer that executes goals - the walking
     policy while the plan walks, the WBC for whole-body phases (manipulation, stepping onto
     platforms, standing heights the policy cannot hold), with a blended hand-over
@@ -465,10 +466,6 @@ class LaunchFile:
             if self.rates.tracker_hz % 50.0:
                 raise LaunchFileError(f"rates.tracker_hz: {self.rates.tracker_hz:g} Hz; tracker.type layer runs "
                                       "the 50 Hz walking policy every n-th tick, so use a multiple of 50 (e.g. 100)")
-        if self.tracker.type == "wbc":
-            if self.generator.type != "scripted":
-                raise LaunchFileError(f"generator.type: tracker.type wbc needs root poses and a contact schedule, "
-                                      f"which only generator.type scripted provides (got {self.generator.type})")
         if self.tracker.type == "wbt" and self.rates.tracker_hz != 50.0:
             raise LaunchFileError(f"rates.tracker_hz: tracker.type wbt runs at the policy's 50 Hz, got "
                                   f"{self.rates.tracker_hz:g}")

@@ -106,7 +106,7 @@ def launch_cases() -> dict[str, str | bytes]:
         "gamepad_script_bad_mapping.yaml": b.replace("type: scripted", "type: gamepad_script").replace(
             "  timeline:\n    - {duration_s: 2.0, vx_mps: 0.3, label: walk}\n",
             "  gamepad_script: [{t_s: 0.0, press: A}]\n  device: {mapping: {buttons: {L1+R1: estop}}}\n"),
-        "wbc_without_scripted.yaml": b + "rates: {tracker_hz: 250}\ntracker: {type: wbc}\n",
+        "layer_with_scripted.yaml": b + "rates: {tracker_hz: 250}\ntracker: {type: layer}\ngenerator: {type: scripted}\n",
         "wbt_wrong_rate.yaml": b + "rates: {tracker_hz: 25}\ntracker: {type: wbt}\n",
         "vy_over_limit.yaml": b.replace("vx_mps: 0.3", "vy_mps: 0.61"),
         "negative_duration.yaml": b.replace("duration_s: 2.0", "duration_s: -1", 1),

@@ -40,8 +40,10 @@ def test_unknown_reference_parameter_is_refused():
         parse_launch(launch_dict(reference="walk", reference_params={"pace": 2.0}))
 
 
-def test_wbc_without_a_scripted_reference_is_refused():
+def test_wbc_with_a_velocity_generator_walks_by_its_own_gait():
+    from g1_control.launch.builder import make_tracker
+
     data = launch_dict()
     data["generator"] = {"type": "velocity"}
-    with pytest.raises(LaunchFileError, match="tracker.type wbc needs root poses and a contact schedule"):
-        parse_launch(data)
+    assert make_tracker(parse_launch(data)).config.footsteps == "velocity"
+    assert make_tracker(parse_launch(launch_dict())).config.footsteps == "plan"

@@ -10,6 +10,9 @@ would give the same optimum at roughly twice the solve time). Constraints:
   stance foot              J_i ddq + J_dot_i v = -k_v v_i              (6 equalities per foot)
   swing foot               f_i = 0                                     (same 6 rows, swapped)
   torque limits            -tau_max <= M_a ddq + h_a - J_a^T f <= tau_max   (29 inequalities)
+  joint velocity limits    |dq + ddq dt| <= fraction * dq_max, one tick ahead (29 inequalities;
+                           the safety layer damps the robot at dq_max: a fast recovery step
+                           drove a knee there, measured)
   per stance foot          friction pyramid, CoP in the sole, yaw torque, normal-force bounds
                            (contacts.py; 11 inequalities per foot, relaxed for a swing foot)
 
@@ -49,6 +52,8 @@ class QpConfig:
     moment_regularisation: float = 1e-2
     """Moments are regularised harder than forces: it keeps each foot's CoP near its centre."""
     effort_limit_nm: tuple[float, ...] = tuple(g1.EFFORT_LIMIT_NM)
+    velocity_limit_fraction: float = 0.75
+    """Joint speeds one tick ahead stay within this fraction of g1.VELOCITY_LIMIT_RADPS."""
     eps_abs: float = 1e-5
     max_iter: int = 200
 
@@ -73,8 +78,11 @@ class InverseDynamicsQP:
         self.nv = nv
         self.n = nv + 12
         self.n_eq = 6 + 12
-        self.n_in = (nv - 6) + 2 * ROWS_PER_FOOT
+        self.n_in = 2 * (nv - 6) + 2 * ROWS_PER_FOOT
         self.effort_limit = np.asarray(self.config.effort_limit_nm, dtype=float)
+        self.velocity_limit = self.config.velocity_limit_fraction * np.asarray(g1.VELOCITY_LIMIT_RADPS, dtype=float)
+        self._vel_rows = slice(nv - 6 + 2 * ROWS_PER_FOOT, 2 * (nv - 6) + 2 * ROWS_PER_FOOT)
+        self._vel_diag = (np.arange(self._vel_rows.start, self._vel_rows.stop), np.arange(6, nv))
         self._foot_rows = wrench_constraint_rows(self.config.foot)
         self.H = np.zeros((self.n, self.n))
         self.g = np.zeros(self.n)
@@ -105,10 +113,12 @@ class InverseDynamicsQP:
         return qp
 
     def solve(self, model: WbcModel, tasks: list[AccelerationTask], stance: np.ndarray,
-              load_fraction: np.ndarray, contact_damping_per_s: float | None = None) -> IdSolution:
+              load_fraction: np.ndarray, contact_damping_per_s: float | None = None,
+              joint_velocity_radps: np.ndarray | None = None, dt_s: float = 0.0) -> IdSolution:
         """Solve for the state last passed to model.update(). stance: (2,) bool; load_fraction:
         (2,) 0..1, each stance foot's share of the full normal-force allowance (contact ramps);
-        contact_damping_per_s overrides the configured value for this solve."""
+        contact_damping_per_s overrides the configured value for this solve; joint_velocity_radps
+        and dt_s (> 0): bound the joint speeds one tick of dt_s ahead (else unbounded)."""
         nv, n = self.nv, self.n
         M, h, Jc = model.mass_matrix, model.bias, model.contact_jac_local
         H, g, A, b, C, l, u = self.H, self.g, self.A, self.b, self.C, self.l, self.u
@@ -133,6 +143,16 @@ class InverseDynamicsQP:
         C[:nv - 6, nv:] = -Jc[:, 6:].T
         l[:nv - 6] = -self.effort_limit - h[6:]
         u[:nv - 6] = self.effort_limit - h[6:]
+        vr = self._vel_rows
+        if joint_velocity_radps is not None and dt_s > 0:
+            C[vr, 6:nv] = 0.0
+            C[self._vel_diag] = dt_s
+            # a joint already past its bound need only not speed up further (ddq = 0 stays feasible)
+            np.minimum(-self.velocity_limit - joint_velocity_radps, 0.0, out=l[vr])
+            np.maximum(self.velocity_limit - joint_velocity_radps, 0.0, out=u[vr])
+        else:
+            C[vr] = 0.0
+            l[vr], u[vr] = -_FREE, _FREE
         fC, fl, fu = self._foot_rows
         kv = self.config.contact_damping_per_s if contact_damping_per_s is None else contact_damping_per_s
         for i in range(2):

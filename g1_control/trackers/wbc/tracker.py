@@ -1,24 +1,30 @@
 """The whole-body controller as a Tracker: act(JointReference, RobotState) -> MotorCommand.
 
-Per tick:
-  1. floating-base state without ground truth: orientation and angular velocity from the IMU,
-     linear velocity from the project's StateEstimator (leg kinematics + accelerometer), position
-     from leg odometry anchored at the stance feet (odometry.py);
-  2. the reference's full configuration (root pose + joints) through forward kinematics gives the
-     task targets: CoM, pelvis and torso orientation, swing-foot poses, hand positions, posture;
-  3. the CoM's horizontal target becomes a CoM acceleration by capture-point feedback clipped to
-     the support polygon (capture_point.py);
-  4. the inverse-dynamics QP (qp.py) returns accelerations, contact wrenches and torques;
-  5. the motor command: feedforward torque plus q/dq targets one tick ahead along the QP's
+Per tick (act() calls one method per step; _contact_state first turns the schedule into contacts):
+  1. _estimate_base: floating-base state without ground truth: orientation and angular velocity
+     from the IMU, linear velocity from the project's StateEstimator (leg kinematics +
+     accelerometer), position from leg odometry anchored at the stance feet (odometry.py);
+  2. _reference_kinematics: the reference's full configuration (root pose + joints) through
+     forward kinematics gives the task targets: CoM, pelvis and torso orientation, swing-foot
+     poses, hand positions, posture;
+  3. _balance_task: the CoM's horizontal target becomes a CoM acceleration by capture-point
+     feedback (capture_point.py);
+  4. _motion_tasks: orientation, swing feet, hands, posture;
+  5. _solve: the inverse-dynamics QP (qp.py) returns accelerations, contact wrenches and torques;
+  6. _motor_command: feedforward torque plus q/dq targets one tick ahead along the QP's
      accelerations, with gains well below the default stiffness (see WbcConfig.kp_scale).
 
-Contact flags come from the reference (JointReference.contacts: the contact schedule). A foot
-that touches down takes load gradually (contact_ramp_s), so torques do not jump.
+Contact flags come from the reference (JointReference.contacts: the contact schedule), or, with
+WbcConfig.footsteps "velocity", from the controller's own gait (gait.py), which walks the
+reference's root twist: then steps 3-4 are _walking_tasks (CoM from the gait's CoP, pelvis at the
+gait's heading, the gait's swing foot, the reference's upper-body posture). A foot that touches
+down takes load gradually (contact_ramp_s), so torques do not jump.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
@@ -27,8 +33,9 @@ from g1_control.estimation.estimator import StateEstimator
 from g1_control.interfaces import Tracker
 from g1_control.robot import g1
 from g1_control.robot.dynamics import WbcModel
-from g1_control.rotations import quat_to_rot, yaw_of
+from g1_control.rotations import quat_to_rot, yaw_of, yaw_of_matrix
 from g1_control.trackers.wbc import capture_point as cp
+from g1_control.trackers.wbc.gait import GaitConfig, VelocityGait, yaw_rotation
 from g1_control.trackers.wbc.odometry import BaseOdometry
 from g1_control.trackers.wbc.qp import IdSolution, InverseDynamicsQP, QpConfig
 from g1_control.trackers.wbc.tasks import (
@@ -70,8 +77,25 @@ class WbcConfig:
     only holds the joints along the QP's one-tick-ahead prediction between controller ticks and
     absorbs model error. At full default stiffness the PD would override the QP's balance torques."""
     qp: QpConfig = field(default_factory=QpConfig)
+    footsteps: Literal["plan", "velocity"] = "plan"
+    """plan: the feet follow the reference's contact schedule and poses (a scripted or goal plan);
+    velocity: the controller walks by its own gait (gait.py) from the reference's root twist (heading
+    frame), taking only the upper body's posture and the pelvis height from the reference."""
+    gait: GaitConfig = field(default_factory=GaitConfig)
+    walking_com_lower_m: float = 0.03
+    """Walking by its own gait, the CoM is held this much below its standing height: bent knees keep
+    the stance leg away from the straight-knee singularity at the end of a long step."""
+    walking_com_lower_per_mps: float = 0.05
+    """... and further by this per m/s of horizontal speed walked: longer steps need more knee bend (at
+    0.77 m/s the trailing knee straightened in double support, then overspeeds at lift-off, measured)."""
+    walking_com_weight: tuple[float, float] = (1000.0, 1000.0)
+    """QP weights of the CoM task's horizontal and vertical rows when walking by the gait."""
+    walking_leg_posture_weight: float = 0.05
+    """Walking by its own gait, the legs' posture task is only a regulariser (relative to `posture`)."""
 
     def __post_init__(self) -> None:
+        if self.footsteps not in ("plan", "velocity"):
+            raise WbcConfigError(f"WbcConfig.footsteps must be 'plan' or 'velocity'; got {self.footsteps!r}")
         if self.rate_hz <= 0:
             raise WbcConfigError(f"WbcConfig.rate_hz must be > 0; got {self.rate_hz}")
         for name in ("kp_scale", "kd_scale", "contact_ramp_s", "liftoff_unload_s", "capture_point_gain", "com_xy_weight"):
@@ -117,7 +141,25 @@ class WholeBodyTracker(Tracker):
         self._v = np.zeros(self.dyn.nv)
         self._q_ref = np.zeros(self.dyn.nq)
         self._v_ref = np.zeros(self.dyn.nv)
+        self._sole_pos = np.zeros((2, 3))
+        """This tick's sole positions (world, after the odometry step), left then right."""
+        self._sole_yaw = np.zeros(2)
+        self._dcm_xy = np.zeros(2)
+        self.gait = VelocityGait(self.config.gait) if self.config.footsteps == "velocity" else None
+        self._com_height_m, self._pelvis_height_m = self._standing_heights()
+        self._posture_weights = np.ones(self.dyn.nv - 6)
+        self._posture_weights[list(g1.LEG_JOINTS)] = self.config.walking_leg_posture_weight
         self.reset()
+
+    def _standing_heights(self) -> tuple[float, float]:
+        """CoM and pelvis heights above the soles in the default pose (the gait's nominal)."""
+        pin, m, d = self._pin, self.dyn.model, self.ref_data
+        q = pin.neutral(m)
+        q[7:] = g1.DEFAULT_Q_RAD
+        pin.framesForwardKinematics(m, d, q)
+        ground = min(d.oMf[f].translation[2] for f in self.dyn.sole_ids)
+        com = pin.centerOfMass(m, d, q)
+        return float(com[2] - ground), float(-ground)
 
     # -- lifecycle ---------------------------------------------------------------------------------
     def reset(self, state: RobotState | None = None) -> None:
@@ -132,6 +174,8 @@ class WholeBodyTracker(Tracker):
         self._com_acc_ref = np.zeros(3)
         self._frame_vel_ref_prev: dict[int, np.ndarray] = {}
         self.diagnostics = WbcDiagnostics()
+        if self.gait is not None:
+            self.gait.reset()
 
     def _start(self, reference: JointReference, state: RobotState) -> None:
         """First tick: the odometry's world frame is the reference's; the robot starts at the
@@ -140,9 +184,20 @@ class WholeBodyTracker(Tracker):
         lowest = offsets[:, 2].min()
         base = np.array([reference.root_pos_w_m[0], reference.root_pos_w_m[1], -lowest])
         self.odometry.reset(base, offsets)
+        self._sole_pos = base + offsets
+        self._sole_yaw = self._yaws(self.ref_data)  # _sole_offsets left the measured pose's kinematics there
+        self._dcm_xy = self._sole_pos[:, :2].mean(axis=0)
         self._stance_since[:] = -np.inf
         self._prev_stance[:] = reference.contacts
         self._started = True
+
+    def _yaws(self, data) -> np.ndarray:
+        """The soles' headings in `data`'s frame placements."""
+        out = self._sole_yaw
+        for i, fid in enumerate(self.dyn.sole_ids):
+            r = data.oMf[fid].rotation
+            out[i] = np.arctan2(r[1, 0], r[0, 0])
+        return out
 
     def _sole_offsets(self, quat_wxyz: np.ndarray, q_rad: np.ndarray) -> np.ndarray:
         pin, m, d = self._pin, self.dyn.model, self.ref_data
@@ -152,27 +207,54 @@ class WholeBodyTracker(Tracker):
 
     # -- the tick --------------------------------------------------------------------------------------
     def act(self, reference: JointReference, state: RobotState) -> MotorCommand:
-        pin, cfg, dyn = self._pin, self.config, self.dyn
         if not self._started:
             self._start(reference, state)
-        dt = 1.0 / cfg.rate_hz if self._last_t is None else max(1e-4, state.t_s - self._last_t)
+        dt = 1.0 / self.config.rate_hz if self._last_t is None else max(1e-4, state.t_s - self._last_t)
         self._last_t = state.t_s
-        scheduled = np.asarray(reference.contacts, dtype=bool)
+        if self.gait is not None:
+            schedule = self.gait.schedule(state.t_s, self._walk_command(reference), self._sole_pos, self._sole_yaw,
+                                          self._dcm_xy)
+        else:
+            schedule = reference.contacts
+        scheduled, stance, load = self._contact_state(schedule, state.t_s)
+        shift = self._estimate_base(state, reference, scheduled, stance, dt)
+        com_ref, com_vel_ref = self._reference_kinematics(reference, dt)
+        if self.gait is None:
+            tasks = [self._balance_task(com_ref, com_vel_ref, stance, shift)]
+            tasks += self._motion_tasks(reference, state, stance, shift, dt)
+        else:
+            tasks = self._walking_tasks(reference, state, stance, shift, dt)
+        sol = self._solve(tasks, stance, load, state.dq_radps, dt)
+        if sol is None:
+            return self._command if self.diagnostics.solution is not None else self._hold(state)
+        return self._motor_command(sol, state, dt)
+
+    def _contact_state(self, schedule: np.ndarray, t_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(scheduled, stance, load): the schedule's stance feet (the reference's, or the gait's); the feet the QP treats as contacts
+        (a foot just lifted stays one while it unloads); each contact's share of its full normal-force
+        allowance (ramped in after touchdown, out after lift-off)."""
+        cfg = self.config
+        scheduled = np.asarray(schedule, dtype=bool)
         if not scheduled.any():
             raise WbcConfigError("JointReference.contacts has no foot in contact; the controller needs at "
                                  "least one stance foot (flight phases are not supported)")
         for i in range(2):
             if scheduled[i] and not self._prev_stance[i]:
-                self._stance_since[i] = state.t_s
+                self._stance_since[i] = t_s
             elif not scheduled[i] and self._prev_stance[i]:
-                self._swing_since[i] = state.t_s
+                self._swing_since[i] = t_s
         self._prev_stance[:] = scheduled
-        load = np.clip((state.t_s - self._stance_since) / max(cfg.contact_ramp_s, 1e-6), 0.0, 1.0)
-        unloading = ~scheduled & (state.t_s - self._swing_since < cfg.liftoff_unload_s)
-        load[unloading] = 1.0 - (state.t_s - self._swing_since[unloading]) / max(cfg.liftoff_unload_s, 1e-6)
-        stance = scheduled | unloading
+        load = np.clip((t_s - self._stance_since) / max(cfg.contact_ramp_s, 1e-6), 0.0, 1.0)
+        unloading = ~scheduled & (t_s - self._swing_since < cfg.liftoff_unload_s)
+        load[unloading] = 1.0 - (t_s - self._swing_since[unloading]) / max(cfg.liftoff_unload_s, 1e-6)
+        return scheduled, scheduled | unloading, load
 
-        # 1. floating-base state
+    def _estimate_base(self, state: RobotState, reference: JointReference, scheduled: np.ndarray,
+                       stance: np.ndarray, dt: float) -> np.ndarray:
+        """Step 1, the floating-base state: fills self._q/_v, updates the dynamics (self.dyn) and the
+        odometry; returns the base's shift by this tick's odometry step (positions the dynamics
+        computed before it move with the base). Keeps the soles' positions in self._sole_pos."""
+        dyn = self.dyn
         # Leg-kinematics velocity from the scheduled stance feet (the lower foot is not the stance
         # foot on a step: with it, a trailing foot swinging up read as the body falling, measured).
         est = self.estimator.update(state, scheduled if scheduled.all() or not stance.all() else stance)
@@ -191,10 +273,16 @@ class WholeBodyTracker(Tracker):
         offsets = sole_pos_before - q[:3]
         base_prev = q[:3].copy()
         base = self.odometry.update(dt, est.base_linvel_w_mps, offsets, stance)
-        shift = base - base_prev  # positions computed before the odometry step move with the base
+        shift = base - base_prev
         q[:3] = base
+        self._sole_pos = sole_pos_before + shift
+        self._yaws(dyn.data)
+        return shift
 
-        # 2. reference kinematics
+    def _reference_kinematics(self, reference: JointReference, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Step 2: the reference's full configuration through forward kinematics (into self.ref_data);
+        returns the reference CoM and its velocity, and filters the CoM's reference acceleration."""
+        pin, dyn = self._pin, self.dyn
         qr, vr, rd = self._q_ref, self._v_ref, self.ref_data
         rq = reference.root_quat_wxyz
         qr[:3] = reference.root_pos_w_m
@@ -217,11 +305,15 @@ class WholeBodyTracker(Tracker):
             raw = (com_vel_ref - self._com_vel_ref_prev) / dt
             self._com_acc_ref += min(1.0, dt / 0.02) * (raw - self._com_acc_ref)
         self._com_vel_ref_prev = com_vel_ref
+        return com_ref, com_vel_ref
 
-        # 3. balance: CoM acceleration from capture-point feedback
+    def _balance_task(self, com_ref: np.ndarray, com_vel_ref: np.ndarray, stance: np.ndarray,
+                      shift: np.ndarray) -> AccelerationTask:
+        """Step 3, balance: the CoM task, its horizontal acceleration from capture-point feedback."""
+        cfg, dyn = self.config, self.dyn
         com = dyn.com_m + shift
         com_vel = dyn.com_vel_mps
-        sole_pos = sole_pos_before + shift
+        sole_pos = self._sole_pos
         sole_rot = np.array([dyn.data.oMf[f].rotation for f in dyn.sole_ids])
         ground_z = float(np.mean(sole_pos[stance, 2]))
         omega = cp.lipm_frequency(max(com[2] - ground_z, 0.2))
@@ -235,12 +327,16 @@ class WholeBodyTracker(Tracker):
         a_com = np.empty(3)
         a_com[:2] = omega**2 * (com[:2] - cop)
         a_com[2] = self._com_acc_ref[2] + h.kp * (com_ref[2] - com[2]) + h.kd * (com_vel_ref[2] - com_vel[2])
-        tasks: list[AccelerationTask] = [
-            AccelerationTask("com", dyn.com_jac, a_com - dyn.com_drift,
-                             np.array([cfg.com_xy_weight, cfg.com_xy_weight, h.weight])),
-        ]
+        diag = self.diagnostics
+        diag.com_m, diag.com_ref_m, diag.cop_des_xy_m = com, com_ref, cop
+        return AccelerationTask("com", dyn.com_jac, a_com - dyn.com_drift,
+                                np.array([cfg.com_xy_weight, cfg.com_xy_weight, h.weight]))
 
-        # 4. orientation, swing feet, hands, posture
+    def _motion_tasks(self, reference: JointReference, state: RobotState, stance: np.ndarray,
+                      shift: np.ndarray, dt: float) -> list[AccelerationTask]:
+        """Step 4: pelvis and torso orientation, swing feet, hands, posture, from the reference."""
+        pin, cfg, dyn, rd = self._pin, self.config, self.dyn, self.ref_data
+        tasks: list[AccelerationTask] = []
         lwa = pin.LOCAL_WORLD_ALIGNED
         for fid, gains in ((dyn.pelvis_id, cfg.pelvis_orientation), (dyn.torso_id, cfg.torso_orientation)):
             ft = dyn.frame(fid)
@@ -271,25 +367,91 @@ class WholeBodyTracker(Tracker):
                                            rd.oMf[fid].translation, ref_v, np.zeros(3), cfg.hands))
         tasks.append(posture_task(dyn.nv, state.q_rad, state.dq_radps, reference.q_rad, reference.dq_radps,
                                   cfg.posture))
+        return tasks
 
-        # 5. solve and command
+    @staticmethod
+    def _walk_command(reference: JointReference) -> np.ndarray:
+        """(vx, vy, wz) in the heading frame: what the gait walks."""
+        lin, ang = reference.root_linvel_h_mps, reference.root_angvel_h_radps
+        return np.array([lin[0], lin[1], ang[2]])
+
+    def _walking_tasks(self, reference: JointReference, state: RobotState, stance: np.ndarray,
+                       shift: np.ndarray, dt: float) -> list[AccelerationTask]:
+        """Steps 3-4 when walking by the gait: the CoM from the gait's CoP (LIPM), the pelvis and
+        torso at the gait's heading (the torso's pose relative to the pelvis from the reference),
+        the swing foot along the gait's path, the reference's posture (legs only regularised)."""
+        cfg, dyn, rd = self.config, self.dyn, self.ref_data
+        assert self.gait is not None
+        com = dyn.com_m + shift
+        com_vel = dyn.com_vel_mps
+        ground_z = float(np.mean(self._sole_pos[stance, 2]))
+        omega = cp.lipm_frequency(max(com[2] - ground_z, 0.2))
+        self._dcm_xy = cp.capture_point(com[:2], com_vel[:2], omega)
+        gt = self.gait.update(state.t_s, dt, self._sole_pos, self._sole_yaw,
+                              self._dcm_xy, omega)
+        h = cfg.com_height
+        speed = float(np.hypot(*self.gait.command_h[:2]))
+        height = self._com_height_m - cfg.walking_com_lower_m - cfg.walking_com_lower_per_mps * speed
+        if reference.pelvis_height_m is not None:
+            height += reference.pelvis_height_m - self._pelvis_height_m
+        a_com = np.empty(3)
+        a_com[:2] = omega**2 * (com[:2] - gt.cop_xy_m)
+        a_com[2] = h.kp * (ground_z + height - com[2]) - h.kd * com_vel[2]
+        diag = self.diagnostics
+        diag.com_m, diag.cop_des_xy_m = com, gt.cop_xy_m.copy()
+        diag.com_ref_m = np.array([*self._dcm_xy, ground_z + height])
+        wxy, wz = cfg.walking_com_weight
+        tasks = [AccelerationTask("com", dyn.com_jac, a_com - dyn.com_drift, np.array([wxy, wxy, wz]))]
+        heading_rot = yaw_rotation(gt.heading_rad)
+        yaw_rate = np.array([0.0, 0.0, gt.yaw_rate_radps])
+        pelvis_ref = rd.oMf[dyn.pelvis_id].rotation
+        for fid, gains in ((dyn.pelvis_id, cfg.pelvis_orientation), (dyn.torso_id, cfg.torso_orientation)):
+            ft = dyn.frame(fid)
+            # the reference's pose relative to its own heading, turned to the gait's heading
+            ref_rot = heading_rot @ yaw_rotation(-float(yaw_of_matrix(pelvis_ref))) @ rd.oMf[fid].rotation
+            tasks.append(orientation_task("orientation", ft.jac_w[3:], ft.drift_w[3:], ft.rot_w, ft.vel_w[3:],
+                                          ref_rot, yaw_rate, gains))
+        f = gt.swing_foot
+        if f >= 0 and not stance[f]:
+            ft = dyn.frame(dyn.sole_ids[f])
+            tasks.append(position_task("swing_foot", ft.jac_w[:3], ft.drift_w[:3], ft.pos_w_m + shift, ft.vel_w[:3],
+                                       gt.swing_pos_m, gt.swing_vel_mps, gt.swing_acc_mps2, cfg.swing_foot))
+            tasks.append(orientation_task("swing_foot_rot", ft.jac_w[3:], ft.drift_w[3:], ft.rot_w, ft.vel_w[3:],
+                                          yaw_rotation(gt.swing_yaw_rad), np.array([0.0, 0.0, gt.swing_yaw_rate_radps]),
+                                          cfg.swing_foot))
+        tasks.append(posture_task(dyn.nv, state.q_rad, state.dq_radps, reference.q_rad, reference.dq_radps,
+                                  cfg.posture, self._posture_weights))
+        return tasks
+
+    def _solve(self, tasks: list[AccelerationTask], stance: np.ndarray, load: np.ndarray, dq_radps: np.ndarray,
+               dt: float) -> IdSolution | None:
+        """Step 5: the inverse-dynamics QP (joint speeds bounded one tick ahead); None when even the
+        relaxed retry fails."""
         diag = self.diagnostics
         diag.ticks += 1
-        diag.base_pos_w_m = base.copy()
-        diag.com_m, diag.com_ref_m, diag.cop_des_xy_m = com, com_ref, cop
+        diag.base_pos_w_m = self._q[:3].copy()
         try:
-            sol = self.qp.solve(dyn, tasks, stance, load)
+            sol = self.qp.solve(self.dyn, tasks, stance, load, joint_velocity_radps=dq_radps, dt_s=dt)
         except WbcSolveError:
             # Seen at touchdown: a foot landing fast cannot be stopped at once within the torque
             # and force limits while its load is still ramping in. Retry with the contact
-            # allowed its full load and no velocity damping; failing that, keep the last command.
+            # allowed its full load and no velocity damping, then also without joint speed
+            # bounds; failing that, keep the last command.
             diag.solve_failures += 1
             try:
-                sol = self.qp.solve(dyn, tasks, stance, np.ones(2), contact_damping_per_s=0.0)
+                sol = self.qp.solve(self.dyn, tasks, stance, np.ones(2), contact_damping_per_s=0.0,
+                                    joint_velocity_radps=dq_radps, dt_s=dt)
             except WbcSolveError:
-                diag.unsolved_ticks += 1
-                return self._command if diag.solution is not None else self._hold(state)
+                try:
+                    sol = self.qp.solve(self.dyn, tasks, stance, np.ones(2), contact_damping_per_s=0.0)
+                except WbcSolveError:
+                    diag.unsolved_ticks += 1
+                    return None
         diag.solution = sol
+        return sol
+
+    def _motor_command(self, sol: IdSolution, state: RobotState, dt: float) -> MotorCommand:
+        """Step 6: feedforward torque plus q/dq targets one tick ahead along the QP's accelerations."""
         out = self._command
         ddq = sol.ddq[6:]
         out.tau_nm[:] = sol.tau_nm

@@ -1,0 +1,305 @@
+"""`g1 bench locomotion`: the model-based controller's walking against holosoma's ppo and fastsac
+walking policies, in one run, one table: per axis and speed, what the robot achieved against
+what was commanded, falls, and the CPU cost of each tracker's act().
+
+Every row is one launch through the one loop builder in lockstep MuJoCo: the velocity generator,
+1 s standing, then the command for --seconds (rows forward/backward/sideways/turning);
+then pushes (push_*: PUSH_N for PUSH_S on the pelvis while walking, 4 directions x 5 points of
+the gait, one run per direction) and 10 seeded random velocity timelines (random_s*: 1-5 s
+segments, reversals, combined axes, stops; 30 s each); the WBC (tracker.type wbc, its own gait) at 250 Hz,
+the policies (tracker.type policy, their trained command range, not the shipped envelope) at their
+50 Hz. Figures, all from the simulator's ground truth:
+  achieved   mean heading-frame (vx, vy, wz) over whole gait cycles after the first STEADY_SKIP_S
+             of walking (the WBC's stride is two of its steps; the policies' gait period is 1 s);
+  error      achieved minus commanded on a commanded axis, in % of the command (the worst axis);
+  off-axis   the largest |achieved| of the uncommanded axes (m/s or rad/s);
+  fell       the loop's fall monitor (pelvis below 0.4 m or tilted), and the lowest pelvis height;
+  act CPU    p50/p99 of the tracker's act() in thread CPU time (not wall time: the machines are
+             shared), beside pinocchio RNEA + CRBA on the WBC's visited states in the same run.
+Exits 1 when any row fell.
+
+    g1 bench locomotion                          # every row (~15 min)
+    g1 bench locomotion --only wbc --seconds 10  # rows whose name starts with a prefix
+    g1 bench locomotion --json out.json
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, cast
+
+import numpy as np
+
+from g1_control.teleop.scripted import Segment
+
+if TYPE_CHECKING:
+    from g1_control.sim.mujoco_backend import MujocoBackend
+
+CONTROLLERS: dict[str, tuple[str, str, float]] = {
+    "wbc": ("wbc", "", 250.0),
+    "ppo": ("policy", "holosoma_loco_ppo", 50.0),
+    "fastsac": ("policy", "holosoma_loco_fastsac", 50.0),
+}
+"""name -> (tracker.type, tracker.policy, tracker rate Hz)."""
+POLICY_GAIT_PERIOD_S = 1.0
+
+
+@dataclass(frozen=True)
+class Case:
+    name: str
+    command: tuple[float, float, float]
+    """(vx m/s, vy m/s, wz rad/s) in the heading frame."""
+    style: str = "default"
+    timeline: tuple[Segment, ...] = ()
+    """Instead of standing then `command`: this timeline (no steady-state figures then)."""
+    pushes: tuple[tuple[float, tuple[float, float, float]], ...] = ()
+    """(time s, force N in the heading frame at that time) pushes on the pelvis, PUSH_S each."""
+
+
+CASES = (
+    Case("forward_0.5", (0.5, 0.0, 0.0)),
+    Case("forward_1.0", (1.0, 0.0, 0.0)),
+    Case("backward_0.5", (-0.5, 0.0, 0.0)),
+    Case("sideways_0.4", (0.0, 0.4, 0.0)),
+    Case("turning_1.2", (0.0, 0.0, 1.2)),
+    Case("combined_0.6_0.5", (0.6, 0.0, 0.5)),
+    Case("carry_forward_0.5", (0.5, 0.0, 0.0), style="carry"),
+    Case("arm_swing_forward_0.5", (0.5, 0.0, 0.0), style="arm_swing"),
+)
+STEADY_SKIP_S = 3.0
+PUSH_S = 0.2
+PUSH_N = 150.0
+PUSH_SPEED_MPS = 0.5
+PUSH_PHASES = 5
+
+
+def random_cases(n: int = 10, duration_s: float = 30.0) -> tuple[Case, ...]:
+    """Seeded random velocity timelines: 1-5 s segments, reversals, combined axes, stops."""
+    from g1_control.teleop.scripted import RandomTimelineConfig, random_timeline
+
+    out = []
+    for seed in range(n):
+        config = RandomTimelineConfig(seed=seed, segment_s=(1.0, 5.0), vx_mps=(-0.5, 0.8), vy_mps=(-0.2, 0.2),
+                                      wz_radps=(-1.0, 1.0), stand_probability=0.15)
+        out.append(Case(f"random_s{seed}", (0.0, 0.0, 0.0), timeline=tuple(random_timeline(config, duration_s))))
+    return tuple(out)
+
+
+def push_cases(walk_s: float) -> tuple[Case, ...]:
+    """Walking forward at PUSH_SPEED_MPS, PUSH_N for PUSH_S on the pelvis from each of 4 directions,
+    PUSH_PHASES pushes per run 2.5 s apart, each at a later point of the gait (a fifth of a step on)."""
+    out = []
+    for name, force in (("front", (-PUSH_N, 0.0, 0.0)), ("back", (PUSH_N, 0.0, 0.0)),
+                        ("left", (0.0, -PUSH_N, 0.0)), ("right", (0.0, PUSH_N, 0.0))):
+        times = tuple(4.0 + k * (2.5 + 0.45 / PUSH_PHASES) for k in range(PUSH_PHASES))
+        duration = max(walk_s, times[-1] + 2.5)
+        out.append(Case(f"push_{name}", (PUSH_SPEED_MPS, 0.0, 0.0),
+                        timeline=(Segment(1.0, label="stand"), Segment(duration, vx_mps=PUSH_SPEED_MPS, label="walk")),
+                        pushes=tuple((t, force) for t in times)))
+    return tuple(out)
+
+
+@dataclass
+class Row:
+    controller: str
+    case: str
+    command: list[float]
+    achieved: list[float] = field(default_factory=lambda: [math.nan] * 3)
+    error_pct: float = math.nan
+    off_axis: float = math.nan
+    fell: bool = False
+    fall: str = ""
+    min_pelvis_m: float = math.nan
+    act_cpu_p50_us: float = math.nan
+    act_cpu_p99_us: float = math.nan
+    sim_s: float = 0.0
+    wall_s: float = 0.0
+    pushes: int = 0
+    pushes_survived: int = 0
+    """Pushes after which the robot was still up 2 s later."""
+
+    @property
+    def name(self) -> str:
+        return f"{self.controller}/{self.case}"
+
+
+def steady_velocity(log: dict[str, np.ndarray], t_from_s: float, t_to_s: float, period_s: float) -> np.ndarray:
+    """Mean of the true heading-frame (vx, vy, wz) over whole `period_s` cycles from t_from_s."""
+    cycles = math.floor((t_to_s - t_from_s) / period_s + 1e-9)
+    if cycles < 1:
+        raise ValueError(f"no whole gait cycle of {period_s:.2f} s between {t_from_s:.2f} and {t_to_s:.2f} s")
+    t = log["t_s"]
+    window = (t >= t_from_s - 1e-9) & (t < t_from_s + cycles * period_s - 1e-9)
+    return log["velocity_true"][window].mean(axis=0)
+
+
+def case_launch(controller: str, case: Case, walk_s: float):
+    from g1_control.launch.schema import LaunchFile
+
+    kind, policy, hz = CONTROLLERS[controller]
+    vx, vy, wz = case.command
+    launch = LaunchFile(name=f"locomotion_{controller}_{case.name}")
+    launch.input.timeline = list(case.timeline) or [
+        Segment(1.0, style=case.style, label="stand"),
+        Segment(walk_s, vx_mps=vx, vy_mps=vy, wz_radps=wz, style=case.style, label="walk")]
+    for seg in launch.input.timeline:
+        vx, vy, wz = max(abs(vx), abs(seg.vx_mps)), max(abs(vy), abs(seg.vy_mps)), max(abs(wz), abs(seg.wz_radps))
+    launch.generator.type = "velocity"
+    launch.tracker.type = kind  # type: ignore[assignment]
+    if policy:
+        launch.tracker.policy = policy
+    launch.tracker.envelope_limits = False
+    launch.rates.tracker_hz = hz
+    launch.limits.max_vx_mps = max(launch.limits.max_vx_mps, abs(vx))
+    launch.limits.max_vy_mps = max(launch.limits.max_vy_mps, abs(vy))
+    launch.limits.max_wz_radps = max(launch.limits.max_wz_radps, abs(wz))
+    launch.validate("locomotion")
+    launch.output.video, launch.output.plot, launch.viewer = False, False, False
+    return launch
+
+
+def run_case(controller: str, case: Case, walk_s: float, states: list | None = None) -> Row:
+    """One row. `states`: gets (q, v) samples of the run appended (the RNEA + CRBA baseline)."""
+    from g1_control.launch.builder import build_loop
+
+    loop = build_loop(case_launch(controller, case, walk_s))
+    loop.reset()
+    tracker = loop.tracker
+    cpu: list[int] = []
+    act = tracker.act
+
+    keep = states is not None and controller == "wbc"
+
+    def timed_act(reference, state):
+        t0 = time.thread_time_ns()
+        out = act(reference, state)
+        cpu.append(time.thread_time_ns() - t0)
+        if keep and len(cpu) % 10 == 0:  # the WBC's own (q, v) this tick: the baseline's inputs
+            states.append((tracker._q.copy(), tracker._v.copy()))  # type: ignore[attr-defined, union-attr]
+        return out
+
+    tracker.act = timed_act  # type: ignore[method-assign]
+    duration = sum(seg.duration_s for seg in case.timeline) if case.timeline else 1.0 + walk_s
+    marks = sorted({t for t, _ in case.pushes if t < duration} | {duration})
+    pushes = dict(case.pushes)
+    t0 = time.perf_counter()
+    try:
+        for mark in marks:
+            loop.scheduler.run(round((mark - loop.time_s) * loop.rates.lowlevel_hz), stop=lambda: loop.fell)
+            if loop.fell:
+                break
+            if mark in pushes:
+                from g1_control.tools.physics_trials import heading_to_world
+
+                sim = cast("MujocoBackend", loop.backend)
+                sim.push(heading_to_world(pushes[mark], sim.data.qpos[3:7]), PUSH_S)
+    finally:
+        wall = time.perf_counter() - t0
+        loop.backend.close()
+    log = loop.log.arrays()
+    row = Row(controller, case.name, list(case.command), sim_s=float(loop.time_s), wall_s=wall)
+    row.fell = loop.fell
+    row.fall = str(loop.fall) if loop.fall else ""
+    row.min_pelvis_m = float(log["base_pos_m"][:, 2].min())
+    samples = np.asarray(cpu, dtype=float) / 1e3
+    row.act_cpu_p50_us, row.act_cpu_p99_us = (float(v) for v in np.percentile(samples, [50, 99]))
+    if case.pushes:
+        t_fall = loop.fall.t_s if loop.fall else math.inf
+        row.pushes_survived = sum(1 for t, _ in case.pushes if t + 2.0 < t_fall and t < duration)
+        row.pushes = len(case.pushes)
+    if not row.fell and not case.timeline:
+        period = 2 * tracker.config.gait.step_s if controller == "wbc" else POLICY_GAIT_PERIOD_S  # type: ignore[attr-defined]
+        achieved = steady_velocity(log, 1.0 + STEADY_SKIP_S, duration, period)
+        row.achieved = [float(v) for v in achieved]
+        errors = [100.0 * (achieved[k] - c) / c for k, c in enumerate(case.command) if c]
+        row.error_pct = float(max(errors, key=abs))
+        row.off_axis = float(max([abs(achieved[k]) for k, c in enumerate(case.command) if not c], default=0.0))
+    return row
+
+
+def rnea_crba_cpu_us(states: list[tuple[np.ndarray, np.ndarray]]) -> tuple[float, float]:
+    """p50/p99 thread CPU time (us) of pinocchio RNEA + CRBA on `states` (the WBC's model)."""
+    import pinocchio as pin
+
+    from g1_control.robot.dynamics import build_model
+
+    model = build_model()
+    data = model.createData()
+    a0 = np.zeros(model.nv)
+    samples = []
+    for q, v in states:
+        t0 = time.thread_time_ns()
+        pin.rnea(model, data, q, v, a0)
+        pin.crba(model, data, q)
+        samples.append((time.thread_time_ns() - t0) / 1e3)
+    p50, p99 = np.percentile(samples, [50, 99])
+    return float(p50), float(p99)
+
+
+def run_table(controllers: list[str], cases: list[Case], walk_s: float, only: list[str] | None = None,
+              echo=print) -> tuple[list[Row], tuple[float, float]]:
+    """Every (controller, case) row whose name starts with one of `only` (all when None), and the
+    RNEA + CRBA baseline (nan without a WBC row)."""
+    rows: list[Row] = []
+    states: list = []
+    for case in cases:
+        for controller in controllers:
+            name = f"{controller}/{case.name}"
+            if only and not any(name.startswith(p) for p in only):
+                continue
+            row = run_case(controller, case, walk_s, states)
+            rows.append(row)
+            echo(format_row(row))
+    baseline = rnea_crba_cpu_us(states) if states else (math.nan, math.nan)
+    return rows, baseline
+
+
+HEADER = (f"{'controller/case':<24} {'command':>17} {'achieved':>23} {'error %':>8} {'off-axis':>8} {'fell':>5} "
+          f"{'min z m':>7} {'pushes':>6} {'act CPU p50/p99 us':>19}")
+
+
+def format_row(row: Row) -> str:
+    cmd = "({:+.2f} {:+.2f} {:+.2f})".format(*row.command)
+    got = "({:+.3f} {:+.3f} {:+.3f})".format(*row.achieved) if np.isfinite(row.achieved).all() else "-"
+    if row.case.startswith("random"):
+        cmd = "random timeline"
+    pushes = f"{row.pushes_survived}/{row.pushes}" if row.pushes else "-"
+    return (f"{row.name:<24} {cmd:>17} {got:>23} {row.error_pct:8.1f} {row.off_axis:8.3f} "
+            f"{'FELL' if row.fell else 'no':>5} {row.min_pelvis_m:7.3f} {pushes:>6} "
+            f"{row.act_cpu_p50_us:9.0f}/{row.act_cpu_p99_us:<9.0f}")
+
+
+def main(args) -> int:
+    only = [p for p in (args.only or "").split(",") if p] or None
+    walk_s = float(args.seconds)
+    print(f"g1 bench locomotion: {walk_s:.0f} s per row after 1 s standing; achieved = ground-truth mean over whole "
+          f"gait cycles after {STEADY_SKIP_S:.0f} s of walking; act() in thread CPU time")
+    print(HEADER, flush=True)
+    cases = [*CASES, *push_cases(walk_s), *random_cases()]
+    rows, (base50, base99) = run_table(list(CONTROLLERS), cases, walk_s, only,
+                                       echo=lambda line: print(line, flush=True))
+    print(f"baseline, same run: pinocchio RNEA + CRBA on the WBC's visited states: p50 {base50:.0f} us, "
+          f"p99 {base99:.0f} us (thread CPU)")
+    for row in rows:
+        if row.controller == "wbc" and np.isfinite(base50):
+            print(f"  {row.name}: act()/RNEA+CRBA p50 {row.act_cpu_p50_us / base50:.1f}x; p99 {row.act_cpu_p99_us:.0f} us "
+                  f"= {row.act_cpu_p99_us / 4000 * 100:.0f} % of the 4 ms tick at 250 Hz")
+    for controller in CONTROLLERS:
+        pushed = [r for r in rows if r.controller == controller and r.pushes]
+        randoms = [r for r in rows if r.controller == controller and r.case.startswith("random")]
+        if pushed or randoms:
+            print(f"  {controller}: pushes survived {sum(r.pushes_survived for r in pushed)}/"
+                  f"{sum(r.pushes for r in pushed)} ({PUSH_N:.0f} N x {PUSH_S} s walking {PUSH_SPEED_MPS} m/s); "
+                  f"random timelines without a fall {sum(not r.fell for r in randoms)}/{len(randoms)}")
+    falls = [row.name for row in rows if row.fell]
+    if falls:
+        print(f"FELL: {', '.join(falls)}")
+    if args.json:
+        Path(args.json).write_text(json.dumps({"walk_s": walk_s, "steady_skip_s": STEADY_SKIP_S,
+                                               "rnea_crba_cpu_p50_us": base50, "rnea_crba_cpu_p99_us": base99,
+                                               "rows": [asdict(r) for r in rows]}, indent=2))
+    return 1 if falls else 0

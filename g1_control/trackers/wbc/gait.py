@@ -1,0 +1,478 @@
+"""Walking from a velocity command: footsteps, step timing, the capture-point (DCM) plan and swing
+feet, per control tick, for the whole-body controller.
+
+The linear inverted pendulum (capture_point.py): with the centre of pressure (CoP) held at a
+stance foot u, the divergent component xi = c + c_dot / w evolves as xi(t) = u + (xi_0 - u) e^{w t}.
+A step lasts T = double support + single support, from the stance foot's touchdown to the next
+foot's. Call b = xi - u the DCM offset at touchdown; the next touchdown then sees
+b' = b E - d with E = e^{w T} and d the step (next foot minus this one). Walking periodically with
+steps d_1, d_2, d_1, ... (the lateral steps alternate out and in) needs, for the stance foot whose
+next two steps are d_1 then d_2,
+
+    b = (d_1 E + d_2) / (E^2 - 1)
+
+(forward: d_1 = d_2 = vx T gives b = vx T / (E - 1)). The commanded velocity sets the steps, the
+steps set the nominal offsets.
+
+Step location adjustment (Khadiv et al. 2016; Griffin et al. 2017): every tick the DCM measured
+now is propagated to the coming touchdown under the CoP the controller asks for, and the swing
+foot is sent to land at that predicted DCM less the nominal offset of the next stance. Whatever
+the DCM's error (a push, model error), the next step absorbs it, and the steps after it are the
+commanded ones again: the robot's speed follows the command within one step. Inside a foot, the
+CoP tracks the nominal DCM, p = u + (1 + k)(xi - xi_nom), clipped to the sole (the rest is left to
+the step). The landing point is frozen late in the swing so the foot can get there.
+
+Swing feet: the horizontal path and the yaw are re-planned each tick as a minimum-jerk segment
+from the reference's current position, velocity and acceleration to the (moving) landing point,
+arriving a little before touchdown; the height is a smooth bump of `swing_height_m` with zero
+velocity and acceleration at both ends.
+
+Starting from standing, a weight shift first brings the DCM onto the first stance foot's nominal
+place; stopping, once the command is zero and the feet stand side by side, the DCM returns to
+the middle between the feet. Nothing here reads simulator ground truth; positions are the
+controller's odometry frame.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from g1_control.errors import WbcConfigError
+from g1_control.rotations import wrap_angle
+from g1_control.trackers.wbc import capture_point as cp
+
+LEFT, RIGHT = 0, 1
+_SIDE = (1.0, -1.0)
+
+
+@dataclass(frozen=True)
+class GaitConfig:
+    single_support_s: float = 0.28
+    double_support_s: float = 0.07
+    start_s: float = 0.5
+    """Weight shift onto the first stance foot before the first lift-off."""
+    stop_s: float = 0.6
+    """DCM back to the middle of the feet after the last step."""
+    step_width_m: float = 0.22
+    """Sole centre to sole centre, side to side, walking straight."""
+    min_width_m: float = 0.16
+    max_width_m: float = 0.45
+    max_forward_m: float = 0.42
+    """Landing sole ahead of the stance sole, at most (heading frame of the step)."""
+    max_backward_m: float = 0.32
+    max_relative_yaw_rad: float = 0.7
+    swing_height_m: float = 0.07
+    swing_rise: float = 0.4
+    swing_fall: float = 0.4
+    """Fractions of the single support the swing foot takes to rise to its apex and to come down."""
+    swing_hold_s: float = 0.05
+    """Fraction of the single support the swing foot rises before it moves across."""
+    swing_arrive_early_s: float = 0.02
+    """The horizontal swing ends this long before touchdown (the foot comes straight down)."""
+    freeze_landing_after: float = 0.75
+    """Fraction of the single support after which the landing point no longer moves."""
+    cop_gain: float = 1.5
+    """k in p = u + (1 + k)(xi - xi_nom): the DCM's error decays as exp(-k w t) while the CoP can."""
+    double_support_cop_gain: float = 1.5
+    cop_limit_x_m: float = 0.05
+    cop_limit_y_m: float = 0.015
+    """How far the CoP may leave the stance sole's centre (sole axes): inside the sole, with margin."""
+    com_offset_x_m: float = 0.0
+    """Where the CoM stands ahead of the soles' centre (heading frame), standing."""
+    moving_speed: float = 0.02
+    """A command whose |vx|, |vy| (m/s) or |wz| (rad/s) exceeds this makes the robot step."""
+    max_accel: tuple[float, float, float] = (0.8, 0.8, 2.0)
+    """The command the gait walks follows the operator's at most this fast (m/s^2, m/s^2, rad/s^2):
+    a step's length cannot change much from the one before without a large DCM error."""
+    timing_adjust_excess_m: float = 0.03
+    """A landing point this far beyond the step limits makes the step land sooner (step timing)."""
+    min_swing_s: float = 0.2
+    min_remaining_s: float = 0.08
+    """A step made sooner still swings this long in all, and lands no sooner than this from now."""
+    speed_feedback_gain: float = 0.3
+    """Per stride, this fraction of the error between the command and the stride's speed (from the
+    feet's measured touchdowns) is added to the speed the steps are planned for: the pendulum model
+    is not the robot, and without it the robot walks ~20 % slow (measured)."""
+    max_speed_correction_mps: float = 0.4
+    speed_margin: float = 0.85
+    """The gait walks at most this fraction of the speeds its step limits allow (the rest is left
+    for the step adjustment that balance needs)."""
+    stop_tolerance_m: float = 0.05
+    """Stopping needs the feet side by side within this (else it steps once more)."""
+
+    def __post_init__(self) -> None:
+        for name in ("single_support_s", "double_support_s", "start_s", "stop_s", "step_width_m", "swing_height_m"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value > 0):
+                raise WbcConfigError(f"GaitConfig.{name} must be a finite number > 0; got {value}")
+        if not 0 < self.min_width_m <= self.step_width_m <= self.max_width_m:
+            raise WbcConfigError(f"GaitConfig needs 0 < min_width_m <= step_width_m <= max_width_m; got "
+                                 f"{self.min_width_m}, {self.step_width_m}, {self.max_width_m}")
+        if not 0 <= self.freeze_landing_after <= 1:
+            raise WbcConfigError(f"GaitConfig.freeze_landing_after must be in [0, 1]; got {self.freeze_landing_after}")
+        if not 0 <= self.swing_arrive_early_s < self.single_support_s:
+            raise WbcConfigError(f"GaitConfig.swing_arrive_early_s must be in [0, single_support_s); got "
+                                 f"{self.swing_arrive_early_s}")
+
+    @property
+    def step_s(self) -> float:
+        return self.single_support_s + self.double_support_s
+
+
+@dataclass
+class GaitTargets:
+    """What the gait asks of the whole-body controller this tick (odometry frame, world axes)."""
+
+    contacts: np.ndarray = field(default_factory=lambda: np.ones(2, dtype=bool))
+    cop_xy_m: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    heading_rad: float = 0.0
+    yaw_rate_radps: float = 0.0
+    swing_foot: int = -1
+    """-1 in double support."""
+    swing_pos_m: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    swing_vel_mps: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    swing_acc_mps2: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    swing_yaw_rad: float = 0.0
+    swing_yaw_rate_radps: float = 0.0
+    landing_m: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    """Where the swing foot (or, in double support, the next one) is to land."""
+    mode: str = "stand"
+
+
+def nominal_dcm_offset(cfg: GaitConfig, stance: int, v_h: np.ndarray, omega: float) -> np.ndarray:
+    """DCM offset b (heading frame) at the touchdown of foot `stance`, walking periodically at the
+    heading-frame velocity v_h = (vx, vy) (module docstring)."""
+    T = cfg.step_s
+    E = math.exp(omega * T)
+    d1, d2 = nominal_step(cfg, 1 - stance, v_h), nominal_step(cfg, stance, v_h)
+    return (d1 * E + d2) / (E * E - 1.0)
+
+
+def nominal_step(cfg: GaitConfig, foot: int, v_h: np.ndarray) -> np.ndarray:
+    """Heading-frame displacement of a step that lands `foot` beside the other: forward vx T;
+    sideways the foot on the side of the motion steps out by the width plus 2 |vy| T and the other
+    closes to the width, so the mean is vy T."""
+    T = cfg.step_s
+    side = _SIDE[foot]
+    out = side * v_h[1] > 0
+    width = cfg.step_width_m + (2.0 * abs(v_h[1]) * T if out else 0.0)
+    return np.array([v_h[0] * T, side * width])
+
+
+def _rot2(yaw: float) -> np.ndarray:
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([[c, -s], [s, c]])
+
+
+def yaw_rotation(yaw: float) -> np.ndarray:
+    """3 x 3 rotation about world z."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _smooth(a: float, duration_s: float) -> tuple[float, float, float]:
+    """Quintic smoothstep of a (clipped to [0, 1]) with its time derivatives for a ramp lasting duration_s."""
+    if a <= 0.0:
+        return 0.0, 0.0, 0.0
+    if a >= 1.0:
+        return 1.0, 0.0, 0.0
+    s = a * a * a * (10 - 15 * a + 6 * a * a)
+    ds = 30 * a * a * (1 - a) ** 2 / duration_s
+    dds = 60 * a * (1 - a) * (1 - 2 * a) / duration_s**2
+    return s, ds, dds
+
+
+def _min_jerk(x0: float, v0: float, a0: float, x1: float, T: float, t: float) -> tuple[float, float, float]:
+    """Position, velocity, acceleration at t of the quintic from (x0, v0, a0) to (x1, 0, 0) over T."""
+    if T <= 1e-6:
+        return x1, 0.0, 0.0
+    t = min(max(t, 0.0), T)
+    T2, T3 = T * T, T * T * T
+    h = x1 - x0
+    c3 = (20 * h - 12 * v0 * T - 3 * a0 * T2) / (2 * T3)
+    c4 = (-30 * h + 16 * v0 * T + 3 * a0 * T2) / (2 * T3 * T)
+    c5 = (12 * h - 6 * v0 * T - a0 * T2) / (2 * T3 * T2)
+    x = x0 + v0 * t + 0.5 * a0 * t * t + c3 * t**3 + c4 * t**4 + c5 * t**5
+    v = v0 + a0 * t + 3 * c3 * t * t + 4 * c4 * t**3 + 5 * c5 * t**4
+    a = a0 + 6 * c3 * t + 12 * c4 * t * t + 20 * c5 * t**3
+    return x, v, a
+
+
+class VelocityGait:
+    """The gait's state machine: stand -> start (weight shift) -> walk (steps) -> stop -> stand."""
+
+    def __init__(self, config: GaitConfig | None = None):
+        self.config = config or GaitConfig()
+        self.targets = GaitTargets()
+        self.reset()
+
+    def reset(self) -> None:
+        self.mode = "stand"
+        self._t0 = 0.0
+        """Start of the current phase: the weight shift, the stop, or the stance foot's touchdown."""
+        self._last_t: float | None = None
+        self.stance = LEFT
+        self.heading = 0.0
+        self._swing_from = np.zeros(3)
+        self._swing_yaw_from = 0.0
+        self._landing = np.zeros(3)
+        self._landing_yaw = 0.0
+        self._ref = np.zeros((4, 3))
+        """Swing reference (x, y, yaw) rows: position, velocity, acceleration; row 3 unused."""
+        self._dcm_from = np.zeros(2)
+        self.step_T = self.config.step_s
+        """This step's duration (touchdown to touchdown): shortened when balance needs a step sooner."""
+        self._lifted_at = math.nan
+        """The _t0 of the step whose swing has started (nan: none)."""
+        self.command_h = np.zeros(3)
+        """The command being walked: the operator's, rate limited (GaitConfig.max_accel)."""
+        self.speed_correction_h = np.zeros(2)
+        """Added to the walked command's (vx, vy) when planning steps (GaitConfig.speed_feedback_gain)."""
+        self._td_pos = np.full((2, 2), np.nan)
+        self._td_t = np.full(2, np.nan)
+        self.steps = 0
+        self.touchdowns: list[tuple[float, int, np.ndarray]] = []
+        """(time, foot, planned landing point) of every step taken, for tests and figures."""
+
+    # -- the schedule (from time and command only) ---------------------------------------------------
+    def schedule(self, t_s: float, command_h: np.ndarray, soles_m: np.ndarray, sole_yaws: np.ndarray,
+                 dcm_xy: np.ndarray) -> np.ndarray:
+        """Advance the state machine to t_s; returns the contact schedule (left, right) for this tick.
+        command_h: (vx, vy, wz) heading frame; soles_m (2, 3), sole_yaws (2,): measured feet; dcm_xy:
+        the measured DCM (only read when a phase starts)."""
+        cfg = self.config
+        dt = 0.0 if self._last_t is None else t_s - self._last_t
+        self._last_t = t_s
+        moving = bool(np.any(np.abs(command_h) > cfg.moving_speed))
+        walked = self.command_h
+        if self.mode == "walk":
+            step = np.asarray(cfg.max_accel) * dt
+            walked += np.clip(self.feasible(command_h) - walked, -step, step)
+        else:
+            walked[:] = 0.0
+        command_h = walked
+        if self.mode == "stand":
+            self.heading = float(math.atan2(np.sin(sole_yaws).sum(), np.cos(sole_yaws).sum()))
+            if moving:
+                self.mode, self._t0 = "start", t_s
+                self.speed_correction_h[:] = 0.0
+                self._td_t[:] = np.nan
+                self._dcm_from = np.array(dcm_xy, dtype=float)
+                # the first swing foot leads on the side of the motion (turning counts as its side)
+                lead = LEFT if (command_h[1] > 0.02 or (abs(command_h[1]) <= 0.02 and command_h[2] > 0)) else RIGHT
+                self.stance = 1 - lead
+        else:
+            self.heading += float(command_h[2]) * dt
+        if self.mode == "start" and t_s - self._t0 >= cfg.start_s:
+            # straight into single support: the stance foot's touchdown is dated a double support ago
+            self.mode, self._t0 = "walk", t_s - cfg.double_support_s
+            self._lift(soles_m, sole_yaws)
+        if self.mode == "walk":
+            if t_s - self._t0 >= self.step_T:
+                # touchdown of the swing foot: it becomes the stance foot
+                self.touchdowns.append((t_s, 1 - self.stance, self._landing.copy()))
+                self._correct_speed(t_s, 1 - self.stance, soles_m[1 - self.stance, :2])
+                self.steps += 1
+                self.stance = 1 - self.stance
+                self._t0 += self.step_T
+                self.step_T = cfg.step_s
+                if not moving and self._side_by_side(soles_m, sole_yaws):
+                    self.mode, self._t0 = "stop", t_s
+                    self._dcm_from = np.array(dcm_xy, dtype=float)
+            elif self._in_swing(t_s) and not self._swinging:
+                self._lift(soles_m, sole_yaws)
+        if self.mode == "stop" and t_s - self._t0 >= cfg.stop_s:
+            self.mode = "stand"
+        contacts = self.targets.contacts
+        contacts[:] = True
+        if self.mode == "walk" and self._in_swing(t_s):
+            contacts[1 - self.stance] = False
+        self.targets.mode = self.mode
+        return contacts
+
+    def feasible(self, command_h: np.ndarray) -> np.ndarray:
+        """`command_h` within what the step limits allow (GaitConfig.speed_margin of them), each axis
+        and together (the three axes' fractions of their limits add up to at most one)."""
+        cfg = self.config
+        T, m = cfg.step_s, cfg.speed_margin
+        out = np.array(command_h, dtype=float)
+        out[0] = min(max(out[0], -m * cfg.max_backward_m / T), m * cfg.max_forward_m / T)
+        vy = m * (cfg.max_width_m - cfg.step_width_m) / (2 * T)
+        out[1] = min(max(out[1], -vy), vy)
+        wz = m * cfg.max_relative_yaw_rad / T
+        out[2] = min(max(out[2], -wz), wz)
+        # combined axes share the step's reach: walking fast while turning hard stretched the swing
+        # leg straight to its landing point (a knee overspeed at touchdown, measured)
+        vx = m * (cfg.max_forward_m if out[0] >= 0 else cfg.max_backward_m) / T
+        load = abs(out[0]) / vx + abs(out[1]) / vy + abs(out[2]) / wz
+        if load > 1.0:
+            out /= load
+        return out
+
+    def _correct_speed(self, t_s: float, foot: int, landed_xy: np.ndarray) -> None:
+        """A foot has landed: compare the stride since its last touchdown with the command walked."""
+        cfg = self.config
+        if np.isfinite(self._td_t[foot]):
+            dt = t_s - self._td_t[foot]
+            v_w = (landed_xy - self._td_pos[foot]) / dt
+            v_h = _rot2(self.heading - 0.5 * dt * float(self.command_h[2])).T @ v_w
+            c = self.speed_correction_h
+            c += cfg.speed_feedback_gain * (self.command_h[:2] - v_h)
+            np.clip(c, -cfg.max_speed_correction_mps, cfg.max_speed_correction_mps, out=c)
+            # no wind-up: the corrected command stays within the step limits
+            c[:] = self.feasible(np.array([*(self.command_h[:2] + c), 0.0]))[:2] - self.command_h[:2]
+        self._td_pos[foot] = landed_xy
+        self._td_t[foot] = t_s
+
+    def _landing_for(self, t_r: float, p: np.ndarray, u: np.ndarray, f: int, dcm_xy: np.ndarray, omega: float,
+                     command_h: np.ndarray) -> tuple[float, np.ndarray, float]:
+        """(heading at touchdown, unclipped landing relative to the stance sole in that heading
+        frame, how far (m) it lies beyond the step limits) for a touchdown t_r from now."""
+        cfg = self.config
+        heading_td = self.heading + float(command_h[2]) * t_r
+        xi_td = p + (dcm_xy - p) * math.exp(omega * t_r)
+        b_next = _rot2(heading_td) @ nominal_dcm_offset(cfg, f, command_h[:2], omega)
+        rel = _rot2(heading_td).T @ (xi_td - b_next - u[:2])
+        side_out = _SIDE[f] * rel[1]
+        excess = max(rel[0] - cfg.max_forward_m, -cfg.max_backward_m - rel[0], side_out - cfg.max_width_m, 0.0)
+        return heading_td, rel, float(excess)
+
+    def _in_swing(self, t_s: float) -> bool:
+        return t_s - self._t0 >= self.config.double_support_s
+
+    @property
+    def _swinging(self) -> bool:
+        return bool(self._lifted_at == self._t0)
+
+    def _lift(self, soles_m: np.ndarray, sole_yaws: np.ndarray) -> None:
+        swing = 1 - self.stance
+        self._swing_from = soles_m[swing].copy()
+        self._swing_yaw_from = float(sole_yaws[swing])
+        self._ref[:] = 0.0
+        self._ref[0] = (soles_m[swing, 0], soles_m[swing, 1], sole_yaws[swing])
+        self._lifted_at = self._t0
+
+    def _side_by_side(self, soles_m: np.ndarray, sole_yaws: np.ndarray) -> bool:
+        cfg = self.config
+        s = self.stance
+        rel = _rot2(-float(sole_yaws[s])) @ (soles_m[1 - s, :2] - soles_m[s, :2])
+        return (abs(rel[0]) < cfg.stop_tolerance_m and abs(abs(rel[1]) - cfg.step_width_m) < cfg.stop_tolerance_m
+                and abs(float(wrap_angle(sole_yaws[0] - sole_yaws[1]))) < 0.15)
+
+    # -- the targets (from the measured DCM) ------------------------------------------------------------
+    def update(self, t_s: float, dt_s: float, soles_m: np.ndarray, sole_yaws: np.ndarray,
+               dcm_xy: np.ndarray, omega: float) -> GaitTargets:
+        """The CoP, heading and swing-foot targets for this tick (call schedule() first; the
+        command walked is schedule()'s, rate limited)."""
+        cfg, out = self.config, self.targets
+        command_h = self.command_h.copy()
+        command_h[:2] += self.speed_correction_h
+        out.heading_rad = self.heading
+        out.yaw_rate_radps = 0.0 if self.mode == "stand" else float(command_h[2])
+        out.swing_foot = -1
+        mid = soles_m[:, :2].mean(axis=0)
+        centre = mid + _rot2(self.heading) @ np.array([cfg.com_offset_x_m, 0.0])
+        if self.mode in ("stand", "start", "stop"):
+            if self.mode == "stand":
+                goal, a = centre, 1.0
+                dur = 1.0
+            elif self.mode == "start":
+                s = self.stance
+                b = nominal_dcm_offset(cfg, s, command_h[:2], omega)
+                goal = soles_m[s, :2] + _rot2(self.heading) @ b * math.exp(omega * cfg.double_support_s)
+                dur = cfg.start_s
+                a = (t_s - self._t0) / dur
+            else:
+                goal, dur = centre, cfg.stop_s
+                a = (t_s - self._t0) / dur
+            # DCM reference moving smoothly from where it was to the goal; CoP tracks it
+            a = min(max(a, 0.0), 1.0)
+            sm = a * a * a * (10 - 15 * a + 6 * a * a)
+            dsm = 30 * a * a * (1 - a) ** 2 / dur if a < 1.0 else 0.0
+            xi_ref = self._dcm_from + sm * (goal - self._dcm_from) if self.mode != "stand" else goal
+            xi_ref_dot = dsm * (goal - self._dcm_from) if self.mode != "stand" else np.zeros(2)
+            out.cop_xy_m[:] = xi_ref - xi_ref_dot / omega + (1.0 + cfg.cop_gain) * (dcm_xy - xi_ref)
+            if self.mode == "start":
+                out.landing_m[:] = soles_m[1 - self.stance]
+            return out
+        # walking
+        s, f = self.stance, 1 - self.stance
+        Tds = cfg.double_support_s
+        t_in = t_s - self._t0
+        t_r = max(self.step_T - t_in, 0.0)
+        u = soles_m[s]
+        b_now = _rot2(self.heading - float(command_h[2]) * t_in) @ nominal_dcm_offset(cfg, s, command_h[:2], omega)
+        xi_nom = u[:2] + b_now * math.exp(omega * t_in)
+        if t_in < Tds or not self._swinging:
+            # double support: the CoP anywhere between the feet, to take out the DCM's error
+            # before the other foot lifts (its offset then grows by e^{w T_ss} until touchdown)
+            p = u[:2] + (1.0 + cfg.double_support_cop_gain) * (dcm_xy - xi_nom)
+            box = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * (cfg.cop_limit_x_m, cfg.cop_limit_y_m)
+            corners = np.vstack([soles_m[i, :2] + box @ _rot2(float(sole_yaws[i])).T for i in range(2)])
+            p = cp.project_into_polygon(p, cp.convex_hull(corners))
+        else:
+            delta = (1.0 + cfg.cop_gain) * (dcm_xy - xi_nom)
+            rs = _rot2(float(sole_yaws[s]))
+            d_local = rs.T @ delta
+            d_local[0] = min(max(d_local[0], -cfg.cop_limit_x_m), cfg.cop_limit_x_m)
+            d_local[1] = min(max(d_local[1], -cfg.cop_limit_y_m), cfg.cop_limit_y_m)
+            p = u[:2] + rs @ d_local
+        out.cop_xy_m[:] = p
+        # where the swing foot lands: the DCM predicted at touchdown less the next stance's offset
+        tau = (t_in - Tds) / cfg.single_support_s
+        if tau < cfg.freeze_landing_after or not self._swinging:
+            heading_td, rel, excess = self._landing_for(t_r, p, u, f, dcm_xy, omega, command_h)
+            if excess > cfg.timing_adjust_excess_m and self._swinging:
+                # step timing: the step cannot reach far enough in time; land sooner, when the
+                # DCM has not yet run as far (the earliest that leaves the swing its minimum)
+                t_sw = t_in - Tds
+                for frac in (0.8, 0.6, 0.45, 0.3):
+                    t_try = max(t_r * frac, cfg.min_swing_s - t_sw, cfg.min_remaining_s)
+                    if t_try >= t_r - 1e-3:
+                        break
+                    heading_td, rel, excess = self._landing_for(t_try, p, u, f, dcm_xy, omega, command_h)
+                    self.step_T = t_in + t_try
+                    if excess <= cfg.timing_adjust_excess_m:
+                        break
+            side = _SIDE[f]
+            rel[0] = min(max(rel[0], -cfg.max_backward_m), cfg.max_forward_m)
+            rel[1] = side * min(max(side * rel[1], cfg.min_width_m), cfg.max_width_m)
+            self._landing[:2] = u[:2] + _rot2(heading_td) @ rel
+            self._landing[2] = u[2]
+            yaw_s = float(sole_yaws[s])
+            dyaw = float(wrap_angle(heading_td - yaw_s))
+            lim = cfg.max_relative_yaw_rad
+            self._landing_yaw = yaw_s + min(max(dyaw, -lim), lim)
+        out.landing_m[:] = self._landing
+        if not self._swinging:
+            return out
+        # the swing foot: horizontal and yaw by re-planned minimum jerk once the foot is off the
+        # ground, height up early, across, down late (a foot moving forward low trips on its toe)
+        out.swing_foot = f
+        Tss = cfg.single_support_s
+        Tsw = self.step_T - Tds  # this step's swing (shorter when its timing was adjusted)
+        t_sw = t_in - Tds
+        ref = self._ref
+        if t_sw >= cfg.swing_hold_s * Tss:
+            goals = (self._landing[0], self._landing[1],
+                     self._swing_yaw_from + float(wrap_angle(self._landing_yaw - self._swing_yaw_from)))
+            h = max(Tsw - cfg.swing_arrive_early_s - t_sw, 0.0)
+            for k in range(3):
+                x, v, acc = _min_jerk(ref[0, k], ref[1, k], ref[2, k], goals[k], h + dt_s, dt_s)
+                ref[0, k], ref[1, k], ref[2, k] = x, v, acc
+        z0, z1 = self._swing_from[2], self._landing[2]
+        apex = max(z0, z1) + cfg.swing_height_m
+        up = _smooth(t_sw / (cfg.swing_rise * Tss), cfg.swing_rise * Tss)
+        fall = min(cfg.swing_fall * Tss, 0.5 * Tsw)
+        down = _smooth((t_sw - (Tsw - fall)) / fall, fall)
+        out.swing_pos_m[:] = (ref[0, 0], ref[0, 1], z0 + up[0] * (apex - z0) + down[0] * (z1 - apex))
+        out.swing_vel_mps[:] = (ref[1, 0], ref[1, 1], up[1] * (apex - z0) + down[1] * (z1 - apex))
+        out.swing_acc_mps2[:] = (ref[2, 0], ref[2, 1], up[2] * (apex - z0) + down[2] * (z1 - apex))
+        out.swing_yaw_rad, out.swing_yaw_rate_radps = float(ref[0, 2]), float(ref[1, 2])
+        return out
+
+
+__all__ = ["GaitConfig", "GaitTargets", "VelocityGait", "nominal_dcm_offset", "nominal_step", "yaw_rotation"]

@@ -1,0 +1,119 @@
+"""The velocity gait's pieces without physics: DCM offsets that repeat step after step, swing
+segments that arrive, commands kept within the step limits, named configuration errors."""
+
+import math
+
+import numpy as np
+import pytest
+
+from g1_control.errors import WbcConfigError
+from g1_control.trackers.wbc.gait import (
+    LEFT,
+    RIGHT,
+    GaitConfig,
+    VelocityGait,
+    _min_jerk,
+    nominal_dcm_offset,
+    nominal_step,
+)
+
+OMEGA = math.sqrt(9.81 / 0.66)
+
+
+@pytest.mark.parametrize("v", [(0.0, 0.0), (0.5, 0.0), (-0.4, 0.1), (0.3, -0.2)])
+def test_nominal_offsets_repeat_under_the_pendulum(v):
+    """Starting a step at the nominal offset with the CoP on the stance foot, the DCM reaches the
+    next foot's nominal offset at its touchdown: b' = b E - d."""
+    cfg = GaitConfig()
+    E = math.exp(OMEGA * cfg.step_s)
+    v = np.array(v)
+    for stance in (LEFT, RIGHT):
+        b = nominal_dcm_offset(cfg, stance, v, OMEGA)
+        d = nominal_step(cfg, 1 - stance, v)
+        np.testing.assert_allclose(b * E - d, nominal_dcm_offset(cfg, 1 - stance, v, OMEGA), atol=1e-12)
+
+
+def test_steps_average_the_commanded_velocity():
+    cfg = GaitConfig()
+    v = np.array([0.4, 0.15])
+    pair = nominal_step(cfg, LEFT, v) + nominal_step(cfg, RIGHT, v)
+    np.testing.assert_allclose(pair / (2 * cfg.step_s), v)
+    # the foot on the side of the motion steps out, the other closes to the nominal width
+    assert nominal_step(cfg, LEFT, v)[1] > cfg.step_width_m
+    assert nominal_step(cfg, RIGHT, v)[1] == pytest.approx(-cfg.step_width_m)
+
+
+def test_minimum_jerk_segment_arrives_at_rest():
+    x, v, a = _min_jerk(0.1, 0.5, -2.0, 0.4, 0.3, 0.3)
+    assert (x, v, a) == pytest.approx((0.4, 0.0, 0.0), abs=1e-9)
+    x0, v0, a0 = _min_jerk(0.1, 0.5, -2.0, 0.4, 0.3, 0.0)
+    assert (x0, v0, a0) == pytest.approx((0.1, 0.5, -2.0))
+
+
+def test_commands_beyond_the_step_limits_are_walked_at_the_limit():
+    gait = VelocityGait()
+    cfg = gait.config
+    T, m = cfg.step_s, cfg.speed_margin
+    limits = (m * cfg.max_forward_m / T, m * (cfg.max_width_m - cfg.step_width_m) / (2 * T),
+              m * cfg.max_relative_yaw_rad / T)
+    for axis, limit in enumerate(limits):
+        command = np.zeros(3)
+        command[axis] = -5.0 if axis == 1 else 5.0
+        out = gait.feasible(command)
+        assert abs(out[axis]) == pytest.approx(limit) and np.sign(out[axis]) == np.sign(command[axis])
+        assert np.count_nonzero(out) == 1
+    assert gait.feasible(np.array([-5.0, 0.0, 0.0]))[0] == pytest.approx(-m * cfg.max_backward_m / T)
+    np.testing.assert_allclose(gait.feasible(np.array([0.3, 0.05, 0.2])), [0.3, 0.05, 0.2])
+    # combined axes share the reach: their fractions of the limits add up to one, direction kept
+    out = gait.feasible(np.array([0.8, 0.2, -1.0]))
+    assert sum(abs(out[k]) / limits[k] for k in range(3)) == pytest.approx(1.0)
+    np.testing.assert_allclose(out / np.linalg.norm(out), np.array([0.8, 0.2, -1.0]) / np.linalg.norm([0.8, 0.2, -1.0]))
+
+
+def _feet():
+    return np.array([[0.0, 0.11, 0.0], [0.0, -0.11, 0.0]]), np.zeros(2)
+
+
+def test_standing_gait_keeps_both_feet_down_and_starts_on_a_command():
+    gait = VelocityGait()
+    soles, yaws = _feet()
+    for k in range(50):
+        contacts = gait.schedule(0.004 * k, np.zeros(3), soles, yaws, np.zeros(2))
+        assert contacts.all() and gait.mode == "stand"
+    t = 0.2
+    while gait.mode != "walk":
+        t += 0.004
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+        assert t < 0.2 + gait.config.start_s + 0.01
+    # single support of the swing foot (forward and straight: the right foot leads)
+    contacts = gait.schedule(t + 0.004, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+    assert contacts.tolist() == [True, False]
+
+
+def test_landing_moves_with_the_measured_dcm():
+    """Step adjustment: a DCM pushed forward sends the swing foot further forward."""
+    landings = []
+    for push in (0.0, 0.12):
+        gait = VelocityGait()
+        soles, yaws = _feet()
+        t = 0.0
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+        while gait.mode != "walk" or gait.targets.contacts.all():  # into the single support
+            t += 0.004
+            gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+        dcm = soles[LEFT, :2] + np.array([push, -0.03])
+        out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+        landings.append(out.landing_m[0])
+    # the CoP takes what the sole allows (5 cm) of the error; the step takes the rest, grown by
+    # the pendulum until touchdown
+    assert landings[1] > landings[0] + 0.2
+
+
+@pytest.mark.parametrize("kwargs, text", [
+    ({"single_support_s": 0.0}, "single_support_s must be a finite number > 0"),
+    ({"min_width_m": 0.3}, "min_width_m <= step_width_m <= max_width_m"),
+    ({"freeze_landing_after": 1.5}, "freeze_landing_after must be in"),
+])
+def test_bad_gait_config_is_refused(kwargs, text):
+    with pytest.raises(WbcConfigError, match=text):
+        GaitConfig(**kwargs)

@@ -1,0 +1,55 @@
+"""The whole-body controller walks by its own gait from a velocity command, in MuJoCo: it moves
+as commanded (ground truth) and does not fall. Ground truth is read for the checks only."""
+
+import numpy as np
+
+from g1_control.robot import g1
+from g1_control.rotations import yaw_of
+from g1_control.sim.mujoco_backend import MujocoBackend
+from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
+from g1_control.types import JointReference
+
+FALL_HEIGHT_M = 0.6
+"""Pelvis height (ground truth) the robot never goes below while walking (it walks at ~0.72 m)."""
+
+
+def walk(command, seconds, start_s=0.5):
+    backend = MujocoBackend()
+    state = backend.reset()
+    tracker = WholeBodyTracker(WbcConfig(footsteps="velocity"))
+    tracker.reset(state)
+    ref = JointReference(q_rad=g1.DEFAULT_Q_RAD.copy())
+    trace = []
+    for _ in range(round(seconds / 0.004)):
+        state = backend.read_state()
+        on = state.t_s >= start_s
+        ref.root_linvel_h_mps[:2] = command[:2] if on else (0.0, 0.0)
+        ref.root_angvel_h_radps[2] = command[2] if on else 0.0
+        backend.write_command(tracker.act(ref, state))
+        backend.step(0.004)
+        trace.append((state.t_s, *state.base_pos_w_m, yaw_of(state.imu_quat_wxyz)))
+        if state.base_pos_w_m[2] < FALL_HEIGHT_M:
+            break
+    return tracker, np.array(trace)
+
+
+def test_walks_forward_at_the_commanded_speed_without_falling():
+    tracker, trace = walk((0.4, 0.0, 0.0), 7.0)
+    t, pos, yaw = trace[:, 0], trace[:, 1:4], trace[:, 4]
+    assert pos[:, 2].min() > FALL_HEIGHT_M, f"fell at {t[np.argmin(pos[:, 2])]:.2f} s"
+    assert t[-1] > 6.9
+    # two whole strides from 3 s on, ground truth
+    stride = 2 * tracker.config.gait.step_s
+    a, b = np.searchsorted(t, 3.0), np.searchsorted(t, 3.0 + 3 * stride)
+    speed = (pos[b, 0] - pos[a, 0]) / (t[b] - t[a])
+    assert abs(speed - 0.4) < 0.06, f"walked {speed:.3f} m/s for 0.4"
+    assert abs(pos[b, 1] - pos[a, 1]) / (t[b] - t[a]) < 0.05  # straight means straight
+    assert abs(yaw[b] - yaw[a]) < 0.1
+    assert tracker.gait is not None and tracker.gait.steps >= 12
+    assert tracker.diagnostics.unsolved_ticks == 0
+
+
+def test_stands_still_without_a_command():
+    tracker, trace = walk((0.0, 0.0, 0.0), 2.0)
+    assert tracker.gait is not None and tracker.gait.steps == 0 and tracker.gait.mode == "stand"
+    assert np.linalg.norm(trace[-1, 1:3] - trace[0, 1:3]) < 0.03
