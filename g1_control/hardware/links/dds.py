@@ -79,6 +79,13 @@ def domain_participant(interface: str, domain_id: int):
     return DomainParticipant(domain_id)
 
 
+_ENTITY_LOCK = threading.Lock()
+"""Held by every link's send/take and close, process-wide: Cyclone DDS (0.10) delivers a write to
+the readers of the same process inline, and deleting a link's entities while another link's
+thread writes on the same domain segfaulted the process (seen in the test suite under load: an
+emulator's state write while a host link closed). Uncontended it costs well under a microsecond."""
+
+
 class DdsLink(Link):
     """One side of the G1 low-level DDS stream."""
 
@@ -125,9 +132,7 @@ class DdsLink(Link):
         self._peer_lock = threading.Lock()
         """Discovered writers on our two topics and partition: instance handle -> (topic, guid)."""
         self._closed = False
-        self._io_lock = threading.Lock()
-        """Held by send/take and by close: Cyclone frees an entity under a thread still writing to it
-        (a segfault, not an error code), so a link closed from another thread must wait for them."""
+        self._io_lock = _ENTITY_LOCK
 
     @property
     def participant(self):
