@@ -364,15 +364,19 @@ class Preflight:
 
 
 def _goals_without_world_pose(launch: LaunchFile) -> str:
-    """'; note: goal seg2.0 (...) will fail at its start: ...' for the launch file's goals that need a
-    world pose, which a robot does not report ('' when none does)."""
+    """'; note: goal seg2.0 (...) is placed by the robot's own estimate ...' for the launch file's goals
+    that need a world pose, which a robot does not report ('' when none does): they steer by the
+    localiser (estimation/localiser.py), anchored where the run starts."""
     from g1_control.generator.goals.executor import world_pose_needed
     from g1_control.launch.builder import timeline_of
     from g1_control.teleop.scripted import timeline_goals
 
-    failing = [(g, why) for g in timeline_goals(timeline_of(launch)) if (why := world_pose_needed(g)) is not None]
-    return "".join(f"; note: goal {g.goal_id} ({g.describe()}) will fail at its start: the robot reports no world "
-                   f"pose and {why}" for g, why in failing)
+    placed = [g for g in timeline_goals(timeline_of(launch)) if world_pose_needed(g) is not None]
+    if not placed:
+        return ""
+    source = "leg odometry" + (" fused with the external pose" if launch.estimation.external_pose else "")
+    return "".join(f"; note: goal {g.goal_id} ({g.describe()}) is placed by the robot's own estimate ({source}, "
+                   "anchored where it starts: the scene's origin, facing +x)" for g in placed)
 
 
 def _segment_speed(segment, run_s: float) -> str:

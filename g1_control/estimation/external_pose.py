@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass, field
+from typing import Literal
 
 from g1_control.errors import LaunchFileError
 from g1_control.rotations import wrap_angle
@@ -55,7 +56,7 @@ class ExternalPoseConfig:
     max_jump_rad: float = 0.5
     correction_tau_s: float = 0.5
     """Time constant of the pull toward the external pose (seconds of poses, not of ticks)."""
-    frame: str = "start"
+    frame: Literal["start", "scene"] = "start"
     """start: align the external frame to the start frame on the first pose; scene: poses are in the scene frame."""
 
     def validate(self, where: str) -> None:

@@ -77,12 +77,12 @@ class Localiser:
         odo = self.odometry.update(state)
         x, y, yaw = self.start.compose(odo.x_m, odo.y_m, odo.yaw_rad)
         if self.fusion is not None:
-            fused = self.fusion.update(Planar(odo.t_s, x, y, yaw))
+            self.fusion.update(Planar(odo.t_s, x, y, yaw))
             if self.source is not None:
                 for sample in self.source.take(state.t_s):
                     self.fusion.measure(sample)
-                fused = self.fusion.fused
-                assert fused is not None
+            fused = self.fusion.fused
+            assert fused is not None  # set by update()
             x, y, yaw = fused.x_m, fused.y_m, fused.yaw_rad
         self.pose = WorldPose(odo.t_s, x, y, odo.z_m, yaw)
         self._yaw_offset = wrap_angle(yaw - yaw_of(state.imu_quat_wxyz))

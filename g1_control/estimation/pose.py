@@ -21,6 +21,7 @@ Nothing here reads simulator ground truth. `g1 bench odometry` measures the drif
 from __future__ import annotations
 
 import math
+
 import numpy as np
 
 from g1_control.estimation.estimator import StateEstimator

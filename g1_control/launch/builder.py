@@ -20,6 +20,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from g1_control.errors import LaunchFileError
+from g1_control.estimation.estimator import StateEstimator
 from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, Tracker
 from g1_control.launch.schema import SKELETON_GENERATORS, LaunchFile
 from g1_control.loop.control_loop import ControlLoop
@@ -29,6 +30,7 @@ from g1_control.teleop.scripted import Segment, random_timeline
 from g1_control.types import CommandLimits
 
 if TYPE_CHECKING:
+    from g1_control.estimation.localiser import Localiser
     from g1_control.sim.mujoco_backend import MujocoBackend
 
 CHAIN_STAGES = ("generator", "retargeter", "tracker", "rates", "safety")
@@ -119,6 +121,26 @@ def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
     return goals, GoalRetargeter(goals, retargeter)
 
 
+def make_localiser(launch: LaunchFile, estimator: StateEstimator) -> Localiser | None:
+    """The robot's world pose estimate when the launch file steers by it (estimation.steer_by; a robot
+    link always does): leg odometry on the loop's estimator, fused with the external pose topic where
+    estimation.external_pose names one. None: goals and programs steer by the simulator's ground truth."""
+    if not launch.steers_by_estimate():
+        return None
+    from g1_control.estimation.external_pose import PoseFusion
+    from g1_control.estimation.localiser import DdsPoseSource, Localiser
+    from g1_control.estimation.pose import LegOdometry
+
+    ext = launch.estimation.external_pose
+    if ext is None:
+        return Localiser(LegOdometry(estimator, shared=True))
+    from g1_control.hardware.ros2.topics import PoseTopicReader
+
+    assert ext.interface is not None  # validated: always named
+    reader = PoseTopicReader(ext.interface, ext.domain, ext.topic, ext.partition)
+    return Localiser(LegOdometry(estimator, shared=True), fusion=PoseFusion(ext), source=DdsPoseSource(reader))
+
+
 def make_sim_backend(launch: LaunchFile) -> MujocoBackend:
     if launch.backend.type != "mujoco":
         raise LaunchFileError(f"launch file '{launch.name}' drives a robot (backend.type {launch.backend.type}); "
@@ -173,8 +195,13 @@ def build_loop(launch: LaunchFile, *, backend: Backend | None = None, input_devi
         wallclock = launch.backend.mode == "wallclock" or not backend.lockstep
     r = launch.rates
     capacity = log_capacity if log_capacity is not None else int(launch.total_duration_s * r.tracker_hz) + 2
+    estimator = StateEstimator()
+    localiser = make_localiser(launch, estimator)
+    if localiser is not None:
+        generator.steer_by(localiser)
+        chain["localiser"] = localiser.describe()
     loop = ControlLoop(backend, input_device, generator, retargeter, tracker, r, wallclock=wallclock,
-                       safety=safety, log_capacity=capacity,
+                       safety=safety, log_capacity=capacity, estimator=estimator, localiser=localiser,
                        falls=FallMonitor(launch.fall, max_tilt_rad=safety.config.max_tilt_rad))
     chain["input"] = type(input_device).__name__
     chain["backend"] = backend.describe()
