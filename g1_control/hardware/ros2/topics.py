@@ -21,7 +21,7 @@ TOPIC_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*$")
 
 def check_topic_name(name: object) -> str | None:
     """Why `name` is not a ROS 2 topic name as this project writes it ('mocap/pose'), or None."""
-    if not isinstance(name, str) or not TOPIC_NAME.match(name):
+    if not isinstance(name, str) or not TOPIC_NAME.match(name) or name.startswith("rt/"):
         return (f"{name!r} is not a ROS 2 topic name (letters, digits and _ in /-separated parts, no leading "
                 "/ and no rt/ prefix, e.g. mocap/pose)")
     return None
