@@ -42,6 +42,17 @@ def register(subparsers) -> None:
                         help="robot: the G1's protocol (default); unitree_mujoco: play Unitree's MuJoCo simulator "
                         "(LowState_ with crc, tick and mode_machine 0 at 200 Hz, PD torque computed when a LowCmd_ "
                         "arrives and held, no motion service), for g1 deploy with backend.simulator: unitree_mujoco")
+    parser.add_argument("--mocap", action="store_true",
+                        help="also publish a motion-capture pose of the pelvis from the simulator's ground truth "
+                        "(geometry_msgs/PoseStamped on rt/<--mocap-topic>, frame 'mocap' = the scene frame), for a "
+                        "launch file's estimation.external_pose")
+    parser.add_argument("--mocap-topic", default="mocap/pose", help="its ROS 2 topic (default mocap/pose)")
+    parser.add_argument("--mocap-rate-hz", type=float, default=100.0, help="poses per second (default 100)")
+    parser.add_argument("--mocap-noise-m", type=float, default=0.0, help="position noise, std per axis (m)")
+    parser.add_argument("--mocap-noise-deg", type=float, default=0.0, help="heading noise, std (deg)")
+    parser.add_argument("--mocap-latency-s", type=float, default=0.0, help="each pose is sent this late (s)")
+    parser.add_argument("--mocap-dropout", type=float, default=0.0, help="probability that a pose is lost (0..1)")
+    parser.add_argument("--mocap-seed", type=int, default=0, help="seed of the noise and dropouts")
     parser.add_argument("--mode-machine", type=int, default=5, help="variant to report with --physics mock (4/5/6)")
     parser.add_argument("--no-builtin", action="store_true",
                         help="start with no built-in controller (as after debug mode on the remote)")
@@ -81,7 +92,21 @@ def _run(args) -> int:
 
         physics = MockG1(mode_machine=args.mode_machine)
     emulator = RobotEmulator(physics, args.interface, args.domain, partition=args.partition,
-                             builtin_mode="" if args.no_builtin else "ai", mode=args.mode).start()
+                             builtin_mode="" if args.no_builtin else "ai", mode=args.mode)
+    if args.mocap:
+        import math
+
+        from g1_control.sim.mocap import MocapConfig
+
+        try:
+            emulator.publish_mocap(MocapConfig(args.mocap_rate_hz, args.mocap_noise_m, math.radians(args.mocap_noise_deg),
+                                               args.mocap_latency_s, args.mocap_dropout, args.mocap_seed),
+                                   args.mocap_topic)
+        except ValueError as exc:
+            emulator.close()
+            print(f"g1 sim-robot: {exc}", file=sys.stderr)
+            return 2
+    emulator.start()
     stop = {"now": False}
 
     def _stop(signum, frame):
@@ -108,4 +133,8 @@ def _run(args) -> int:
     print(f"g1 sim-robot: {report['states_sent']} states sent, {report['commands_applied']} commands applied, "
           f"{report['bad_crc']} bad CRC, {report['wrong_mode_machine']} wrong mode_machine, "
           f"{report['ignored_while_builtin_active']} ignored while the built-in controller ran", file=sys.stderr)
+    if "mocap" in report:
+        m = report["mocap"]
+        print(f"g1 sim-robot: motion capture: {m['sent']} poses sent, {m['dropped']} of {m['measured']} dropped",
+              file=sys.stderr)
     return 0

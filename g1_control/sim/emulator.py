@@ -16,6 +16,7 @@ import json
 import sys
 import threading
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -26,8 +27,13 @@ from g1_control.hardware.unitree.motion_service import MotionServiceEmulator
 from g1_control.hardware.unitree.remote import encode_wireless_remote
 from g1_control.interfaces import Backend
 from g1_control.robot import g1
+from g1_control.rotations import yaw_of
 from g1_control.sim.robot_endpoint import RobotEndpoint
 from g1_control.types import MotorCommand, RobotState
+
+if TYPE_CHECKING:
+    from g1_control.hardware.ros2.topics import PoseTopicWriter
+    from g1_control.sim.mocap import MocapConfig, SimulatedMocap
 
 FAULTS = {
     "state_stops": "LowState_ stops (robot side silent)",
@@ -222,6 +228,8 @@ class RobotEmulator:
         self.service = MotionServiceEmulator(self.link._participant, partition, active_mode=builtin_mode,
                                              on_change=self._on_mode_change) if mode == "robot" else None
         self._lock = threading.Lock()
+        self.mocap: SimulatedMocap | None = None
+        self._mocap_writer: PoseTopicWriter | None = None
 
     @staticmethod
     def _unitree_mujoco_traits() -> tuple[float, str]:
@@ -281,12 +289,35 @@ class RobotEmulator:
             p.hot_joint = g1.JOINT_INDEX["waist_yaw_joint"]
         return time.monotonic()
 
+    def publish_mocap(self, config: MocapConfig, topic: str = "mocap/pose") -> SimulatedMocap:
+        """Publish a motion-capture pose of the pelvis from the simulator's ground truth on rt/<topic>
+        (geometry_msgs/PoseStamped, frame 'mocap' = the simulator's world = the scene frame), stamped
+        with the wall clock when measured and sent `latency_s` later (sim/mocap.py)."""
+        from g1_control.hardware.ros2.topics import PoseTopicWriter
+        from g1_control.sim.mocap import SimulatedMocap
+
+        mocap = SimulatedMocap(config)
+        writer = PoseTopicWriter(self.link.interface, self.link.domain_id, topic, self.link.partition)
+        self._mocap_writer = writer
+
+        def sample(state: RobotState) -> None:
+            if state.base_pos_w_m is None:
+                return
+            for stamp, pos, quat in mocap.sample(time.time(), state.base_pos_w_m, state.imu_quat_wxyz):
+                writer.write(stamp, pos, quat)
+
+        self.endpoint.on_state = sample
+        self.mocap = mocap
+        return mocap
+
     def start(self) -> RobotEmulator:
         self.endpoint.start()
         return self
 
     def close(self) -> None:
         self.endpoint.stop()
+        if self._mocap_writer is not None:
+            self._mocap_writer.close()
         if self.service is not None:
             self.service.close()
         self.link.close()
@@ -303,6 +334,10 @@ class RobotEmulator:
         out.update(self.endpoint.whole_run_period_stats())
         state = self.physics.read_state()
         out["base_pos_w_m"] = None if state.base_pos_w_m is None else [float(v) for v in state.base_pos_w_m]
+        out["base_yaw_rad"] = float(yaw_of(state.imu_quat_wxyz))
+        if self.mocap is not None and self._mocap_writer is not None:
+            out["mocap"] = {"measured": self.mocap.measured, "dropped": self.mocap.dropped,
+                            "sent": self._mocap_writer.sent}
         out["first_damping_base_pos_w_m"] = self.endpoint.first_damping_base_pos_w_m
         last = self.endpoint.last_command
         out["last_command_is_damping"] = None if last is None else bool(

@@ -17,6 +17,7 @@ import sys
 import threading
 import time
 from collections import deque
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -27,7 +28,7 @@ from g1_control.hardware.unitree.conversions import lowcmd_to_motor_command, rob
 from g1_control.hardware.unitree.messages import LowCmd
 from g1_control.interfaces import Backend
 from g1_control.robot import g1
-from g1_control.types import MotorCommand
+from g1_control.types import MotorCommand, RobotState
 
 PERIOD_BIN_S = 1e-5
 PERIOD_BINS = 20_000
@@ -76,6 +77,9 @@ class RobotEndpoint:
         self.unset_state_fields = False
         """As Unitree's MuJoCo simulator (g1_control/sim/unitree_mujoco.py): LowState_ with crc, tick and
         mode_machine left at 0, and every LowCmd_ taken whatever its CRC and mode_machine."""
+        self.on_state: Callable[[RobotState], None] | None = None
+        """Called with every state the physics reports before it is published (on the endpoint's
+        thread): g1 sim-robot's motion capture samples ground truth here."""
         self._frozen: bytes | None = None
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -195,6 +199,8 @@ class RobotEndpoint:
             payload = self._frozen
         else:
             state = self.physics.read_state()
+            if self.on_state is not None:
+                self.on_state(state)
             state.tick = self._tick
             msg = robot_state_to_lowstate(state)
             if self.unset_state_fields:

@@ -37,7 +37,7 @@ def test_a_late_pose_is_carried_to_now_by_the_odometrys_motion_since_its_stamp()
     error over the 0.2 s it carries each pose (2 cm) and the filter's lag between poses (2 cm)."""
     fusion = PoseFusion(_config(max_age_s=0.5))
     truth = {}
-    for t, x, y, _ in _walk(fusion, 6.0, drift=0.8):
+    for t, x, _y, _ in _walk(fusion, 6.0, drift=0.8):
         truth[round(t, 2)] = x
         stamp = round(t - 0.2, 2)
         if stamp >= 0 and round(t * 100) % 5 == 0:

@@ -16,6 +16,8 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
+HISTORY_DEPTH = 64
+"""Poses a reader keeps between takes (0.64 s of a 100 Hz motion capture, read every loop tick)."""
 TOPIC_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*$")
 
 
@@ -55,6 +57,7 @@ class PoseTopicReader:
     """Takes PoseStamped samples from rt/<topic> (no thread: take() drains what arrived)."""
 
     def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
+        from cyclonedds.qos import Policy, Qos
         from cyclonedds.sub import DataReader, Subscriber
         from cyclonedds.topic import Topic
 
@@ -66,15 +69,18 @@ class PoseTopicReader:
             raise ValueError(f"external pose topic: {problem}")
         self.topic = topic
         self._participant: Any = domain_participant(interface, domain)
+        # Every pose since the last take (DDS keeps only the latest by default): a late pose and a
+        # fresher one arriving together are each judged (the fusion refuses the stale one by name).
         self._reader = DataReader(Subscriber(self._participant, qos=_group_qos(partition)),
-                                  Topic(self._participant, m.TOPIC_PREFIX + topic, m.PoseStamped_))
+                                  Topic(self._participant, m.TOPIC_PREFIX + topic, m.PoseStamped_),
+                                  qos=Qos(Policy.History.KeepLast(HISTORY_DEPTH)))
         self._seconds = m.seconds
         self.received = 0
 
     def take(self) -> list[PoseReading]:
         now = time.time()
         out = []
-        for msg in self._reader.take(64):
+        for msg in self._reader.take(HISTORY_DEPTH):
             if not hasattr(msg, "pose"):
                 continue  # a sample-less info (writer gone)
             stamp = self._seconds(msg.header.stamp)
