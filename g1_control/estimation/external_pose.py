@@ -101,13 +101,13 @@ class Planar:
     def compose(self, dx: float, dy: float, dyaw: float) -> tuple[float, float, float]:
         """This pose moved by (dx, dy, dyaw) given in its own frame."""
         c, s = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
-        return self.x_m + c * dx - s * dy, self.y_m + s * dx + c * dy, wrap_angle(self.yaw_rad + dyaw)
+        return self.x_m + c * dx - s * dy, self.y_m + s * dx + c * dy, float(wrap_angle(self.yaw_rad + dyaw))
 
     def relative(self, other: Planar) -> tuple[float, float, float]:
         """`other` in this pose's frame (this^-1 * other)."""
         c, s = math.cos(self.yaw_rad), math.sin(self.yaw_rad)
         dx, dy = other.x_m - self.x_m, other.y_m - self.y_m
-        return c * dx + s * dy, -s * dx + c * dy, wrap_angle(other.yaw_rad - self.yaw_rad)
+        return c * dx + s * dy, -s * dx + c * dy, float(wrap_angle(other.yaw_rad - self.yaw_rad))
 
 
 @dataclass
