@@ -49,6 +49,7 @@ class ExternalPoseConfig:
     """Network interface of the pose's publisher (always named; lo: this computer)."""
     domain: int = 0
     partition: str | None = None
+    """DDS partition; default: the robot link's (backend.partition, g1 deploy --partition)."""
     max_age_s: float = 0.3
     """Older poses are refused (stale); latency below this is compensated by the odometry."""
     max_jump_m: float = 0.3

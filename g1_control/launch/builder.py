@@ -137,7 +137,8 @@ def make_localiser(launch: LaunchFile, estimator: StateEstimator) -> Localiser |
     from g1_control.hardware.ros2.topics import PoseTopicReader
 
     assert ext.interface is not None  # validated: always named
-    reader = PoseTopicReader(ext.interface, ext.domain, ext.topic, ext.partition)
+    # the backend's partition by default: g1 deploy --partition isolates the pose topic with the robot link
+    reader = PoseTopicReader(ext.interface, ext.domain, ext.topic, ext.partition or launch.backend.partition)
     return Localiser(LegOdometry(estimator, shared=True), fusion=PoseFusion(ext), source=DdsPoseSource(reader))
 
 
