@@ -480,7 +480,8 @@ def _report_goals(report: DeployReport, loop, launch: LaunchFile, folder: RunFol
 
 
 def _report_localisation(report: DeployReport, loop) -> None:
-    """The localiser's last pose and external pose counters into the report; its pose topic is closed."""
+    """The localiser's last pose, its pose when damping began (the robot then stops walking: judged against
+    a simulator's ground truth there) and external pose counters into the report; its pose topic is closed."""
     localiser = loop.localiser
     if localiser is None:
         return
@@ -488,6 +489,9 @@ def _report_localisation(report: DeployReport, loop) -> None:
     out: dict = {"source": localiser.describe().split(";")[0],
                  "pose": None if pose is None else {"x_m": pose.x_m, "y_m": pose.y_m, "z_m": pose.z_m,
                                                     "yaw_rad": pose.yaw_rad}}
+    damping = next((t["t_s"] for t in report.transitions if t["to"] == "damping"), None)
+    at = localiser.pose_at(damping) if damping is not None else None
+    out["pose_at_damping"] = None if at is None else {"t_s": at.t_s, "x_m": at.x_m, "y_m": at.y_m, "yaw_rad": at.yaw_rad}
     if localiser.fusion is not None:
         c = localiser.fusion.counters
         out["external_pose"] = {"accepted": c.accepted, "rejected": dict(c.rejected), "last_rejection": c.last_rejection,

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections import deque
 from typing import Protocol
 
 import numpy as np
@@ -29,6 +30,9 @@ from g1_control.estimation.external_pose import Planar, PoseFusion, PoseSample
 from g1_control.estimation.pose import LegOdometry
 from g1_control.rotations import wrap_angle, yaw_of
 from g1_control.types import RobotState, WorldPose
+
+TRACK_PERIOD_S = 0.1
+TRACK_LENGTH = 36_000
 
 
 class PoseSource(Protocol):
@@ -65,11 +69,14 @@ class Localiser:
         self.fusion = fusion
         self.source = source
         self.pose: WorldPose | None = None
+        self.track: deque[WorldPose] = deque(maxlen=TRACK_LENGTH)
+        """The pose every TRACK_PERIOD_S (the last hour), for reports: where the estimate was when."""
         self._yaw_offset = 0.0
 
     def reset(self, state: RobotState) -> None:
         self.odometry.restart()
         self.pose = None
+        self.track.clear()
         if self.fusion is not None:
             self.fusion = PoseFusion(self.fusion.config)
 
@@ -85,8 +92,16 @@ class Localiser:
             assert fused is not None  # set by update()
             x, y, yaw = fused.x_m, fused.y_m, fused.yaw_rad
         self.pose = WorldPose(odo.t_s, x, y, odo.z_m, yaw)
+        if not self.track or odo.t_s >= self.track[-1].t_s + TRACK_PERIOD_S:
+            self.track.append(self.pose)
         self._yaw_offset = wrap_angle(yaw - yaw_of(state.imu_quat_wxyz))
         return self.pose
+
+    def pose_at(self, t_s: float) -> WorldPose | None:
+        """The tracked pose nearest `t_s` (the loop's clock), None before the first."""
+        if not self.track:
+            return None
+        return min(self.track, key=lambda p: abs(p.t_s - t_s))
 
     def scene_state(self, state: RobotState) -> RobotState:
         """`state` with this estimate as its base pose in the scene frame: base_pos_w_m, the IMU's

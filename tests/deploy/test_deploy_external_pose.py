@@ -46,7 +46,7 @@ def test_the_fused_estimate_ends_where_the_simulator_says_the_robot_is(tmp_path,
     mocap = wire["mocap"]
     assert 0.05 < mocap["dropped"] / mocap["measured"] < 0.15  # 10 % dropouts
     assert ext["accepted"] > 500 and ext["rejected"]["jump"] == 0
-    truth, pose = wire["first_damping_base_pos_w_m"], loc["pose"]
+    truth, pose = wire["first_damping_base_pos_w_m"], loc["pose_at_damping"]
     lowered = wire["gantry_lowered_base_pos_w_m"]
     walked = math.hypot(truth[0] - lowered[0], truth[1] - lowered[1])
     error = math.hypot(pose["x_m"] - truth[0], pose["y_m"] - truth[1])
