@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from g1_control.errors import G1ControlError, RobotNotConnectedError, VariantMismatchError
-from g1_control.launch.schema import InputConfig, LaunchFile, Segment
+from g1_control.launch.schema import EstimationConfig, InputConfig, LaunchFile, Segment
 from g1_control.robot import g1
 from g1_control.rotations import tilt_rad
 
@@ -470,7 +470,8 @@ def dry_run_launch(launch: LaunchFile, program=None) -> LaunchFile:
                                 pose="estimator", start_delay_s=cfg.start_delay_s)
         dry = dataclasses.replace(launch, name=f"{launch.name}-dry-run", duration_s=None, input=run_input,
                                   backend=BackendConfig(type="mujoco", mode="lockstep",
-                                                        physics_dt_s=launch.backend.physics_dt_s), viewer=False)
+                                                        physics_dt_s=launch.backend.physics_dt_s), viewer=False,
+                                  estimation=dry_run_estimation(launch))
         dry.duration_s = max(duration, dry.total_duration_s)
         return dry
     if launch.input.type == "scripted":
@@ -482,4 +483,10 @@ def dry_run_launch(launch: LaunchFile, program=None) -> LaunchFile:
     return dataclasses.replace(
         launch, name=f"{launch.name}-dry-run", duration_s=duration,
         backend=BackendConfig(type="mujoco", mode="lockstep", physics_dt_s=launch.backend.physics_dt_s),
-        input=InputConfig(type="scripted", timeline=timeline), viewer=False)
+        input=InputConfig(type="scripted", timeline=timeline), viewer=False, estimation=dry_run_estimation(launch))
+
+
+def dry_run_estimation(launch: LaunchFile) -> EstimationConfig:
+    """The dry run steers by what the robot will steer by: its own estimate (leg odometry) where the
+    launch file does; no external pose (nothing publishes one to the simulated run)."""
+    return EstimationConfig(steer_by="estimate" if launch.steers_by_estimate() else launch.estimation.steer_by)
