@@ -149,6 +149,10 @@ class WorldPoseEstimate(Protocol):
         """`state` with the estimate as its base pose (base_pos_w_m, heading, velocity in scene axes)."""
         ...
 
+    def object_positions(self) -> Mapping[str, np.ndarray]:
+        """Named objects (boxes) seen by perception, their centres in the scene frame ({} without perception)."""
+        ...
+
 
 class Generator(ABC):
     """Operator intent -> the whole-body plan for this tick. A generator that executes task goals

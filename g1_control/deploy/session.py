@@ -496,6 +496,10 @@ def _report_localisation(report: DeployReport, loop) -> None:
         c = localiser.fusion.counters
         out["external_pose"] = {"accepted": c.accepted, "rejected": dict(c.rejected), "last_rejection": c.last_rejection,
                                 "max_correction_m": c.max_correction_m}
+    if localiser.objects is not None:
+        p = localiser.objects.counters
+        out["perception"] = {"frames": p.frames, "rejected": dict(p.rejected), "last_rejection": p.last_rejection,
+                             "objects_w_m": {n: [float(v) for v in xyz] for n, xyz in localiser.objects.positions.items()}}
     report.localisation = out
     localiser.close()
 

@@ -27,12 +27,13 @@ from typing import Protocol
 import numpy as np
 
 from g1_control.estimation.external_pose import Planar, PoseFusion, PoseSample
+from g1_control.estimation.perception import ObjectPerception
 from g1_control.estimation.pose import LegOdometry
 from g1_control.rotations import wrap_angle, yaw_of
 from g1_control.types import RobotState, WorldPose
 
-TRACK_PERIOD_S = 0.1
-TRACK_LENGTH = 36_000
+TRACK_PERIOD_S = 0.05
+TRACK_LENGTH = 72_000
 
 
 class PoseSource(Protocol):
@@ -61,16 +62,19 @@ class Localiser:
     """See the module docstring. start: the robot's start pose in the scene (x_m, y_m, yaw_rad)."""
 
     def __init__(self, odometry: LegOdometry, start: tuple[float, float, float] = (0.0, 0.0, 0.0),
-                 fusion: PoseFusion | None = None, source: PoseSource | None = None):
+                 fusion: PoseFusion | None = None, source: PoseSource | None = None,
+                 objects: ObjectPerception | None = None):
         if source is not None and fusion is None:
             raise ValueError("Localiser: an external pose source needs a PoseFusion to fuse it")
         self.odometry = odometry
         self.start = Planar(0.0, *start)
         self.fusion = fusion
         self.source = source
+        self.objects = objects
+        """Perception of named objects, placed in the scene with this estimate (estimation/perception.py)."""
         self.pose: WorldPose | None = None
         self.track: deque[WorldPose] = deque(maxlen=TRACK_LENGTH)
-        """The pose every TRACK_PERIOD_S (the last hour), for reports: where the estimate was when."""
+        """The pose every TRACK_PERIOD_S (the last hour): where the estimate was when (reports, perception)."""
         self._yaw_offset = 0.0
 
     def reset(self, state: RobotState) -> None:
@@ -94,14 +98,31 @@ class Localiser:
         self.pose = WorldPose(odo.t_s, x, y, odo.z_m, yaw)
         if not self.track or odo.t_s >= self.track[-1].t_s + TRACK_PERIOD_S:
             self.track.append(self.pose)
+        if self.objects is not None:
+            self.objects.update(state.t_s, self.pose_at)
         self._yaw_offset = wrap_angle(yaw - yaw_of(state.imu_quat_wxyz))
         return self.pose
 
     def pose_at(self, t_s: float) -> WorldPose | None:
-        """The tracked pose nearest `t_s` (the loop's clock), None before the first."""
-        if not self.track:
+        """The estimate at `t_s` (the loop's clock): linear between tracked poses, the current pose after
+        the last; None before the track or after now."""
+        pose, track = self.pose, self.track
+        if pose is None or not track or t_s < track[0].t_s or t_s > pose.t_s + 1e-9:
             return None
-        return min(self.track, key=lambda p: abs(p.t_s - t_s))
+        later = pose
+        for earlier in reversed(track):  # recent stamps: a few steps from the end
+            if earlier.t_s <= t_s:
+                span = later.t_s - earlier.t_s
+                f = 0.0 if span <= 0 else (t_s - earlier.t_s) / span
+                return WorldPose(t_s, earlier.x_m + f * (later.x_m - earlier.x_m),
+                                 earlier.y_m + f * (later.y_m - earlier.y_m), earlier.z_m + f * (later.z_m - earlier.z_m),
+                                 float(wrap_angle(earlier.yaw_rad + f * wrap_angle(later.yaw_rad - earlier.yaw_rad))))
+            later = earlier
+        return None
+
+    def object_positions(self) -> dict[str, np.ndarray]:
+        """Objects seen by perception (estimation/perception.py), in the scene frame; {} without one."""
+        return self.objects.positions if self.objects is not None else {}
 
     def scene_state(self, state: RobotState) -> RobotState:
         """`state` with this estimate as its base pose in the scene frame: base_pos_w_m, the IMU's
@@ -121,12 +142,18 @@ class Localiser:
     def describe(self) -> str:
         what = "leg odometry"
         if self.fusion is not None:
-            what += " fused with an external pose; " + self.fusion.describe()
+            what += " fused with an external pose"
+        if self.objects is not None:
+            what += ", objects from perception"
+        if self.fusion is not None:
+            what += "; " + self.fusion.describe()
         return what
 
     def close(self) -> None:
         if self.source is not None:
             self.source.close()
+        if self.objects is not None:
+            self.objects.close()
 
 
 __all__ = ["DdsPoseSource", "Localiser", "PoseSource"]

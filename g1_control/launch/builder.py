@@ -131,15 +131,24 @@ def make_localiser(launch: LaunchFile, estimator: StateEstimator) -> Localiser |
     from g1_control.estimation.localiser import DdsPoseSource, Localiser
     from g1_control.estimation.pose import LegOdometry
 
-    ext = launch.estimation.external_pose
-    if ext is None:
-        return Localiser(LegOdometry(estimator, shared=True))
-    from g1_control.hardware.ros2.topics import PoseTopicReader
+    # the backend's partition by default: g1 deploy --partition isolates the topics with the robot link
+    ext, seen = launch.estimation.external_pose, launch.estimation.perception
+    fusion, source, objects = None, None, None
+    if ext is not None:
+        from g1_control.hardware.ros2.topics import PoseTopicReader
 
-    assert ext.interface is not None  # validated: always named
-    # the backend's partition by default: g1 deploy --partition isolates the pose topic with the robot link
-    reader = PoseTopicReader(ext.interface, ext.domain, ext.topic, ext.partition or launch.backend.partition)
-    return Localiser(LegOdometry(estimator, shared=True), fusion=PoseFusion(ext), source=DdsPoseSource(reader))
+        assert ext.interface is not None  # validated: always named
+        fusion = PoseFusion(ext)
+        source = DdsPoseSource(PoseTopicReader(ext.interface, ext.domain, ext.topic,
+                                               ext.partition or launch.backend.partition))
+    if seen is not None:
+        from g1_control.estimation.perception import DdsObjectSource, ObjectPerception
+        from g1_control.hardware.ros2.topics import ObjectPosesReader
+
+        assert seen.interface is not None  # validated: always named
+        objects = ObjectPerception(seen, DdsObjectSource(ObjectPosesReader(
+            seen.interface, seen.domain, seen.topic, seen.partition or launch.backend.partition)))
+    return Localiser(LegOdometry(estimator, shared=True), fusion=fusion, source=source, objects=objects)
 
 
 def make_sim_backend(launch: LaunchFile) -> MujocoBackend:

@@ -13,6 +13,7 @@ from typing import Any, Literal
 from g1_control.config import apply_overrides, from_dict, read_yaml
 from g1_control.errors import LaunchFileError, SafetyConfigError
 from g1_control.estimation.external_pose import ExternalPoseConfig
+from g1_control.estimation.perception import PerceptionConfig
 from g1_control.loop.rates import LoopRates
 from g1_control.safety.config import SafetyConfig
 from g1_control.safety.fall import FallConfig
@@ -323,6 +324,9 @@ class EstimationConfig:
 
     steer_by: Literal["auto", "ground_truth", "estimate"] = "auto"
     external_pose: ExternalPoseConfig | None = None
+    perception: PerceptionConfig | None = None
+    """Object poses arriving at run time (g1_control/estimation/perception.py; g1 sim-robot --scene):
+    the scene's boxes move to where perception sees them, placed with the estimate."""
 
 
 @dataclass
@@ -386,6 +390,10 @@ class LaunchFile:
         if est.steer_by == "ground_truth" and self.backend.type != "mujoco":
             raise LaunchFileError(f"estimation.steer_by: ground_truth needs a simulator's ground truth; backend.type "
                                   f"{self.backend.type} drives a robot, which reports none (use auto or estimate)")
+        if est.perception is not None and not self.steers_by_estimate():
+            raise LaunchFileError("estimation.perception: objects are placed with the robot's estimate, which this "
+                                  f"MuJoCo run does not steer by (steer_by {est.steer_by}: ground truth); set "
+                                  "estimation.steer_by: estimate to use it")
         if est.external_pose is not None and not self.steers_by_estimate():
             raise LaunchFileError("estimation.external_pose: the external pose is fused into the robot's estimate, "
                                   "which this MuJoCo run does not steer by (steer_by "

@@ -32,8 +32,9 @@ from g1_control.sim.robot_endpoint import RobotEndpoint
 from g1_control.types import MotorCommand, RobotState
 
 if TYPE_CHECKING:
-    from g1_control.hardware.ros2.topics import PoseTopicWriter
-    from g1_control.sim.mocap import MocapConfig, SimulatedMocap
+    from g1_control.hardware.ros2.topics import ObjectPosesWriter, PoseTopicWriter
+    from g1_control.sim.mocap import MocapConfig, SimulatedMocap, SimulatedPerception
+    from g1_control.sim.mujoco_backend import MujocoBackend
 
 FAULTS = {
     "state_stops": "LowState_ stops (robot side silent)",
@@ -230,6 +231,10 @@ class RobotEmulator:
         self._lock = threading.Lock()
         self.mocap: SimulatedMocap | None = None
         self._mocap_writer: PoseTopicWriter | None = None
+        self.perception: SimulatedPerception | None = None
+        self.scene_sim: MujocoBackend | None = None
+        """The MuJoCo physics holding a launch file's scene (publish_perception), for its ground truth."""
+        self._perception_writer: ObjectPosesWriter | None = None
 
     @staticmethod
     def _unitree_mujoco_traits() -> tuple[float, str]:
@@ -306,9 +311,34 @@ class RobotEmulator:
             for stamp, pos, quat in mocap.sample(time.time(), state.base_pos_w_m, state.imu_quat_wxyz):
                 writer.write(stamp, pos, quat)
 
-        self.endpoint.on_state = sample
+        self.endpoint.state_observers.append(sample)
         self.mocap = mocap
         return mocap
+
+    def publish_perception(self, sim: MujocoBackend, config: MocapConfig, topic: str = "perception/objects"
+                           ) -> SimulatedPerception:
+        """Publish the scene's boxes as a perception system on the robot sees them (ObjectPoses_ on
+        rt/<topic>, each box in the robot's heading frame), from `sim`'s ground truth (sim/mocap.py)."""
+        from g1_control.hardware.ros2.topics import ObjectPosesWriter
+        from g1_control.sim.mocap import SimulatedPerception
+
+        names = [b.name for b in sim.scene.boxes]
+        if not names:
+            raise ValueError("perception: the scene has no boxes to publish")
+        perception = SimulatedPerception(config)
+        writer = ObjectPosesWriter(self.link.interface, self.link.domain_id, topic, self.link.partition)
+        self._perception_writer = writer
+
+        def sample(state: RobotState) -> None:
+            if state.base_pos_w_m is None:
+                return
+            objects = {name: sim.object_pose(name) for name in names}
+            for stamp, seen in perception.sample(time.time(), state.base_pos_w_m, state.imu_quat_wxyz, objects):
+                writer.write(stamp, seen)
+
+        self.endpoint.state_observers.append(sample)
+        self.perception, self.scene_sim = perception, sim
+        return perception
 
     def start(self) -> RobotEmulator:
         self.endpoint.start()
@@ -316,8 +346,9 @@ class RobotEmulator:
 
     def close(self) -> None:
         self.endpoint.stop()
-        if self._mocap_writer is not None:
-            self._mocap_writer.close()
+        for writer in (self._mocap_writer, self._perception_writer):
+            if writer is not None:
+                writer.close()
         if self.service is not None:
             self.service.close()
         self.link.close()
@@ -338,6 +369,12 @@ class RobotEmulator:
         if self.mocap is not None and self._mocap_writer is not None:
             out["mocap"] = {"measured": self.mocap.measured, "dropped": self.mocap.dropped,
                             "sent": self._mocap_writer.sent}
+        if self.perception is not None and self._perception_writer is not None:
+            out["perception"] = {"measured": self.perception.measured, "dropped": self.perception.dropped,
+                                 "sent": self._perception_writer.sent}
+        sim = self.scene_sim
+        if sim is not None:  # the ground-truth outcome, for judging: where the boxes and the feet are
+            out["boxes_w_m"] = {b.name: [float(v) for v in sim.object_pose(b.name)[0]] for b in sim.scene.boxes}
         out["first_damping_base_pos_w_m"] = self.endpoint.first_damping_base_pos_w_m
         last = self.endpoint.last_command
         out["last_command_is_damping"] = None if last is None else bool(

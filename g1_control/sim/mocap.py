@@ -1,5 +1,7 @@
-"""A motion-capture system played from the simulator's ground truth: the pelvis pose sampled at
-`rate_hz`, with Gaussian noise, a latency and random dropouts, seeded.
+"""A motion-capture system and a perception system played from the simulator's ground truth, sampled
+at `rate_hz`, with Gaussian noise, a latency and random dropouts, seeded. SimulatedMocap: the pelvis
+pose in the world; SimulatedPerception: the scene's boxes in the robot's heading frame (origin at the
+pelvis, x along its heading), as a camera on the robot sees them.
 
     mocap = SimulatedMocap(MocapConfig(rate_hz=100, noise_m=0.01, latency_s=0.05, dropout=0.1))
     for stamp_s, position_m, quat_wxyz in mocap.sample(t_s, base_pos_w_m, imu_quat_wxyz):
@@ -82,4 +84,44 @@ class SimulatedMocap:
         return out
 
 
-__all__ = ["MocapConfig", "SimulatedMocap"]
+class SimulatedPerception:
+    """Boxes seen from the robot: name -> (position, quat wxyz) in the heading frame, each frame
+    stamped when seen and released `latency_s` later; a dropped frame loses every object in it."""
+
+    def __init__(self, config: MocapConfig):
+        self.config = config.validate()
+        self._rng = np.random.default_rng(config.seed)
+        self._next_s: float | None = None
+        self._pending: deque[tuple[float, float, dict]] = deque()
+        self.measured = self.dropped = 0
+
+    def sample(self, t_s: float, base_pos_w_m: np.ndarray, base_quat_wxyz: np.ndarray,
+               objects_w: dict[str, tuple[np.ndarray, np.ndarray]]) -> list[tuple[float, dict]]:
+        cfg = self.config
+        if self._next_s is None:
+            self._next_s = t_s
+        if t_s >= self._next_s - 1e-9:
+            self._next_s = max(self._next_s + 1.0 / cfg.rate_hz, t_s)
+            self.measured += 1
+            if self._rng.random() < cfg.dropout:
+                self.dropped += 1
+            else:
+                w, x, y, z = (float(v) for v in base_quat_wxyz)
+                yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+                c, s = math.cos(yaw), math.sin(yaw)
+                seen = {}
+                for name, (pos, quat) in objects_w.items():
+                    d = np.asarray(pos, dtype=float) - np.asarray(base_pos_w_m, dtype=float)
+                    rel = np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1], d[2]])
+                    rel += self._rng.normal(0.0, cfg.noise_m, 3)
+                    turn = -yaw + float(self._rng.normal(0.0, cfg.noise_rad))
+                    seen[name] = (rel, _rot_z(quat, turn))
+                self._pending.append((t_s + cfg.latency_s, t_s, seen))
+        out = []
+        while self._pending and self._pending[0][0] <= t_s + 1e-9:
+            _, stamp, seen = self._pending.popleft()
+            out.append((stamp, seen))
+        return out
+
+
+__all__ = ["MocapConfig", "SimulatedMocap", "SimulatedPerception"]

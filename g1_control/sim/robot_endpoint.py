@@ -77,9 +77,10 @@ class RobotEndpoint:
         self.unset_state_fields = False
         """As Unitree's MuJoCo simulator (g1_control/sim/unitree_mujoco.py): LowState_ with crc, tick and
         mode_machine left at 0, and every LowCmd_ taken whatever its CRC and mode_machine."""
-        self.on_state: Callable[[RobotState], None] | None = None
+        self.state_observers: list[Callable[[RobotState], None]] = []
         """Called with every state the physics reports before it is published (on the endpoint's
-        thread): g1 sim-robot's motion capture samples ground truth here."""
+        thread, which also steps the physics): g1 sim-robot's motion capture and perception sample
+        ground truth here."""
         self._frozen: bytes | None = None
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -199,8 +200,8 @@ class RobotEndpoint:
             payload = self._frozen
         else:
             state = self.physics.read_state()
-            if self.on_state is not None:
-                self.on_state(state)
+            for observe in self.state_observers:
+                observe(state)
             state.tick = self._tick
             msg = robot_state_to_lowstate(state)
             if self.unset_state_fields:

@@ -111,6 +111,13 @@ def test_the_launch_file_refuses_an_external_pose_that_nothing_steers_by():
     with pytest.raises(LaunchFileError, match="estimation.steer_by: ground_truth needs a simulator's ground truth"):
         parse_launch({"name": "x", "backend": {"type": "unitree_dds", "interface": "lo"},
                       "estimation": {"steer_by": "ground_truth"}})
+    with pytest.raises(LaunchFileError, match="estimation.perception: objects are placed with the robot's estimate"):
+        parse_launch({"name": "x", "estimation": {"perception": {"interface": "lo"}}})
+    with pytest.raises(LaunchFileError, match="estimation.perception.interface: a perception input must name"):
+        parse_launch({"name": "x", "estimation": {"steer_by": "estimate", "perception": {}}})
+    with pytest.raises(LaunchFileError, match=r"estimation.perception.max_age_s: 3.0 is outside \(0, 2\] s"):
+        parse_launch({"name": "x", "estimation": {"steer_by": "estimate", "perception": {"interface": "lo",
+                                                                                        "max_age_s": 3}}})
     launch = parse_launch({"name": "x", "estimation": {"steer_by": "estimate", "external_pose": {"interface": "lo"}}})
     assert launch.steers_by_estimate() and launch.estimation.external_pose is not None
     assert not parse_launch({"name": "x"}).steers_by_estimate()

@@ -157,7 +157,18 @@ class GoalGenerator(Generator):
         return self._reference(command, state)
 
     def _located(self, state: RobotState) -> RobotState:
-        return state if self.estimate is None else self.estimate.scene_state(state)
+        if self.estimate is None:
+            return state
+        self._perceive(self.estimate.object_positions())
+        return self.estimate.scene_state(state)
+
+    def _perceive(self, seen) -> None:
+        """Boxes where perception last saw them (scene frame), except the one in the hands."""
+        ctx = self.ctx
+        held = ctx.held.box.name if ctx.held is not None else None
+        for name, position in seen.items():
+            if name in ctx.box_positions and name != held:
+                ctx.box_positions[name] = position
 
     def _reference(self, command: Command, state: RobotState) -> KinematicReference:
         ctx = self.ctx

@@ -96,6 +96,19 @@ class PoseStamped_(IdlStruct, typename=dds_type("geometry_msgs", "PoseStamped"))
 @dataclass
 @final
 @autoid("sequential")
+class ObjectPoses_(IdlStruct, typename="g1_msgs::msg::dds_::ObjectPoses_"):
+    """This project's own type (no ROS 2 standard fits): named objects seen at the header's stamp, each
+    pose in the robot's heading frame (frame_id 'heading': origin at the pelvis, x forward along its
+    heading, z up), as a perception system (e.g. AprilTags) reports them. names[i] goes with poses[i]."""
+
+    header: Header_ = field(default_factory=Header_)
+    names: sequence[str] = field(default_factory=list)
+    poses: sequence[Pose_] = field(default_factory=list)
+
+
+@dataclass
+@final
+@autoid("sequential")
 class PoseWithCovariance_(IdlStruct, typename=dds_type("geometry_msgs", "PoseWithCovariance")):
     pose: Pose_ = field(default_factory=Pose_)
     covariance: array[float64, 36] = field(default_factory=lambda: [0.0] * 36)

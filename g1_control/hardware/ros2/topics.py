@@ -130,4 +130,91 @@ class PoseTopicWriter:
             self._participant = None
 
 
-__all__ = ["PoseReading", "PoseTopicReader", "PoseTopicWriter", "check_topic_name"]
+@dataclass(frozen=True)
+class ObjectsReading:
+    """One ObjectPoses as read: stamp (publisher's wall clock), its age when read, name -> (xyz, quat wxyz)
+    in the robot's heading frame."""
+
+    stamp_s: float
+    age_s: float
+    objects: dict[str, tuple[tuple[float, float, float], tuple[float, float, float, float]]]
+
+
+class ObjectPosesReader:
+    """Takes ObjectPoses samples from rt/<topic> (perception: objects in the robot's heading frame)."""
+
+    def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
+        from cyclonedds.qos import Policy, Qos
+        from cyclonedds.sub import DataReader, Subscriber
+        from cyclonedds.topic import Topic
+
+        from g1_control.hardware.links.dds import domain_participant
+        from g1_control.hardware.ros2 import messages as m
+
+        problem = check_topic_name(topic)
+        if problem:
+            raise ValueError(f"perception topic: {problem}")
+        self._participant: Any = domain_participant(interface, domain)
+        self._reader = DataReader(Subscriber(self._participant, qos=_group_qos(partition)),
+                                  Topic(self._participant, m.TOPIC_PREFIX + topic, m.ObjectPoses_),
+                                  qos=Qos(Policy.History.KeepLast(HISTORY_DEPTH)))
+        self._seconds = m.seconds
+
+    def take(self) -> list[ObjectsReading]:
+        now = time.time()
+        out = []
+        for msg in self._reader.take(HISTORY_DEPTH):
+            if not hasattr(msg, "poses"):
+                continue
+            stamp = self._seconds(msg.header.stamp)
+            objects = {name: ((p.position.x, p.position.y, p.position.z),
+                              (p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z))
+                       for name, p in zip(msg.names, msg.poses)}
+            out.append(ObjectsReading(stamp, now - stamp, objects))
+        return out
+
+    def close(self) -> None:
+        if self._participant is not None:
+            del self._reader
+            self._participant = None
+
+
+class ObjectPosesWriter:
+    """Writes ObjectPoses samples to rt/<topic> (g1 sim-robot --scene's perception)."""
+
+    def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
+        from cyclonedds.pub import DataWriter, Publisher
+        from cyclonedds.topic import Topic
+
+        from g1_control.hardware.links.dds import domain_participant
+        from g1_control.hardware.ros2 import messages as m
+
+        problem = check_topic_name(topic)
+        if problem:
+            raise ValueError(f"perception topic: {problem}")
+        self._m = m
+        self._participant: Any = domain_participant(interface, domain)
+        self._writer = DataWriter(Publisher(self._participant, qos=_group_qos(partition)),
+                                  Topic(self._participant, m.TOPIC_PREFIX + topic, m.ObjectPoses_))
+        self.sent = 0
+
+    def write(self, stamp_s: float, objects: dict) -> None:
+        """objects: name -> (position xyz, quat wxyz) in the robot's heading frame."""
+        m = self._m
+        names, poses = [], []
+        for name, (pos, quat) in objects.items():
+            x, y, z = (float(v) for v in pos)
+            w, qx, qy, qz = (float(v) for v in quat)
+            names.append(name)
+            poses.append(m.Pose_(m.Point_(x, y, z), m.Quaternion_(qx, qy, qz, w)))
+        self._writer.write(m.ObjectPoses_(m.Header_(m.stamp(stamp_s), "heading"), names, poses))
+        self.sent += 1
+
+    def close(self) -> None:
+        if self._participant is not None:
+            del self._writer
+            self._participant = None
+
+
+__all__ = ["ObjectPosesReader", "ObjectPosesWriter", "ObjectsReading", "PoseReading", "PoseTopicReader",
+           "PoseTopicWriter", "check_topic_name"]
