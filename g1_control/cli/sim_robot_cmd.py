@@ -23,7 +23,10 @@ def register(subparsers) -> None:
         epilog="examples:\n  g1 sim-robot                      # lo, domain 1, until Ctrl-C\n"
         "  g1 sim-robot --seconds 30 --physics mock\n"
         "  g1 sim-robot --control-stdin      # faults / remote buttons by name on stdin (test harnesses)\n"
-        "  g1 sim-robot --lower-gantry-on-policy   # sim2sim with g1 deploy launch/sim2sim.yaml --yes",
+        "  g1 sim-robot --lower-gantry-on-policy   # sim2sim with g1 deploy launch/sim2sim.yaml --yes\n"
+        "  g1 sim-robot --lower-gantry-on-policy --mocap --mocap-noise-m 0.02 --mocap-latency-s 0.1   # sim2sim_mocap.yaml\n"
+        "  g1 sim-robot --lower-gantry-on-policy --scene launch/sim2sim_box.yaml --perception-noise-m 0.02 "
+        "--perception-latency-s 0.1 --perception-dropout 0.1",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--interface", default="lo", help="network interface; loopback only (default lo)")
