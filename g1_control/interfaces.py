@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -141,6 +141,19 @@ class LineInput(InputDevice):
         """Open a line now, as if the operator had pressed the instruction key (to ask a question)."""
 
 
+class WorldPoseEstimate(Protocol):
+    """The robot's own world pose estimate in the scene frame (g1_control/estimation/localiser.py),
+    which a generator that executes goals may steer by (Generator.steer_by)."""
+
+    def scene_state(self, state: RobotState) -> RobotState:
+        """`state` with the estimate as its base pose (base_pos_w_m, heading, velocity in scene axes)."""
+        ...
+
+    def object_positions(self) -> Mapping[str, np.ndarray]:
+        """Named objects (boxes) seen by perception, their centres in the scene frame ({} without perception)."""
+        ...
+
+
 class Generator(ABC):
     """Operator intent -> the whole-body plan for this tick. A generator that executes task goals
     (Command.tasks: g1_control/generator/goals/) reports on them through the attributes below,
@@ -165,6 +178,10 @@ class Generator(ABC):
 
     def reset(self, state: RobotState) -> None:
         """Start over from `state`."""
+
+    def steer_by(self, estimate: WorldPoseEstimate) -> None:
+        """Place goals by `estimate` instead of the state's ground truth (the loop builder, where the
+        launch file steers by the estimate); a generator without goals has nothing to place."""
 
 
 class Retargeter(ABC):

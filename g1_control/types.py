@@ -402,6 +402,18 @@ class EstimatedState:
     """Pelvis height above the lower foot's sole (leg kinematics: the ground under a standing foot)."""
 
 
+@dataclass(frozen=True)
+class WorldPose:
+    """The pelvis in a run's frame (estimation/pose.py: the start frame, x forward and y left of where
+    the robot started; estimation/localiser.py: the launch file's scene frame)."""
+
+    t_s: float
+    x_m: float
+    y_m: float
+    z_m: float
+    yaw_rad: float
+
+
 NO_GOALS: Mapping[str, Any] = MappingProxyType({})
 """An empty, read-only goal table: what a generator without task goals reports."""
 
@@ -431,6 +443,9 @@ class ExecutionFeedback:
     """goal_id -> why the goal failed (Generator.goal_messages)."""
     phase: str = PHASE_LOCOMOTION
     """The generator's phase now (Generator.phase): PHASE_WHOLE_BODY while the execution layer holds the robot."""
+    pose: WorldPose | None = None
+    """The robot's own world pose estimate in the scene frame (leg odometry, fused with an external pose
+    where one is configured: estimation/localiser.py); None where the loop runs no localiser."""
 
 
 @dataclass

@@ -24,7 +24,10 @@ def register(subparsers) -> None:
         "  g1 sim-robot --seconds 30 --physics mock\n"
         "  g1 sim-robot --control-stdin      # faults / remote buttons by name on stdin (test harnesses)\n"
         "  g1 sim-robot --lower-gantry-on-policy   # sim2sim with g1 deploy launch/sim2sim.yaml --yes\n"
-        "  g1 sim-robot --mode-machine 4 --lower-gantry-on-policy   # the 23-DoF G1 (g1 deploy launch/sim2sim_23dof.yaml)",
+        "  g1 sim-robot --mode-machine 4 --lower-gantry-on-policy   # the 23-DoF G1 (g1 deploy launch/sim2sim_23dof.yaml)\n"
+        "  g1 sim-robot --lower-gantry-on-policy --mocap --mocap-noise-m 0.02 --mocap-latency-s 0.1   # sim2sim_mocap.yaml\n"
+        "  g1 sim-robot --lower-gantry-on-policy --scene launch/sim2sim_box.yaml --perception-noise-m 0.02 "
+        "--perception-latency-s 0.1 --perception-dropout 0.1",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--interface", default="lo", help="network interface; loopback only (default lo)")
@@ -43,6 +46,28 @@ def register(subparsers) -> None:
                         help="robot: the G1's protocol (default); unitree_mujoco: play Unitree's MuJoCo simulator "
                         "(LowState_ with crc, tick and mode_machine 0 at 200 Hz, PD torque computed when a LowCmd_ "
                         "arrives and held, no motion service), for g1 deploy with backend.simulator: unitree_mujoco")
+    parser.add_argument("--mocap", action="store_true",
+                        help="also publish a motion-capture pose of the pelvis from the simulator's ground truth "
+                        "(geometry_msgs/PoseStamped on rt/<--mocap-topic>, frame 'mocap' = the scene frame), for a "
+                        "launch file's estimation.external_pose")
+    parser.add_argument("--mocap-topic", default="mocap/pose", help="its ROS 2 topic (default mocap/pose)")
+    parser.add_argument("--mocap-rate-hz", type=float, default=100.0, help="poses per second (default 100)")
+    parser.add_argument("--mocap-noise-m", type=float, default=0.0, help="position noise, std per axis (m)")
+    parser.add_argument("--mocap-noise-deg", type=float, default=0.0, help="heading noise, std (deg)")
+    parser.add_argument("--mocap-latency-s", type=float, default=0.0, help="each pose is sent this late (s)")
+    parser.add_argument("--mocap-dropout", type=float, default=0.0, help="probability that a pose is lost (0..1)")
+    parser.add_argument("--mocap-seed", type=int, default=0, help="seed of the noise and dropouts")
+    parser.add_argument("--scene", metavar="FILE",
+                        help="build this launch file's scene (tables, platforms, boxes) in the MuJoCo physics and "
+                        "publish its boxes as perception sees them (g1_msgs ObjectPoses_ on rt/<--perception-topic>, "
+                        "each box in the robot's heading frame); the exit report gives the boxes' ground truth")
+    parser.add_argument("--perception-topic", default="perception/objects", help="default perception/objects")
+    parser.add_argument("--perception-rate-hz", type=float, default=10.0, help="frames per second (default 10)")
+    parser.add_argument("--perception-noise-m", type=float, default=0.0, help="position noise, std per axis (m)")
+    parser.add_argument("--perception-noise-deg", type=float, default=0.0, help="heading noise, std (deg)")
+    parser.add_argument("--perception-latency-s", type=float, default=0.0, help="each frame is sent this late (s)")
+    parser.add_argument("--perception-dropout", type=float, default=0.0, help="probability that a frame is lost")
+    parser.add_argument("--perception-seed", type=int, default=0, help="seed of the noise and dropouts")
     parser.add_argument("--mode-machine", type=int, default=5,
                         help="the G1 variant to emulate and report: 4 = 23-DoF (no waist roll/pitch, no wrist "
                         "pitch/yaw: MuJoCo builds it without those joints), 5 = 29-DoF (default), 6 = 29-DoF with "
@@ -66,6 +91,19 @@ def _run(args) -> int:
 
     realtime(args.rt_priority)
     physics: Backend
+    scene = None
+    if args.scene:
+        from g1_control.errors import LaunchFileError
+        from g1_control.launch.schema import load_launch
+
+        if args.physics != "mujoco":
+            print("g1 sim-robot: --scene needs --physics mujoco", file=sys.stderr)
+            return 2
+        try:
+            scene = load_launch(args.scene).scene
+        except LaunchFileError as exc:
+            print(f"g1 sim-robot: --scene: {exc}", file=sys.stderr)
+            return 2
     if args.physics == "mujoco":
         from g1_control.robot import g1
         from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
@@ -78,9 +116,10 @@ def _run(args) -> int:
         if args.mode == "unitree_mujoco":
             from g1_control.sim.unitree_mujoco import PHYSICS_DT_S, HeldTorqueMujoco
 
-            physics = mujoco = HeldTorqueMujoco(MujocoConfig(lockstep=True, physics_dt_s=PHYSICS_DT_S, variant=variant))
+            physics = mujoco = HeldTorqueMujoco(MujocoConfig(lockstep=True, physics_dt_s=PHYSICS_DT_S, variant=variant),
+                                                scene=scene)
         else:
-            physics = mujoco = MujocoBackend(MujocoConfig(lockstep=True, variant=variant))
+            physics = mujoco = MujocoBackend(MujocoConfig(lockstep=True, variant=variant), scene=scene)
         if args.gantry or args.lower_gantry_on_policy:
             from g1_control.sim.emulator import Gantry
 
@@ -91,7 +130,25 @@ def _run(args) -> int:
 
         physics = MockG1(mode_machine=args.mode_machine)
     emulator = RobotEmulator(physics, args.interface, args.domain, partition=args.partition,
-                             builtin_mode="" if args.no_builtin else "ai", mode=args.mode).start()
+                             builtin_mode="" if args.no_builtin else "ai", mode=args.mode)
+    try:
+        import math
+
+        from g1_control.sim.mocap import MocapConfig
+
+        if args.mocap:
+            emulator.publish_mocap(MocapConfig(args.mocap_rate_hz, args.mocap_noise_m, math.radians(args.mocap_noise_deg),
+                                               args.mocap_latency_s, args.mocap_dropout, args.mocap_seed),
+                                   args.mocap_topic)
+        if scene is not None:
+            emulator.publish_perception(mujoco, MocapConfig(
+                args.perception_rate_hz, args.perception_noise_m, math.radians(args.perception_noise_deg),
+                args.perception_latency_s, args.perception_dropout, args.perception_seed), args.perception_topic)
+    except ValueError as exc:
+        emulator.close()
+        print(f"g1 sim-robot: {exc}", file=sys.stderr)
+        return 2
+    emulator.start()
     stop = {"now": False}
 
     def _stop(signum, frame):
@@ -119,4 +176,11 @@ def _run(args) -> int:
     print(f"g1 sim-robot: {report['states_sent']} states sent, {report['commands_applied']} commands applied, "
           f"{report['bad_crc']} bad CRC, {report['wrong_mode_machine']} wrong mode_machine, "
           f"{report['ignored_while_builtin_active']} ignored while the built-in controller ran", file=sys.stderr)
+    if "boxes_w_m" in report:
+        boxes = ", ".join(f"{name} ({x:+.3f}, {y:+.3f}, {z:+.3f})" for name, (x, y, z) in report["boxes_w_m"].items())
+        print(f"g1 sim-robot: ground truth at exit: boxes {boxes}; pelvis {report['base_pos_w_m']}", file=sys.stderr)
+    if "mocap" in report:
+        m = report["mocap"]
+        print(f"g1 sim-robot: motion capture: {m['sent']} poses sent, {m['dropped']} of {m['measured']} dropped",
+              file=sys.stderr)
     return 0

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from g1_control.errors import G1ControlError, RobotNotConnectedError, VariantMismatchError
-from g1_control.launch.schema import InputConfig, LaunchFile, Segment
+from g1_control.launch.schema import EstimationConfig, InputConfig, LaunchFile, Segment
 from g1_control.loop.control_loop import first_fault
 from g1_control.robot import g1
 from g1_control.rotations import tilt_rad
@@ -379,15 +379,19 @@ class Preflight:
 
 
 def _goals_without_world_pose(launch: LaunchFile) -> str:
-    """'; note: goal seg2.0 (...) will fail at its start: ...' for the launch file's goals that need a
-    world pose, which a robot does not report ('' when none does)."""
+    """'; note: goal seg2.0 (...) is placed by the robot's own estimate ...' for the launch file's goals
+    that need a world pose, which a robot does not report ('' when none does): they steer by the
+    localiser (estimation/localiser.py), anchored where the run starts."""
     from g1_control.generator.goals.executor import world_pose_needed
     from g1_control.launch.builder import timeline_of
     from g1_control.teleop.scripted import timeline_goals
 
-    failing = [(g, why) for g in timeline_goals(timeline_of(launch)) if (why := world_pose_needed(g)) is not None]
-    return "".join(f"; note: goal {g.goal_id} ({g.describe()}) will fail at its start: the robot reports no world "
-                   f"pose and {why}" for g, why in failing)
+    placed = [g for g in timeline_goals(timeline_of(launch)) if world_pose_needed(g) is not None]
+    if not placed:
+        return ""
+    source = "leg odometry" + (" fused with the external pose" if launch.estimation.external_pose else "")
+    return "".join(f"; note: goal {g.goal_id} ({g.describe()}) is placed by the robot's own estimate ({source}, "
+                   "anchored where it starts: the scene's origin, facing +x)" for g in placed)
 
 
 def _segment_speed(segment, run_s: float) -> str:
@@ -487,7 +491,8 @@ def dry_run_launch(launch: LaunchFile, program=None) -> LaunchFile:
         run_input = InputConfig(type="program", program=steps, instruction=text, places=dict(cfg.places),
                                 pose="estimator", start_delay_s=cfg.start_delay_s)
         dry = dataclasses.replace(launch, name=f"{launch.name}-dry-run", duration_s=None, input=run_input,
-                                  backend=_dry_run_backend(launch), viewer=False)
+                                  backend=_dry_run_backend(launch), viewer=False,
+                                  estimation=dry_run_estimation(launch))
         dry.duration_s = max(duration, dry.total_duration_s)
         return dry
     if launch.input.type == "scripted":
@@ -499,4 +504,10 @@ def dry_run_launch(launch: LaunchFile, program=None) -> LaunchFile:
     return dataclasses.replace(
         launch, name=f"{launch.name}-dry-run", duration_s=duration,
         backend=_dry_run_backend(launch),
-        input=InputConfig(type="scripted", timeline=timeline), viewer=False)
+        input=InputConfig(type="scripted", timeline=timeline), viewer=False, estimation=dry_run_estimation(launch))
+
+
+def dry_run_estimation(launch: LaunchFile) -> EstimationConfig:
+    """The dry run steers by what the robot will steer by: its own estimate (leg odometry) where the
+    launch file does; no external pose (nothing publishes one to the simulated run)."""
+    return EstimationConfig(steer_by="estimate" if launch.steers_by_estimate() else launch.estimation.steer_by)

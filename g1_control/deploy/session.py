@@ -14,6 +14,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
+import math
 import signal
 import time
 from collections.abc import Callable
@@ -86,6 +87,9 @@ class DeployReport:
     goals: list[dict] = field(default_factory=list)
     """Every goal's status and message, as the execution layer reports them (report/outcomes.py
     goal_reports: no ground truth on a robot), including the launch file's goals that never started."""
+    localisation: dict = field(default_factory=dict)
+    """What goals and programs steered by (the robot's own estimate: estimation/localiser.py): its last
+    pose in the scene frame and, with an external pose input, how many poses were accepted and refused why."""
     error: str = ""
     """The error that ended the deploy, if one did (set by `g1 deploy`, which writes --json whatever happened)."""
 
@@ -405,6 +409,7 @@ class _RobotControl:
         log = folder.close_log(self.loop)
         _fill_report(report, log, self.loop, self.tracker, self.backend, self.safety, self.t_loop0, self.device)
         _report_goals(report, self.loop, self.launch, folder)
+        _report_localisation(report, self.loop)
         folder.write_npz(log)
         status = ("error" if error is not None else "fault" if report.fault
                   else "interrupted" if report.end_reason.startswith("SIG") else "completed")
@@ -473,6 +478,31 @@ def _report_goals(report: DeployReport, loop, launch: LaunchFile, folder: RunFol
         folder.event({"type": "goal", **goal})
 
 
+def _report_localisation(report: DeployReport, loop) -> None:
+    """The localiser's last pose, its pose when damping began (the robot then stops walking: judged against
+    a simulator's ground truth there) and external pose counters into the report; its pose topic is closed."""
+    localiser = loop.localiser
+    if localiser is None:
+        return
+    pose = localiser.pose
+    out: dict = {"source": localiser.describe().split(";")[0],
+                 "pose": None if pose is None else {"x_m": pose.x_m, "y_m": pose.y_m, "z_m": pose.z_m,
+                                                    "yaw_rad": pose.yaw_rad}}
+    damping = next((t["t_s"] for t in report.transitions if t["to"] == "damping"), None)
+    at = localiser.pose_at(damping) if damping is not None else None
+    out["pose_at_damping"] = None if at is None else {"t_s": at.t_s, "x_m": at.x_m, "y_m": at.y_m, "yaw_rad": at.yaw_rad}
+    if localiser.fusion is not None:
+        c = localiser.fusion.counters
+        out["external_pose"] = {"accepted": c.accepted, "rejected": dict(c.rejected), "last_rejection": c.last_rejection,
+                                "max_correction_m": c.max_correction_m}
+    if localiser.objects is not None:
+        p = localiser.objects.counters
+        out["perception"] = {"frames": p.frames, "rejected": dict(p.rejected), "last_rejection": p.last_rejection,
+                             "objects_w_m": {n: [float(v) for v in xyz] for n, xyz in localiser.objects.positions.items()}}
+    report.localisation = out
+    localiser.close()
+
+
 def _print_summary(report: DeployReport, say) -> None:
     link = report.link
     say(f"deploy ended in damping: {report.end_reason}" + (" (FAULT)" if report.fault else ""))
@@ -495,6 +525,19 @@ def _print_summary(report: DeployReport, say) -> None:
         say("goals (the execution layer's own verdicts; a robot has no ground truth):")
         for goal in report.goals:
             say("  " + outcome_line(goal))
+    loc = report.localisation
+    if loc:
+        pose = loc["pose"]
+        where = "no pose" if pose is None else (f"last pose ({pose['x_m']:+.2f}, {pose['y_m']:+.2f}) m, heading "
+                                                f"{math.degrees(pose['yaw_rad']):+.0f} deg in the scene")
+        line = f"localisation ({loc['source']}, anchored at the start): {where}"
+        ext = loc.get("external_pose")
+        if ext is not None:
+            refused = ", ".join(f"{n} {why}" for why, n in ext["rejected"].items() if n) or "none"
+            line += f"; external poses: {ext['accepted']} accepted, refused: {refused}"
+            if ext["last_rejection"]:
+                line += f" (last: {ext['last_rejection']})"
+        say(line)
     say(f"loop: {report.loop['ticks']} ticks, {report.loop['deadline_misses']} deadline misses (worst "
         f"{report.loop['lateness_max_ms']:.1f} ms late, p99 {report.loop['lateness_p99_ms']:.1f} ms), "
         f"{report.loop['clamped_commands']} commands clamped by the safety layer")

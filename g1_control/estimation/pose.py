@@ -21,37 +21,30 @@ Nothing here reads simulator ground truth. `g1 bench odometry` measures the drif
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from g1_control.estimation.estimator import StateEstimator
 from g1_control.rotations import wrap_angle, yaw_of
-from g1_control.types import RobotState
+from g1_control.types import RobotState, WorldPose
 
 STANCE_WEIGHT = 0.25
 """A foot with at least this stance weight stands (the estimator's soft weight: the higher foot of
 two within ~3 mm of each other still has more than this, so both stand in double support)."""
 
 
-@dataclass(frozen=True)
-class WorldPose:
-    """The pelvis in the run's start frame: x forward and y left of where the robot started."""
-
-    t_s: float
-    x_m: float
-    y_m: float
-    z_m: float
-    yaw_rad: float
-
-
 class LegOdometry:
-    def __init__(self, estimator: StateEstimator | None = None, correction_tau_s: float = 0.05):
-        """estimator: a StateEstimator this odometry updates itself (not the loop's, which its own
-        stage updates): one update per call of update()."""
+    def __init__(self, estimator: StateEstimator | None = None, correction_tau_s: float = 0.05,
+                 shared: bool = False):
+        """estimator: a StateEstimator this odometry updates itself (one update per call of update()),
+        or, with shared=True, one its owner updates (the loop's) just before each call of update():
+        the odometry then reads its latest estimate and kinematics (no second forward kinematics)."""
         if not correction_tau_s > 0:
             raise ValueError(f"LegOdometry correction_tau_s must be > 0; got {correction_tau_s}")
+        if shared and estimator is None:
+            raise ValueError("LegOdometry shared=True needs the estimator it shares")
         self.estimator = estimator or StateEstimator()
+        self.shared = shared
         self.correction_tau_s = correction_tau_s
         self.position_m = np.zeros(3)
         self.anchors_m = np.zeros((2, 3))
@@ -63,8 +56,11 @@ class LegOdometry:
 
     def reset(self, state: RobotState) -> WorldPose:
         """Anchor the start frame here: the pelvis at (0, 0) over the floor, heading 0, both feet standing."""
-        self.estimator.reset(state)
-        est = self.estimator.update(state)
+        if self.shared:
+            est = self.estimator.estimate
+        else:
+            self.estimator.reset(state)
+            est = self.estimator.update(state)
         self._yaw0 = yaw_of(state.imu_quat_wxyz)
         c, s = math.cos(-self._yaw0), math.sin(-self._yaw0)
         self._rot0 = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
@@ -76,11 +72,15 @@ class LegOdometry:
         self.pose = WorldPose(state.t_s, 0.0, 0.0, float(self.position_m[2]), 0.0)
         return self.pose
 
+    def restart(self) -> None:
+        """Anchor the start frame at the next update() (a shared estimator updated first)."""
+        self._last_t = None
+
     def update(self, state: RobotState, contacts: np.ndarray | None = None) -> WorldPose:
         """contacts: (left, right) in stance by a controller's schedule; None: the estimator's weights."""
         if self._last_t is None:
             return self.reset(state)
-        est = self.estimator.update(state, contacts)
+        est = self.estimator.estimate if self.shared else self.estimator.update(state, contacts)
         dt = max(0.0, state.t_s - self._last_t)
         self._last_t = state.t_s
         stance = np.asarray(contacts, dtype=bool) if contacts is not None else est.stance_weight >= STANCE_WEIGHT

@@ -21,6 +21,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from g1_control.errors import LaunchFileError
+from g1_control.estimation.estimator import StateEstimator
 from g1_control.interfaces import Backend, Generator, InputDevice, Tracker
 from g1_control.launch.schema import SKELETON_GENERATORS, LaunchFile
 from g1_control.launch.variant import check_tracker_fits, robot_variant
@@ -31,6 +32,7 @@ from g1_control.teleop.scripted import Segment, random_timeline
 from g1_control.types import CommandLimits
 
 if TYPE_CHECKING:
+    from g1_control.estimation.localiser import Localiser
     from g1_control.ik.stage import IKStage
     from g1_control.sim.mujoco_backend import MujocoBackend
 
@@ -144,6 +146,36 @@ def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
     return GoalGenerator(generator, launch.scene, config)
 
 
+def make_localiser(launch: LaunchFile, estimator: StateEstimator) -> Localiser | None:
+    """The robot's world pose estimate when the launch file steers by it (estimation.steer_by; a robot
+    link always does): leg odometry on the loop's estimator, fused with the external pose topic where
+    estimation.external_pose names one. None: goals and programs steer by the simulator's ground truth."""
+    if not launch.steers_by_estimate():
+        return None
+    from g1_control.estimation.external_pose import PoseFusion
+    from g1_control.estimation.localiser import DdsPoseSource, Localiser
+    from g1_control.estimation.pose import LegOdometry
+
+    # the backend's partition by default: g1 deploy --partition isolates the topics with the robot link
+    ext, seen = launch.estimation.external_pose, launch.estimation.perception
+    fusion, source, objects = None, None, None
+    if ext is not None:
+        from g1_control.hardware.ros2.topics import PoseTopicReader
+
+        assert ext.interface is not None  # validated: always named
+        fusion = PoseFusion(ext)
+        source = DdsPoseSource(PoseTopicReader(ext.interface, ext.domain, ext.topic,
+                                               ext.partition or launch.backend.partition))
+    if seen is not None:
+        from g1_control.estimation.perception import DdsObjectSource, ObjectPerception
+        from g1_control.hardware.ros2.topics import ObjectPosesReader
+
+        assert seen.interface is not None  # validated: always named
+        objects = ObjectPerception(seen, DdsObjectSource(ObjectPosesReader(
+            seen.interface, seen.domain, seen.topic, seen.partition or launch.backend.partition)))
+    return Localiser(LegOdometry(estimator, shared=True), fusion=fusion, source=source, objects=objects)
+
+
 def make_sim_backend(launch: LaunchFile) -> MujocoBackend:
     if launch.backend.type != "mujoco":
         raise LaunchFileError(f"launch file '{launch.name}' drives a robot (backend.type {launch.backend.type}); "
@@ -201,8 +233,13 @@ def build_loop(launch: LaunchFile, *, backend: Backend | None = None, input_devi
         wallclock = launch.backend.mode == "wallclock" or not backend.lockstep
     r = launch.rates
     capacity = log_capacity if log_capacity is not None else int(launch.total_duration_s * r.tracker_hz) + 2
+    estimator = StateEstimator()
+    localiser = make_localiser(launch, estimator)
+    if localiser is not None:
+        generator.steer_by(localiser)
+        chain["localiser"] = localiser.describe()
     loop = ControlLoop(backend, input_device, generator, ik, tracker, r, wallclock=wallclock,
-                       safety=safety, log_capacity=capacity,
+                       safety=safety, log_capacity=capacity, estimator=estimator, localiser=localiser,
                        falls=FallMonitor(launch.fall, max_tilt_rad=safety.config.max_tilt_rad))
     chain["input"] = type(input_device).__name__
     chain["backend"] = backend.describe()

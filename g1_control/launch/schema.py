@@ -13,6 +13,8 @@ from typing import Any, Literal
 
 from g1_control.config import apply_overrides, from_dict, read_yaml
 from g1_control.errors import LaunchFileError, SafetyConfigError
+from g1_control.estimation.external_pose import ExternalPoseConfig
+from g1_control.estimation.perception import PerceptionConfig
 from g1_control.loop.rates import LoopRates
 from g1_control.robot import g1
 from g1_control.safety.config import SafetyConfig
@@ -381,6 +383,29 @@ class InputConfig:
             raise LaunchFileError(f"{where}.{str(exc).removeprefix('world.')}") from None
 
 
+STEER_BY = ("auto", "ground_truth", "estimate")
+
+
+@dataclass
+class EstimationConfig:
+    """Where the robot is (g1_control/estimation/localiser.py): what goals and programs steer by.
+
+    steer_by auto: the simulator's ground truth where the backend gives it (MuJoCo: g1 launch), the
+    robot's own estimate (leg odometry, fused with external_pose where given) on a robot link;
+    estimate: the estimate everywhere (to try in simulation what the robot will do); ground_truth:
+    MuJoCo only. The estimate is anchored where the run starts: the launch file's scene is relative
+    to the robot's start (the origin, facing +x). Outcomes are judged from ground truth either way.
+    external_pose: a geometry_msgs/PoseStamped topic (motion capture, SLAM; g1 sim-robot --mocap)
+    fused with the leg odometry (g1_control/estimation/external_pose.py).
+    """
+
+    steer_by: Literal["auto", "ground_truth", "estimate"] = "auto"
+    external_pose: ExternalPoseConfig | None = None
+    perception: PerceptionConfig | None = None
+    """Object poses arriving at run time (g1_control/estimation/perception.py; g1 sim-robot --scene):
+    the scene's boxes move to where perception sees them, placed with the estimate."""
+
+
 @dataclass
 class LimitsConfig:
     max_vx_mps: float = 1.0
@@ -434,8 +459,30 @@ class LaunchFile:
     description: str = ""
     scene: SceneConfig = field(default_factory=SceneConfig)
     """Tables, platforms and boxes around the robot (g1_control/scene.py); goals refer to them by name."""
+    estimation: EstimationConfig = field(default_factory=EstimationConfig)
+    """What goals and programs steer by (the estimate on a robot) and an optional external pose input."""
+
+    def steers_by_estimate(self) -> bool:
+        """Whether goals and programs steer by the robot's own estimate (estimation.steer_by)."""
+        steer = self.estimation.steer_by
+        return steer == "estimate" or (steer == "auto" and self.backend.type != "mujoco")
+
+    def _validate_estimation(self) -> None:
+        est = self.estimation
+        if est.steer_by == "ground_truth" and self.backend.type != "mujoco":
+            raise LaunchFileError(f"estimation.steer_by: ground_truth needs a simulator's ground truth; backend.type "
+                                  f"{self.backend.type} drives a robot, which reports none (use auto or estimate)")
+        if est.perception is not None and not self.steers_by_estimate():
+            raise LaunchFileError("estimation.perception: objects are placed with the robot's estimate, which this "
+                                  f"MuJoCo run does not steer by (steer_by {est.steer_by}: ground truth); set "
+                                  "estimation.steer_by: estimate to use it")
+        if est.external_pose is not None and not self.steers_by_estimate():
+            raise LaunchFileError("estimation.external_pose: the external pose is fused into the robot's estimate, "
+                                  "which this MuJoCo run does not steer by (steer_by "
+                                  f"{est.steer_by}: ground truth); set estimation.steer_by: estimate to use it")
 
     def validate(self, where: str) -> None:
+        self._validate_estimation()
         if self.duration_s is not None and self.duration_s <= 0:
             raise LaunchFileError(f"duration_s: must be > 0, got {self.duration_s}")
         if self.generator.type == "scripted":

@@ -12,6 +12,7 @@ import numpy as np
 
 from g1_control.errors import InvalidCommandError, InvalidStateError
 from g1_control.estimation.estimator import StateEstimator
+from g1_control.estimation.localiser import Localiser
 from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, Tracker
 from g1_control.loop.rates import LoopRates
 from g1_control.loop.scheduler import Scheduler, Stage
@@ -123,11 +124,15 @@ class ControlLoop:
     def __init__(self, backend: Backend, input_device: InputDevice, generator: Generator, retargeter: Retargeter,
                  tracker: Tracker, rates: LoopRates | None = None, *, estimator: StateEstimator | None = None,
                  wallclock: bool = False, max_tilt_rad: float = 1.0, log_capacity: int = 0,
-                 safety: SafetyFilter | None = None, falls: FallMonitor | None = None):
+                 safety: SafetyFilter | None = None, falls: FallMonitor | None = None,
+                 localiser: Localiser | None = None):
         self.backend, self.input, self.generator = backend, input_device, generator
         self.retargeter, self.tracker = retargeter, tracker
         self.rates = rates or LoopRates()
         self.estimator = estimator or StateEstimator()
+        self.localiser = localiser
+        """The robot's world pose estimate (estimation/localiser.py), updated after the estimator; None:
+        the loop runs none (goals and programs steer by the simulator's ground truth)."""
         self.safety = safety or SafetyFilter(SafetyConfig(max_tilt_rad=max_tilt_rad))
         self.falls = falls or FallMonitor(max_tilt_rad=self.safety.config.max_tilt_rad)
         self.command = Command()
@@ -168,6 +173,8 @@ class ControlLoop:
         self.state = self.backend.reset()
         self.falls.reset()
         self.estimator.reset(self.state)
+        if self.localiser is not None:
+            self.localiser.reset(self.state)
         self.tracker.reset(self.state)
         self.generator.reset(self.state)
         return self.state
@@ -238,6 +245,7 @@ class ControlLoop:
         fb.state = s
         fb.truth = s if s.base_pos_w_m is not None else None
         fb.goal_status, fb.goal_messages, fb.phase = g.goal_status, g.goal_messages, g.phase
+        fb.pose = self.localiser.pose if self.localiser is not None else None
         self.input.observe(fb)
 
     def _read_state(self) -> RobotState | None:
@@ -258,6 +266,12 @@ class ControlLoop:
         state = self._read_state()
         if state is not None:
             self.tracker.observe(self.estimator.update(state))
+            self._localise(state)
+
+    def _localise(self, state: RobotState) -> None:
+        """The world pose estimate after the estimator (it shares the estimator's kinematics)."""
+        if self.localiser is not None:
+            self.localiser.update(state)
 
     def _generate(self) -> None:
         self._kin_ref = self.generator.update(self.command, self.state)

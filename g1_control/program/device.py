@@ -4,9 +4,10 @@
     loop = build_loop(launch, input_device=device)     # the loop feeds it back (observe) before each poll
     ... loop runs; device.records: one StepRecord per step, judged against ground truth
 
-What the runner steers by is what the robot itself has (pose="estimator", the default): the
-state estimator's yaw (IMU) and its base velocity integrated into a planar position (leg
-odometry, Odometry below). On the robot there is nothing else; in simulation the same holds, so
+What the runner steers by is what the robot itself has (pose="estimator", the default): the loop's
+world pose estimate where it runs one (ExecutionFeedback.pose: leg odometry anchored at the stance
+feet, fused with an external pose where configured; estimation/localiser.py), else the state
+estimator's yaw (IMU) and its base velocity integrated into a planar position (Odometry below). On the robot there is nothing else; in simulation the same holds, so
 a program behaves in MuJoCo as it would on the robot, odometry drift included. pose="ground_truth"
 steers by the simulator's pose instead (for comparing the two). Either way, in simulation every
 step is also *judged* from ground truth (StepRecord.truth_*, g1_control/program/judge.py): the
@@ -148,7 +149,11 @@ class ProgramInput(InputDevice):
         if self._feedback is None:
             raise RuntimeError("ProgramInput is not attached to a loop: it steers by the loop's feedback "
                                "(ControlLoop gives it before every poll, InputDevice.observe)")
-        return self._odometry.pose(self._feedback.estimate)
+        fb = self._feedback
+        if fb.pose is not None:  # the loop's localiser (leg odometry, fused): a robot link, or steer_by estimate
+            p = fb.pose
+            return PlanarPose(p.x_m, p.y_m, p.yaw_rad, fb.estimate.pelvis_height_m)
+        return self._odometry.pose(fb.estimate)
 
     def poll(self, now_s: float) -> Command:
         op = self.operator.poll(now_s) if self.operator is not None else None

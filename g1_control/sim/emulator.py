@@ -16,6 +16,7 @@ import json
 import sys
 import threading
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -26,13 +27,20 @@ from g1_control.hardware.unitree.motion_service import MotionServiceEmulator
 from g1_control.hardware.unitree.remote import encode_wireless_remote
 from g1_control.interfaces import Backend
 from g1_control.robot import g1
+from g1_control.rotations import yaw_of
 from g1_control.sim.robot_endpoint import RobotEndpoint
 from g1_control.types import MotorCommand, RobotState
+
+if TYPE_CHECKING:
+    from g1_control.hardware.ros2.topics import ObjectPosesWriter, PoseTopicWriter
+    from g1_control.sim.mocap import MocapConfig, SimulatedMocap, SimulatedPerception
+    from g1_control.sim.mujoco_backend import MujocoBackend
 
 CRC_BURST_STATES = 10
 """States with a wrong CRC in one "crc_burst": 20 ms at 500 Hz, under the host's 50 ms stale-state limit."""
 COLLAPSED_LEG_Q_RAD = np.array([-1.6, 0.0, 0.0, 2.6, -0.8, 0.0])
 """One leg (hip pitch, roll, yaw, knee, ankle pitch, roll) of a collapsed G1: inside the joint limits."""
+
 FAULTS = {
     "state_stops": "LowState_ stops (robot side silent)",
     "state_frozen": "LowState_ keeps arriving with the same contents and tick",
@@ -233,6 +241,12 @@ class RobotEmulator:
         self.service = MotionServiceEmulator(self.link._participant, partition, active_mode=builtin_mode,
                                              on_change=self._on_mode_change) if mode == "robot" else None
         self._lock = threading.Lock()
+        self.mocap: SimulatedMocap | None = None
+        self._mocap_writer: PoseTopicWriter | None = None
+        self.perception: SimulatedPerception | None = None
+        self.scene_sim: MujocoBackend | None = None
+        """The MuJoCo physics holding a launch file's scene (publish_perception), for its ground truth."""
+        self._perception_writer: ObjectPosesWriter | None = None
 
     @staticmethod
     def _unitree_mujoco_traits() -> tuple[float, str]:
@@ -296,12 +310,61 @@ class RobotEmulator:
             p.hot_joint = g1.JOINT_INDEX["waist_yaw_joint"]
         return time.monotonic()
 
+    def publish_mocap(self, config: MocapConfig, topic: str = "mocap/pose") -> SimulatedMocap:
+        """Publish a motion-capture pose of the pelvis from the simulator's ground truth on rt/<topic>
+        (geometry_msgs/PoseStamped, frame 'mocap' = the simulator's world = the scene frame), stamped
+        with the wall clock when measured and sent `latency_s` later (sim/mocap.py)."""
+        from g1_control.hardware.ros2.topics import PoseTopicWriter
+        from g1_control.sim.mocap import SimulatedMocap
+
+        mocap = SimulatedMocap(config)
+        writer = PoseTopicWriter(self.link.interface, self.link.domain_id, topic, self.link.partition)
+        self._mocap_writer = writer
+
+        def sample(state: RobotState) -> None:
+            if state.base_pos_w_m is None:
+                return
+            for stamp, pos, quat in mocap.sample(time.time(), state.base_pos_w_m, state.imu_quat_wxyz):
+                writer.write(stamp, pos, quat)
+
+        self.endpoint.state_observers.append(sample)
+        self.mocap = mocap
+        return mocap
+
+    def publish_perception(self, sim: MujocoBackend, config: MocapConfig, topic: str = "perception/objects"
+                           ) -> SimulatedPerception:
+        """Publish the scene's boxes as a perception system on the robot sees them (ObjectPoses_ on
+        rt/<topic>, each box in the robot's heading frame), from `sim`'s ground truth (sim/mocap.py)."""
+        from g1_control.hardware.ros2.topics import ObjectPosesWriter
+        from g1_control.sim.mocap import SimulatedPerception
+
+        names = [b.name for b in sim.scene.boxes]
+        if not names:
+            raise ValueError("perception: the scene has no boxes to publish")
+        perception = SimulatedPerception(config)
+        writer = ObjectPosesWriter(self.link.interface, self.link.domain_id, topic, self.link.partition)
+        self._perception_writer = writer
+
+        def sample(state: RobotState) -> None:
+            if state.base_pos_w_m is None:
+                return
+            objects = {name: sim.object_pose(name) for name in names}
+            for stamp, seen in perception.sample(time.time(), state.base_pos_w_m, state.imu_quat_wxyz, objects):
+                writer.write(stamp, seen)
+
+        self.endpoint.state_observers.append(sample)
+        self.perception, self.scene_sim = perception, sim
+        return perception
+
     def start(self) -> RobotEmulator:
         self.endpoint.start()
         return self
 
     def close(self) -> None:
         self.endpoint.stop()
+        for writer in (self._mocap_writer, self._perception_writer):
+            if writer is not None:
+                writer.close()
         if self.service is not None:
             self.service.close()
         self.link.close()
@@ -318,6 +381,16 @@ class RobotEmulator:
         out.update(self.endpoint.whole_run_period_stats())
         state = self.physics.read_state()
         out["base_pos_w_m"] = None if state.base_pos_w_m is None else [float(v) for v in state.base_pos_w_m]
+        out["base_yaw_rad"] = float(yaw_of(state.imu_quat_wxyz))
+        if self.mocap is not None and self._mocap_writer is not None:
+            out["mocap"] = {"measured": self.mocap.measured, "dropped": self.mocap.dropped,
+                            "sent": self._mocap_writer.sent}
+        if self.perception is not None and self._perception_writer is not None:
+            out["perception"] = {"measured": self.perception.measured, "dropped": self.perception.dropped,
+                                 "sent": self._perception_writer.sent}
+        sim = self.scene_sim
+        if sim is not None:  # the ground-truth outcome, for judging: where the boxes and the feet are
+            out["boxes_w_m"] = {b.name: [float(v) for v in sim.object_pose(b.name)[0]] for b in sim.scene.boxes}
         out["first_damping_base_pos_w_m"] = self.endpoint.first_damping_base_pos_w_m
         last = self.endpoint.last_command
         # damping on every motor the robot has (a 23-DoF G1's empty slots go out disabled, gains 0)

@@ -17,6 +17,7 @@ import sys
 import threading
 import time
 from collections import deque
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -27,7 +28,7 @@ from g1_control.hardware.unitree.conversions import lowcmd_to_motor_command, rob
 from g1_control.hardware.unitree.messages import LowCmd
 from g1_control.interfaces import Backend
 from g1_control.robot import g1
-from g1_control.types import MotorCommand
+from g1_control.types import MotorCommand, RobotState
 
 PERIOD_BIN_S = 1e-5
 PERIOD_BINS = 20_000
@@ -78,6 +79,10 @@ class RobotEndpoint:
         mode_machine left at 0, and every LowCmd_ taken whatever its CRC and mode_machine."""
         self.corrupt_next_states = 0
         """The next this many states carry a wrong CRC (a burst), counted down as they go out."""
+        self.state_observers: list[Callable[[RobotState], None]] = []
+        """Called with every state the physics reports before it is published (on the endpoint's
+        thread, which also steps the physics): g1 sim-robot's motion capture and perception sample
+        ground truth here."""
         self._frozen: bytes | None = None
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -198,6 +203,8 @@ class RobotEndpoint:
             payload = self._frozen
         else:
             state = self.physics.read_state()
+            for observe in self.state_observers:
+                observe(state)
             state.tick = self._tick
             msg = robot_state_to_lowstate(state)
             if self.unset_state_fields:

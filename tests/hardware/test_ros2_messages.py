@@ -40,3 +40,15 @@ def test_stamps_split_seconds_and_nanoseconds():
     assert m.stamp(12.25) == m.Time_(12, 250_000_000)
     assert m.stamp(0.0) == m.Time_(0, 0)
     assert m.stamp(3.9999999999) == m.Time_(3, 999_999_999)
+
+
+def test_pose_stamped_is_ros2s_and_object_poses_is_our_own_type():
+    assert m.PoseStamped_.__idl_typename__ == "geometry_msgs::msg::dds_::PoseStamped_"
+    assert m.ObjectPoses_.__idl_typename__ == "g1_msgs::msg::dds_::ObjectPoses_"
+    msg = m.PoseStamped_(m.Header_(m.Time_(3, 5), "mocap"), m.Pose_(m.Point_(1.0, 2.0, 3.0), m.Quaternion_(0, 0, 0, 1)))
+    assert m.PoseStamped_.deserialize(msg.serialize()) == msg
+    assert msg.serialize() == CDR_LE + (struct.pack("<iI", 3, 5) + struct.pack("<I", 6) + b"mocap\x00" + b"\x00" * 6  # doubles align to 8
+                                        + struct.pack("<7d", 1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 1.0))
+    seen = m.ObjectPoses_(m.Header_(m.Time_(1, 0), "heading"), ["box"], [m.Pose_()])
+    assert m.ObjectPoses_.deserialize(seen.serialize()) == seen
+    assert m.seconds(m.stamp(12.25)) == 12.25

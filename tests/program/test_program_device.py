@@ -285,3 +285,23 @@ def test_goal_verdicts_from_the_execution_layers_ground_truth():
     assert not goal_verdict({"kind": "step_down", "status": "reached", "on_floor_at_end": False}).ok
     v = goal_verdict({"kind": "reach", "status": "failed", "message": "out of reach"})
     assert not v.ok and "out of reach" in v.text
+
+
+class LocalisedLoop(FakeLoop):
+    """As FakeLoop with a velocity odometry reading 80 %, plus the loop's localiser pose (ExecutionFeedback.pose)
+    reading the true position, as a fused estimate would."""
+
+    def _publish(self, v_w):
+        super()._publish(v_w)
+        from g1_control.types import WorldPose
+
+        self.feedback.pose = WorldPose(self.t, self.x, self.y, 0.75, self.yaw)
+
+
+def test_the_runner_steers_by_the_loops_localiser_pose_where_there_is_one():
+    """The velocity odometry under-reads (it alone walks 2.5 m for 2 m: previous test); the localiser's
+    pose reads true, and the runner steers by it: 2 m by ground truth."""
+    loop = LocalisedLoop(odometry_scale=0.8)
+    device = drive(ProgramInput(Program([Walk(distance_m=2.0)]), start_delay_s=0.0), loop)
+    [walk] = device.records
+    assert walk.truth_end.x_m == pytest.approx(2.0, abs=0.03)

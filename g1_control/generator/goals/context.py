@@ -161,15 +161,16 @@ class GoalContext:
     # -- where the robot is -------------------------------------------------------------------------
     @property
     def localised(self) -> bool:
-        """Whether the robot's world pose is known (the simulator's ground truth; a robot has none)."""
+        """Whether the robot's world pose is known (the simulator's ground truth, or the robot's own
+        estimate where the executor steers by one: GoalGenerator.steer_by)."""
         return self.state is not None and self.state.base_pos_w_m is not None
 
     def require_world_pose(self, goal: TaskGoal) -> None:
         """GoalFailed, before anything moves, when `goal` needs a world pose and there is none."""
         why = world_pose_needed(goal)
         if why is not None and not self.localised:
-            raise GoalFailed(f"no world pose for the robot: {why} (a robot reports none; in simulation the "
-                             "simulator gives it); nothing moved for this goal")
+            raise GoalFailed(f"no world pose for the robot: {why} (a robot reports none and no estimate was given; "
+                             "in simulation the simulator gives it); nothing moved for this goal")
 
     def world_pose(self) -> tuple[RobotState, np.ndarray]:
         """This tick's state and the robot's world position; goals in world coordinates need one."""

@@ -12,8 +12,8 @@ sequence of phases, each a reference the tracking layer (trackers/layer.py) can 
 The first whole-body reference after walking starts at the measured configuration (the soles
 where they are), so the hand-over does not jump; each later one starts where the previous ended.
 Where the robot must be is planned from the scene (task knowledge: where the boxes, tables and
-platforms are) and the robot's world pose: the simulator's ground truth in simulation (a stand-in
-for a localisation system). Goals that need no world (a reach relative to the robot, heights) are
+platforms are) and the robot's world pose: the simulator's ground truth in simulation, or the
+robot's own estimate (steer_by: leg odometry, fused with an external pose; always on a robot). Goals that need no world (a reach relative to the robot, heights) are
 planned in the frame of the stance the robot stands in and run without one; a goal that does need
 one fails at its start, before anything moves, saying why (context.world_pose_needed).
 
@@ -43,7 +43,7 @@ from g1_control.generator.goals.poses import ReachRefused, flat_soles
 from g1_control.generator.goals.reach import reach
 from g1_control.generator.styles import ROLLOUT_STYLES
 from g1_control.generator.whole_body import keyframe_trajectory
-from g1_control.interfaces import Generator
+from g1_control.interfaces import Generator, WorldPoseEstimate
 from g1_control.robot import g1
 from g1_control.scene import SceneConfig
 from g1_control.types import (
@@ -82,6 +82,8 @@ class GoalGenerator(Generator):
         """Per goal, for judging it from outside: kind, start/end time, the hold window of a reach,
         its target in the world (reach point, box, where the box goes, platform)."""
         self.log = self.goal_log = self.ctx.log
+        self.estimate: WorldPoseEstimate | None = None
+        """Where the robot is for the goals (steer_by); None: the state's own base pose (ground truth)."""
         self._ref = KinematicReference()
         self._joint = JointReference()
         self.reset_state()
@@ -99,6 +101,11 @@ class GoalGenerator(Generator):
     def reset(self, state: RobotState) -> None:
         self.reset_state()
         self.inner.reset(state)
+
+    def steer_by(self, estimate: WorldPoseEstimate) -> None:
+        """Goals are placed by the robot's own estimate (the state the skills see carries it as its
+        base pose); the launch file's generator in between still sees the robot's state as reported."""
+        self.estimate = estimate
 
     @property
     def phase(self) -> str:
@@ -131,7 +138,7 @@ class GoalGenerator(Generator):
     # -- the tick ---------------------------------------------------------------------------------
     def update(self, command: Command, state: RobotState) -> KinematicReference:
         ctx = self.ctx
-        ctx.state, self._command, ctx.t = state, command, state.t_s
+        ctx.state, self._command, ctx.t = self._located(state), command, state.t_s
         for goal in command.tasks:
             if goal.goal_id not in self._seen:
                 self._seen.add(goal.goal_id)
@@ -148,6 +155,20 @@ class GoalGenerator(Generator):
             except StopIteration:
                 self._coro = None
         return self._reference(command, state)
+
+    def _located(self, state: RobotState) -> RobotState:
+        if self.estimate is None:
+            return state
+        self._perceive(self.estimate.object_positions())
+        return self.estimate.scene_state(state)
+
+    def _perceive(self, seen) -> None:
+        """Boxes where perception last saw them (scene frame), except the one in the hands."""
+        ctx = self.ctx
+        held = ctx.held.box.name if ctx.held is not None else None
+        for name, position in seen.items():
+            if name in ctx.box_positions and name != held:
+                ctx.box_positions[name] = position
 
     def _reference(self, command: Command, state: RobotState) -> KinematicReference:
         ctx = self.ctx

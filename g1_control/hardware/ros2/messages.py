@@ -85,6 +85,30 @@ class Pose_(IdlStruct, typename=dds_type("geometry_msgs", "Pose")):
 @dataclass
 @final
 @autoid("sequential")
+class PoseStamped_(IdlStruct, typename=dds_type("geometry_msgs", "PoseStamped")):
+    """A pose at the header's stamp, in the header's frame (motion capture, SLAM: the external pose
+    input, g1_control/estimation/external_pose.py)."""
+
+    header: Header_ = field(default_factory=Header_)
+    pose: Pose_ = field(default_factory=Pose_)
+
+
+@dataclass
+@final
+@autoid("sequential")
+class ObjectPoses_(IdlStruct, typename="g1_msgs::msg::dds_::ObjectPoses_"):
+    """This project's own type (no ROS 2 standard fits): named objects seen at the header's stamp, each
+    pose in the robot's heading frame (frame_id 'heading': origin at the pelvis, x forward along its
+    heading, z up), as a perception system (e.g. AprilTags) reports them. names[i] goes with poses[i]."""
+
+    header: Header_ = field(default_factory=Header_)
+    names: sequence[str] = field(default_factory=list)
+    poses: sequence[Pose_] = field(default_factory=list)
+
+
+@dataclass
+@final
+@autoid("sequential")
 class PoseWithCovariance_(IdlStruct, typename=dds_type("geometry_msgs", "PoseWithCovariance")):
     pose: Pose_ = field(default_factory=Pose_)
     covariance: array[float64, 36] = field(default_factory=lambda: [0.0] * 36)
@@ -141,6 +165,11 @@ class TransformStamped_(IdlStruct, typename=dds_type("geometry_msgs", "Transform
 @autoid("sequential")
 class TFMessage_(IdlStruct, typename=dds_type("tf2_msgs", "TFMessage")):
     transforms: sequence[TransformStamped_] = field(default_factory=list)
+
+
+def seconds(time: Time_) -> float:
+    """A builtin_interfaces/Time in seconds."""
+    return time.sec + time.nanosec * 1e-9
 
 
 def stamp(t_s: float) -> Time_:

@@ -1,0 +1,117 @@
+"""Where things are, from perception: named objects seen in the robot's heading frame (origin at the
+pelvis, x along its heading; e.g. AprilTags on boxes), stamped when seen, placed in the scene frame
+with the robot's own estimate at that stamp (the Localiser's track: latency compensated), so the scene
+follows the objects as the robot moves. Frames older than max_age_s are refused (stale), as are frames
+stamped before the estimate's track or after now (no pose to place them with).
+
+    perception = ObjectPerception(PerceptionConfig(interface="lo", max_age_s=0.5), source)
+    perception.update(now_s, localiser.pose_at)     # every estimator tick, after the localiser
+    perception.positions["box"]                      # (x, y, z) in the scene frame
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from g1_control.errors import LaunchFileError
+from g1_control.types import WorldPose
+
+
+@dataclass
+class PerceptionConfig:
+    """launch file `estimation.perception`: the topic of object poses (g1 sim-robot --scene publishes one)."""
+
+    topic: str = "perception/objects"
+    interface: str | None = None
+    domain: int = 0
+    partition: str | None = None
+    """Default: the robot link's (backend.partition)."""
+    max_age_s: float = 0.5
+
+    def validate(self, where: str) -> None:
+        from g1_control.hardware.ros2.topics import check_topic_name
+
+        if not isinstance(self.interface, str) or not self.interface:
+            raise LaunchFileError(f"{where}.interface: a perception input must name the network interface of its "
+                                  "publisher (lo for this computer, e.g. g1 sim-robot --scene)")
+        problem = check_topic_name(self.topic)
+        if problem:
+            raise LaunchFileError(f"{where}.topic: {problem}")
+        if not 0 <= self.domain <= 232:
+            raise LaunchFileError(f"{where}.domain: {self.domain} is not a DDS domain id (0..232)")
+        if not (math.isfinite(self.max_age_s) and 0 < self.max_age_s <= 2.0):
+            raise LaunchFileError(f"{where}.max_age_s: {self.max_age_s} is outside (0, 2] s")
+
+
+Objects = dict[str, tuple[tuple[float, float, float], tuple[float, float, float, float]]]
+
+
+class ObjectSource(Protocol):
+    def take(self, now_s: float) -> list[tuple[float, Objects]]:
+        """Frames that arrived: (stamp on the loop's clock, name -> (xyz, quat wxyz) in the heading frame)."""
+        ...
+
+    def close(self) -> None: ...
+
+
+class DdsObjectSource:
+    """ObjectPoses_ from a DDS topic (hardware/ros2/topics.py), stamps moved onto the loop's clock by age."""
+
+    def __init__(self, reader) -> None:
+        self.reader = reader
+
+    def take(self, now_s: float) -> list[tuple[float, Objects]]:
+        return [(now_s - r.age_s, r.objects) for r in self.reader.take()]
+
+    def close(self) -> None:
+        self.reader.close()
+
+
+@dataclass
+class PerceptionCounters:
+    frames: int = 0
+    rejected: dict[str, int] = field(default_factory=lambda: {"stale": 0, "no_pose": 0})
+    last_rejection: str = ""
+
+
+class ObjectPerception:
+    """See the module docstring."""
+
+    def __init__(self, config: PerceptionConfig, source: ObjectSource):
+        self.config = config
+        self.source = source
+        self.positions: dict[str, np.ndarray] = {}
+        """name -> the object's centre in the scene frame, as last seen."""
+        self.seen_s: dict[str, float] = {}
+        self.counters = PerceptionCounters()
+
+    def update(self, now_s: float, pose_at: Callable[[float], WorldPose | None]) -> None:
+        c = self.counters
+        for stamp, objects in self.source.take(now_s):
+            age = now_s - stamp
+            if age > self.config.max_age_s:
+                c.rejected["stale"] += 1
+                c.last_rejection = f"stale: {age:.3f} s old (max_age_s {self.config.max_age_s:g})"
+                continue
+            pose = pose_at(stamp)
+            if pose is None:
+                c.rejected["no_pose"] += 1
+                c.last_rejection = f"no_pose: no estimate of the robot's pose at the stamp ({age:.3f} s ago)"
+                continue
+            cy, sy = math.cos(pose.yaw_rad), math.sin(pose.yaw_rad)
+            for name, (p, _) in objects.items():
+                x, y, z = p
+                self.positions[name] = np.array([pose.x_m + cy * x - sy * y, pose.y_m + sy * x + cy * y, pose.z_m + z])
+                self.seen_s[name] = stamp
+            c.frames += 1
+
+    def close(self) -> None:
+        self.source.close()
+
+
+__all__ = ["DdsObjectSource", "ObjectPerception", "ObjectSource", "PerceptionConfig", "PerceptionCounters"]

@@ -1,0 +1,220 @@
+"""geometry_msgs/PoseStamped over Cyclone DDS: a reader (the external pose input) and a writer
+(g1 sim-robot's motion capture, tests).
+
+Stamps are the publisher's wall clock (ROS time: seconds since the epoch). The reader hands each
+pose on with the wall-clock age it had when it was read, so a consumer can place it on its own clock
+(the loop's monotonic or simulated time): stamp_on_my_clock = my_now - age. On one computer the
+clocks agree; across computers they must be synchronised (chrony/PTP), or poses are refused as
+stale or from the future (estimation/external_pose.py).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import time
+from dataclasses import dataclass
+from typing import Any
+
+HISTORY_DEPTH = 64
+"""Poses a reader keeps between takes (0.64 s of a 100 Hz motion capture, read every loop tick)."""
+TOPIC_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*$")
+
+
+def check_topic_name(name: object) -> str | None:
+    """Why `name` is not a ROS 2 topic name as this project writes it ('mocap/pose'), or None."""
+    if not isinstance(name, str) or not TOPIC_NAME.match(name) or name.startswith("rt/"):
+        return (f"{name!r} is not a ROS 2 topic name (letters, digits and _ in /-separated parts, no leading "
+                "/ and no rt/ prefix, e.g. mocap/pose)")
+    return None
+
+
+@dataclass(frozen=True)
+class PoseReading:
+    """One PoseStamped as read: the stamp (publisher's wall clock), its age when read, the pose."""
+
+    stamp_s: float
+    age_s: float
+    x_m: float
+    y_m: float
+    z_m: float
+    quat_wxyz: tuple[float, float, float, float]
+    frame_id: str
+
+    @property
+    def yaw_rad(self) -> float:
+        w, x, y, z = self.quat_wxyz
+        return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def _group_qos(partition: str | None):
+    from cyclonedds.qos import Policy, Qos
+
+    return Qos(Policy.Partition([partition])) if partition else None
+
+
+class PoseTopicReader:
+    """Takes PoseStamped samples from rt/<topic> (no thread: take() drains what arrived)."""
+
+    def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
+        from cyclonedds.qos import Policy, Qos
+        from cyclonedds.sub import DataReader, Subscriber
+        from cyclonedds.topic import Topic
+
+        from g1_control.hardware.links.dds import domain_participant
+        from g1_control.hardware.ros2 import messages as m
+
+        problem = check_topic_name(topic)
+        if problem:
+            raise ValueError(f"external pose topic: {problem}")
+        self.topic = topic
+        self._participant: Any = domain_participant(interface, domain)
+        # Every pose since the last take (DDS keeps only the latest by default): a late pose and a
+        # fresher one arriving together are each judged (the fusion refuses the stale one by name).
+        self._reader = DataReader(Subscriber(self._participant, qos=_group_qos(partition)),
+                                  Topic(self._participant, m.TOPIC_PREFIX + topic, m.PoseStamped_),
+                                  qos=Qos(Policy.History.KeepLast(HISTORY_DEPTH)))
+        self._seconds = m.seconds
+        self.received = 0
+
+    def take(self) -> list[PoseReading]:
+        now = time.time()
+        out = []
+        for msg in self._reader.take(HISTORY_DEPTH):
+            if not hasattr(msg, "pose"):
+                continue  # a sample-less info (writer gone)
+            stamp = self._seconds(msg.header.stamp)
+            p, q = msg.pose.position, msg.pose.orientation
+            out.append(PoseReading(stamp, now - stamp, p.x, p.y, p.z, (q.w, q.x, q.y, q.z), msg.header.frame_id))
+        self.received += len(out)
+        return out
+
+    def close(self) -> None:
+        if self._participant is not None:
+            del self._reader
+            self._participant = None
+
+
+class PoseTopicWriter:
+    """Writes PoseStamped samples to rt/<topic>."""
+
+    def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None,
+                 frame_id: str = "mocap"):
+        from cyclonedds.pub import DataWriter, Publisher
+        from cyclonedds.topic import Topic
+
+        from g1_control.hardware.links.dds import domain_participant
+        from g1_control.hardware.ros2 import messages as m
+
+        problem = check_topic_name(topic)
+        if problem:
+            raise ValueError(f"pose topic: {problem}")
+        self._m = m
+        self.frame_id = frame_id
+        self._participant: Any = domain_participant(interface, domain)
+        self._writer = DataWriter(Publisher(self._participant, qos=_group_qos(partition)),
+                                  Topic(self._participant, m.TOPIC_PREFIX + topic, m.PoseStamped_))
+        self.sent = 0
+
+    def write(self, stamp_s: float, position_m, quat_wxyz) -> None:
+        m = self._m
+        x, y, z = (float(v) for v in position_m)
+        w, qx, qy, qz = (float(v) for v in quat_wxyz)
+        self._writer.write(m.PoseStamped_(m.Header_(m.stamp(stamp_s), self.frame_id),
+                                          m.Pose_(m.Point_(x, y, z), m.Quaternion_(qx, qy, qz, w))))
+        self.sent += 1
+
+    def close(self) -> None:
+        if self._participant is not None:
+            del self._writer
+            self._participant = None
+
+
+@dataclass(frozen=True)
+class ObjectsReading:
+    """One ObjectPoses as read: stamp (publisher's wall clock), its age when read, name -> (xyz, quat wxyz)
+    in the robot's heading frame."""
+
+    stamp_s: float
+    age_s: float
+    objects: dict[str, tuple[tuple[float, float, float], tuple[float, float, float, float]]]
+
+
+class ObjectPosesReader:
+    """Takes ObjectPoses samples from rt/<topic> (perception: objects in the robot's heading frame)."""
+
+    def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
+        from cyclonedds.qos import Policy, Qos
+        from cyclonedds.sub import DataReader, Subscriber
+        from cyclonedds.topic import Topic
+
+        from g1_control.hardware.links.dds import domain_participant
+        from g1_control.hardware.ros2 import messages as m
+
+        problem = check_topic_name(topic)
+        if problem:
+            raise ValueError(f"perception topic: {problem}")
+        self._participant: Any = domain_participant(interface, domain)
+        self._reader = DataReader(Subscriber(self._participant, qos=_group_qos(partition)),
+                                  Topic(self._participant, m.TOPIC_PREFIX + topic, m.ObjectPoses_),
+                                  qos=Qos(Policy.History.KeepLast(HISTORY_DEPTH)))
+        self._seconds = m.seconds
+
+    def take(self) -> list[ObjectsReading]:
+        now = time.time()
+        out = []
+        for msg in self._reader.take(HISTORY_DEPTH):
+            if not hasattr(msg, "poses"):
+                continue
+            stamp = self._seconds(msg.header.stamp)
+            objects = {name: ((p.position.x, p.position.y, p.position.z),
+                              (p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z))
+                       for name, p in zip(msg.names, msg.poses)}
+            out.append(ObjectsReading(stamp, now - stamp, objects))
+        return out
+
+    def close(self) -> None:
+        if self._participant is not None:
+            del self._reader
+            self._participant = None
+
+
+class ObjectPosesWriter:
+    """Writes ObjectPoses samples to rt/<topic> (g1 sim-robot --scene's perception)."""
+
+    def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
+        from cyclonedds.pub import DataWriter, Publisher
+        from cyclonedds.topic import Topic
+
+        from g1_control.hardware.links.dds import domain_participant
+        from g1_control.hardware.ros2 import messages as m
+
+        problem = check_topic_name(topic)
+        if problem:
+            raise ValueError(f"perception topic: {problem}")
+        self._m = m
+        self._participant: Any = domain_participant(interface, domain)
+        self._writer = DataWriter(Publisher(self._participant, qos=_group_qos(partition)),
+                                  Topic(self._participant, m.TOPIC_PREFIX + topic, m.ObjectPoses_))
+        self.sent = 0
+
+    def write(self, stamp_s: float, objects: dict) -> None:
+        """objects: name -> (position xyz, quat wxyz) in the robot's heading frame."""
+        m = self._m
+        names, poses = [], []
+        for name, (pos, quat) in objects.items():
+            x, y, z = (float(v) for v in pos)
+            w, qx, qy, qz = (float(v) for v in quat)
+            names.append(name)
+            poses.append(m.Pose_(m.Point_(x, y, z), m.Quaternion_(qx, qy, qz, w)))
+        self._writer.write(m.ObjectPoses_(m.Header_(m.stamp(stamp_s), "heading"), names, poses))
+        self.sent += 1
+
+    def close(self) -> None:
+        if self._participant is not None:
+            del self._writer
+            self._participant = None
+
+
+__all__ = ["ObjectPosesReader", "ObjectPosesWriter", "ObjectsReading", "PoseReading", "PoseTopicReader",
+           "PoseTopicWriter", "check_topic_name"]
