@@ -88,7 +88,8 @@ def test_g1_sim_robot_scene_perception_over_dds_places_the_box_where_the_simulat
         emulator.start()
         t0 = time.monotonic()
         localiser.reset(state)
-        while time.monotonic() < t0 + 4.0:
+        # 4 s, longer on a loaded host until 45 frames arrived (20 Hz, 10 % dropped)
+        while time.monotonic() < t0 + 4.0 or (perception.counters.frames < 45 and time.monotonic() < t0 + 15.0):
             state.t_s = time.monotonic() - t0
             localiser.update(state)
             if "box" in perception.positions:
@@ -104,7 +105,9 @@ def test_g1_sim_robot_scene_perception_over_dds_places_the_box_where_the_simulat
     errors = np.linalg.norm(np.array(placed) - (truth + offset), axis=1)
     frames = perception.counters.frames
     print(f"\nperception over DDS: {frames} frames, {report['perception']}, box error mean {errors.mean() * 100:.1f} cm")
-    assert frames > 40 and perception.counters.rejected == {"stale": 0, "no_pose": 0}
+    rejected = perception.counters.rejected
+    # a loaded host may deliver a frame late past max_age_s: a few stale ones are refused, never placed
+    assert frames > 40 and rejected["no_pose"] == 0 and rejected["stale"] <= 0.1 * frames
     assert 0.05 < report["perception"]["dropped"] / report["perception"]["measured"] < 0.2
     assert errors.mean() < 0.045  # 2 cm noise per axis: 3.2 cm expected
     assert np.abs(truth[:2] - [1.1, 0.1]).max() < 0.02  # the box stands where the scene put it
