@@ -16,7 +16,6 @@ and printed report: g1_control/report/results.py):
 from __future__ import annotations
 
 import dataclasses
-import json
 import signal
 import time
 from pathlib import Path
@@ -232,11 +231,7 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, f
 
 def _scene_arrays(launch: LaunchFile, watcher: GoalWatcher | None) -> dict | None:
     """The scene and where its boxes were (ground truth), for the video; None without a scene."""
-    if launch.scene.empty or watcher is None:
-        return None
-    truth = watcher.arrays()
-    out = {"scene_json": np.asarray(json.dumps(dataclasses.asdict(launch.scene))), "object_t_s": truth["t_s"]}
-    for key, rows in truth.items():
-        if key.startswith("box_") and len(rows):
-            out["object_" + key.removeprefix("box_")] = rows
-    return out
+    from g1_control.report.replay import scene_with_truth
+
+    scene = scene_with_truth(launch.scene, watcher.arrays() if watcher is not None else {})
+    return scene.arrays() if scene is not None else None
