@@ -113,8 +113,11 @@ def test_web_view_draws_the_scene_and_moves_its_box():
 
 
 def box_pixels(image: np.ndarray) -> int:
-    """Pixels of the boxes' green (sim/scene.py BOX_RGBA, shaded)."""
-    r, g, b = (image[..., k].astype(int) for k in range(3))
+    """Pixels of the boxes' green (sim/scene.py BOX_RGBA, shaded) in the 3D canvas's middle (not
+    the page's green "connected" icon or axis gizmo)."""
+    h, w, _ = image.shape
+    middle = image[h // 5: h, w // 5: 4 * w // 5]
+    r, g, b = (middle[..., k].astype(int) for k in range(3))
     return int(((g > 60) & (g > 1.6 * r) & (g > 1.6 * b)).sum())
 
 
