@@ -134,10 +134,11 @@ def test_browser_shows_the_box(tmp_path):
         adr = model.jnt_qposadr[model.joint("box_free").id]
         q[adr:adr + 7] = [0.6, 0.3, 0.9, 1.0, 0.0, 0.0, 0.0]
         view.show(q, "box beside the robot")
-        image = screenshot(view.url, tmp_path / "box.png")
+        # a longer virtual-time budget than the robot's: under load the page was still blank at 8 s
+        image = screenshot(view.url, tmp_path / "box.png", wait_ms=20000)
         q[adr:adr + 3] = [60.0, 60.0, 0.15]  # recorded far away: gone from the picture
         view.show(q, "box gone")
-        gone = screenshot(view.url, tmp_path / "gone.png")
+        gone = screenshot(view.url, tmp_path / "gone.png", wait_ms=20000)
     finally:
         view.close()
     assert box_pixels(image) > 500, f"box not in the screenshot ({box_pixels(image)} green pixels)"
