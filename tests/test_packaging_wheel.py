@@ -90,7 +90,8 @@ def test_installed_wheel_runs_the_quick_start_check_anywhere(wheel, tmp_path):
     assert where.startswith(str(venv)), f"g1_control imported from {where}, not from the wheel"
     assert str(venv) in run(str(g1), "--version")
     assert "OK (sim_walk" in run(str(g1), "launch", "sim_walk", "--check")
-    assert "OK (sim_walk" in run(str(g1), "launch", "launch/sim_walk.yaml", "--check")  # the README's path
+    assert "OK (sim_walk" in run(str(g1), "launch", "launch/sim_walk.yaml", "--check")  # the README's paths
+    assert "OK (sim_tour" in run(str(g1), "launch", "launch/sim_tour.yaml", "--check")
     assert "sim_walk" in run(str(g1), "launch", "--list")
     run(str(g1), "init", "mine")
     assert (elsewhere / "mine" / "sim_walk.yaml").is_file()

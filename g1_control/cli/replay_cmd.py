@@ -53,8 +53,9 @@ def register(subparsers) -> None:
         "replay",
         help="look at a recorded run again (viewer, video, browser)",
         description="Replay a run folder written by g1 launch (runs/NAME-TIME, or its log.npz) from its "
-        "recorded base pose and joints, with an overlay of the command, the achieved velocity (ground "
-        "truth, 1 s gait-cycle mean) and the safety state: in the MuJoCo viewer when a display exists, "
+        "recorded base pose and joints and its scene (the tables, platforms and boxes of the launch.yaml in "
+        "the folder, each box where truth.npz recorded it), with an overlay of the command, the achieved velocity "
+        "(ground truth, 1 s gait-cycle mean) and the safety state: in the MuJoCo viewer when a display exists, "
         "else as a headless MP4 (RUN/replay.mp4); --frame writes one PNG; --web plays it in the browser.",
         epilog="examples:\n  g1 replay runs/sim_walk-20261121-154328\n  g1 replay runs/sim_walk-* --video\n"
         "  g1 replay RUN --frame 12.5          # RUN/replay-12.5s.png\n  g1 replay RUN --web 8080",

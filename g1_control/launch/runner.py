@@ -16,7 +16,6 @@ and printed report: g1_control/report/results.py):
 from __future__ import annotations
 
 import dataclasses
-import json
 import signal
 import time
 from pathlib import Path
@@ -90,9 +89,13 @@ def _run_loop(launch: LaunchFile, sim: MujocoBackend, loop: ControlLoop, segment
     view = _open_viewer(sim) if viewer else None
     web = _open_web(sim, web_port, launch.name) if web_port is not None else None
 
+    pushes = sorted(launch.pushes, key=lambda p: p.at_s)
+
     def on_tick(i: int) -> None:
         if watcher is not None:
             watcher.tick(i)
+        if pushes and sim.data.time >= pushes[0].at_s:
+            _push(sim, pushes.pop(0))
         if bar is not None and (i + 1) % ticks_per_update == 0:
             bar.update(1.0)
             if loop.faulted:
@@ -139,6 +142,8 @@ def _run_loop(launch: LaunchFile, sim: MujocoBackend, loop: ControlLoop, segment
     result = run_result(launch.name, loop, segments, wall, log)
     if watcher is not None:
         result.extra["goals"] = watcher.outcomes()
+    if launch.pushes:
+        result.extra["pushes"] = push_outcomes(launch.pushes, log, result.fall)
     if program is not None:
         from g1_control.program.device import record_dict
 
@@ -152,6 +157,42 @@ def _run_loop(launch: LaunchFile, sim: MujocoBackend, loop: ControlLoop, segment
     if interrupted is not None:
         raise interrupted
     return result
+
+
+def _push(sim: MujocoBackend, push) -> None:
+    from g1_control.rotations import heading_to_world, yaw_of
+
+    force_w = heading_to_world(np.asarray(push.force_h_n, dtype=float), yaw_of(sim.data.qpos[3:7]))
+    sim.push(force_w, push.duration_s)
+
+
+PUSH_WINDOW_S = 3.0
+"""A push is judged over this long after it starts."""
+UPRIGHT_TILT_RAD = 0.1
+"""Upright again: the pelvis within this of vertical (standing and walking stay within ~0.05)."""
+
+
+def push_outcomes(pushes: list, log: dict[str, np.ndarray], fall: dict | None) -> list[dict]:
+    """Per push, from the simulator's ground truth in the log: recovered (no fall from the push to the
+    end of its window, upright again), the peak tilt, how far the pelvis went in the window and
+    when it was upright again."""
+    t, tilt, pos = log["t_s"], log["tilt_rad"], log["base_pos_m"]
+    out = []
+    for p in pushes:
+        window = (t >= p.at_s) & (t <= p.at_s + PUSH_WINDOW_S)
+        fell = fall is not None and fall["t_s"] >= p.at_s and (fall["t_s"] <= p.at_s + PUSH_WINDOW_S)
+        entry = {"label": p.label, "at_s": p.at_s, "force_h_n": list(p.force_h_n), "duration_s": p.duration_s,
+                 "fell": bool(fell or (fall is not None and fall["t_s"] < p.at_s))}
+        if window.any() and not entry["fell"]:
+            tw, tilt_w = t[window], tilt[window]
+            peak = int(np.argmax(tilt_w))
+            after = np.flatnonzero(tilt_w[peak:] <= UPRIGHT_TILT_RAD)
+            entry.update(peak_tilt_rad=float(tilt_w[peak]), moved_m=float(np.linalg.norm(pos[window][-1, :2]
+                                                                                          - pos[window][0, :2])),
+                         upright_after_s=float(tw[peak + after[0]] - p.at_s) if after.size else None)
+        entry["recovered"] = not entry["fell"] and entry.get("upright_after_s") is not None
+        out.append(entry)
+    return out
 
 
 def finish_program_verdicts(records: list, goals: list[dict], fall: dict | None) -> None:
@@ -232,11 +273,7 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, f
 
 def _scene_arrays(launch: LaunchFile, watcher: GoalWatcher | None) -> dict | None:
     """The scene and where its boxes were (ground truth), for the video; None without a scene."""
-    if launch.scene.empty or watcher is None:
-        return None
-    truth = watcher.arrays()
-    out = {"scene_json": np.asarray(json.dumps(dataclasses.asdict(launch.scene))), "object_t_s": truth["t_s"]}
-    for key, rows in truth.items():
-        if key.startswith("box_") and len(rows):
-            out["object_" + key.removeprefix("box_")] = rows
-    return out
+    from g1_control.report.replay import scene_with_truth
+
+    scene = scene_with_truth(launch.scene, watcher.arrays() if watcher is not None else {})
+    return scene.arrays() if scene is not None else None

@@ -436,6 +436,24 @@ class OutputConfig:
 
 
 @dataclass
+class PushConfig:
+    """A shove on the pelvis in simulation (g1 launch only): does the robot recover?"""
+
+    at_s: float
+    force_h_n: tuple[float, float, float]
+    """Heading frame at the push's start: x forward, y left, z up (a push "from the right" is +y)."""
+    duration_s: float = 0.2
+    label: str = ""
+
+    def validate(self, where: str) -> None:
+        if self.at_s < 0 or not 0 < self.duration_s <= 2.0:
+            raise LaunchFileError(f"{where}: at_s must be >= 0 and duration_s in (0, 2] s; got at_s {self.at_s}, "
+                                  f"duration_s {self.duration_s}")
+        if len(self.force_h_n) != 3:
+            raise LaunchFileError(f"{where}.force_h_n: need 3 numbers (x forward, y left, z up), got {self.force_h_n}")
+
+
+@dataclass
 class LaunchFile:
     name: str
     duration_s: float | None = None
@@ -462,6 +480,9 @@ class LaunchFile:
     estimation: EstimationConfig = field(default_factory=EstimationConfig)
     """What goals and programs steer by (the estimate on a robot) and an optional external pose input."""
 
+    pushes: list[PushConfig] = field(default_factory=list)
+    """Shoves on the pelvis during a simulated run; the summary says whether each was recovered."""
+
     def steers_by_estimate(self) -> bool:
         """Whether goals and programs steer by the robot's own estimate (estimation.steer_by)."""
         steer = self.estimation.steer_by
@@ -485,6 +506,8 @@ class LaunchFile:
         self._validate_estimation()
         if self.duration_s is not None and self.duration_s <= 0:
             raise LaunchFileError(f"duration_s: must be > 0, got {self.duration_s}")
+        if self.pushes and self.backend.type != "mujoco":
+            raise LaunchFileError("pushes: only a simulated run (backend.type mujoco) can be pushed")
         if self.generator.type == "scripted":
             from g1_control.generator.scripted import REFERENCES
 

@@ -1,8 +1,11 @@
 """Look at a recorded run or a motion clip again: `g1 replay RUN`, `g1 view CLIP`.
 
-Both become a Playback (times, base pose, joints and one overlay text per frame), which goes to
-the MuJoCo viewer (with a display), a headless MP4 or one PNG frame (g1_control/sim/render.py),
-or the browser (g1_control/sim/web.py). A run's overlay shows the command, the achieved velocity
+Both become a Playback (times, base pose, joints, one overlay text per frame and what else to
+draw: a ReplayScene, g1_control/sim/replay_scene.py), which goes to the MuJoCo viewer (with a
+display), a headless MP4 or one PNG frame (g1_control/sim/render.py), or the browser
+(g1_control/sim/web.py). A run's scene comes from the launch.yaml in its folder, its boxes move
+as truth.npz recorded them (ground truth, every tick); a clip's scene shapes and handled object
+come from the clip. A run's overlay shows the command, the achieved velocity
 (ground truth, averaged over one gait cycle) and the safety state, rebuilt from log.npz and the
 events in summary.json; a clip's overlay shows its name, frame, style and foot contacts.
 """
@@ -18,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from g1_control.errors import G1ControlError
+from g1_control.sim.replay_scene import ReplayScene, replay_model
 
 
 @dataclass
@@ -28,6 +32,8 @@ class Playback:
     base_quat_wxyz: np.ndarray
     q_rad: np.ndarray
     overlay: list[str]
+    scene: ReplayScene | None = None
+    """What is drawn besides the robot (None: the robot alone)."""
 
     @property
     def duration_s(self) -> float:
@@ -67,7 +73,41 @@ def from_run(path: str | Path) -> Playback:
 
     rows = run_overlay_rows(log, summary.get("events", []), summary.get("segments", []))
     title = f"run {summary.get('name', folder.name)}"
-    return Playback(title, log["t_s"], log["base_pos_m"], log["base_quat_wxyz"], log["q_rad"], rows)
+    return Playback(title, log["t_s"], log["base_pos_m"], log["base_quat_wxyz"], log["q_rad"], rows,
+                    run_scene(folder))
+
+
+def run_scene(folder: Path) -> ReplayScene | None:
+    """The scene of the launch.yaml a run folder holds, its boxes where truth.npz recorded them
+    (None: the run had no scene; a box without recorded poses stays where the scene put it)."""
+    import yaml
+
+    launch_path = folder / "launch.yaml"
+    if not launch_path.is_file():
+        return None
+    try:
+        scene = (yaml.safe_load(launch_path.read_text()) or {}).get("scene") or {}
+    except yaml.YAMLError as exc:
+        raise G1ControlError(f"{launch_path}: not readable as YAML ({exc})") from None
+    truth: dict[str, np.ndarray] = {}
+    if (folder / "truth.npz").is_file():
+        with np.load(folder / "truth.npz") as data:
+            truth = {k: data[k] for k in data.files}
+    return scene_with_truth(scene, truth)
+
+
+def scene_with_truth(scene, truth: dict[str, np.ndarray]) -> ReplayScene | None:
+    """A ReplayScene of `scene` (a SceneConfig or its dict) with the boxes' recorded poses from
+    `truth` (report/outcomes.py GoalWatcher.arrays: t_s and box_<name>); None for an empty scene."""
+    import dataclasses
+
+    as_dict = dataclasses.asdict(scene) if dataclasses.is_dataclass(scene) and not isinstance(scene, type) \
+        else dict(scene)
+    if not any(as_dict.get(k) for k in ("tables", "platforms", "boxes")):
+        return None
+    poses = {k.removeprefix("box_"): v for k, v in truth.items() if k.startswith("box_") and len(v)}
+    return ReplayScene(scene_json=json.dumps(as_dict), object_t_s=truth.get("t_s", np.zeros(0)),
+                       object_poses=poses)
 
 
 def from_clip(path: str | Path) -> Playback:
@@ -92,13 +132,29 @@ def from_clip(path: str | Path) -> Playback:
         feet = " ".join(s for s, on in (("L", left), ("R", right)) if on) or "-"
         rows.append(f"{name}\nframe {i + 1}/{n}   t {t[i]:5.2f} s   {clip.fps:g} fps\n"
                     f"style {clip.style}   feet in contact {feet}")
-    return Playback(f"clip {name}", t, clip.root_pos_w_m, clip.root_quat_wxyz, clip.joint_pos_rad, rows)
+    return Playback(f"clip {name}", t, clip.root_pos_w_m, clip.root_quat_wxyz, clip.joint_pos_rad, rows,
+                    clip_scene(clip, t))
+
+
+def clip_scene(clip, t_s: np.ndarray) -> ReplayScene | None:
+    """A clip's static scene shapes (world coordinates) and the object it handles, moving as the
+    clip's object track says; None when it has neither."""
+    shapes = {f"{i}_{s.name or 'shape'}": s.vertices() for i, s in enumerate(clip.scene)}
+    movers, poses = {}, {}
+    if clip.object is not None:
+        name = f"object_{clip.object.shape.name or 'object'}"
+        movers[name] = clip.object.shape.vertices()
+        poses[name] = np.c_[clip.object.pos_w_m, clip.object.quat_wxyz]
+    if not shapes and not movers:
+        return None
+    return ReplayScene(shapes_w_m=shapes, movers_m=movers, object_t_s=t_s, object_poses=poses)
 
 
 def _trajectory_file(pb: Playback, folder: Path) -> Path:
     path = folder / "trajectory.npz"
+    scene = pb.scene.arrays() if pb.scene is not None else {}
     np.savez(path, t_s=pb.t_s, base_pos_m=pb.base_pos_m, base_quat_wxyz=pb.base_quat_wxyz, q_rad=pb.q_rad,
-             overlay=np.asarray(pb.overlay, dtype=str))
+             overlay=np.asarray(pb.overlay, dtype=str), **scene)  # type: ignore[arg-type]  # numpy's stub: see run_folder
     return path
 
 
@@ -124,10 +180,12 @@ def write_frame(pb: Playback, at_s: float, out: Path, *, size=(640, 480)) -> str
     return backend
 
 
-def _robot_model():
-    from g1_control.robot import description
-
-    return description.mujoco_spec().compile()
+def pose(pb: Playback, model, data, i: int) -> None:
+    """Frame `i` of `pb` into `data` of replay_model(pb.scene): the robot's base and joints, and
+    each moving box or object where it was then."""
+    data.qpos[:7 + pb.q_rad.shape[1]] = pb.qpos(i)
+    if pb.scene is not None:
+        pb.scene.pose(model, data, float(pb.t_s[i]))
 
 
 def _play(pb: Playback, show, running, speed: float, repeat: bool) -> None:
@@ -153,12 +211,12 @@ def play_viewer(pb: Playback, *, speed: float = 1.0, repeat: bool = False) -> No
 
     from g1_control.sim.viewer import open_viewer, update_viewer
 
-    model = _robot_model()
+    model = replay_model(pb.scene)
     data = mujoco.MjData(model)
     view = open_viewer(model, data)
 
     def show(i: int) -> None:
-        data.qpos[:] = pb.qpos(i)
+        pose(pb, model, data, i)
         mujoco.mj_forward(model, data)
         update_viewer(view, pb.overlay[i], "")
 
@@ -173,10 +231,15 @@ def serve_web(pb: Playback, *, port: int = 8080, host: str = "127.0.0.1", speed:
     """Play in the browser (viser) until interrupted (or once through without `repeat`)."""
     from g1_control.sim.web import WebView
 
-    view = WebView(_robot_model(), port=port, host=host, title=pb.title)
+    view = WebView(replay_model(pb.scene), port=port, host=host, title=pb.title)
     if on_ready is not None:
         on_ready(view)
+
+    def show(i: int) -> None:
+        pose(pb, view.model, view.data, i)
+        view.show(view.data.qpos.copy(), pb.overlay[i])
+
     try:
-        _play(pb, lambda i: view.show(pb.qpos(i), pb.overlay[i]), lambda: True, speed, repeat)
+        _play(pb, show, lambda: True, speed, repeat)
     finally:
         view.close()

@@ -215,8 +215,23 @@ def format_summary(result: RunResult) -> str:
         from g1_control.report.outcomes import outcome_line
 
         lines += ["", "goals (ground truth):"] + ["  " + outcome_line(o) for o in result.extra["goals"]]
+    if result.extra.get("pushes"):
+        lines += ["", "pushes (ground truth):"] + ["  " + push_line(p) for p in result.extra["pushes"]]
     if result.extra.get("program"):
         lines += ["", program_summary(result.extra["program"])]
     if result.run_dir:
         lines.append(f"run folder: {result.run_dir}" + (f" (video: {Path(result.video).name})" if result.video else ""))
     return "\n".join(lines)
+
+
+def push_line(p: dict) -> str:
+    """One push's outcome (launch/runner.py push_outcomes) in words."""
+    fx, fy, _ = p["force_h_n"]
+    text = f"push {p['label'] or ''} at {p['at_s']:.1f} s ({np.hypot(fx, fy):.0f} N for {p['duration_s']:.2f} s, " \
+           f"heading frame x {fx:+.0f} y {fy:+.0f}): "
+    if p["fell"]:
+        return text + "FELL"
+    if not p["recovered"]:
+        return text + f"not upright again within the window (peak tilt {p.get('peak_tilt_rad', float('nan')):.2f} rad)"
+    return text + (f"recovered; peak tilt {p['peak_tilt_rad']:.2f} rad, upright again after {p['upright_after_s']:.1f} s, "
+                   f"pelvis moved {p['moved_m']:.2f} m")

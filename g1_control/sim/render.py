@@ -7,9 +7,10 @@ Without a GPU both render in software; without multisampling, shadows and reflec
 ~0.04 s per 480x360 frame instead of ~1 s.
 
 The trajectory file holds t_s, base_pos_m, base_quat_wxyz and q_rad per row (a run's log.npz is
-one) and optionally `overlay`: one text per row, drawn in the frame's top-left corner; `scene_json`
-(a SceneConfig, g1_control/scene.py: its tables, platforms and boxes are drawn) with
-`object_t_s` and `object_<box>` (position + quaternion per sample: where each box was).
+one) and optionally `overlay`: one text per row, drawn in the frame's top-left corner, and what
+else to draw (a ReplayScene's arrays, g1_control/sim/replay_scene.py): `scene_json` (a SceneConfig,
+g1_control/scene.py: its tables, platforms and boxes), clip shapes, and `object_t_s` with
+`object_<box>` (position + quaternion per sample: where each box was).
 """
 
 from __future__ import annotations
@@ -62,24 +63,21 @@ def render_video(log_path: Path, out_path: Path, fps: float = 10.0, size=(480, 3
     return None
 
 
-def _video_model(scene_json: str | None = None):
-    """The scene without multisampling and shadow maps: in software rendering those cost ~25x
-    (1.1 s vs 0.04 s per 320x240 frame, measured with Mesa's llvmpipe)."""
-    from g1_control.robot import description
+def _video_model(scene=None):
+    from g1_control.sim.replay_scene import replay_model
 
-    spec = description.mujoco_spec()
-    if scene_json:
-        import json
+    return replay_model(scene, video=True)
 
-        from g1_control.config import from_dict
-        from g1_control.scene import SceneConfig
-        from g1_control.sim.scene import build_scene
 
-        build_scene(spec, from_dict(SceneConfig, json.loads(scene_json), "scene"))
-    model = spec.compile()
-    model.vis.quality.offsamples = 0
-    model.vis.quality.shadowsize = 0
-    return model
+def tracking_camera(model):
+    """The video's camera: 3 m from the pelvis, from the front left, slightly above."""
+    import mujoco
+
+    camera = mujoco.MjvCamera()
+    camera.type = mujoco.mjtCamera.mjCAMERA_TRACKING
+    camera.trackbodyid = model.body("pelvis").id
+    camera.distance, camera.elevation, camera.azimuth = 3.0, -15.0, 135.0
+    return camera
 
 
 def _cheap_scene(renderer) -> None:
@@ -131,31 +129,22 @@ def _render(log_path: Path, out_path: Path, fps: float, size: tuple[int, int], q
     import numpy as np
     from tqdm import tqdm
 
+    from g1_control.sim.replay_scene import ReplayScene
+
     log = np.load(log_path)
     t, pos, quat, q = log["t_s"], log["base_pos_m"], log["base_quat_wxyz"], log["q_rad"]
     overlay = log["overlay"] if "overlay" in log.files else None
     if len(t) == 0 or np.isnan(pos).all():
         raise SystemExit("log has no ground-truth base pose to replay")
-    scene_json = str(log["scene_json"]) if "scene_json" in log.files else None
-    model = _video_model(scene_json)
+    scene = ReplayScene.from_arrays({k: log[k] for k in log.files if k not in TRAJECTORY_KEYS})
+    model = _video_model(scene)
     data = mujoco.MjData(model)
-    objects = []  # (qpos address, samples, their times) per box
-    if scene_json:
-        for key in log.files:
-            if key.startswith("object_") and key != "object_t_s":
-                joint = model.joint(f"{key.removeprefix('object_')}_free")
-                objects.append((int(model.jnt_qposadr[joint.id]), log[key], log["object_t_s"]))
     renderer = mujoco.Renderer(model, height=size[1], width=size[0])
-    camera = mujoco.MjvCamera()
-    camera.type = mujoco.mjtCamera.mjCAMERA_TRACKING
-    camera.trackbodyid = model.body("pelvis").id
-    camera.distance, camera.elevation, camera.azimuth = 3.0, -15.0, 135.0
+    camera = tracking_camera(model)
 
     def frame(i: int):
         data.qpos[:3], data.qpos[3:7], data.qpos[7:7 + q.shape[1]] = pos[i], quat[i], q[i]
-        for adr, poses, times in objects:
-            k = int(np.searchsorted(times, t[i]).clip(0, len(times) - 1))
-            data.qpos[adr:adr + 7] = poses[k]
+        scene.pose(model, data, float(t[i]))
         mujoco.mj_forward(model, data)  # also the subtree CoM the tracking camera follows
         renderer.update_scene(data, camera)
         _cheap_scene(renderer)

@@ -29,6 +29,9 @@ TABLE_LEG_HALF_M = 0.05
 HAND_BOX_CENTER_M = np.array([0.066, 0.0145, 0.010])
 HAND_BOX_HALF_M = np.array([0.066, 0.0335, 0.053])
 HAND_BODIES = ("left_rubber_hand", "right_rubber_hand")
+BOX_RGBA = (0.25, 0.7, 0.25, 1.0)
+"""Boxes are green: apart from the robot (grey in MuJoCo, blue in the browser), the brown tables
+and the grey platforms in every video, replay and screenshot (tests look for it)."""
 
 
 def _quat_z(yaw: float) -> list[float]:
@@ -91,7 +94,7 @@ def build_scene(spec: mujoco.MjSpec, scene: SceneConfig) -> None:
         body.add_freejoint(name=f"{b.name}_free")
         body.add_geom(name=f"{b.name}_geom", type=mujoco.mjtGeom.mjGEOM_BOX, size=(b.size / 2).tolist(),
                       mass=b.mass_kg, contype=OBJECT_COLLISION[0], conaffinity=OBJECT_COLLISION[1], condim=4,
-                      friction=[b.friction, 0.01, 0.0001], rgba=[0.2, 0.5, 0.8, 1.0])
+                      friction=[b.friction, 0.01, 0.0001], rgba=list(BOX_RGBA))
 
 
 def free_body_pose(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> tuple[np.ndarray, np.ndarray]:

@@ -1,8 +1,10 @@
 """A 3D view of the G1 in the browser (viser), live or replayed: `--web` on g1 launch, g1 replay, g1 view.
 
-The robot's visual meshes (the MuJoCo model's group-1 mesh geoms) are sent once; each update
-moves one frame per body to the pose MuJoCo's forward kinematics gives for a full configuration
-(base position, base quaternion w x y z, 29 joints). A text panel shows the overlay (command,
+The robot's visual meshes (the MuJoCo model's group-1 mesh geoms) and the scene's boxes and
+meshes (tables, platforms, boxes, a clip's shapes: every box or mesh geom outside the robot, in
+its own colour) are sent once; each update moves one frame per body to the pose MuJoCo's forward
+kinematics gives for a full configuration (base position, base quaternion w x y z, 29 joints, then
+the free bodies of the scene: its boxes). A text panel shows the overlay (command,
 achieved velocity, safety state). viser serves its own page and client, so nothing is fetched
 from the network; install it with `pip install 'g1-control[web]'` (scripts/setup.sh does).
 """
@@ -14,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from g1_control.errors import G1ControlError
+from g1_control.robot import g1
 
 ROBOT_RGB = (70, 110, 200)
 """One colour for the whole robot (a screenshot test looks for it)."""
@@ -44,19 +47,29 @@ class WebView:
         self.title = self.server.gui.add_markdown(f"**{title}**")
         self.text = self.server.gui.add_markdown("")
         self.frames: dict[int, Any] = {}  # body id -> viser frame handle
+        robot_root = model.body(g1.BASE_BODY).id
         for g in range(model.ngeom):
-            if model.geom_type[g] != mujoco.mjtGeom.mjGEOM_MESH or model.geom_group[g] != VISUAL_GROUP:
-                continue
             body = int(model.geom_bodyid[g])
+            on_robot = int(model.body_rootid[body]) == robot_root
+            kind = mujoco.mjtGeom(int(model.geom_type[g]))
+            if on_robot and (kind != mujoco.mjtGeom.mjGEOM_MESH or model.geom_group[g] != VISUAL_GROUP):
+                continue
+            if not on_robot and kind not in (mujoco.mjtGeom.mjGEOM_MESH, mujoco.mjtGeom.mjGEOM_BOX):
+                continue  # the floor (the grid stands for it)
             if body not in self.frames:
                 self.frames[body] = self.server.scene.add_frame(f"/robot/b{body}", show_axes=False)
+            color = ROBOT_RGB if on_robot else tuple(round(255 * float(c)) for c in model.geom_rgba[g][:3])
+            where = {"position": tuple(model.geom_pos[g]), "wxyz": tuple(model.geom_quat[g])}
+            if kind == mujoco.mjtGeom.mjGEOM_BOX:
+                self.server.scene.add_box(f"/robot/b{body}/g{g}", color=color,
+                                          dimensions=tuple(2.0 * model.geom_size[g]), **where)
+                continue
             mesh = int(model.geom_dataid[g])
             va, vn = model.mesh_vertadr[mesh], model.mesh_vertnum[mesh]
             fa, fn = model.mesh_faceadr[mesh], model.mesh_facenum[mesh]
             self.server.scene.add_mesh_simple(
                 f"/robot/b{body}/g{g}", vertices=np.asarray(model.mesh_vert[va:va + vn], dtype=np.float32),
-                faces=np.asarray(model.mesh_face[fa:fa + fn], dtype=np.uint32), color=ROBOT_RGB,
-                position=tuple(model.geom_pos[g]), wxyz=tuple(model.geom_quat[g]))
+                faces=np.asarray(model.mesh_face[fa:fa + fn], dtype=np.uint32), color=color, **where)
 
     @property
     def url(self) -> str:

@@ -45,8 +45,8 @@ def _tick(gen: GoalGenerator, inner: Walking, state: RobotState, command: Comman
         state.q_rad, state.imu_quat_wxyz = j.q_rad.copy(), j.root_quat_wxyz.copy()
         state.base_pos_w_m = j.root_pos_w_m.copy()
         state.base_linvel_w_mps = np.zeros(3)
-    elif state.base_pos_w_m is not None:  # walking: the base moves as commanded
-        c = inner.command
+    elif state.base_pos_w_m is not None:  # walking: the base moves as commanded (a goal's approach: its walker's)
+        c = Command(*(float(v) for v in gen.ctx.walk)) if gen.walking_to_goal else inner.command
         yaw = yaw_of(state.imu_quat_wxyz)
         v = np.array([math.cos(yaw) * c.vx_mps - math.sin(yaw) * c.vy_mps,
                       math.sin(yaw) * c.vx_mps + math.cos(yaw) * c.vy_mps, 0.0])

@@ -78,3 +78,68 @@ def test_browser_shows_the_robot(tmp_path):
         view.close()
     assert robot_pixels(image) > 3000, f"robot not in the screenshot ({robot_pixels(image)} robot-coloured pixels)"
     assert robot_pixels(empty) < 100
+
+
+def _scene_model():
+    from g1_control.config import from_dict
+    from g1_control.scene import SceneConfig
+    from g1_control.sim.replay_scene import ReplayScene, replay_model
+
+    scene = {"tables": [{"name": "table_a", "center_xy_m": [1.0, -0.8], "size_xy_m": [0.5, 0.8], "height_m": 0.7}],
+             "boxes": [{"name": "box", "stands_on": "table_a", "xy_m": [1.0, -0.8], "size_m": [0.3, 0.3, 0.3]}]}
+    from_dict(SceneConfig, scene, "scene")  # a valid scene
+    import json
+
+    return replay_model(ReplayScene(scene_json=json.dumps(scene)))
+
+
+def test_web_view_draws_the_scene_and_moves_its_box():
+    from g1_control.sim.web import WebView
+
+    model = _scene_model()
+    view = WebView(model, port=_free_port(), title="scene")
+    try:
+        box, table = model.body("box").id, model.body("table_a").id
+        assert box in view.frames and table in view.frames, "the scene's bodies are not in the browser view"
+        q = np.zeros(model.nq)
+        q[2], q[3], q[7:36] = 0.79, 1.0, g1.DEFAULT_Q_RAD
+        adr = model.jnt_qposadr[model.joint("box_free").id]
+        q[adr:adr + 7] = [0.7, 0.2, 0.9, 1.0, 0.0, 0.0, 0.0]
+        view.show(q, "box in the air")
+        np.testing.assert_allclose(view.frames[box].position, [0.7, 0.2, 0.9])
+        np.testing.assert_allclose(view.frames[table].position, [1.0, -0.8, 0.0])
+    finally:
+        view.close()
+
+
+def box_pixels(image: np.ndarray) -> int:
+    """Pixels of the boxes' green (sim/scene.py BOX_RGBA, shaded) in the 3D canvas's middle (not
+    the page's green "connected" icon or axis gizmo)."""
+    h, w, _ = image.shape
+    middle = image[h // 5: h, w // 5: 4 * w // 5]
+    r, g, b = (middle[..., k].astype(int) for k in range(3))
+    return int(((g > 60) & (g > 1.6 * r) & (g > 1.6 * b)).sum())
+
+
+@pytest.mark.slow
+def test_browser_shows_the_box(tmp_path):
+    _needs("chromium", CHROMIUM is not None)
+    from g1_control.sim.web import WebView
+
+    model = _scene_model()
+    view = WebView(model, port=_free_port(), title="scene")
+    try:
+        q = np.zeros(model.nq)
+        q[2], q[3], q[7:36] = 0.79, 1.0, g1.DEFAULT_Q_RAD
+        adr = model.jnt_qposadr[model.joint("box_free").id]
+        q[adr:adr + 7] = [0.6, 0.3, 0.9, 1.0, 0.0, 0.0, 0.0]
+        view.show(q, "box beside the robot")
+        # a longer virtual-time budget than the robot's: under load the page was still blank at 8 s
+        image = screenshot(view.url, tmp_path / "box.png", wait_ms=20000)
+        q[adr:adr + 3] = [60.0, 60.0, 0.15]  # recorded far away: gone from the picture
+        view.show(q, "box gone")
+        gone = screenshot(view.url, tmp_path / "gone.png", wait_ms=20000)
+    finally:
+        view.close()
+    assert box_pixels(image) > 500, f"box not in the screenshot ({box_pixels(image)} green pixels)"
+    assert box_pixels(gone) < 50
