@@ -48,6 +48,10 @@ def register(subparsers) -> None:
     parser.add_argument("--rt-priority", type=int, default=30, metavar="N",
                         help="SCHED_RR priority (default 30; 0: normal scheduling): the emulated robot keeps its 500 Hz "
                         "on a busy host, as the robot's own computer would (needs root, else nice -10 with a warning)")
+    parser.add_argument("--hands", choices=("none", "dex3"), default="none",
+                        help="dex3: emulate the two Dex3-1 hands too (HandState_ on rt/dex3/left|right/state at "
+                        "100 Hz, HandCmd_ applied from rt/dex3/left|right/cmd; a per-finger motor model, "
+                        "g1_control/sim/dex3_hands.py), for launch files with backend.hands: dex3")
     parser.add_argument("--seconds", type=float, help="stop after this long (default: until Ctrl-C)")
     parser.add_argument("--control-stdin", action="store_true",
                         help="read fault names and remote commands ('press start', 'press A', 'stick ly 0.5', "
@@ -82,6 +86,11 @@ def _run(args) -> int:
         physics = MockG1(mode_machine=args.mode_machine)
     emulator = RobotEmulator(physics, args.interface, args.domain, partition=args.partition,
                              builtin_mode="" if args.no_builtin else "ai", mode=args.mode).start()
+    hands = None
+    if args.hands == "dex3":
+        from g1_control.sim.dex3_hands import Dex3HandsEmulator
+
+        hands = Dex3HandsEmulator(args.interface, args.domain, partition=args.partition).start()
     stop = {"now": False}
 
     def _stop(signum, frame):
@@ -90,7 +99,8 @@ def _run(args) -> int:
     signal.signal(signal.SIGTERM, _stop)
     with frozen_heap():  # the 500 Hz robot loop never waits for a full collection of the startup heap
         played = ", as Unitree's unitree_mujoco" if args.mode == "unitree_mujoco" else ""
-        print(f"g1 sim-robot: emulating a G1 ({args.physics}{played}) on interface {args.interface}, domain {args.domain}"
+        print(f"g1 sim-robot: emulating a G1 ({args.physics}{played}"
+              + (", Dex3-1 hands" if hands is not None else "") + f") on interface {args.interface}, domain {args.domain}"
               + (f", partition {args.partition}" if args.partition else ""), file=sys.stderr, flush=True)
         print("ready", flush=True)
         try:
@@ -105,6 +115,11 @@ def _run(args) -> int:
         finally:
             report = emulator.report()
             emulator.close()
+            if hands is not None:
+                hand_states, hand_commands = sum(hands.states_sent.values()), sum(hands.commands_applied.values())
+                hands.close()
+                print(f"g1 sim-robot: hands: {hand_states} HandState_ sent, {hand_commands} HandCmd_ applied",
+                      file=sys.stderr)
     print(f"g1 sim-robot: {report['states_sent']} states sent, {report['commands_applied']} commands applied, "
           f"{report['bad_crc']} bad CRC, {report['wrong_mode_machine']} wrong mode_machine, "
           f"{report['ignored_while_builtin_active']} ignored while the built-in controller ran", file=sys.stderr)

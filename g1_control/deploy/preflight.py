@@ -40,6 +40,9 @@ CHECKS: dict[str, str] = {
     "joint_limits": "every joint reads inside its limits",
     "temperatures": "every motor is cooler than deploy.max_start_temperature_c",
     "battery": "battery voltage above deploy.min_battery_v (when the robot reports it)",
+    "hands_present": "both Dex3-1 hands publish HandState_ (backend.hands: dex3; g1_control/deploy/hands.py)",
+    "hand_state_stream": "each hand's HandState_ arrives at >= 50 Hz and is not frozen",
+    "finger_limits": "every finger joint reads inside its URDF limits",
     "estop_input": "the operator input opens, has an e-stop, and is not lost",
     "dry_run": "a lockstep MuJoCo run of the same launch file does not fall",
 }
