@@ -87,6 +87,7 @@ class Dex3HandLink:
         self._states: dict[str, FingerState] = {}
         self._arrivals: dict[str, deque[tuple[float, bool]]] = {s: deque(maxlen=4000) for s in sides}
         self._last_sample: dict[str, Any] = {}
+        self._changed_s: dict[str, float] = {}
         self._received: dict[str, int] = dict.fromkeys(sides, 0)
         self._malformed: dict[str, int] = dict.fromkeys(sides, 0)
         self._sent: dict[str, int] = dict.fromkeys(sides, 0)
@@ -144,6 +145,13 @@ class Dex3HandLink:
                 f"{', '.join(dex3.state_topic(s) for s in silent)} ({self.describe()}): check that the hand is "
                 "connected and powered (or that `g1 sim-robot --hands dex3` runs on the same interface and domain)")
         return {s: self._states[s] for s in sides}
+
+    def last_change_s(self, side: dex3.Side) -> float:
+        """time.monotonic() of the newest HandState_ of `side` whose contents differed from the one
+        before it (-inf before the first): a live hand's noisy current and torque readings change
+        every sample, a frozen hand's do not."""
+        with self._lock:
+            return self._changed_s.get(side, float("-inf"))
 
     def stats(self, side: dex3.Side, window_s: float = 1.0) -> HandStats:
         self._check_known(side)
@@ -204,6 +212,8 @@ class Dex3HandLink:
                     with self._lock:
                         changed = sample != self._last_sample.get(side)  # every field, pressures included
                         self._last_sample[side] = sample
+                        if changed:
+                            self._changed_s[side] = now
                         self._states[side] = state
                         self._received[side] += 1
                         self._arrivals[side].append((now, changed))

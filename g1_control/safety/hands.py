@@ -9,7 +9,8 @@ What it does to each FingerCommand, per hand:
 - the target moves at most `max_speed_radps` times the time since the last command (the first
   command starts from the measured position), so a jump becomes a ramp;
 - kp, kd clamped to `max_kp`, `max_kd`; feed-forward torque to the URDF's effort limit;
-- the hand's state older than `stale_state_s`, never received, or reporting an error: trip, damp.
+- the hand's state older than `stale_state_s`, never received, unchanged for `frozen_state_s`
+  (samples arriving with identical contents), or reporting an error: trip, damp.
 """
 
 from __future__ import annotations
@@ -39,6 +40,8 @@ class HandLink(Protocol):
 
     def damp(self, sides: tuple[dex3.Side, ...] | None = None) -> None: ...
 
+    def last_change_s(self, side: dex3.Side) -> float: ...
+
 
 @dataclass(frozen=True)
 class HandSafetyConfig:
@@ -52,13 +55,15 @@ class HandSafetyConfig:
     """Velocity gain cap (N m s/rad)."""
     stale_state_s: float = 0.1
     """Damp when the hand's newest state is older than this (10 samples at 100 Hz)."""
+    frozen_state_s: float = 0.25
+    """Damp when the hand's state has not changed for this long (samples arriving, contents frozen)."""
 
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
             if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value) or value < 0:
                 raise SafetyConfigError(f"HandSafetyConfig.{f.name} is {value!r}; it must be a finite number >= 0")
-        for name in ("max_speed_radps", "max_kp", "max_kd", "stale_state_s"):
+        for name in ("max_speed_radps", "max_kp", "max_kd", "stale_state_s", "frozen_state_s"):
             if getattr(self, name) == 0:
                 raise SafetyConfigError(f"HandSafetyConfig.{name} is 0; it must be positive")
 
@@ -131,6 +136,10 @@ class GuardedHands:
         if now - state.t_s > self.config.stale_state_s:
             return (f"the {side} hand's state is {now - state.t_s:.2f} s old (limit "
                     f"{self.config.stale_state_s:.2f} s); the fingers were damped")
+        unchanged_s = now - self.link.last_change_s(side)
+        if unchanged_s > self.config.frozen_state_s:
+            return (f"the {side} hand's state has not changed for {unchanged_s:.2f} s (limit "
+                    f"{self.config.frozen_state_s:.2f} s): frozen; the fingers were damped")
         if any(state.error):
             return f"the {side} hand reports error {state.error[0]:#x}/{state.error[1]:#x}; the fingers were damped"
         return None

@@ -24,6 +24,10 @@ from g1_control.robot import dex3
 from g1_control.types import FingerCommand, FingerState
 
 
+MAX_STEP_S = 0.02
+"""The most time one act() advances the targets by, however long since the last call."""
+
+
 class ForceLimitedGrasp:
     def __init__(self, side: dex3.Side, torque_limit_nm: float = 0.5, closing_speed_radps: float = 1.5,
                  kp: float = 3.0, kd: float = 0.05, hold_fraction: float = 0.9,
@@ -58,7 +62,8 @@ class ForceLimitedGrasp:
     def act(self, state: FingerState, now_s: float) -> FingerCommand:
         if self.target is None:
             self.target = np.where(self.closing, state.q_rad, self.limits.open_rad).astype(float)
-        dt = 0.0 if self._t is None else max(0.0, now_s - self._t)
+        # a late tick must not jump the target (the hand would squeeze by kp times the jump)
+        dt = 0.0 if self._t is None else min(max(0.0, now_s - self._t), MAX_STEP_S)
         self._t = now_s
         squeeze = self.sign * state.tau_nm  # the motors' torque toward closing: what the object resists
         self.touched |= self.closing & (squeeze >= self.touch_fraction * self.torque_limit_nm)
