@@ -10,7 +10,7 @@ spring: the torque it takes is the emulator's ground truth (`truth()`), apart fr
 reports. Reported tau_est and current carry a little sensor noise, as a live hand's do.
 
 Faults, by name (`inject`): hand_state_frozen (the same sample repeated), hand_silent (no
-HandState_), clear.
+HandState_), finger_miscalibrated (one finger's reading offset past its limit), clear.
 """
 
 from __future__ import annotations
@@ -34,9 +34,11 @@ finger's own few grams); the emulator's figure, not a measured one."""
 FINGER_FRICTION_NMS = 0.01
 CONTACT_STIFFNESS_NM_PER_RAD = 20.0
 PHYSICS_DT_S = 0.0005
+MISCALIBRATION_RAD = 0.3
 HAND_FAULTS = {
     "hand_state_frozen": "HandState_ keeps arriving with the same contents",
     "hand_silent": "no HandState_ (hand unplugged)",
+    "finger_miscalibrated": "middle_1 reads 0.3 rad past its closed limit (an encoder offset)",
     "clear": "remove every injected hand fault",
 }
 
@@ -131,6 +133,7 @@ class Dex3HandsEmulator:
                          for s in sides}
         self.frozen: set[str] = set()
         self.silent: set[str] = set()
+        self.miscalibrated: set[str] = set()
         self._frozen_sample: dict[str, Any] = {}
         self.commands_applied = dict.fromkeys(sides, 0)
         self.malformed = dict.fromkeys(sides, 0)
@@ -172,9 +175,12 @@ class Dex3HandsEmulator:
                 if fault == "clear":
                     self.frozen.discard(s)
                     self.silent.discard(s)
+                    self.miscalibrated.discard(s)
                     self._frozen_sample.pop(s, None)
                 elif fault == "hand_state_frozen":
                     self.frozen.add(s)
+                elif fault == "finger_miscalibrated":
+                    self.miscalibrated.add(s)
                 else:
                     self.silent.add(s)
         return time.monotonic()
@@ -249,6 +255,9 @@ class Dex3HandsEmulator:
                                           else np.zeros(dex3.NUM_MOTORS, dtype=bool),
                                           power_v=24.0, power_a=0.3 + float(np.abs(hand.motor_tau).sum()) * 0.5
                                           + float(self.rng.normal(0.0, 0.005)))
+                    if side in self.miscalibrated:
+                        i = dex3.FINGERS.index("middle_1")
+                        reading.q_rad[i] = hand.limits.closed_rad[i] + hand.limits.closing_sign[i] * MISCALIBRATION_RAD
                     sample = finger_state_to_handstate(reading, pressure=np.zeros((3, 12)))
                     if side in self.frozen:
                         self._frozen_sample[side] = sample

@@ -23,7 +23,6 @@ import numpy as np
 from g1_control.robot import dex3
 from g1_control.types import FingerCommand, FingerState
 
-
 MAX_STEP_S = 0.02
 """The most time one act() advances the targets by, however long since the last call."""
 

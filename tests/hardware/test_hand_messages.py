@@ -44,7 +44,8 @@ def test_handcmd_serialises_to_the_known_bytes():
     assert data == _expected_handcmd_bytes(_command())
     assert len(data) == 4 + 4 + 7 * 28 + 16
     # the first motor spelled out: mode 0x10 (id 0, enabled), q -0.5, dq 0.125, tau -0.0625, kp 1.5, kd 0.1
-    assert data[8:36].hex() == "10000000" "000000bf" "0000003e" "000080bd" "0000c03f" "cdcccc3d" "00000000"
+    words = ["10000000", "000000bf", "0000003e", "000080bd", "0000c03f", "cdcccc3d", "00000000"]
+    assert data[8:36].hex() == "".join(words)
 
 
 def test_handstate_serialises_to_the_known_bytes():

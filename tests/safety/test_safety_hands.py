@@ -88,7 +88,7 @@ def test_a_jump_becomes_a_ramp_from_the_measured_position(rig):
 
 
 def test_gains_and_torque_are_capped(rig):
-    hands, link, clock = rig
+    hands, link, _ = rig
     cmd = FingerCommand(q_rad=link.q["right"], kp=np.full(7, 100.0), kd=np.full(7, 9.0), tau_nm=np.full(7, -10.0),
                         dq_radps=np.full(7, 50.0))
     out = hands.write("right", cmd)
@@ -122,7 +122,7 @@ def test_nan_is_refused_and_both_hands_damp_until_reset(rig):
     ("error", "the left hand reports error 0x4/0x0"),
 ])
 def test_a_stale_frozen_or_faulted_hand_damps(rig, fault, words):
-    hands, link, clock = rig
+    hands, link, _ = rig
     assert not hands.write("left", _stiff(link.q["left"])).is_damping
     if fault == "stale":
         link.state_age_s = 0.2
