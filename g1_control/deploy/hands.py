@@ -7,7 +7,7 @@ Rows (names in preflight.CHECKS, --override takes them):
   deploy.state_window_s, and its contents change (a live hand's current and torque readings
   carry sensor noise; byte-identical samples mean its firmware stopped sampling);
 - finger_limits: every finger reads inside its URDF limits (+ deploy.joint_limit_tolerance_rad).
-With backend.hands: none the rows are skipped.
+With backend.hands: none the rows are left out of the table (nothing to check).
 """
 
 from __future__ import annotations
@@ -45,12 +45,10 @@ def open_hand_link(launch: LaunchFile) -> Dex3HandLink:
 
 def check_hands(pf: Preflight, launch: LaunchFile, hands: Dex3HandLink | None, open_error: str = "") -> None:
     """Record the three hand rows of `pf` (hands: None when the link could not open)."""
-    from g1_control.deploy.preflight import FAIL, PASS, SKIP
+    from g1_control.deploy.preflight import FAIL, PASS
 
     if launch.backend.hands != "dex3":
-        for name in HAND_CHECKS:
-            pf.record(name, SKIP, f"backend.hands: {launch.backend.hands}")
-        return
+        return  # nothing to check: the rows stay out of the table (preflight.OPTIONAL_CHECKS)
     if hands is None:
         pf.record("hands_present", FAIL, f"the hand link did not open: {open_error}", overridable=False)
         pf.not_run(["hand_state_stream", "finger_limits"], "no hand link")
@@ -76,15 +74,17 @@ def check_hands(pf: Preflight, launch: LaunchFile, hands: Dex3HandLink | None, o
     time.sleep(window)
     stats = {s: hands.stats(s, window) for s in hands.sides}
     slow = [f"{s} {st.state_rate_hz:.0f} Hz" for s, st in stats.items() if st.state_rate_hz < MIN_HAND_STATE_RATE_HZ]
-    frozen = [s for s, st in stats.items() if st.state_rate_hz >= MIN_HAND_STATE_RATE_HZ and st.distinct_states <= 1]
+    frozen = [s for s, st in stats.items() if st.state_rate_hz * window >= 2 and st.distinct_states <= 1]
     detail = ", ".join(f"{s} {st.state_rate_hz:.0f} Hz" for s, st in stats.items()) + f" over {window:.1f} s"
+    problems = []
     if slow:
-        pf.record("hand_state_stream", FAIL, f"{', '.join(slow)}; need >= {MIN_HAND_STATE_RATE_HZ:.0f} Hz from "
-                  "each hand: check its cable and that nothing else loads this host")
-    elif frozen:
-        pf.record("hand_state_stream", FAIL, f"{detail}; the {' and '.join(frozen)} hand's HandState_ is frozen "
-                  "(every sample identical, its sensor noise included): the hand's firmware stopped sampling; "
-                  "power-cycle the hand")
+        problems.append(f"{', '.join(slow)}: need >= {MIN_HAND_STATE_RATE_HZ:.0f} Hz from each hand; check its "
+                        "cable and that nothing else loads this host")
+    if frozen:
+        problems.append(f"the {' and '.join(frozen)} hand's HandState_ is frozen (every sample identical, its "
+                        "sensor noise included): the hand's firmware stopped sampling; power-cycle the hand")
+    if problems:
+        pf.record("hand_state_stream", FAIL, f"{detail}; " + "; ".join(problems))
     else:
         pf.record("hand_state_stream", PASS, detail)
 

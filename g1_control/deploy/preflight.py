@@ -47,6 +47,8 @@ CHECKS: dict[str, str] = {
     "dry_run": "a lockstep MuJoCo run of the same launch file does not fall",
 }
 """Check name -> what it asserts (the names --override takes)."""
+OPTIONAL_CHECKS = frozenset({"hands_present", "hand_state_stream", "finger_limits"})
+"""Rows in the table only where they apply (the hand rows: backend.hands dex3, deploy/hands.py)."""
 
 PASS, FAIL, SKIP, NOT_RUN = "pass", "fail", "skip", "not run"
 
@@ -95,7 +97,8 @@ class Preflight:
         if unknown:
             raise G1ControlError(f"--override {', '.join(sorted(unknown))}: no such check; checks: {', '.join(CHECKS)}")
         for name in CHECKS:
-            self.results[name] = CheckResult(name, NOT_RUN, "not run")
+            if name not in OPTIONAL_CHECKS:
+                self.results[name] = CheckResult(name, NOT_RUN, "not run")
 
     def record(self, name: str, status: str, reason: str, *, overridable: bool = True) -> bool:
         result = CheckResult(name, status, reason, overridable)
@@ -106,13 +109,20 @@ class Preflight:
                           name, reason, name)
             else:
                 result.reason += f" (--override {name} refused: this failure cannot be overridden)"
-        self.results[name] = result
+        self._put(result)
         return status != FAIL
+
+    def _put(self, result: CheckResult) -> None:
+        """Store `result`; a row new to the table (an optional one) takes its place in CHECKS order."""
+        new = result.name not in self.results
+        self.results[result.name] = result
+        if new:
+            self.results = {n: self.results[n] for n in CHECKS if n in self.results}
 
     def not_run(self, names, why: str) -> None:
         for name in names:
-            if self.results[name].status == NOT_RUN:
-                self.results[name] = CheckResult(name, NOT_RUN, f"not run: {why}")
+            if name not in self.results or self.results[name].status == NOT_RUN:
+                self._put(CheckResult(name, NOT_RUN, f"not run: {why}"))
 
     # -- the checks ----------------------------------------------------------------------------------
     def check_launch_file(self, path: Path) -> LaunchFile | None:

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from g1_control.deploy.preflight import CHECKS, FAIL, Preflight
+from g1_control.deploy.preflight import CHECKS, FAIL, OPTIONAL_CHECKS, Preflight
 from g1_control.deploy.state_machine import DeployState, DeployTracker, OperatorButtons, Transition
 from g1_control.errors import G1ControlError, LaunchFileError
 from g1_control.hardware.links.network import LOOPBACK
@@ -175,7 +175,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             pf.record("launch_file", FAIL, f"command-line override: {exc}", overridable=False)
             launch = None
     if launch is None:
-        pf.not_run([n for n in CHECKS if n != "launch_file"], "no valid launch file")
+        pf.not_run([n for n in CHECKS if n != "launch_file" and n not in OPTIONAL_CHECKS], "no valid launch file")
         return _refuse(pf, report, say)
     if options.program is not None and not _confirm_program(launch, options, say, ask):
         report.refused = True
