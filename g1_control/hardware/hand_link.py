@@ -14,6 +14,7 @@ close() streams damping for a moment, so the last thing the hands heard is "damp
 
 from __future__ import annotations
 
+import itertools
 import threading
 import time
 from collections import deque
@@ -41,6 +42,8 @@ class HandStats:
     distinct_states: int
     """Samples within the window whose contents differed from the sample before them."""
     last_state_age_s: float
+    max_gap_s: float
+    """The longest time between two samples within the window (inf with fewer than two)."""
     malformed: int
     commands_sent: int
 
@@ -157,11 +160,14 @@ class Dex3HandLink:
         self._check_known(side)
         now = time.monotonic()
         with self._lock:
-            recent = [changed for t, changed in self._arrivals[side] if now - t <= window_s]
+            arrivals = [(t, changed) for t, changed in self._arrivals[side] if now - t <= window_s]
             state = self._states.get(side)
             received, malformed, sent = self._received[side], self._malformed[side], self._sent[side]
-        return HandStats(side, received, len(recent) / window_s, sum(recent),
-                         now - state.t_s if state is not None else float("inf"), malformed, sent)
+        times = [t for t, _ in arrivals]
+        gaps = [b - a for a, b in itertools.pairwise(times)]
+        return HandStats(side, received, len(arrivals) / window_s, sum(changed for _, changed in arrivals),
+                         now - state.t_s if state is not None else float("inf"), max(gaps, default=float("inf")),
+                         malformed, sent)
 
     # -- lifetime --------------------------------------------------------------------------------
     def close(self) -> None:
@@ -196,12 +202,15 @@ class Dex3HandLink:
 
     # -- threads ---------------------------------------------------------------------------------
     def _read_loop(self) -> None:
+        from g1_control.hardware.unitree.hand_idl import HandState_
         from g1_control.hardware.unitree.hand_messages import handstate_to_finger_state
 
         while not self._stop.is_set():
             self._waitset.wait(50_000_000)
             for side, reader in list(self._readers.items()):
                 for sample in reader.take(N=16):
+                    if not isinstance(sample, HandState_):  # an InvalidSample: the hand's writer went away
+                        continue
                     now = time.monotonic()
                     try:
                         state = handstate_to_finger_state(sample, now)

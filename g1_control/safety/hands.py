@@ -53,9 +53,11 @@ class HandSafetyConfig:
     """Position gain cap (N m/rad): 5 turns a 0.28 rad error into the 1.4 N m a finger motor has."""
     max_kd: float = 0.5
     """Velocity gain cap (N m s/rad)."""
-    stale_state_s: float = 0.1
-    """Damp when the hand's newest state is older than this (10 samples at 100 Hz)."""
-    frozen_state_s: float = 0.25
+    stale_state_s: float = 0.25
+    """Damp when the hand's newest state is older than this (25 samples at 100 Hz). Measured on a loaded
+    2-core host (load 5.5), emulator and host in separate processes: gaps of up to 0.17 s between
+    HandState_ samples; a finger motor's 1.4 N m does little harm in a quarter second."""
+    frozen_state_s: float = 0.5
     """Damp when the hand's state has not changed for this long (samples arriving, contents frozen)."""
 
     def __post_init__(self) -> None:

@@ -222,10 +222,13 @@ class Dex3HandsEmulator:
 
     def _apply_commands(self) -> None:
         from g1_control.errors import MalformedMessageError
+        from g1_control.hardware.unitree.hand_idl import HandCmd_
         from g1_control.hardware.unitree.hand_messages import handcmd_to_finger_command
 
         for side, reader in list(self._readers.items()):
             for sample in reader.take(N=8):
+                if not isinstance(sample, HandCmd_):  # an InvalidSample: a writer went away
+                    continue
                 try:
                     cmd = handcmd_to_finger_command(sample)
                 except (MalformedMessageError, TypeError, ValueError):

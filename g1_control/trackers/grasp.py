@@ -5,15 +5,16 @@ harder than a torque limit.
     while not grasp.done:
         command = grasp.act(hands.read("right"), now_s)   # then GuardedHands.write("right", command)
 
-Every closing joint's target moves toward the closed pose at `closing_speed_radps`. A joint whose
-measured torque (the hand's tau_est, toward closing) reaches touch_fraction * limit has touched:
-it stops closing, and from then on its target sits at measured position + hold_fraction * limit / kp
-in the closing direction, so the squeeze settles at hold_fraction * limit whatever the object's
-stiffness. Touch is declared below the limit because the target keeps moving for the loop's
-latency after the torque rose (measured on the emulator at 1.5 rad/s, 100 Hz: ~0.13 N m of
-overshoot when a joint was stopped only at the limit itself). A joint
-that reaches its closed pose without touching anything stops too. thumb_0 (which swings the thumb
-across the palm rather than closing it) holds its open angle.
+Every closing joint's target moves toward the closed pose at `closing_speed_radps`, advancing
+only when a new state arrived. A joint whose measured torque (the hand's tau_est, toward closing)
+reaches touch_fraction * limit has touched: it stops closing, and its target is set once to the
+angle where it touched + hold_fraction * limit / kp in the closing direction. As the finger then
+presses in, kp (target - q) only falls, so the squeeze stays below hold_fraction * limit whatever
+the object's stiffness. Touch is declared below the limit because the target keeps moving for the
+loop's latency after the torque rose (measured on the emulator at 1.5 rad/s, 100 Hz: ~0.13 N m of
+overshoot when joints were stopped only at the limit itself). A joint that reaches its closed
+pose without touching anything stops too. thumb_0 (which swings the thumb across the palm rather
+than closing it) holds its open angle.
 """
 
 from __future__ import annotations
@@ -24,12 +25,12 @@ from g1_control.robot import dex3
 from g1_control.types import FingerCommand, FingerState
 
 MAX_STEP_S = 0.02
-"""The most time one act() advances the targets by, however long since the last call."""
+"""The most closing time one new state advances the targets by, however long since the last one."""
 
 
 class ForceLimitedGrasp:
     def __init__(self, side: dex3.Side, torque_limit_nm: float = 0.5, closing_speed_radps: float = 1.5,
-                 kp: float = 3.0, kd: float = 0.05, hold_fraction: float = 0.9,
+                 kp: float = 3.0, kd: float = 0.05, hold_fraction: float = 0.8,
                  touch_fraction: float = 0.5):
         limits = dex3.hand_limits(side)
         if not 0 < torque_limit_nm <= float(np.min(limits.effort_nm)):
@@ -51,7 +52,7 @@ class ForceLimitedGrasp:
         """Joints stopped by the torque limit (they touch the object)."""
         self.closed = np.zeros(dex3.NUM_MOTORS, dtype=bool)
         """Joints stopped at their closed pose without touching anything."""
-        self._t: float | None = None
+        self._state_t: float | None = None
 
     @property
     def done(self) -> bool:
@@ -59,20 +60,26 @@ class ForceLimitedGrasp:
         return bool(np.all((self.touched | self.closed)[self.closing]))
 
     def act(self, state: FingerState, now_s: float) -> FingerCommand:
+        """The command for this tick from the hand's newest state (received at state.t_s)."""
         if self.target is None:
             self.target = np.where(self.closing, state.q_rad, self.limits.open_rad).astype(float)
-        # a late tick must not jump the target (the hand would squeeze by kp times the jump)
-        dt = 0.0 if self._t is None else min(max(0.0, now_s - self._t), MAX_STEP_S)
-        self._t = now_s
+        # Targets advance only on a state not seen before, by at most MAX_STEP_S of closing: a late
+        # tick, or a hand whose samples stalled, must not wind the target up beyond what was felt.
+        fresh = self._state_t is None or state.t_s != self._state_t
+        dt = 0.0 if self._state_t is None or not fresh else min(max(0.0, state.t_s - self._state_t), MAX_STEP_S)
+        self._state_t = state.t_s
         squeeze = self.sign * state.tau_nm  # the motors' torque toward closing: what the object resists
-        self.touched |= self.closing & (squeeze >= self.touch_fraction * self.torque_limit_nm)
+        touch = self.closing & ~self.touched & ~self.closed & (squeeze >= self.touch_fraction * self.torque_limit_nm)
+        # held from the angle where it touched: as the finger presses in, the squeeze can only fall
+        # below hold_fraction * limit (kp (target - q) with q moving toward the target)
+        hold = state.q_rad + self.sign * self.hold_fraction * self.torque_limit_nm / self.kp
+        self.target = np.where(touch, hold, self.target)
+        self.touched |= touch
         moving = self.closing & ~self.touched & ~self.closed
         closed_pose = self.limits.closed_rad
         advanced = self.target + self.sign * self.closing_speed_radps * dt
         past = self.sign * (advanced - closed_pose) >= 0
         self.closed |= moving & past & (self.sign * (state.q_rad - closed_pose) >= -0.05)
         self.target = np.where(moving, np.where(past, closed_pose, advanced), self.target)
-        hold = state.q_rad + self.sign * self.hold_fraction * self.torque_limit_nm / self.kp
-        self.target = np.where(self.touched, hold, self.target)
         return FingerCommand(q_rad=self.target.copy(), kp=np.full(dex3.NUM_MOTORS, self.kp),
                              kd=np.full(dex3.NUM_MOTORS, self.kd))

@@ -117,17 +117,17 @@ def test_nan_is_refused_and_both_hands_damp_until_reset(rig):
 
 
 @pytest.mark.parametrize("fault, words", [
-    ("stale", "the left hand's state is 0.20 s old (limit 0.10 s)"),
-    ("frozen", "the left hand's state has not changed for 0.30 s (limit 0.25 s): frozen"),
+    ("stale", "the left hand's state is 0.30 s old (limit 0.25 s)"),
+    ("frozen", "the left hand's state has not changed for 0.60 s (limit 0.50 s): frozen"),
     ("error", "the left hand reports error 0x4/0x0"),
 ])
 def test_a_stale_frozen_or_faulted_hand_damps(rig, fault, words):
     hands, link, _ = rig
     assert not hands.write("left", _stiff(link.q["left"])).is_damping
     if fault == "stale":
-        link.state_age_s = 0.2
+        link.state_age_s = 0.3
     elif fault == "frozen":
-        link.unchanged_s = 0.3
+        link.unchanged_s = 0.6
     else:
         link.error = (4, 0)
     assert hands.write("left", _stiff(link.q["left"])).is_damping

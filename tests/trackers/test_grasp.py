@@ -28,7 +28,7 @@ def hands():
     emulator = Dex3HandsEmulator("lo", 1, partition=partition).start()
     link = Dex3HandLink("lo", 1, partition=partition)
     link.wait_for_state(dex3.SIDES, 5.0)
-    time.sleep(0.3)  # > GuardedHands' frozen window: the stream's noise has been seen changing
+    time.sleep(0.1)  # the stream's noise has been seen changing (GuardedHands' frozen check)
     yield emulator, link
     link.close()
     emulator.close()
