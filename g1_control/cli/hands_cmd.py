@@ -36,7 +36,8 @@ def register(subparsers) -> None:
     grasp.add_argument("--side", choices=("left", "right"), required=True)
     grasp.add_argument("--torque-limit", type=float, default=0.5, metavar="NM",
                        help="no finger squeezes harder than this (N m; default 0.5, at most the motors' 1.4)")
-    grasp.add_argument("--speed", type=float, default=1.5, metavar="RADPS", help="closing speed (default 1.5 rad/s)")
+    grasp.add_argument("--speed", type=float, metavar="RADPS",
+                       help="closing speed (default: 3 rad/s per N m of --torque-limit, at most 1.5)")
     grasp.add_argument("--hold-s", type=float, default=1.0, help="how long to hold before releasing (default 1 s)")
     grasp.add_argument("--timeout-s", type=float, default=5.0, help="give up closing after this long (default 5 s)")
     parser.set_defaults(func=_run)

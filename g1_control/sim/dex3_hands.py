@@ -158,6 +158,11 @@ class Dex3HandsEmulator:
             hand.max_motor_tau[:] = 0.0
         return contact
 
+    def release_object(self, side: dex3.Side) -> None:
+        """Take the object out of hand `side`."""
+        with self._lock:
+            self.hands[side].contact_q = None
+
     def truth(self, side: dex3.Side) -> FingerTruth:
         hand = self.hands[side]
         with self._lock:

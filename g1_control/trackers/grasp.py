@@ -28,9 +28,23 @@ MAX_STEP_S = 0.02
 """The most closing time one new state advances the targets by, however long since the last one."""
 
 
+KP_PER_NM = 6.0
+"""Default position gain per N m of torque limit (kp 3 for 0.5 N m): the torque a target step adds
+scales with the limit, so the overshoot past touch during the loop's latency is the same fraction
+of any limit, and the hold offset (hold_fraction * limit / kp, 0.13 rad) is the same angle."""
+
+
+SPEED_PER_NM = 3.0
+MAX_CLOSING_SPEED_RADPS = 1.5
+"""Default closing speed: 3 rad/s per N m of limit, at most 1.5 rad/s (0.9 rad/s for 0.3 N m). A
+finger meets the object with its momentum: on the emulator (reflected inertia 1e-3 kg m^2, a stiff
+object) 1.5 rad/s alone struck with ~0.2 N m, most of a 0.3 N m limit, before any torque reading
+could stop it."""
+
+
 class ForceLimitedGrasp:
-    def __init__(self, side: dex3.Side, torque_limit_nm: float = 0.5, closing_speed_radps: float = 1.5,
-                 kp: float = 3.0, kd: float = 0.05, hold_fraction: float = 0.8,
+    def __init__(self, side: dex3.Side, torque_limit_nm: float = 0.5, closing_speed_radps: float | None = None,
+                 kp: float | None = None, kd: float = 0.05, hold_fraction: float = 0.8,
                  touch_fraction: float = 0.5):
         limits = dex3.hand_limits(side)
         if not 0 < torque_limit_nm <= float(np.min(limits.effort_nm)):
@@ -39,6 +53,10 @@ class ForceLimitedGrasp:
         if not 0 < hold_fraction <= 1 or not 0 < touch_fraction <= 1:
             raise ValueError(f"hold_fraction and touch_fraction must be in (0, 1]; got {hold_fraction}, "
                              f"{touch_fraction}")
+        if kp is None:
+            kp = KP_PER_NM * torque_limit_nm
+        if closing_speed_radps is None:
+            closing_speed_radps = min(MAX_CLOSING_SPEED_RADPS, SPEED_PER_NM * torque_limit_nm)
         if not closing_speed_radps > 0 or not kp > 0 or not kd >= 0:
             raise ValueError(f"closing_speed_radps and kp must be positive and kd >= 0; got "
                              f"{closing_speed_radps}, {kp}, {kd}")

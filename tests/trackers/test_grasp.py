@@ -112,3 +112,44 @@ def test_a_fault_while_holding_damps_both_hands(hands, fault):
     time.sleep(0.3)
     # damped (kp 0): nothing squeezes the object any more
     assert np.max(np.abs(emulator.truth("right").contact_tau_nm)) < 0.05
+
+
+# -- the controller alone, on hand-made states ------------------------------------------------------
+
+def _state(q, tau, t_s):
+    from g1_control.types import FingerState
+
+    return FingerState(q_rad=np.asarray(q, dtype=float), tau_nm=np.asarray(tau, dtype=float), t_s=t_s)
+
+
+def test_targets_advance_only_on_new_states_and_never_by_more_than_a_step():
+    from g1_control.trackers.grasp import MAX_STEP_S
+
+    grasp = ForceLimitedGrasp("right", torque_limit_nm=0.5)  # 1.5 rad/s, kp 3 by default
+    q0 = dex3.hand_limits("right").open_rad
+    first = grasp.act(_state(q0, np.zeros(7), 1.0), 1.0).q_rad
+    again = grasp.act(_state(q0, np.zeros(7), 1.0), 1.5).q_rad  # the same state, half a second later
+    np.testing.assert_array_equal(first, again)
+    late = grasp.act(_state(q0, np.zeros(7), 2.0), 2.0).q_rad  # a new state after a 1 s stall
+    step = np.abs(late - first)
+    assert np.max(step) == pytest.approx(1.5 * MAX_STEP_S) and step[0] == 0.0  # thumb_0 holds
+
+
+def test_a_touching_finger_holds_a_fixed_target_below_the_limit():
+    grasp = ForceLimitedGrasp("left", torque_limit_nm=0.5)
+    sign = dex3.hand_limits("left").closing_sign
+    q = np.full(7, 0.0) + sign * 0.3
+    grasp.act(_state(q, np.zeros(7), 1.0), 1.0)
+    tau = sign * 0.3  # above half the limit on every closing joint: touched
+    held = grasp.act(_state(q, tau, 1.01), 1.01).q_rad
+    assert grasp.touched[sign != 0].all() and grasp.done
+    np.testing.assert_allclose(held[sign != 0], (q + sign * 0.8 * 0.5 / 3.0)[sign != 0])
+    pressed_in = q + sign * 0.05  # the finger presses further into the object
+    later = grasp.act(_state(pressed_in, tau, 1.02), 1.02).q_rad
+    np.testing.assert_array_equal(later, held)  # the target stays where it was set
+    assert np.all(3.0 * sign * (later - pressed_in) <= 0.8 * 0.5 + 1e-12)
+
+
+def test_a_limit_beyond_the_motors_is_refused():
+    with pytest.raises(ValueError, match=r"torque_limit_nm must be in \(0, 1.4\] N m .*; got 2.0"):
+        ForceLimitedGrasp("left", torque_limit_nm=2.0)
