@@ -52,6 +52,9 @@ def register(subparsers) -> None:
                         help="dex3: emulate the two Dex3-1 hands too (HandState_ on rt/dex3/left|right/state at "
                         "100 Hz, HandCmd_ applied from rt/dex3/left|right/cmd; a per-finger motor model, "
                         "g1_control/sim/dex3_hands.py), for launch files with backend.hands: dex3")
+    parser.add_argument("--hand-object", type=float, metavar="CLOSURE",
+                        help="with --hands dex3: an object in each hand that every closing finger touches at this "
+                        "fraction of its travel (0 open .. 1 closed), for trying `g1 hands grasp`")
     parser.add_argument("--seconds", type=float, help="stop after this long (default: until Ctrl-C)")
     parser.add_argument("--control-stdin", action="store_true",
                         help="read fault names and remote commands ('press start', 'press A', 'stick ly 0.5', "
@@ -91,6 +94,13 @@ def _run(args) -> int:
         from g1_control.sim.dex3_hands import Dex3HandsEmulator
 
         hands = Dex3HandsEmulator(args.interface, args.domain, partition=args.partition).start()
+        if args.hand_object is not None:
+            for side in hands.hands:
+                hands.hold_object(side, args.hand_object)
+    elif args.hand_object is not None:
+        print("g1 sim-robot: --hand-object needs --hands dex3", file=sys.stderr)
+        emulator.close()
+        return 2
     stop = {"now": False}
 
     def _stop(signum, frame):

@@ -62,10 +62,11 @@ def check_hands(pf: Preflight, launch: LaunchFile, hands: Dex3HandLink | None, o
             pass
     silent = [s for s in hands.sides if hands.read(s) is None]
     if silent:
-        pf.record("hands_present", FAIL, f"no HandState_ from the {' and '.join(silent)} hand within {timeout:.1f} s "
+        which = f"{' and '.join(silent)} hand{'s' if len(silent) > 1 else ''}"
+        pf.record("hands_present", FAIL, f"no HandState_ from the {which} within {timeout:.1f} s "
                   f"on {', '.join(dex3.state_topic(s) for s in silent)} ({hands.describe()}): check that the hand is "
                   "cabled and powered, or set backend.hands: none", overridable=False)
-        pf.not_run(["hand_state_stream", "finger_limits"], f"the {' and '.join(silent)} hand is silent")
+        pf.not_run(["hand_state_stream", "finger_limits"], f"the {which} {'are' if len(silent) > 1 else 'is'} silent")
         return
     pf.record("hands_present", PASS, f"left and right publish on {dex3.state_topic('left')}, "
               f"{dex3.state_topic('right')}")
@@ -81,7 +82,10 @@ def check_hands(pf: Preflight, launch: LaunchFile, hands: Dex3HandLink | None, o
         problems.append(f"{', '.join(slow)}: need >= {MIN_HAND_STATE_RATE_HZ:.0f} Hz from each hand; check its "
                         "cable and that nothing else loads this host")
     if frozen:
-        problems.append(f"the {' and '.join(frozen)} hand's HandState_ is frozen (every sample identical, its "
+        owner = f"{' and '.join(frozen)} {'hands' if len(frozen) > 1 else 'hand'}'"
+        owner += "" if len(frozen) > 1 else "s"
+        problems.append(f"the {owner} HandState_ {'are' if len(frozen) > 1 else 'is'} frozen "
+                        "(every sample identical, its "
                         "sensor noise included): the hand's firmware stopped sampling; power-cycle the hand")
     if problems:
         pf.record("hand_state_stream", FAIL, f"{detail}; " + "; ".join(problems))
