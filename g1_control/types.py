@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from g1_control.errors import InvalidCommandError, InvalidStateError, LaunchFileError
+from g1_control.robot import dex3
 from g1_control.robot.g1 import DEFAULT_PELVIS_HEIGHT_M, NUM_JOINTS
 
 _sum = np.add.reduce
@@ -454,7 +455,7 @@ class MotorCommand:
                                 + self.tau_nm.sum()))
 
 
-NUM_HAND_MOTORS = 7
+NUM_HAND_MOTORS = dex3.NUM_MOTORS
 """Motors of one Dex3-1 hand (g1_control/robot/dex3.py names them)."""
 
 
@@ -475,7 +476,7 @@ class FingerCommand:
     enable: np.ndarray = field(default_factory=lambda: np.ones(NUM_HAND_MOTORS, dtype=bool))
 
     @classmethod
-    def damping(cls, kd: float = 0.05) -> FingerCommand:
+    def damping(cls, kd: float = dex3.DAMPING_KD) -> FingerCommand:
         """The fail-safe command for a hand: no stiffness, velocity damping only."""
         return cls(kd=np.full(NUM_HAND_MOTORS, float(kd)))
 

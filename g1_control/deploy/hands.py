@@ -40,7 +40,7 @@ def open_hand_link(launch: LaunchFile) -> Dex3HandLink:
     if b.type != "unitree_dds":
         raise G1ControlError(f"backend.hands: dex3 needs backend.type unitree_dds (the Dex3-1 hands speak DDS); "
                              f"backend.type is {b.type}")
-    return Dex3HandLink(b.interface or "", b.domain, partition=b.partition, damping_kd=0.05)
+    return Dex3HandLink(b.interface or "", b.domain, partition=b.partition)
 
 
 def check_hands(pf: Preflight, launch: LaunchFile, hands: Dex3HandLink | None, open_error: str = "") -> None:

@@ -113,11 +113,13 @@ class Preflight:
         return status != FAIL
 
     def _put(self, result: CheckResult) -> None:
-        """Store `result`; a row new to the table (an optional one) takes its place in CHECKS order."""
+        """Store `result`; an optional row new to the table takes its place in CHECKS order (rows of
+        other names, such as g1 doctor's, keep theirs)."""
         new = result.name not in self.results
         self.results[result.name] = result
-        if new:
-            self.results = {n: self.results[n] for n in CHECKS if n in self.results}
+        if new and result.name in OPTIONAL_CHECKS:
+            order = [n for n in CHECKS if n in self.results] + [n for n in self.results if n not in CHECKS]
+            self.results = {n: self.results[n] for n in order}
 
     def not_run(self, names, why: str) -> None:
         for name in names:

@@ -22,13 +22,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from g1_control.errors import MalformedMessageError, RobotNotConnectedError
-from g1_control.hardware.links.dds import domain_participant
+from g1_control.hardware.links.dds import domain_participant, import_cyclonedds
 from g1_control.robot import dex3
 from g1_control.types import FingerCommand, FingerState
-
-DEFAULT_HAND_KD = 0.05
-"""kd of the hands' damping command (N m s/rad): a finger's effort limit is 1.4-2.45 N m, so a
-body-sized kd (2) would be a brake, not a damper."""
 
 
 @dataclass
@@ -51,7 +47,8 @@ class HandStats:
 class Dex3HandLink:
     def __init__(self, interface: str, domain_id: int = 0, *, partition: str | None = None,
                  sides: tuple[dex3.Side, ...] = dex3.SIDES, command_rate_hz: float = 100.0,
-                 damping_kd: float = DEFAULT_HAND_KD, close_damping_s: float = 0.1):
+                 damping_kd: float = dex3.DAMPING_KD, close_damping_s: float = 0.1):
+        import_cyclonedds()  # a named error, with the install hint, where the binding is missing
         from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState, WaitSet
         from cyclonedds.pub import DataWriter, Publisher
         from cyclonedds.qos import Policy, Qos

@@ -29,6 +29,9 @@ FINGERS = ("thumb_0", "thumb_1", "thumb_2", "middle_0", "middle_1", "index_0", "
 NUM_MOTORS = len(FINGERS)
 HAND_URDF_RELATIVE = "robots/g1_description/urdf/g1_29dof_with_hand_rev_1_0.urdf"
 
+DAMPING_KD = 0.05
+"""kd of a hand's fail-safe damping (N m s/rad, kp 0): a finger motor has 1.4-2.45 N m, so the body's
+damping kd (2) would be a brake, not a damper."""
 MODE_STATUS_ENABLED = 1
 """Status bits (4-6) of a motor's mode byte: 1 enables the motor (assumed from Unitree's example)."""
 

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from g1_control.errors import NetworkInterfaceError
-from g1_control.hardware.links.dds import domain_participant
+from g1_control.hardware.links.dds import domain_participant, import_cyclonedds
 from g1_control.hardware.links.network import LOOPBACK
 from g1_control.robot import dex3
 from g1_control.types import FingerCommand, FingerState
@@ -111,6 +111,7 @@ class Dex3HandsEmulator:
     def __init__(self, interface: str = LOOPBACK, domain_id: int = 1, partition: str | None = None,
                  state_rate_hz: float = 100.0, sides: tuple[dex3.Side, ...] = dex3.SIDES, seed: int = 0):
         """sides: the hands that exist (a missing hand publishes nothing and hears nothing)."""
+        import_cyclonedds()
         from cyclonedds.pub import DataWriter, Publisher
         from cyclonedds.qos import Policy, Qos
         from cyclonedds.sub import DataReader, Subscriber
