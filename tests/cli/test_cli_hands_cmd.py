@@ -52,3 +52,32 @@ def test_a_torque_limit_above_the_motors_is_refused(emulated, capsys):
     _, partition = emulated
     assert main(["hands", "grasp", "--side", "right", "--torque-limit", "3", "--partition", partition]) == 1
     assert "torque_limit_nm must be in (0, 1.4] N m" in capsys.readouterr().err
+
+
+def test_grasp_against_g1_sim_robot_with_hands_in_another_process(capsys):
+    """`g1 sim-robot --hands dex3 --hand-object 0.5` as its own process, `g1 hands grasp` here."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    partition = f"g1hands-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "g1_control.cli.main", "sim-robot", "--physics", "mock", "--hands", "dex3",
+         "--hand-object", "0.5", "--partition", partition, "--seconds", "12", "--rt-priority", "0"],
+        cwd=root, env={**os.environ, "PYTHONPATH": str(root)}, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        text=True)
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+        rc = main(["hands", "grasp", "--side", "right", "--torque-limit", "0.5", "--hold-s", "0.3", "--json",
+                   "--partition", partition])
+        out = json.loads(capsys.readouterr().out)
+        _, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert rc == 0 and out["tripped"] is None
+    closing = dex3.hand_limits("right").closing_sign != 0
+    assert [f["stop"] for f, c in zip(out["fingers"].values(), closing) if c] == ["touched"] * 6
+    assert out["peak_measured_tau_nm"] <= 0.5
+    assert "Dex3-1 hands" in err and " HandCmd_ applied" in err and " 0 HandCmd_ applied" not in err
