@@ -168,6 +168,9 @@ class Generator(ABC):
 
 
 class Retargeter(ABC):
+    """The IK stage (the loop's: g1_control/ik/stage.py, IKStage). A reference that carries a plan
+    feasible by construction (KinematicReference.feasible_plan) needs no solving."""
+
     @abstractmethod
     def solve(self, reference: KinematicReference, q_prev: np.ndarray) -> JointReference: ...
 

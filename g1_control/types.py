@@ -327,10 +327,16 @@ class KinematicReference:
 
     hand_q_rad: np.ndarray | None = None
     """Dex3 finger angles (14, generator.skeleton.FINGER_JOINTS order) on a G1 with hands; None otherwise."""
+    feasible_plan: JointReference | None = None
+    """The tracker's reference when the generator made it feasible by construction (a sampled
+    whole-body plan with exact joint velocities and hand forces; the default legs with a style's
+    upper-body pose): the IK stage (g1_control/ik/stage.py) passes it on unchanged. None: the IK
+    stage solves this reference. The generator owns it and refills it every tick; nobody
+    downstream writes to it."""
 
     def set_from(self, j: JointReference) -> KinematicReference:
         """Root pose and twist, joints, contacts and phase from a joint reference (a whole-body
-        plan sampled as both); returns self."""
+        plan sampled as both), and `j` itself as the feasible plan; returns self."""
         self.t_s = j.t_s
         self.root_pos_w_m[:] = j.root_pos_w_m
         self.root_quat_wxyz[:] = j.root_quat_wxyz
@@ -339,6 +345,7 @@ class KinematicReference:
         self.q_rad[:] = j.q_rad
         self.contacts[:] = j.contacts
         self.phase = j.phase
+        self.feasible_plan = j
         return self
 
 

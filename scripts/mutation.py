@@ -59,6 +59,16 @@ GROUPS: dict[str, dict[str, list[str]]] = {
                   "tests/deploy/test_deploy_launch_schema.py", "tests/launch/test_launch_goals.py",
                   "tests/launch/test_launch_schema_paths.py"],
     },
+    "loop": {
+        # The robot path's runtime trips (issue 26): the loop's CRC, peer and fall checks, the fall
+        # judge, the deploy. Its tests include deploys over DDS (~10 s each): hours per run on 2 cores.
+        "mutate": ["g1_control/loop/control_loop.py", "g1_control/safety/fall.py",
+                   "g1_control/deploy/state_machine.py", "g1_control/deploy/session.py"],
+        "tests": ["tests/loop/test_control_loop.py", "tests/safety/test_safety_fall.py",
+                  "tests/launch/test_launch_trips.py", "tests/deploy/test_deploy_state_machine.py",
+                  "tests/deploy/test_deploy_runtime_trips.py", "tests/deploy/test_deploy_state_validation.py",
+                  "tests/deploy/test_deploy_run_folder.py"],
+    },
     "velocity": {
         # locomotion.py is mutated whole; only VelocityCorrector's mutants are counted (the tracker's
         # other code is covered by physics tests that are too slow to run per mutant).

@@ -19,9 +19,9 @@ $G1 library build --variant g1_23dof
 $G1 library build --variant g1_29dof_with_hand
 
 # the shipped backbone: one model for the 29-DoF G1, the 23-DoF G1 and the G1 with hands
-$G1 train generator --seed "$SEED"                                  # -> g1_control/policies/generator/
+$G1 train generator --seed "$SEED"          # -> g1_control/policies/generator/ (records: training_records/generator/)
 # learned motion matching (decompressor, stepper, projector) for the 29-DoF G1
-$G1 train lmm --seed "$SEED"                                        # -> g1_control/policies/generator/lmm/
+$G1 train lmm --seed "$SEED"                # -> g1_control/policies/generator/lmm/ (records: training_records/generator/lmm/)
 if [ -z "${SKIP_VARIANT_MODELS:-}" ]; then
   # per-variant models, only for the comparison table of `g1 bench generator` (not shipped)
   for sk in g1_29dof g1_23dof g1_29dof_with_hand; do

@@ -80,11 +80,19 @@ def _run(args) -> int:
     if args.duration is not None:
         launch.duration_s = args.duration
     if args.check:
-        from g1_control.trackers.policy_spec import load_spec
+        from g1_control.launch.variant import POLICY_TRACKERS, check_tracker_fits
 
-        spec = load_spec(launch.tracker.policy)
+        if launch.tracker.type in POLICY_TRACKERS:
+            from g1_control.trackers.policy_spec import load_spec
+
+            spec = load_spec(launch.tracker.policy)
+            check_tracker_fits(launch, spec)
+            what = f"policy {spec.name}"
+        else:
+            check_tracker_fits(launch)
+            what = f"tracker {launch.tracker.type}"
         print(f"{args.file}: OK ({launch.name}: {launch.backend.type} {launch.backend.mode}, "
-              f"policy {spec.name}, {launch.total_duration_s:.1f} s, input {launch.input.type})")
+              f"{launch.backend.expected_variant}, {what}, {launch.total_duration_s:.1f} s, input {launch.input.type})")
         return 0
     from g1_control.launch.runner import run
     from g1_control.report.results import format_summary

@@ -10,7 +10,12 @@ Sources: MuJoCo rollouts of the holosoma locomotion policy under seeded random c
 upper-body style per rollout (tracked in physics through the policy's upper-body override); the
 131 s dance clip stored in holosoma's WBT policy; the seven holosoma demo mocap sequences
 retargeted by the project's IK; all mirrored left/right. Clips are cut into 8 s pieces; whole
-pieces (with their mirror images) are held out for evaluation. A build takes about 1-2 minutes
+pieces (with their mirror images) are held out for evaluation. Every piece must pass `g1 check`
+(no joint beyond its limits, no link in the floor or the scene, no self-collision, sliding on at
+most 1 % of stance frames): a piece that fails is repaired through the IK (self-collision, ground
+and contact limits; admitted only if it then passes) or else left out with its mirror, and the
+build (and `g1 library show`) lists which and why; `--no-repair` leaves them out, `--no-gate`
+admits them. A build takes about 1-2 minutes
 on 2 cores and is skipped when the index on disk was built with the same configuration.
 """
 
@@ -31,6 +36,11 @@ def register(subparsers) -> None:
     build.add_argument("--rollouts-per-style", type=int, default=2, help="rollouts (seeds) per style (default 2)")
     build.add_argument("--no-dance", action="store_true", help="leave out the WBT dance clip")
     build.add_argument("--no-demo", action="store_true", help="leave out the retargeted demo mocap")
+    build.add_argument("--no-gate", action="store_true",
+                       help="admit every piece, even those that fail `g1 check` (default: they are repaired through "
+                       "the IK or left out, and the build says which and why)")
+    build.add_argument("--no-repair", action="store_true",
+                       help="leave out a piece that fails `g1 check` instead of repairing it through the IK")
     build.add_argument("--jobs", type=int, default=2, help="rollout worker processes (default 2)")
     build.add_argument("--variant", default="g1_29dof", choices=("g1_29dof", "g1_23dof", "g1_29dof_with_hand"),
                        help="robot variant (default g1_29dof; the others are derived from the 29-DoF library through "
@@ -48,7 +58,7 @@ def _build(args) -> int:
     from g1_control.motion.library import default_library_dir
 
     config = LibraryConfig(rollout_seconds=args.rollout_seconds, rollouts_per_style=args.rollouts_per_style,
-                           dance=not args.no_dance, demo=not args.no_demo)
+                           dance=not args.no_dance, demo=not args.no_demo, gate=not args.no_gate, repair=not args.no_repair)
     if args.variant != "g1_29dof":
         from g1_control.library.variants import build_variant_library
 
@@ -72,4 +82,9 @@ def _show(args) -> int:
     for info in lib.index.get("rollouts", []):
         if info.get("fault"):
             print(f"rollout {info['style']} seed {info['seed']}: {info['fault']}, kept {info['recorded_s']:.1f} s")
+    gate = lib.index.get("gate", {})
+    if gate.get("left_out") or gate.get("repaired"):
+        from g1_control.library.builder import gate_summary
+
+        print(gate_summary(gate))
     return 0

@@ -23,7 +23,8 @@ def register(subparsers) -> None:
         epilog="examples:\n  g1 sim-robot                      # lo, domain 1, until Ctrl-C\n"
         "  g1 sim-robot --seconds 30 --physics mock\n"
         "  g1 sim-robot --control-stdin      # faults / remote buttons by name on stdin (test harnesses)\n"
-        "  g1 sim-robot --lower-gantry-on-policy   # sim2sim with g1 deploy launch/sim2sim.yaml --yes",
+        "  g1 sim-robot --lower-gantry-on-policy   # sim2sim with g1 deploy launch/sim2sim.yaml --yes\n"
+        "  g1 sim-robot --mode-machine 4 --lower-gantry-on-policy   # the 23-DoF G1 (g1 deploy launch/sim2sim_23dof.yaml)",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--interface", default="lo", help="network interface; loopback only (default lo)")
@@ -42,7 +43,10 @@ def register(subparsers) -> None:
                         help="robot: the G1's protocol (default); unitree_mujoco: play Unitree's MuJoCo simulator "
                         "(LowState_ with crc, tick and mode_machine 0 at 200 Hz, PD torque computed when a LowCmd_ "
                         "arrives and held, no motion service), for g1 deploy with backend.simulator: unitree_mujoco")
-    parser.add_argument("--mode-machine", type=int, default=5, help="variant to report with --physics mock (4/5/6)")
+    parser.add_argument("--mode-machine", type=int, default=5,
+                        help="the G1 variant to emulate and report: 4 = 23-DoF (no waist roll/pitch, no wrist "
+                        "pitch/yaw: MuJoCo builds it without those joints), 5 = 29-DoF (default), 6 = 29-DoF with "
+                        "the waist locked (--physics mock reports any value)")
     parser.add_argument("--no-builtin", action="store_true",
                         help="start with no built-in controller (as after debug mode on the remote)")
     parser.add_argument("--rt-priority", type=int, default=30, metavar="N",
@@ -63,21 +67,27 @@ def register(subparsers) -> None:
 
 
 def _run(args) -> int:
+    from g1_control.errors import G1ControlError
     from g1_control.loop.priority import frozen_heap, realtime
     from g1_control.sim.emulator import RobotEmulator
 
     realtime(args.rt_priority)
     physics: Backend
     if args.physics == "mujoco":
+        from g1_control.robot import g1
         from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
 
+        try:
+            variant = g1.variant_for_mode_machine(args.mode_machine).name
+        except ValueError as exc:
+            raise G1ControlError(f"--mode-machine: {exc}") from None
         mujoco: MujocoBackend
         if args.mode == "unitree_mujoco":
             from g1_control.sim.unitree_mujoco import PHYSICS_DT_S, HeldTorqueMujoco
 
-            physics = mujoco = HeldTorqueMujoco(MujocoConfig(lockstep=True, physics_dt_s=PHYSICS_DT_S))
+            physics = mujoco = HeldTorqueMujoco(MujocoConfig(lockstep=True, physics_dt_s=PHYSICS_DT_S, variant=variant))
         else:
-            physics = mujoco = MujocoBackend(MujocoConfig(lockstep=True))
+            physics = mujoco = MujocoBackend(MujocoConfig(lockstep=True, variant=variant))
         if args.gantry or args.lower_gantry_on_policy:
             from g1_control.sim.emulator import Gantry
 
@@ -109,8 +119,9 @@ def _run(args) -> int:
     signal.signal(signal.SIGTERM, _stop)
     with frozen_heap():  # the 500 Hz robot loop never waits for a full collection of the startup heap
         played = ", as Unitree's unitree_mujoco" if args.mode == "unitree_mujoco" else ""
-        print(f"g1 sim-robot: emulating a G1 ({args.physics}{played}"
-              + (", Dex3-1 hands" if hands is not None else "") + f") on interface {args.interface}, domain {args.domain}"
+        print(f"g1 sim-robot: emulating a G1 ({args.physics}{played}, mode_machine {args.mode_machine}"
+              + (", Dex3-1 hands" if hands is not None else "") + f") on interface {args.interface}, "
+              f"domain {args.domain}"
               + (f", partition {args.partition}" if args.partition else ""), file=sys.stderr, flush=True)
         print("ready", flush=True)
         try:

@@ -7,9 +7,11 @@
     g1 train lmm                                    # learned motion matching -> policies/generator/lmm/
 
 Needs the motion libraries (`g1 library build [--variant ...]`; built on first use). The backbone
-run writes backbone.pt (checkpoint), backbone.onnx (runtime model), model.json (skeletons),
-style_stats.json, feedback.npz (reference mixtures), train_config.json, loss_history.json and
-loss.png, keeping the model with the lowest loss on held-out clips. A run stops at its step
+run writes backbone.onnx (runtime model), model.json (skeletons), style_stats.json, feedback.npz
+(reference mixtures) and train_config.json, and the records the runtime never reads, backbone.pt
+(checkpoint), loss_history.json and loss.png, keeping the model with the lowest loss on held-out
+clips. The records go next to the model, except for the shipped models (no -o), whose records go to
+the repository's training_records/ (--records overrides), outside the import package. A run stops at its step
 count or its time limit (default 25 min), whichever comes first, with the learning-rate schedule
 finished either way. Under torchrun each process samples its own windows and gradients are
 averaged (DDP, gloo backend, so it runs on CPUs). scripts/retrain_generator.sh retrains all.
@@ -27,6 +29,8 @@ def register(subparsers) -> None:
     gen = sub.add_parser("generator", help="the in-betweening backbone of the motion generator",
                          description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     gen.add_argument("-o", "--output", help="output folder (default: policies/generator, the shipped model)")
+    gen.add_argument("--records", help="folder for the checkpoint, loss history and plot (default: the output "
+                     "folder; for the shipped model, training_records/generator)")
     gen.add_argument("--library", help="motion library folder (default: the user cache; built when missing)")
     gen.add_argument("--steps", type=int, default=6000, help="optimizer steps (default 6000)")
     gen.add_argument("--skeletons", default=None,
@@ -47,6 +51,8 @@ def register(subparsers) -> None:
     lmm = sub.add_parser("lmm", help="learned motion matching: decompressor, stepper, projector",
                          description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     lmm.add_argument("-o", "--output", help="output folder (default: policies/generator/lmm, the shipped model)")
+    lmm.add_argument("--records", help="folder for the checkpoint, loss history and plot (default: the output "
+                     "folder; for the shipped model, training_records/generator/lmm)")
     lmm.add_argument("--library", help="motion library folder (default: the skeleton's library in the user cache)")
     lmm.add_argument("--skeleton", default="g1_29dof", help="skeleton (default g1_29dof)")
     lmm.add_argument("--time-limit", type=float, default=25.0, metavar="MIN",
@@ -92,8 +98,11 @@ def _generator(args) -> int:
                          wall_limit_s=args.wall_limit * 60,
                          threads=args.threads, seed=args.seed, eval_every=args.eval_every, model=model,
                          skeletons=skeletons)
+    from g1_control.training import TRAINING_RECORDS_DIR
+
     out = args.output or SHIPPED_DIR
-    result = train(out, config, args.library)
+    records = args.records or (None if args.output else TRAINING_RECORDS_DIR / "generator")
+    result = train(out, config, args.library, records_dir=records)
     if result.get("best_val_loss") is not None:
         print(f"trained {result['steps']} steps in {result['wall_s'] / 60:.1f} min ({result['cpu_s'] / 60:.1f} CPU-min) "
               f"(world size {result['world_size']}); best held-out loss {result['best_val_loss']:.4f}; "
@@ -112,10 +121,13 @@ def _lmm(args) -> int:
 
         build_library(default_library_dir())
         build_variant_library(args.skeleton)
+    from g1_control.training import TRAINING_RECORDS_DIR
+
     out = args.output or SHIPPED_LMM_DIR
+    records = args.records or (None if args.output else TRAINING_RECORDS_DIR / "generator" / "lmm")
     result = train_lmm(out, LmmTrainConfig(seed=args.seed, time_limit_s=args.time_limit * 60,
                                            wall_limit_s=args.wall_limit * 60, scale=args.scale,
-                                           skeleton=args.skeleton), args.library)
+                                           skeleton=args.skeleton), args.library, records_dir=records)
     print(f"trained learned motion matching in {result['wall_s'] / 60:.1f} min ({result['cpu_s'] / 60:.1f} CPU-min); "
           f"written to {out}")
     return 0

@@ -21,6 +21,7 @@ import numpy as np
 
 from g1_control.errors import G1ControlError, RobotNotConnectedError, VariantMismatchError
 from g1_control.launch.schema import InputConfig, LaunchFile, Segment
+from g1_control.loop.control_loop import first_fault
 from g1_control.robot import g1
 from g1_control.rotations import tilt_rad
 
@@ -146,6 +147,8 @@ class Preflight:
     def check_policy(self, launch: LaunchFile):
         from g1_control.trackers.policy_spec import load_spec, read_spec_file, resolve_spec_path
 
+        if launch.tracker.type == "wbc":
+            return self.check_model_based(launch)
         try:
             spec = load_spec(launch.tracker.policy)
             variant = read_spec_file(resolve_spec_path(launch.tracker.policy)).variant
@@ -167,6 +170,16 @@ class Preflight:
         self.record("policy", PASS, f"{spec.name}: {len(spec.joint_names)} joints in G1 order, gains and default pose "
                     f"match the robot, ONNX {spec.onnx_path.name}" + (f", for {variant}" if variant else ""))
         return spec, variant
+
+    def check_model_based(self, launch: LaunchFile):
+        """tracker.type wbc: no learned policy; the model-based controller runs the launch file's
+        variant from that variant's own model, so any G1 variant passes. (None, the variant's name)."""
+        from g1_control.launch.variant import robot_variant
+
+        variant = robot_variant(launch)
+        self.record("policy", PASS, f"tracker.type wbc: no learned policy; the model-based controller runs the "
+                    f"{variant.name} model ({variant.num_dof} joints)")
+        return None, variant.name
 
     def check_interface(self, launch: LaunchFile) -> bool:
         from g1_control.deploy.backends import check_link_endpoint
@@ -338,17 +351,19 @@ class Preflight:
             return self.record("dry_run", FAIL, f"the simulated dry run could not run: {exc}")
         self.dry_run = result
         moved = ", ".join(_segment_speed(s, result.duration_s) for s in result.segments if abs(s.commanded[0]) > 0)
-        what = (f"{result.duration_s:.1f} s lockstep MuJoCo of policy {launch.tracker.policy} at the launch "
+        driver = (f"the model-based controller on the {launch.backend.expected_variant} G1"
+                  if launch.tracker.type == "wbc" else f"policy {launch.tracker.policy}")
+        what = (f"{result.duration_s:.1f} s lockstep MuJoCo of {driver} at the launch "
                 f"file's rates ({result.wall_s:.1f} s wall)" + (f"; {moved}" if moved else ""))
         if result.fell:
             fall = result.fall or {}
             when = f" at {fall['t_s']:.1f} s ({fall['detail']})" if fall else ""
             return self.record("dry_run", FAIL, f"FELL in simulation{when}: "
                                f"{what}; do not run this policy/launch file on the robot")
-        faults = [e for e in result.events if "damping" in e["detail"]]
-        if faults:
-            return self.record("dry_run", FAIL, f"the safety layer tripped in simulation: {faults[0]['kind']}: "
-                               f"{faults[0]['detail']}")
+        fault = first_fault(result.events)
+        if fault is not None:
+            return self.record("dry_run", FAIL, f"the safety layer tripped in simulation: {fault['kind']}: "
+                               f"{fault['detail']}")
         ran = result.extra.get("program")
         if ran is not None:
             missed = [s["label"] for s in ran["steps"] if not s.get("verdict", {}).get("ok", True)]
@@ -466,12 +481,19 @@ DRY_RUN_EXERCISE = (("stand", 2.0, 0.0, 0.0), ("forward", 4.0, 0.5, 0.0), ("turn
 dry run of a launch file whose commands come from an operator (unknown in advance)."""
 
 
+def _dry_run_backend(launch: LaunchFile):
+    """Lockstep MuJoCo of the robot the launch file is for (its variant and hands)."""
+    from g1_control.launch.schema import BackendConfig
+
+    b = launch.backend
+    return BackendConfig(type="mujoco", mode="lockstep", physics_dt_s=b.physics_dt_s,
+                         expected_variant=b.expected_variant, hands=b.hands)
+
+
 def dry_run_launch(launch: LaunchFile, program=None) -> LaunchFile:
     """The same launch file on lockstep MuJoCo: same policy, rates, limits and safety thresholds; the
     behaviour program when there is one (`program`, or input.type program: run to its end), the
     scripted timeline when there is one, else a stand-walk-turn-stand exercise."""
-    from g1_control.launch.schema import BackendConfig
-
     duration = launch.deploy.dry_run_s
     if program is not None or launch.input.type == "program":
         cfg = launch.input
@@ -480,8 +502,7 @@ def dry_run_launch(launch: LaunchFile, program=None) -> LaunchFile:
         run_input = InputConfig(type="program", program=steps, instruction=text, places=dict(cfg.places),
                                 pose="estimator", start_delay_s=cfg.start_delay_s)
         dry = dataclasses.replace(launch, name=f"{launch.name}-dry-run", duration_s=None, input=run_input,
-                                  backend=BackendConfig(type="mujoco", mode="lockstep",
-                                                        physics_dt_s=launch.backend.physics_dt_s), viewer=False)
+                                  backend=_dry_run_backend(launch), viewer=False)
         dry.duration_s = max(duration, dry.total_duration_s)
         return dry
     if launch.input.type == "scripted":
@@ -492,5 +513,5 @@ def dry_run_launch(launch: LaunchFile, program=None) -> LaunchFile:
                             label=label) for label, s, fx, fw in DRY_RUN_EXERCISE]
     return dataclasses.replace(
         launch, name=f"{launch.name}-dry-run", duration_s=duration,
-        backend=BackendConfig(type="mujoco", mode="lockstep", physics_dt_s=launch.backend.physics_dt_s),
+        backend=_dry_run_backend(launch),
         input=InputConfig(type="scripted", timeline=timeline), viewer=False)

@@ -38,8 +38,6 @@ if TYPE_CHECKING:
 log = logging.getLogger("g1_control.deploy")
 
 ROBOT_CHECKS = ("variant", "state_stream", "peers", "imu_upright", "joint_limits", "temperatures", "battery")
-CLEAN_ENDINGS = ("operator stop", "control time over", "SIGINT received", "SIGTERM received")
-"""Trip details that end a deploy as planned (exit code 0); any other trip is a fault (exit code 3)."""
 
 
 @dataclass
@@ -212,7 +210,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             device = ProgramInput(options.program, launch.program_world(), pose="estimator",
                                   start_delay_s=launch.input.start_delay_s, operator=device,
                                   on_record=lambda r: say("program step " + describe_record(r)))
-        if spec is not None:
+        if spec is not None or (launch.tracker.type == "wbc" and pf.results["policy"].status == "pass"):
             say(f"simulated dry run ({launch.deploy.dry_run_s:.0f} s lockstep MuJoCo"
                 + (", the whole program" if options.program is not None or launch.input.type == "program" else "")
                 + ") ...")
@@ -449,7 +447,8 @@ def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTr
                           for t in tracker.transitions]
     trip = safety.trip_event
     report.end_reason = trip.detail if trip else "exit"
-    report.fault = trip is None or not any(trip.detail.startswith(c) for c in CLEAN_ENDINGS)
+    # A planned ending (operator stop, control time over, a signal) exits 0; any other trip is a fault (exit 3).
+    report.fault = trip is None or not trip.planned
     report.safety_events = [{"t_s": e.t_s, "kind": e.kind.value, "detail": e.detail, "trips": e.trips,
                              "planned": e.planned} for e in safety.events]
     report.link = dataclasses.asdict(backend.stats())

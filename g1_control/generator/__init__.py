@@ -14,5 +14,6 @@ skeleton.py      the G1 variants (29-DoF, 23-DoF, with Dex3 hands) over one set 
 data.py          a built library as generator features (any variant)
 features.py, fk.py   the 67-D frame representation and batched forward kinematics
 evaluation.py    Harvey et al. protocol (L2P, L2Q, NPSS); `g1 bench generator` is tools/bench_generator.py
-retarget.py, factory.py   the IK path to the locomotion tracker; generators by name for launch files
+factory.py       generators by name for launch files (the IK stage is built apart: g1_control/ik/stage.py)
+scripted.py, whole_body.py   scripted whole-body references; WholeBodyTrajectory (feasible plans)
 """

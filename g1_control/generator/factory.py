@@ -1,6 +1,8 @@
-"""Generator + retargeter pairs by name, for launch files and tools.
+"""Generators by name, for launch files and tools. The IK stage is built apart from the generator
+(g1_control/launch/builder.py:make_ik); a generator whose references are feasible by construction
+says so on each reference (KinematicReference.feasible_plan), and the IK stage passes those on.
 
-    velocity   the operator's velocity at the default pose; copy retargeter (no IK)
+    velocity   the operator's velocity at the default pose; feasible by construction (no IK)
     backbone   the in-betweening generator with the trained backbone (ONNX), through the IK
     learned_motion_matching   the same runtime with learned motion matching (lmm.py)
     interpolation / motion_matching   the same runtime with a baseline in-betweener (for comparison)
@@ -15,6 +17,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from g1_control.errors import G1ControlError
+from g1_control.interfaces import Generator
 from g1_control.types import CommandLimits
 
 GENERATORS = ("velocity", "backbone", "interpolation", "motion_matching", "learned_motion_matching")
@@ -44,19 +47,18 @@ def make_inbetweener(kind: str, *, model: str | Path | None = None, skeleton: st
 
 
 def make_generator(kind: str, *, model: str | Path | None = None, limits: CommandLimits | None = None,
-                   skeleton: str = "g1_29dof", feedback: bool = True):
-    """The generator and its retargeter; `limits`: the operator command range (the loop builder's
-    one source of velocity limits, g1_control/launch/builder.py); `skeleton`: the robot's
-    (generator/skeleton.py); `feedback`: reference-guided feedback when the model ships mixtures."""
-    from g1_control.generator.velocity import CopyRetargeter, VelocityReferenceGenerator
+                   skeleton: str = "g1_29dof", feedback: bool = True) -> Generator:
+    """The generator; `limits`: the operator command range (the loop builder's one source of
+    velocity limits, g1_control/launch/builder.py); `skeleton`: the robot's (generator/skeleton.py);
+    `feedback`: reference-guided feedback when the model ships mixtures."""
+    from g1_control.generator.velocity import VelocityReferenceGenerator
 
     if kind == "velocity":
-        return VelocityReferenceGenerator(limits), CopyRetargeter()
+        return VelocityReferenceGenerator(limits)
     if kind not in GENERATORS:
         raise G1ControlError(f"unknown generator '{kind}'; known: {', '.join(GENERATORS)}")
     from g1_control.generator.feedback import ReferenceFeedback
     from g1_control.generator.learned import SHIPPED_DIR
-    from g1_control.generator.retarget import GeneratorRetargeter
     from g1_control.generator.runtime import InbetweeningGenerator, RuntimeConfig
     from g1_control.generator.style_stats import load_style_stats
 
@@ -70,4 +72,4 @@ def make_generator(kind: str, *, model: str | Path | None = None, limits: Comman
         config.spring.max_vx_mps = min(config.spring.max_vx_mps, max(-limits.vx_mps[0], limits.vx_mps[1]))
         config.spring.max_vy_mps = min(config.spring.max_vy_mps, max(-limits.vy_mps[0], limits.vy_mps[1]))
         config.spring.max_wz_radps = min(config.spring.max_wz_radps, max(-limits.wz_radps[0], limits.wz_radps[1]))
-    return InbetweeningGenerator(inbetweener, styles, config, skeleton=skeleton, feedback=fb), GeneratorRetargeter()
+    return InbetweeningGenerator(inbetweener, styles, config, skeleton=skeleton, feedback=fb)

@@ -25,6 +25,12 @@ on the frame of its t_s when that falls inside the plan. The goal-error feedback
 own remaining error at the goal frame (FK of its joints, no IK) to the next plan's goal. The skeleton (29-DoF,
 23-DoF, with hands) is an input of the model; joints it lacks stay at 0 and, on the G1 with hands,
 the reference carries the finger angles (KinematicReference.hand_q_rad).
+
+Its references are not feasible by construction (no feasible_plan): the IK stage
+(g1_control/ik/stage.py) makes them so (limits, smoothness, effector goals as frame targets). The
+plan's heading-frame root velocity passes through the IK as the walking tracker's command, and
+the references ask for the upper body (upper_body_override), so the policy walks the generated
+root path while waist and arms follow the generated pose.
 """
 
 from __future__ import annotations
@@ -161,7 +167,7 @@ class InbetweeningGenerator(Generator):
         self._goal_offset: dict[str, tuple] = {}
         self._gap_goals: list[tuple] = []  # (frame, columns, value given, goal name, goal point)
         self.stats = PlanStats()
-        self.ref = KinematicReference()
+        self.ref = KinematicReference(upper_body_override=True)
         self._dt = 1.0 / self.config.fps
         self.history = np.zeros((0, F.DIM))
         self.plan = np.zeros((0, F.DIM))

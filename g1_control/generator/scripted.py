@@ -2,8 +2,8 @@
 
 Each builder returns a WholeBodyTrajectory (generator/whole_body.py): root pose, joint angles and
 the contact schedule sampled in time, played back through cubic splines. Poses that must keep the
-feet planted or put a hand somewhere come from the whole-body IK (WholeBodyIK, joint limits inside
-its iteration); stepping references take their CoM from ZMP preview control over a footstep plan
+feet planted or put a hand somewhere come from the whole-body IK (ik/whole_body.py: WholeBodyIK,
+joint limits inside its iteration); stepping references take their CoM from ZMP preview control over a footstep plan
 (zmp_preview.py).
 
     stand          the default pose, still
@@ -23,14 +23,10 @@ from collections.abc import Callable
 import numpy as np
 
 from g1_control.errors import WbcConfigError
-from g1_control.generator.whole_body import (
-    WholeBodyIK,
-    WholeBodyTrajectory,
-    smoothstep,
-    trajectory_from_configurations,
-)
+from g1_control.generator.whole_body import WholeBodyTrajectory, smoothstep, trajectory_from_configurations
 from g1_control.generator.zmp_preview import ZmpPreviewController
-from g1_control.interfaces import Generator, Retargeter
+from g1_control.ik.whole_body import WholeBodyIK
+from g1_control.interfaces import Generator
 from g1_control.robot import g1
 from g1_control.robot.dynamics import SOLE_FRAMES
 from g1_control.types import Command, JointReference, KinematicReference, RobotState
@@ -39,7 +35,9 @@ _trajectory = trajectory_from_configurations
 
 
 class TrajectoryGenerator(Generator):
-    """Plays a trajectory as the generator stage (time from the robot state's clock)."""
+    """Plays a trajectory as the generator stage (time from the robot state's clock). The trajectory
+    is feasible by construction: each reference carries its sample (with the exact joint
+    velocities a KinematicReference does not hold) as the feasible plan the IK stage passes on."""
 
     def __init__(self, trajectory: WholeBodyTrajectory):
         self.trajectory = trajectory
@@ -57,27 +55,16 @@ class TrajectoryGenerator(Generator):
         return ref
 
 
-class TrajectoryRetargeter(Retargeter):
-    """The trajectory is feasible by construction: sample it (with exact joint velocities, which
-    a KinematicReference does not carry) at the generator's time."""
-
-    def __init__(self, trajectory: WholeBodyTrajectory):
-        self.trajectory = trajectory
-        self._out = JointReference()
-
-    def solve(self, reference: KinematicReference, q_prev: np.ndarray) -> JointReference:
-        return self.trajectory.sample(reference.t_s, self._out)
-
-
 # -- the references ------------------------------------------------------------------------------------------
-def stand(duration_s: float = 60.0) -> WholeBodyTrajectory:
-    q0 = WholeBodyIK().nominal()
+def stand(duration_s: float = 60.0, variant: str = "g1_29dof") -> WholeBodyTrajectory:
+    q0 = WholeBodyIK(g1.variant_named(variant)).nominal()
     t = np.array([0.0, duration_s])
     return _trajectory("stand", t, np.array([q0, q0]), np.ones((2, 2), dtype=bool))
 
 
-def arm_wave(duration_s: float = 10.0, frequency_hz: float = 0.5, amplitude_rad: float = 0.6) -> WholeBodyTrajectory:
-    q0 = WholeBodyIK().nominal()
+def arm_wave(duration_s: float = 10.0, frequency_hz: float = 0.5, amplitude_rad: float = 0.6,
+             variant: str = "g1_29dof") -> WholeBodyTrajectory:
+    q0 = WholeBodyIK(g1.variant_named(variant)).nominal()
     t = np.arange(0.0, duration_s + 1e-9, 0.01)
     qs = np.repeat(q0[None], len(t), axis=0)
     ramp = smoothstep(t / 1.0) * smoothstep((duration_s - t) / 1.0)
@@ -94,8 +81,8 @@ def _planted_feet(ik: WholeBodyIK, q0: np.ndarray) -> list[tuple[np.ndarray, np.
     return [ik.frame_pose(q0, name) for name in SOLE_FRAMES]
 
 
-def crouch(depth_m: float = 0.15, down_s: float = 2.0, hold_s: float = 1.5) -> WholeBodyTrajectory:
-    ik = WholeBodyIK()
+def crouch(depth_m: float = 0.15, down_s: float = 2.0, hold_s: float = 1.5, variant: str = "g1_29dof") -> WholeBodyTrajectory:
+    ik = WholeBodyIK(g1.variant_named(variant))
     q0 = ik.nominal()
     soles = _planted_feet(ik, q0)
     com_xy = ik.com(q0)[:2]
@@ -110,10 +97,10 @@ def crouch(depth_m: float = 0.15, down_s: float = 2.0, hold_s: float = 1.5) -> W
 
 
 def lean_reach(ahead_m: float = 0.5, height_m: float = 0.8, side_m: float = -0.2,
-               reach_s: float = 2.5, hold_s: float = 2.0) -> WholeBodyTrajectory:
+               reach_s: float = 2.5, hold_s: float = 2.0, variant: str = "g1_29dof") -> WholeBodyTrajectory:
     """Right hand to (ahead_m, side_m, height_m) in the start pelvis's ground frame, CoM kept over
     the feet (the hips move back as the torso leans), then back to the default pose."""
-    ik = WholeBodyIK()
+    ik = WholeBodyIK(g1.variant_named(variant))
     q0 = ik.nominal()
     soles = _planted_feet(ik, q0)
     com_xy = ik.com(q0)[:2]
@@ -135,11 +122,12 @@ def lean_reach(ahead_m: float = 0.5, height_m: float = 0.8, side_m: float = -0.2
 
 def stepping(footsteps: list[tuple[int, np.ndarray]], *, single_support_s: float = 0.4,
              double_support_s: float = 0.15, lift_m: float = 0.05, start_s: float = 1.0, end_s: float = 1.5,
-             pelvis_drop_m: float = 0.02, name: str = "stepping", dt_s: float = 0.01) -> WholeBodyTrajectory:
+             pelvis_drop_m: float = 0.02, name: str = "stepping", dt_s: float = 0.01,
+             variant: str = "g1_29dof") -> WholeBodyTrajectory:
     """Footsteps (foot index 0 left / 1 right, new sole xy) taken one after another; CoM from
     ZMP preview control, ZMP on the stance sole during single support and moving linearly
     between soles during double support."""
-    ik = WholeBodyIK()
+    ik = WholeBodyIK(g1.variant_named(variant))
     q0 = ik.nominal()
     soles0 = _planted_feet(ik, q0)
     com0 = ik.com(q0)

@@ -3,8 +3,9 @@
 Root velocity from the command, both feet in contact, and the posture of the commanded style
 (g1_control/generator/styles.py: a waist and arm pose, maybe with a periodic part; legs at the
 default pose). The 'default' style and the data-only styles leave the upper body to the tracker.
-It is feasible by construction, so its retargeter only copies fields (no IK). The learned
-generator replaces both without touching the loop.
+It is feasible by construction: each reference carries its own joint reference as the feasible
+plan, which the IK stage passes on without solving. The learned generator replaces it without
+touching the loop.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from g1_control.generator.styles import ROLLOUT_STYLES
-from g1_control.interfaces import Generator, Retargeter
+from g1_control.interfaces import Generator
 from g1_control.robot import g1
 from g1_control.types import Command, CommandLimits, JointReference, KinematicReference, RobotState
 
@@ -26,6 +27,8 @@ class VelocityReferenceGenerator(Generator):
         self.limits = limits or CommandLimits()
         self.blend_s = blend_s
         self._ref = KinematicReference(q_rad=g1.DEFAULT_Q_RAD.copy())
+        self._plan = JointReference()
+        self._ref.feasible_plan = self._plan
         self._style: str | None = None
         self._from_q = g1.DEFAULT_Q_RAD.copy()
         self._from_override = False
@@ -65,17 +68,12 @@ class VelocityReferenceGenerator(Generator):
         else:
             ref.q_rad[:] = target
             ref.upper_body_override = override
+        self._fill_plan(ref)
         return ref
 
-
-class CopyRetargeter(Retargeter):
-    """For references that are feasible by construction: copies fields, solves nothing."""
-
-    def __init__(self) -> None:
-        self._out = JointReference()
-
-    def solve(self, reference: KinematicReference, q_prev: np.ndarray) -> JointReference:
-        out = self._out
+    def _fill_plan(self, reference: KinematicReference) -> None:
+        """The reference as the tracker takes it (no joint velocities, no hand forces)."""
+        out = self._plan
         out.t_s = reference.t_s
         out.q_rad[:] = reference.q_rad
         out.root_pos_w_m[:] = reference.root_pos_w_m
@@ -85,4 +83,3 @@ class CopyRetargeter(Retargeter):
         out.contacts[:] = reference.contacts
         out.upper_body_override = reference.upper_body_override
         out.pelvis_height_m = reference.pelvis_height_m
-        return out

@@ -22,6 +22,43 @@ from g1_control.ik.tasks.frame_task import FrameTask, stack_frame_tasks
 BACKENDS = ("daqp", "proxqp")
 
 
+def import_proxsuite():
+    """proxsuite with its portable (SSE2) build of the solver rather than the AVX2/AVX-512 build its
+    package picks on this CPU: those builds give answers that differ in the last bits depending on
+    where their work buffers happen to lie in memory (measured: the same dense QP, solved 200 times
+    in one process, gave two different x under AVX-512 and under AVX2, one under the portable build,
+    which costs ~5 % more per solve), and a lockstep run must be bit-identical from run to run.
+
+    The package's own __init__ (which loads the fastest build) is bypassed; `import proxsuite`
+    elsewhere then gets this module. If proxsuite was imported before, that module is returned
+    as it is (two builds cannot live in one process)."""
+    import importlib
+    import importlib.util
+    import sys
+    import types
+
+    loaded = sys.modules.get("proxsuite")
+    if loaded is not None:
+        return loaded
+    spec = importlib.util.find_spec("proxsuite")
+    if spec is None or spec.submodule_search_locations is None:
+        raise ImportError("proxsuite is not installed (pip install proxsuite)")
+    package = types.ModuleType("proxsuite", "proxsuite, its portable build (g1_control.ik.solver.import_proxsuite)")
+    package.__path__ = list(spec.submodule_search_locations)
+    package.__spec__ = spec
+    sys.modules["proxsuite"] = package
+    try:
+        core = importlib.import_module("proxsuite.proxsuite_pywrap")
+    except ImportError:
+        del sys.modules["proxsuite"]
+        import proxsuite
+
+        return proxsuite
+    package.__dict__.update({k: v for k, v in vars(core).items() if not k.startswith("__")})
+    package.build = "portable"  # type: ignore[attr-defined]
+    return package
+
+
 class QPSolver:
     """Reusable solver for one model size; keeps its work arrays between calls."""
 
@@ -40,9 +77,7 @@ class QPSolver:
 
             self._daqp = daqp
         else:
-            import proxsuite
-
-            self._proxsuite = proxsuite
+            self._proxsuite = import_proxsuite()
 
     def build(self, configuration: Configuration, tasks: Sequence[Task], limits: Sequence[Limit],
               dt_s: float) -> tuple[list[RowConstraint], list[RowConstraint]]:

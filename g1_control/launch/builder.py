@@ -6,8 +6,9 @@
     loop = build_loop(dry_run_launch(launch))                   # the deploy preflight's dry run
 
 `g1 launch`, `g1 deploy`, the preflight's dry run, the motion library's physics rollouts and the
-WBC evaluation all call `build_loop`: the generator -> retargeter -> tracker chain, the rates, the
-safety filter and the estimator come from the launch file alone. Only the backend (MuJoCo or a
+WBC evaluation all call `build_loop`: the generator -> IK -> tracker chain (each stage built on its
+own, from its own section: make_generator, make_ik, make_tracker), the rates, the safety filter
+and the estimator come from the launch file alone. Only the backend (MuJoCo or a
 robot link) and the input device may be handed in, and on the robot the deploy state machine
 wraps the tracker. `loop.chain` names the stages, so a deploy can show that its dry run ran the
 same chain as the robot (g1_control/deploy/session.py).
@@ -20,8 +21,9 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from g1_control.errors import LaunchFileError
-from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, Tracker
+from g1_control.interfaces import Backend, Generator, InputDevice, Tracker
 from g1_control.launch.schema import SKELETON_GENERATORS, LaunchFile
+from g1_control.launch.variant import check_tracker_fits, robot_variant
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.safety import SafetyConfig, SafetyFilter
 from g1_control.safety.fall import FallMonitor
@@ -29,6 +31,7 @@ from g1_control.teleop.scripted import Segment, random_timeline
 from g1_control.types import CommandLimits
 
 if TYPE_CHECKING:
+    from g1_control.ik.stage import IKStage
     from g1_control.sim.mujoco_backend import MujocoBackend
 
 CHAIN_STAGES = ("generator", "retargeter", "tracker", "rates", "safety")
@@ -52,6 +55,7 @@ def timeline_of(launch: LaunchFile) -> list[Segment]:
 
 def make_tracker(launch: LaunchFile) -> Tracker:
     cfg = launch.tracker
+    check_tracker_fits(launch)  # a policy that does not fit the robot variant is refused by name
     if cfg.type == "policy":
         from g1_control.trackers.locomotion import LocomotionPolicyTracker, VelocityCorrectionConfig
         from g1_control.trackers.policy_spec import load_spec
@@ -61,7 +65,8 @@ def make_tracker(launch: LaunchFile) -> Tracker:
     if cfg.type == "wbc":
         from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
 
-        return WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz))
+        return WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz), variant=robot_variant(launch),
+                                hands=launch.backend.hands)
     if cfg.type == "wbt":
         from g1_control.trackers.wbt import WbtPolicyTracker
 
@@ -74,7 +79,9 @@ def make_tracker(launch: LaunchFile) -> Tracker:
 
         policy = LocomotionPolicyTracker(load_spec(cfg.policy), VelocityCorrectionConfig(enabled=cfg.velocity_correction),
                                          envelope_limits=cfg.envelope_limits)
-        return TrackingLayer(policy, WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz)), launch.rates.tracker_hz)
+        wbc = WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz), variant=robot_variant(launch),
+                               hands=launch.backend.hands)
+        return TrackingLayer(policy, wbc, launch.rates.tracker_hz)
     raise LaunchFileError(f"tracker.type: unknown tracker '{cfg.type}'")
 
 
@@ -86,16 +93,33 @@ def command_limits(launch: LaunchFile, tracker_limits: CommandLimits | None) -> 
     return limits if tracker_limits is None else limits.intersect(tracker_limits)
 
 
+def make_ik(launch: LaunchFile) -> IKStage:
+    """The IK stage of the launch file's `ik:` section (g1_control/launch/schema.py: IKSection), one
+    solve per tracker tick."""
+    from g1_control.ik.exceptions import InvalidFrameError
+    from g1_control.ik.retargeter import IKConfig
+    from g1_control.ik.stage import IKStage
+
+    section = dataclasses.asdict(launch.ik)
+    stage = IKStage(IKConfig(dt_s=1.0 / launch.rates.tracker_hz, **section))
+    for frame in launch.ik.frame_costs:
+        try:
+            stage.ik.configuration.frame_id(frame)
+        except InvalidFrameError as exc:
+            raise LaunchFileError(f"ik.frame_costs.{frame}: {exc}") from None
+    return stage
+
+
 def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
-                   tracker: Tracker | None = None) -> tuple[Generator, Retargeter]:
-    """The generator and retargeter; with tracker.type layer, the launch file's generator inside a
-    GoalGenerator that executes task goals against the scene (g1_control/generator/goals/)."""
+                   tracker: Tracker | None = None) -> Generator:
+    """The generator; with tracker.type layer, the launch file's generator inside a GoalGenerator
+    that executes task goals against the scene (g1_control/generator/goals/)."""
     cfg = launch.generator
     if cfg.type == "scripted":
-        from g1_control.generator.scripted import TrajectoryGenerator, TrajectoryRetargeter, build_reference
+        from g1_control.generator.scripted import TrajectoryGenerator, build_reference
 
-        trajectory = build_reference(cfg.reference, **cfg.reference_params)
-        return TrajectoryGenerator(trajectory), TrajectoryRetargeter(trajectory)
+        return TrajectoryGenerator(build_reference(cfg.reference, variant=launch.backend.expected_variant,
+                                                   **cfg.reference_params))
     from g1_control.generator.factory import make_generator as make_named
 
     skeleton = "g1_29dof"
@@ -103,11 +127,10 @@ def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
         from g1_control.generator.skeleton import skeleton_for_robot
 
         skeleton = skeleton_for_robot(launch.backend.expected_variant, launch.backend.hands)
-    generator, retargeter = make_named(cfg.type, model=cfg.model or None, limits=limits, skeleton=skeleton,
-                                       feedback=cfg.feedback)
+    generator = make_named(cfg.type, model=cfg.model or None, limits=limits, skeleton=skeleton, feedback=cfg.feedback)
     if launch.tracker.type != "layer":
-        return generator, retargeter
-    from g1_control.generator.goals.executor import GoalConfig, GoalGenerator, GoalRetargeter
+        return generator
+    from g1_control.generator.goals.executor import GoalConfig, GoalGenerator
     from g1_control.trackers.layer import TrackingLayer
 
     config = GoalConfig()
@@ -115,8 +138,7 @@ def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
     config.plan_in_background = launch.backend.mode == "wallclock" or launch.backend.type != "mujoco"
     if isinstance(tracker, TrackingLayer):  # the walking policy's own height range (its envelope)
         config.policy_height_m = tracker.policy.command_limits.pelvis_height_m
-    goals = GoalGenerator(generator, launch.scene, config)
-    return goals, GoalRetargeter(goals, retargeter)
+    return GoalGenerator(generator, launch.scene, config)
 
 
 def make_sim_backend(launch: LaunchFile) -> MujocoBackend:
@@ -125,10 +147,12 @@ def make_sim_backend(launch: LaunchFile) -> MujocoBackend:
                               "run it with `g1 deploy`, which checks the robot before anything moves")
     from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
 
-    return MujocoBackend(MujocoConfig(physics_dt_s=launch.backend.physics_dt_s, lockstep=True), scene=launch.scene)
+    return MujocoBackend(MujocoConfig(physics_dt_s=launch.backend.physics_dt_s, lockstep=True,
+                                      variant=launch.backend.expected_variant, hands=launch.backend.hands),
+                         scene=launch.scene)
 
 
-def describe_chain(launch: LaunchFile, generator: Generator, retargeter: Retargeter, tracker: Tracker) -> dict[str, str]:
+def describe_chain(launch: LaunchFile, generator: Generator, ik: IKStage, tracker: Tracker) -> dict[str, str]:
     g, t, r = launch.generator, launch.tracker, launch.rates
     what_generator = g.type + (f" {g.model}" if g.model else "") + (
         f" {g.reference} {g.reference_params}" if g.type == "scripted" else "")
@@ -137,7 +161,7 @@ def describe_chain(launch: LaunchFile, generator: Generator, retargeter: Retarge
     s = safety_config(launch)
     return {
         "generator": f"{type(generator).__name__} [{what_generator}]",
-        "retargeter": type(retargeter).__name__,
+        "retargeter": ik.describe(),
         "tracker": f"{type(tracker).__name__} [{what_tracker}]",
         "rates": f"tracker {r.tracker_hz:g} Hz, input {r.input_hz:g} Hz, estimator {r.estimator_hz:g} Hz, "
                  f"low-level {r.lowlevel_hz:g} Hz",
@@ -159,8 +183,9 @@ def build_loop(launch: LaunchFile, *, backend: Backend | None = None, input_devi
 
     tracker = make_tracker(launch)
     limits = command_limits(launch, tracker.command_limits)
-    generator, retargeter = make_generator(launch, limits, tracker)
-    chain = describe_chain(launch, generator, retargeter, tracker)
+    generator = make_generator(launch, limits, tracker)
+    ik = make_ik(launch)
+    chain = describe_chain(launch, generator, ik, tracker)
     if backend is None:
         backend = make_sim_backend(launch)
     if input_device is None:
@@ -173,7 +198,7 @@ def build_loop(launch: LaunchFile, *, backend: Backend | None = None, input_devi
         wallclock = launch.backend.mode == "wallclock" or not backend.lockstep
     r = launch.rates
     capacity = log_capacity if log_capacity is not None else int(launch.total_duration_s * r.tracker_hz) + 2
-    loop = ControlLoop(backend, input_device, generator, retargeter, tracker, r, wallclock=wallclock,
+    loop = ControlLoop(backend, input_device, generator, ik, tracker, r, wallclock=wallclock,
                        safety=safety, log_capacity=capacity,
                        falls=FallMonitor(launch.fall, max_tilt_rad=safety.config.max_tilt_rad))
     chain["input"] = type(input_device).__name__

@@ -28,7 +28,7 @@ from g1_control.errors import Interrupted
 from g1_control.interfaces import InputDevice
 from g1_control.launch.builder import build_loop, make_sim_backend, timeline_of
 from g1_control.launch.schema import LaunchFile
-from g1_control.loop.control_loop import ControlLoop
+from g1_control.loop.control_loop import ControlLoop, first_fault
 from g1_control.report.overlay import overlay_lines
 from g1_control.report.results import RunResult, run_result, summary_dict
 from g1_control.report.run_folder import RunFolder, interrupt_on_signals
@@ -219,7 +219,7 @@ def write_run_folder(result: RunResult, launch: LaunchFile, loop: ControlLoop, f
                                launch.output.video_size, overlay=overlay, extra=_scene_arrays(launch, watcher))
         result.video = str(run_dir / "video.mp4") if backend else None
         result.extra["render_backend"] = backend
-    trip = next((e for e in result.events if "damping" in e["detail"]), None)
+    trip = first_fault(result.events)
     if interrupted is not None:
         status, reason = "interrupted", str(interrupted)
     elif trip is not None:

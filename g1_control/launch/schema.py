@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -13,6 +14,7 @@ from typing import Any, Literal
 from g1_control.config import apply_overrides, from_dict, read_yaml
 from g1_control.errors import LaunchFileError, SafetyConfigError
 from g1_control.loop.rates import LoopRates
+from g1_control.robot import g1
 from g1_control.safety.config import SafetyConfig
 from g1_control.safety.fall import FallConfig
 from g1_control.scene import FLOOR, SceneConfig
@@ -77,6 +79,9 @@ class BackendConfig:
         if not 0.0005 <= self.physics_dt_s <= 0.005:
             raise LaunchFileError(f"{where}.physics_dt_s: {self.physics_dt_s} is outside [0.0005, 0.005] s "
                                   "(physics must run at 200 Hz or faster)")
+        if self.hands == "dex3" and self.expected_variant != "g1_29dof":
+            raise LaunchFileError(f"{where}.hands: Dex3 hands are modelled on the 29-DoF G1 only; "
+                                  f"expected_variant is {self.expected_variant}")
         if self.type == "mujoco":
             return
         if self.type == "unitree_dds":
@@ -136,9 +141,11 @@ class DeployConfig:
     joint_limit_tolerance_rad: float = 0.02
     """Measured joints may sit this far outside their limits (encoder noise at an end stop)."""
     max_start_temperature_c: float = 70.0
-    """Every motor must be cooler than this to start (the runtime trip is safety.max_motor_temperature_c)."""
+    """Every motor must be cooler than this to start (the runtime trip is safety.max_motor_temperature_c); at
+    most the motors' rating (robot.g1.MOTOR_MAX_TEMPERATURE_C)."""
     min_battery_v: float = 40.0
-    """Checked when the transport reports a battery voltage (the G1's LowState_ does not)."""
+    """Checked when the transport reports a battery voltage (the G1's LowState_ does not); inside the pack's
+    range (robot.g1.BATTERY_EMPTY_V, BATTERY_FULL_V), where the check can fire."""
     dry_run_s: float = 10.0
     """Lockstep MuJoCo run of the same launch file before the robot moves; it must not fall."""
     input_check_s: float = 0.3
@@ -160,6 +167,16 @@ class DeployConfig:
         if not 0 <= self.realtime_priority <= 99:
             raise LaunchFileError(f"{where}.realtime_priority: {self.realtime_priority} is not a real-time priority "
                                   "(1..99, or 0 for normal scheduling)")
+        if self.max_start_temperature_c > g1.MOTOR_MAX_TEMPERATURE_C:
+            raise LaunchFileError(f"{where}.max_start_temperature_c: {self.max_start_temperature_c} °C is above the "
+                                  f"motors' rating ({g1.MOTOR_MAX_TEMPERATURE_C:g} °C); the start check could never "
+                                  "refuse a motor in time")
+        if not g1.BATTERY_EMPTY_V < self.min_battery_v < g1.BATTERY_FULL_V:
+            never = "fire (the pack is never that low)" if self.min_battery_v <= g1.BATTERY_EMPTY_V else \
+                "pass (the pack is never that high)"
+            raise LaunchFileError(f"{where}.min_battery_v: {self.min_battery_v} V is outside the G1 battery's range "
+                                  f"({g1.BATTERY_EMPTY_V:g} V empty, {g1.BATTERY_FULL_V:g} V full); the check could "
+                                  f"never {never}")
         if self.min_state_rate_hz <= 0 or self.max_start_tilt_rad <= 0 or self.joint_limit_tolerance_rad < 0:
             raise LaunchFileError(f"{where}: min_state_rate_hz and max_start_tilt_rad must be positive, "
                                   "joint_limit_tolerance_rad not negative")
@@ -212,6 +229,65 @@ class GeneratorConfig:
     reference_params: dict[str, float] = field(default_factory=dict)
     """type scripted: the reference's parameters (e.g. {duration_s: 20} for stand, {speed_mps: 0.3}
     for walk; see the functions in g1_control/generator/scripted.py)."""
+
+
+@dataclass
+class IKSection:
+    """The IK stage between generator and tracker (g1_control/ik/stage.py: IKStage). A reference
+    the generator made feasible by construction (velocity, scripted, a goal's whole-body plan)
+    passes through; any other (backbone and the other learned generators) is solved by the
+    differential-IK QP (g1_control/ik/retargeter.py: IKRetargeter) with these settings, one solve
+    per tracker tick (its time step is 1 / rates.tracker_hz). The names are IKConfig's.
+
+    The defaults are the loop's: the legs belong to the walking policy. Holding stance feet where
+    they touched down or moving the CoM would make the IK bend the arms to reach a generated root
+    the real robot is not at (measured: it swung both arms overhead and tipped the robot over), so
+    contacts are free and the CoM has no cost; what the IK adds is feasibility of the upper body
+    (joint position and velocity limits, smoothness) and effector goals as frame targets.
+    """
+
+    backend: Literal["daqp", "proxqp"] = "daqp"
+    """The QP solver (g1_control/ik/solver.py)."""
+    iterations: int = 1
+    """QP steps per tick (one is enough online: the target moves little per tick)."""
+    root_cost: tuple[float, float] = (10.0, 5.0)
+    """(position 1/m, orientation 1/rad) cost of the pelvis following the reference root pose."""
+    com_cost: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    """Per world axis: the CoM follows the reference posture's CoM (0: free, see above)."""
+    posture_cost: float = 0.3
+    default_frame_cost: tuple[float, float] = (5.0, 1.0)
+    """(position, orientation) cost of a frame target (an effector goal) not in frame_costs."""
+    frame_costs: dict[str, tuple[float, float]] = field(default_factory=dict)
+    """Per frame name (a link of the G1 model): (position, orientation) cost."""
+    damping_cost: float = 1e-3
+    smoothness_cost: float = 0.05
+    velocity_limit_scale: float = 1.0
+    """Fraction of the motors' velocity limits the IK may use, in (0, 1]."""
+    joint_margin_rad: float = 0.0
+    """The IK keeps the joints this far inside their position limits."""
+    hold_contacts: bool = False
+    """Hold stance feet where they touched down (off in the loop, see above)."""
+    enforce_ground: bool = True
+    """Keep the feet above the floor."""
+    self_collision: bool = False
+    """Keep every pair of non-adjacent links apart (the URDF's collision meshes; costs CPU)."""
+
+    def validate(self, where: str) -> None:
+        if self.iterations < 1:
+            raise LaunchFileError(f"{where}.iterations: {self.iterations} must be >= 1 (QP steps per tick)")
+        costs = {"root_cost": self.root_cost, "com_cost": self.com_cost, "posture_cost": (self.posture_cost,),
+                 "default_frame_cost": self.default_frame_cost, "damping_cost": (self.damping_cost,),
+                 "smoothness_cost": (self.smoothness_cost,)}
+        costs.update({f"frame_costs.{name}": cost for name, cost in self.frame_costs.items()})
+        for name, values in costs.items():
+            if any(v < 0 for v in values):
+                shown = values[0] if len(values) == 1 else list(values)
+                raise LaunchFileError(f"{where}.{name}: {shown} has a negative cost (costs are >= 0; 0 disables)")
+        if not 0.0 < self.velocity_limit_scale <= 1.0:
+            raise LaunchFileError(f"{where}.velocity_limit_scale: {self.velocity_limit_scale} is outside (0, 1] "
+                                  "(a fraction of the motors' velocity limits)")
+        if not 0.0 <= self.joint_margin_rad < 0.2:
+            raise LaunchFileError(f"{where}.joint_margin_rad: {self.joint_margin_rad} is outside [0, 0.2) rad")
 
 
 TELEOP_DEVICES = ("gamepad", "keyboard", "unitree_remote")
@@ -310,7 +386,7 @@ class LimitsConfig:
     max_vy_mps: float = 0.6
     max_wz_radps: float = 1.0
     max_tilt_rad: float = 1.0
-    """Beyond this pelvis tilt the robot counts as fallen and the loop damps it."""
+    """Beyond this pelvis tilt the robot counts as fallen and the loop damps it (below pi: no tilt exceeds pi)."""
 
     def validate(self, where: str) -> None:
         for name in ("max_vx_mps", "max_vy_mps", "max_wz_radps", "max_tilt_rad"):
@@ -318,6 +394,9 @@ class LimitsConfig:
             if not value > 0:
                 raise LaunchFileError(f"{where}.{name}: {value} must be > 0 (a limit on the magnitude, both "
                                       "directions)")
+        if self.max_tilt_rad >= math.pi:
+            raise LaunchFileError(f"{where}.max_tilt_rad: {self.max_tilt_rad} rad must be below pi ({math.pi:.4f}): "
+                                  "no tilt exceeds pi, so the fall could never be detected")
 
 
 @dataclass
@@ -339,6 +418,8 @@ class LaunchFile:
     rates: LoopRates = field(default_factory=LoopRates)
     tracker: TrackerConfig = field(default_factory=TrackerConfig)
     generator: GeneratorConfig = field(default_factory=GeneratorConfig)
+    ik: IKSection = field(default_factory=IKSection)
+    """The IK stage (absent: the loop's defaults, IKSection)."""
     input: InputConfig = field(default_factory=InputConfig)
     limits: LimitsConfig = field(default_factory=LimitsConfig)
     output: OutputConfig = field(default_factory=OutputConfig)
@@ -364,7 +445,8 @@ class LaunchFile:
                                       f"known: {', '.join(REFERENCES)}")
             import inspect
 
-            accepted = inspect.signature(REFERENCES[self.generator.reference]).parameters
+            # the robot variant is backend.expected_variant's, never a reference parameter
+            accepted = [p for p in inspect.signature(REFERENCES[self.generator.reference]).parameters if p != "variant"]
             unknown = sorted(set(self.generator.reference_params) - set(accepted))
             if unknown:
                 raise LaunchFileError(f"generator.reference_params: {', '.join(unknown)} not a parameter of reference "
@@ -487,8 +569,8 @@ def parse_launch(data, source: str = "<launch>") -> LaunchFile:
         return from_dict(LaunchFile, data, "")
     except LaunchFileError as exc:
         raise LaunchFileError(f"{source}: {exc}") from None
-    except SafetyConfigError as exc:
-        raise LaunchFileError(f"{source}: safety: {exc}") from None
+    except SafetyConfigError as exc:  # SafetyConfig's own messages, or fall.* (FallConfig, which names its key)
+        raise LaunchFileError(f"{source}: {'safety: ' if str(exc).startswith('SafetyConfig') else ''}{exc}") from None
 
 
 def load_launch(path: str | Path, overrides: Iterable[str] = ()) -> LaunchFile:

@@ -18,6 +18,7 @@ from g1_control.loop.scheduler import Scheduler, Stage
 from g1_control.robot import g1
 from g1_control.rotations import quat_to_rot_rows, tilt_rad, yaw_of
 from g1_control.safety import SafetyConfig, SafetyFilter
+from g1_control.safety.events import SafetyEvent
 from g1_control.safety.fall import Fall, FallMonitor
 from g1_control.types import Button, Command, ExecutionFeedback, JointReference, KinematicReference, RobotState
 
@@ -27,6 +28,24 @@ class LoopEvent:
     t_s: float
     kind: str
     detail: str
+    trips: bool = False
+    """True for the safety event that switched the robot to damping for good (SafetyEvent.trips)."""
+    planned: bool = False
+    """A planned ending (operator stop, end of the control time, a signal): not a fault."""
+
+    @classmethod
+    def of_safety(cls, event: SafetyEvent, loop_t_s: float) -> LoopEvent:
+        """The loop's record of a safety event (its kind, detail and type flags kept as they are)."""
+        return cls(loop_t_s, event.kind.value, event.detail, event.trips, event.planned)
+
+    def __str__(self) -> str:
+        return f"{self.kind}{' (damping)' if self.trips else ''}: {self.detail}"
+
+
+def first_fault(events: list[dict]) -> dict | None:
+    """The first unplanned trip among a run's events (LoopEvent dicts, as in summary.json), or None.
+    Trips are found by their type (the `trips` flag), never by the wording of their detail."""
+    return next((e for e in events if e.get("trips") and not e.get("planned")), None)
 
 
 @dataclass
@@ -161,8 +180,8 @@ class ControlLoop:
     def time_s(self) -> float:
         return self.scheduler.time_s
 
-    def _event(self, kind: str, detail: str, record: dict | None = None) -> None:
-        self.events.append(LoopEvent(self.time_s, kind, detail))
+    def _event(self, kind: str, detail: str, record: dict | None = None, event: LoopEvent | None = None) -> None:
+        self.events.append(event or LoopEvent(self.time_s, kind, detail))
         if self.on_record is not None:
             self.on_record(record or {"type": "loop", "t_s": self.time_s, "kind": kind, "detail": detail})
 
@@ -182,10 +201,11 @@ class ControlLoop:
     def fell(self) -> bool:
         return self.falls.fall is not None
 
-    def _on_safety_event(self, event) -> None:
-        self._event(event.kind.value, event.detail + ("; damping" if event.trips else ""),
+    def _on_safety_event(self, event: SafetyEvent) -> None:
+        self._event(event.kind.value, event.detail,
                     {"type": "safety", "t_s": event.t_s, "loop_t_s": self.time_s, "kind": event.kind.value,
-                     "detail": event.detail, "trips": event.trips, "planned": event.planned})
+                     "detail": event.detail, "trips": event.trips, "planned": event.planned},
+                    LoopEvent.of_safety(event, self.time_s))
 
     # -- stages --------------------------------------------------------------------------------------
     def _input(self) -> None:

@@ -36,12 +36,12 @@ WARNING_SHOWN_S = 2.0
 
 def safety_state_at(t_s: float, events: list[dict]) -> str:
     """The safety state at `t_s` from a run's events (summary.json): DAMPING once a tripping event
-    happened (the loop appends '; damping' to those), a recent warning, else ok."""
+    happened (its `trips` flag), a recent warning, else ok."""
     state = "ok"
     for e in events:
         if e["t_s"] > t_s:
             break
-        if str(e.get("detail", "")).endswith("damping"):
+        if e.get("trips"):
             return f"DAMPING ({e['kind']})"
         if t_s - e["t_s"] <= WARNING_SHOWN_S:
             state = f"warning: {e['kind']}"

@@ -76,11 +76,7 @@ def plot_run(log: dict[str, np.ndarray], result, out: Path) -> None:
         axes[0].text((seg.start_s + seg.end_s) / 2, 1.02, seg.label, transform=axes[0].get_xaxis_transform(),
                      ha="center", va="bottom", fontsize=8, clip_on=False,
                      rotation=0 if seg.end_s - seg.start_s >= 4.5 else 30)
-    trip = None
-    for e in result.events:
-        if str(e.get("detail", "")).endswith("damping"):
-            trip = e
-            break
+    trip = next((e for e in result.events if e.get("trips")), None)
     if trip is not None:
         for ax in axes:
             ax.axvline(trip["t_s"], color="tab:red", lw=1.2, zorder=7)

@@ -210,7 +210,7 @@ def format_summary(result: RunResult) -> str:
     if result.estimator_rms_mps is not None:
         lines.append(f"state estimator velocity RMS error vs ground truth: {result.estimator_rms_mps:.3f} m/s")
     for e in result.events:
-        lines.append(f"event at {e['t_s']:.2f} s: {e['kind']}: {e['detail']}")
+        lines.append(f"event at {e['t_s']:.2f} s: {e['kind']}{' (damping)' if e.get('trips') else ''}: {e['detail']}")
     if result.extra.get("goals"):
         from g1_control.report.outcomes import outcome_line
 

@@ -94,6 +94,31 @@ class ClipMetrics:
                 and (kept is None or kept >= min_object_contact_fraction))
 
 
+def failures(metrics: ClipMetrics, max_sliding_fraction: float = 0.01,
+             min_object_contact_fraction: float = 0.95) -> list[str]:
+    """Why a clip misses the acceptance figures (ClipMetrics.passes), one phrase per figure it
+    misses, with the numbers; [] when it passes."""
+    m, out = metrics, []
+    if m.joint_limit_violations:
+        out.append(f"{m.joint_limit_violations} joint position(s) outside the URDF's limits")
+    if m.velocity_limit_violations:
+        out.append(f"{m.velocity_limit_violations} joint velocit(ies) above the URDF's limits (up to "
+                   f"{m.max_velocity_ratio:.2f}x)")
+    if m.penetration_frames:
+        out.append(f"{m.penetration_fraction:.0%} of frames with a link > 1 cm inside the floor or the scene, up to "
+                   f"{m.max_penetration_m * 100:.1f} cm ({m.penetration_link})")
+    if m.sliding_fraction > max_sliding_fraction:
+        out.append(f"{m.sliding_fraction:.0%} of stance frames sliding > 1 cm/frame (up to "
+                   f"{m.max_sliding_m_per_frame * 100:.1f} cm)")
+    if m.self_collision_frames:
+        out.append(f"{m.self_collision_frames} self-collision frame(s), up to {m.max_self_penetration_m * 100:.1f} cm "
+                   f"({m.self_collision_pair})")
+    kept = m.object_contact_preserved_fraction
+    if kept is not None and kept < min_object_contact_fraction:
+        out.append(f"{kept:.0%} of the source's hand-object contacts kept")
+    return out
+
+
 def compute_metrics(clip: MotionClip, scene: tuple[ObjectShape, ...] | None = None, penetration_m: float = 0.01,
                     sliding_m: float = 0.01, tolerance: float = 1e-6, object_contact_m: float = 0.08,
                     geometry: ClipGeometry | None = None) -> ClipMetrics:

@@ -19,6 +19,18 @@ from g1_control.errors import RobotDescriptionError
 from g1_control.robot import g1
 
 URDF_RELATIVE = "robots/g1_description/urdf/g1_29dof_rev_1_0.urdf"
+HAND_URDF_RELATIVE = "robots/g1_description/urdf/g1_29dof_with_hand_rev_1_0.urdf"
+"""The G1 with Dex3-1 hands (backend.hands: dex3): the same 29 joints, a palm and 7 finger joints per
+hand instead of the rubber hand."""
+
+HANDS = ("none", "dex3")
+
+FINGER_STIFFNESS_NM_PER_RAD = 2.0
+FINGER_DAMPING_NMS_PER_RAD = 0.05
+FINGER_ARMATURE_KGM2 = 1e-4
+"""The simulated Dex3's fingers hold the open pose (every finger joint at 0, inside each range) as
+a spring-damper: what the hand's own controller does with its last command. Nothing commands the
+fingers yet (no HandCmd_ path); the hand is there for its mass, its shape and its contacts."""
 
 
 @functools.cache
@@ -37,8 +49,21 @@ def description_dir() -> Path:
     )
 
 
-def urdf_path() -> Path:
-    return description_dir() / URDF_RELATIVE
+def urdf_path(hands: str = "none") -> Path:
+    """The G1 URDF: with rubber hands (hands 'none'), or with Dex3-1 hands ('dex3')."""
+    if hands not in HANDS:
+        raise RobotDescriptionError(f"unknown hands '{hands}'; known: {', '.join(HANDS)}")
+    return description_dir() / (HAND_URDF_RELATIVE if hands == "dex3" else URDF_RELATIVE)
+
+
+@functools.cache
+def finger_joint_names() -> tuple[str, ...]:
+    """The Dex3 hands' finger joints as the hand URDF lists them (left hand, then right)."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(urdf_path("dex3")).getroot()
+    return tuple(j.get("name", "") for j in root.iter("joint")
+                 if j.get("type") == "revolute" and "_hand_" in j.get("name", ""))
 
 
 def mesh_dir() -> Path:
@@ -69,11 +94,16 @@ def urdf_joint_limits() -> dict[str, np.ndarray]:
 
 
 @functools.cache
-def pinocchio_model():
-    """pinocchio.Model of the G1 with a free-flyer root (nq 36, nv 35)."""
+def pinocchio_model(hands: str = "none"):
+    """pinocchio.Model of the G1 with a free-flyer root (nq 36, nv 35). hands 'dex3': the G1 with
+    Dex3-1 hands, fingers locked in the open pose (every finger joint at 0), so the joints are the
+    same 29 and the hands count with their own masses and frames."""
     import pinocchio as pin
 
-    model = pin.buildModelFromUrdf(str(urdf_path()), pin.JointModelFreeFlyer())
+    model = pin.buildModelFromUrdf(str(urdf_path(hands)), pin.JointModelFreeFlyer())
+    if hands == "dex3":
+        fingers = [model.getJointId(n) for n in finger_joint_names()]
+        model = pin.buildReducedModel(model, fingers, pin.neutral(model))
     names = [model.names[i] for i in range(2, model.njoints)]
     if tuple(names) != g1.JOINT_NAMES:
         raise RobotDescriptionError(f"URDF joint order {names} differs from g1.JOINT_NAMES")
@@ -86,11 +116,19 @@ def pinocchio_q(base_pos_w: np.ndarray, base_quat_wxyz: np.ndarray, q_rad: np.nd
     return np.concatenate([base_pos_w, [x, y, z, w], q_rad])
 
 
-def mujoco_spec(floor: bool = True, timestep_s: float = 0.005):
-    """MjSpec of the G1 scene built from the URDF (see module docstring)."""
+def mujoco_spec(floor: bool = True, timestep_s: float = 0.005, variant: g1.Variant = g1.G1_29DOF,
+                hands: str = "none"):
+    """MjSpec of the G1 scene built from the URDF (see module docstring), as `variant` is built:
+    the joints the variant lacks (g1_23dof: waist roll/pitch, wrist pitch/yaw) are removed, so
+    their links are welded to their parents at the joint's zero, as the locked waist and the
+    wrist-less forearm of the real robot are. Its actuators are the variant's joints, in g1.JOINT_NAMES
+    order (nu = variant.num_dof). hands 'dex3': the G1 with Dex3-1 hands, fingers held open
+    (FINGER_STIFFNESS_NM_PER_RAD), no finger motors; the 29-DoF G1 only."""
     import mujoco
 
-    xml = urdf_path().read_text()
+    if hands == "dex3" and variant.num_dof != g1.NUM_JOINTS:
+        raise RobotDescriptionError(f"Dex3 hands are modelled on the 29-DoF G1 only, not on {variant.name}")
+    xml = urdf_path(hands).read_text()
     # MuJoCo's URDF importer resolves meshes by file name in meshdir.
     xml = xml.replace("package://example-robot-data/robots/g1_description/meshes/", "")
     mujoco_ext = (
@@ -111,7 +149,10 @@ def mujoco_spec(floor: bool = True, timestep_s: float = 0.005):
     pelvis.add_freejoint(name="floating_base")
     pelvis.pos = [0.0, 0.0, g1.DEFAULT_PELVIS_HEIGHT_M]
 
-    for i, name in enumerate(g1.JOINT_NAMES):
+    for i in sorted(set(range(g1.NUM_JOINTS)) - set(variant.active_joints)):
+        spec.delete(spec.joint(g1.JOINT_NAMES[i]))
+    for i in variant.active_joints:
+        name = g1.JOINT_NAMES[i]
         joint = spec.joint(name)
         joint.armature = float(g1.ARMATURE_KGM2[i])
         joint.range = [float(g1.Q_MIN_RAD[i]), float(g1.Q_MAX_RAD[i])]
@@ -121,6 +162,13 @@ def mujoco_spec(floor: bool = True, timestep_s: float = 0.005):
         limit = float(g1.EFFORT_LIMIT_NM[i])
         motor.ctrlrange = [-limit, limit]
         motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
+    if hands == "dex3":
+        for name in finger_joint_names():
+            finger = spec.joint(name)
+            finger.armature = FINGER_ARMATURE_KGM2
+            finger.stiffness = [FINGER_STIFFNESS_NM_PER_RAD, 0.0, 0.0]  # linear spring to springref 0: open
+            finger.damping = [FINGER_DAMPING_NMS_PER_RAD, 0.0, 0.0]
+            finger.limited = mujoco.mjtLimited.mjLIMITED_TRUE
 
     # Collisions: robot geoms touch the floor only (contype 0 / conaffinity 1 vs floor 1 / 0), so a
     # fallen robot lies on the floor instead of sinking through it. The URDF importer marks visual

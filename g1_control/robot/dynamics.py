@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from g1_control.errors import RobotDescriptionError
 from g1_control.robot import description, g1
 
 SOLE_OFFSET_M = np.array([0.035, 0.0, -0.035])
@@ -24,11 +25,12 @@ HAND_OFFSET_M = np.array([0.1, 0.0, 0.0])
 """Hand point in the wrist-yaw link: roughly the palm centre (the URDF's rubber hand extends ~0.1 m)."""
 
 
-def build_model():
-    """pinocchio Model of the G1 with armature and the controller's extra frames."""
+def build_model(hands: str = "none"):
+    """pinocchio Model of the G1 (with `hands`: description.pinocchio_model) with armature and the
+    controller's extra frames."""
     import pinocchio as pin
 
-    model = pin.Model(description.pinocchio_model())
+    model = pin.Model(description.pinocchio_model(hands))
     # MuJoCo (and the robot) have reflected rotor inertia on every joint; without it the
     # controller's mass matrix is wrong by up to 30 % on the distal joints.
     model.armature[6:] = g1.ARMATURE_KGM2
@@ -57,17 +59,56 @@ class FrameTerms:
     """6: (linear m/s, angular rad/s), LOCAL_WORLD_ALIGNED."""
 
 
-class WbcModel:
-    """Evaluates the dynamics terms the QP needs at one state; reuses its buffers."""
+def build_variant_model(variant: g1.Variant, hands: str = "none"):
+    """(full model, the variant's model): build_model(), and the same with the joints `variant`
+    lacks locked at zero (pinocchio's reduced model: their links welded to their parents, the
+    masses and frames kept; None for the 29-DoF G1). The frames keep their ids and names."""
+    import pinocchio as pin
 
-    def __init__(self) -> None:
+    full = build_model(hands)
+    if variant.num_dof == g1.NUM_JOINTS:
+        return full, None
+    locked = [full.getJointId(g1.JOINT_NAMES[i]) for i in range(g1.NUM_JOINTS) if i not in variant.active_joints]
+    reduced = pin.buildReducedModel(full, locked, pin.neutral(full))
+    if [f.name for f in reduced.frames] != [f.name for f in full.frames]:
+        raise RobotDescriptionError(f"pinocchio's {variant.name} model renumbered the G1's frames; the controller "
+                                    "addresses frames of both models by one id")
+    return full, reduced
+
+
+class WbcModel:
+    """Evaluates the dynamics terms the QP needs at one state; reuses its buffers.
+
+    Every array is in the 29-DoF G1's coordinates (nv 35: base, then g1.JOINT_NAMES), whatever the
+    variant, so that the controller and its QP serve every variant unchanged. For a variant without
+    some joints (the 23-DoF G1), the terms are those of the variant's own model (build_variant_model:
+    the joints it lacks locked), scattered into those coordinates: a locked joint's coordinate is
+    decoupled from everything (unit inertia, no bias, no Jacobian column, no contact or gravity
+    term), so the QP can neither use it nor feel it, and the rest is the reduced model's dynamics
+    exactly. `model` stays the 29-DoF kinematic model (for references, whose locked joints are 0 on
+    such a robot); `data` holds the kinematics of the last update() (of the variant's model: frame
+    ids are the same in both).
+    """
+
+    def __init__(self, variant: g1.Variant = g1.G1_29DOF, hands: str = "none") -> None:
+        """hands 'dex3': the G1 with Dex3-1 hands, fingers locked open (their mass and frames)."""
         import pinocchio as pin
 
         self._pin = pin
-        self.model = build_model()
-        self.data = self.model.createData()
+        self.variant = variant
+        self.model, reduced = build_variant_model(variant, hands)
+        self.dynamics_model = self.model if reduced is None else reduced
+        """The variant's own model: the one update() evaluates."""
+        self.data = self.dynamics_model.createData()
         self.nv = self.model.nv
         self.nq = self.model.nq
+        self._reduced = reduced is not None
+        active = np.array(variant.active_joints)
+        self._qi = np.concatenate([np.arange(7), 7 + active])
+        """Indices of the variant model's configuration in the 29-DoF one."""
+        self._vi = np.concatenate([np.arange(6), 6 + active])
+        """Indices of the variant model's velocity coordinates in the 29-DoF ones."""
+        self._locked_v = np.setdiff1d(np.arange(self.nv), self._vi)
         self.mass_kg = float(sum(i.mass for i in self.model.inertias))
         self.sole_ids = tuple(self.model.getFrameId(n) for n in SOLE_FRAMES)
         self.hand_ids = tuple(self.model.getFrameId(n) for n in HAND_FRAMES)
@@ -89,9 +130,21 @@ class WbcModel:
         the hands (its weight share, the squeeze's reaction). update() folds them into `bias`
         (bias - J^T f), so the QP's dynamics, torque limits and foot forces account for them and
         its torques push back."""
+        if self._reduced:
+            nr = self.dynamics_model.nv
+            self._mr = np.zeros((nr, nr))
+            self._mr_lower = np.tril_indices(nr, -1)
+            self._m_flat = (self._vi[:, None] * self.nv + self._vi[None, :]).ravel()
+            """Where the variant model's mass matrix goes in the flattened 29-DoF one."""
+            self._a0r = np.zeros(nr)
+            self.mass_matrix[self._locked_v, self._locked_v] = 1.0
 
     def update(self, q: np.ndarray, v: np.ndarray) -> None:
-        """Compute M, bias (C v + g), CoM terms and the soles' contact Jacobians at (q, v)."""
+        """Compute M, bias (C v + g), CoM terms and the soles' contact Jacobians at (q, v)
+        (the 29-DoF G1's coordinates; a variant's locked joints are read as locked)."""
+        if self._reduced:
+            self._update_reduced(q, v)
+            return
         pin, m, d = self._pin, self.model, self.data
         pin.computeAllTerms(m, d, q, v)  # M (upper triangle), nle, joint Jacobians, CoM, Jcom
         self.mass_matrix[:] = d.M
@@ -117,10 +170,46 @@ class WbcModel:
 
     def frame(self, frame_id: int) -> FrameTerms:
         """Kinematics of one frame at the state of the last update()."""
-        pin, m, d = self._pin, self.model, self.data
+        pin, m, d = self._pin, self.dynamics_model, self.data
         lwa = pin.LOCAL_WORLD_ALIGNED
         placement = d.oMf[frame_id]
-        return FrameTerms(placement.translation.copy(), placement.rotation.copy(),
-                          pin.getFrameJacobian(m, d, frame_id, lwa),
+        jac = pin.getFrameJacobian(m, d, frame_id, lwa)
+        if self._reduced:
+            jac = self._columns(jac)
+        return FrameTerms(placement.translation.copy(), placement.rotation.copy(), jac,
                           pin.getFrameClassicalAcceleration(m, d, frame_id, lwa).vector,
                           pin.getFrameVelocity(m, d, frame_id, lwa).vector)
+
+    # -- a variant with locked joints ------------------------------------------------------------------
+    def _columns(self, jac: np.ndarray) -> np.ndarray:
+        """A Jacobian of the variant's model with the 29-DoF G1's columns (0 for locked joints)."""
+        out = np.zeros((jac.shape[0], self.nv))
+        out[:, self._vi] = jac
+        return out
+
+    def _update_reduced(self, q: np.ndarray, v: np.ndarray) -> None:
+        # Only the variant's rows and columns are written: the locked coordinates' entries keep what
+        # __init__ gave them (unit inertia, zeros) for good.
+        pin, m, d, vi = self._pin, self.dynamics_model, self.data, self._vi
+        qr, vr = q[self._qi], v[vi]
+        pin.computeAllTerms(m, d, qr, vr)
+        mr = self._mr
+        mr[:] = d.M  # upper triangle
+        mr[self._mr_lower] = mr.T[self._mr_lower]
+        self.mass_matrix.flat[self._m_flat] = mr.ravel()
+        self.bias[vi] = d.nle
+        self.com_m[:] = d.com[0]
+        self.com_vel_mps[:] = d.vcom[0]
+        self.com_jac[:, vi] = d.Jcom
+        pin.forwardKinematics(m, d, qr, vr, self._a0r)
+        pin.updateFramePlacements(m, d)
+        pin.centerOfMass(m, d, qr, vr, self._a0r)
+        self.com_drift[:] = d.acom[0]
+        for i, fid in enumerate(self.sole_ids):
+            rows = slice(6 * i, 6 * i + 6)
+            self.contact_jac_local[rows, vi] = pin.getFrameJacobian(m, d, fid, pin.LOCAL)
+            self.contact_drift_local[rows] = pin.getFrameAcceleration(m, d, fid, pin.LOCAL).vector
+            self.contact_vel_local[rows] = pin.getFrameVelocity(m, d, fid, pin.LOCAL).vector
+        if self.hand_forces_w_n.any():
+            for fid, force in zip(self.hand_ids, self.hand_forces_w_n):
+                self.bias[vi] -= pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED)[:3].T @ force

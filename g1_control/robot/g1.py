@@ -166,6 +166,20 @@ for _arr in (Q_MIN_RAD, Q_MAX_RAD, EFFORT_LIMIT_NM, VELOCITY_LIMIT_RADPS, ARMATU
              KD_DEFAULT, DEFAULT_Q_RAD):
     _arr.setflags(write=False)
 
+MOTOR_MAX_TEMPERATURE_C = 120.0
+"""The hottest a G1 joint motor may report before it is damaged: no motor-temperature threshold
+(the runtime trip, the start check) may be set above it, or it could never fire in time. Unitree
+publishes no winding or magnet rating for the G1's motors; 120 °C is the working limit of H-grade
+NdFeB magnets (irreversible demagnetisation beyond it), an upper bound for any such motor. Replace
+it with the vendor's figure when one is published."""
+
+BATTERY_FULL_V = 54.6
+"""The G1 battery's limited charge voltage (Unitree "G1 Battery and Charger User Manual" V1.0: 13
+Li-ion cells in series, rated 46.8 V, charged to 54.6 V): a pack never reads more."""
+BATTERY_EMPTY_V = 13 * 2.5
+"""13 cells at 2.5 V, the discharge cut-off of Li-ion cells: a pack never delivers less (its BMS
+switches off first), so a low-battery threshold below it could never fire."""
+
 BASE_BODY = "pelvis"
 TORSO_BODY = "torso_link"
 FOOT_BODIES = ("left_ankle_roll_link", "right_ankle_roll_link")
@@ -203,6 +217,19 @@ G1_29DOF_LOCKED_WAIST = Variant(
     "g1_29dof_locked_waist", 6, tuple(i for i in range(NUM_JOINTS) if i not in (13, 14))
 )
 VARIANTS = {v.mode_machine: v for v in (G1_23DOF, G1_29DOF, G1_29DOF_LOCKED_WAIST)}
+
+
+def variant_named(name: str) -> Variant:
+    """The variant called `name` (a launch file's backend.expected_variant); raises for an unknown name."""
+    for v in VARIANTS.values():
+        if v.name == name:
+            return v
+    raise ValueError(f"unknown G1 variant '{name}'; known: {', '.join(v.name for v in VARIANTS.values())}")
+
+
+def missing_joints(variant: Variant, joint_names) -> list[str]:
+    """The names in `joint_names` that `variant` has no motor for (a 29-DoF policy on a 23-DoF G1)."""
+    return [n for n in joint_names if n in JOINT_INDEX and JOINT_INDEX[n] not in variant.active_joints]
 
 
 def variant_for_mode_machine(mode_machine: int) -> Variant:

@@ -6,6 +6,7 @@ import math
 from dataclasses import dataclass, fields
 
 from g1_control.errors import SafetyConfigError
+from g1_control.robot import g1
 
 MAX_KP_CAP = 1000.0
 """The largest position-gain cap a SafetyConfig accepts (N m/rad): far above any G1 controller's
@@ -20,11 +21,13 @@ class SafetyConfig:
     stale_state_s: float = 0.05
     """Damp when the newest state is older than this (SONIC's deploy allows 0.5 s; 25 robot ticks is plenty)."""
     max_tilt_rad: float = 1.0
-    """Damp when the pelvis z axis leans further than this from vertical (a fall)."""
+    """Damp when the pelvis z axis leans further than this from vertical (a fall); below pi (no tilt
+    exceeds pi, so a larger limit could never fire)."""
     overspeed_factor: float = 1.0
     """Damp when any |dq| exceeds this times the joint's velocity limit."""
     max_motor_temperature_c: float = 90.0
-    """Damp when any motor reports a hotter winding/case (both sensors are checked)."""
+    """Damp when any motor reports a hotter winding/case (both sensors are checked); at most the
+    motors' rating (robot.g1.MOTOR_MAX_TEMPERATURE_C)."""
     crc_burst_count: int = 5
     """Damp on this many bad-CRC states within crc_burst_window_s (a lone bad sample is only counted)."""
     crc_burst_window_s: float = 0.1
@@ -65,6 +68,13 @@ class SafetyConfig:
         for name in ("crc_burst_count", "overrun_burst_count"):
             if int(getattr(self, name)) != getattr(self, name) or getattr(self, name) < 1:
                 raise SafetyConfigError(f"SafetyConfig.{name} is {getattr(self, name)}; it must be a whole number >= 1")
+        if self.max_tilt_rad >= math.pi:
+            raise SafetyConfigError(f"SafetyConfig.max_tilt_rad is {self.max_tilt_rad}; it must be below pi "
+                                    f"({math.pi:.4f} rad): no tilt exceeds pi, so the tilt trip could never fire")
+        if self.max_motor_temperature_c > g1.MOTOR_MAX_TEMPERATURE_C:
+            raise SafetyConfigError(f"SafetyConfig.max_motor_temperature_c is {self.max_motor_temperature_c} °C; it may "
+                                    f"be at most the motors' rating, {g1.MOTOR_MAX_TEMPERATURE_C:g} °C (a hotter "
+                                    "threshold trips only after the damage)")
         if self.max_kp > MAX_KP_CAP:
             raise SafetyConfigError(f"SafetyConfig.max_kp is {self.max_kp}; the gain cap may be at most {MAX_KP_CAP:g}")
         if self.max_kd > MAX_KD_CAP:

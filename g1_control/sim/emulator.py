@@ -29,11 +29,19 @@ from g1_control.robot import g1
 from g1_control.sim.robot_endpoint import RobotEndpoint
 from g1_control.types import MotorCommand, RobotState
 
+CRC_BURST_STATES = 10
+"""States with a wrong CRC in one "crc_burst": 20 ms at 500 Hz, under the host's 50 ms stale-state limit."""
+COLLAPSED_LEG_Q_RAD = np.array([-1.6, 0.0, 0.0, 2.6, -0.8, 0.0])
+"""One leg (hip pitch, roll, yaw, knee, ankle pitch, roll) of a collapsed G1: inside the joint limits."""
 FAULTS = {
     "state_stops": "LowState_ stops (robot side silent)",
     "state_frozen": "LowState_ keeps arriving with the same contents and tick",
     "crc_corrupted": "every LowState_ carries a wrong CRC",
+    "crc_burst": f"the next {CRC_BURST_STATES} LowState_ carry a wrong CRC, then the stream is clean again "
+                 "(a burst too short to make the state stale)",
     "tilt": "pelvis tilted 1.3 rad (fall)",
+    "collapse": "the legs report a deep squat (pelvis ~0.31 m above the soles by leg kinematics) with the IMU "
+                "upright: a robot sinking to the floor, which only the estimator's pelvis height shows",
     "overspeed": "left knee reports 30 rad/s",
     "over_temperature": "waist yaw motor reports 110 degC",
     "clear": "remove every injected fault",
@@ -57,6 +65,7 @@ class FaultyPhysics(Backend):
         self.tilt_rad = 0.0
         self.overspeed_joint: int | None = None
         self.hot_joint: int | None = None
+        self.collapsed = False
         # The operator's Unitree remote, as the robot reports it inside LowState_ (press/stick).
         self.remote_held: frozenset[str] = frozenset()
         self.remote_pressed: frozenset[str] = frozenset()
@@ -73,6 +82,8 @@ class FaultyPhysics(Backend):
         if self.tilt_rad:
             half = self.tilt_rad / 2
             state.imu_quat_wxyz = np.array([np.cos(half), np.sin(half), 0.0, 0.0])
+        if self.collapsed:
+            state.q_rad[0:6] = state.q_rad[6:12] = COLLAPSED_LEG_Q_RAD  # left leg, right leg
         if self.overspeed_joint is not None:
             state.dq_radps[self.overspeed_joint] = 30.0
         if self.hot_joint is not None:
@@ -266,13 +277,17 @@ class RobotEmulator:
         e, p = self.endpoint, self.physics
         if fault == "clear":
             e.mark_faults_clear()
-            p.tilt_rad, p.overspeed_joint, p.hot_joint = 0.0, None, None
+            p.tilt_rad, p.overspeed_joint, p.hot_joint, p.collapsed = 0.0, None, None, False
         elif fault == "state_stops":
             e.publish = False
         elif fault == "state_frozen":
             e.freeze_state = True
         elif fault == "crc_corrupted":
             e.corrupt_state_crc = True
+        elif fault == "crc_burst":
+            e.corrupt_next_states = CRC_BURST_STATES
+        elif fault == "collapse":
+            p.collapsed = True
         elif fault == "tilt":
             p.tilt_rad = 1.3
         elif fault == "overspeed":
@@ -305,8 +320,11 @@ class RobotEmulator:
         out["base_pos_w_m"] = None if state.base_pos_w_m is None else [float(v) for v in state.base_pos_w_m]
         out["first_damping_base_pos_w_m"] = self.endpoint.first_damping_base_pos_w_m
         last = self.endpoint.last_command
+        # damping on every motor the robot has (a 23-DoF G1's empty slots go out disabled, gains 0)
+        motors = g1.VARIANTS.get(int(state.mode_machine), g1.G1_29DOF).active_mask
         out["last_command_is_damping"] = None if last is None else bool(
-            float(np.max(last.motor_kp_nm_per_rad)) == 0.0 and float(np.min(last.motor_kd_nms_per_rad[:g1.NUM_JOINTS])) > 0)
+            float(np.max(last.motor_kp_nm_per_rad)) == 0.0
+            and float(np.min(last.motor_kd_nms_per_rad[:g1.NUM_JOINTS][motors])) > 0)
         gantry = self.physics.inner
         if isinstance(gantry, Gantry):
             out["gantry_lowered_at_s"] = gantry.lowered_at_s

@@ -26,17 +26,20 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from g1_control.errors import RobotDescriptionError
 from g1_control.interfaces import Backend
 from g1_control.robot import description, g1
 from g1_control.scene import SceneConfig
 from g1_control.types import MotorCommand, RobotState
 
 
-def motor_law_scene(physics_dt_s: float) -> mujoco.MjSpec:
-    """The G1 scene (robot/description.py) with the drivers' motor law in its actuators (see above)."""
-    spec = description.mujoco_spec(timestep_s=physics_dt_s)
+def motor_law_scene(physics_dt_s: float, variant: g1.Variant = g1.G1_29DOF, hands: str = "none") -> mujoco.MjSpec:
+    """The G1 scene (robot/description.py) of `variant` (with `hands`) with the drivers' motor law
+    in its actuators (see above): one actuator per joint the variant has."""
+    spec = description.mujoco_spec(timestep_s=physics_dt_s, variant=variant, hands=hands)
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
-    for i, name in enumerate(g1.JOINT_NAMES):
+    for i in variant.active_joints:
+        name = g1.JOINT_NAMES[i]
         actuator = spec.actuator(name.removesuffix("_joint"))
         actuator.gaintype = mujoco.mjtGain.mjGAIN_FIXED
         actuator.gainprm[0] = 0.0  # ctrl unused: the whole law sits in the bias
@@ -56,6 +59,12 @@ class MujocoConfig:
     motor_temperature_c: float = 40.0
     init_height_clearance_m: float = 0.002
     seed: int = 0
+    hands: str = "none"
+    """'dex3': the G1 with Dex3-1 hands (fingers held open, robot/description.py; 29-DoF G1 only)."""
+    variant: str = "g1_29dof"
+    """Which G1 is built (g1.VARIANTS by name; a launch file's backend.expected_variant): a variant
+    without some joints has no such joints and motors in the model, and its state reports them as 0
+    (q, dq, tau), as the robot's LowState_ does for the slots it has no motor behind."""
 
 
 class MujocoBackend(Backend):
@@ -66,17 +75,31 @@ class MujocoBackend(Backend):
         self.config = config or MujocoConfig()
         self.lockstep = self.config.lockstep
         self.scene = scene or SceneConfig()
+        try:
+            self.variant = g1.variant_named(self.config.variant)
+        except ValueError as exc:
+            raise RobotDescriptionError(f"MujocoConfig.variant: {exc}") from None
         self.model = self._compile()
         self.data = mujoco.MjData(self.model)
         m = self.model
         base = m.joint(0)  # the robot's floating base is the model's first joint
         qa, va = int(m.jnt_qposadr[base.id]), int(m.jnt_dofadr[base.id])
         self._base_q, self._base_v = slice(qa, qa + 7), slice(va, va + 6)
-        # The robot's joints follow its base in the model (objects are added after the robot).
-        self._q = slice(qa + 7, qa + 7 + g1.NUM_JOINTS)
-        self._v = slice(va + 6, va + 6 + g1.NUM_JOINTS)
-        self._bias = self.model.actuator_biasprm[:, :3]
-        """(b0, b1, b2) per joint: a view into the model, rewritten by write_command."""
+        # The robot's joints follow its base in the model (objects are added after the robot); with
+        # Dex3 hands, each hand's finger joints sit between its arm and the next limb.
+        n = self.variant.num_dof
+        self._active = np.array(self.variant.active_joints)
+        """The robot's joint indices (g1.JOINT_NAMES) of the model's joints and actuators, in order."""
+        names = [g1.JOINT_NAMES[i] for i in self._active]
+        qadr = np.array([m.jnt_qposadr[m.joint(name).id] for name in names])
+        vadr = np.array([m.jnt_dofadr[m.joint(name).id] for name in names])
+        self._contiguous = bool(np.array_equal(qadr, np.arange(qa + 7, qa + 7 + n))
+                                and np.array_equal(vadr, np.arange(va + 6, va + 6 + n)))
+        self._q: slice | np.ndarray = slice(qa + 7, qa + 7 + n) if self._contiguous else qadr
+        self._v: slice | np.ndarray = slice(va + 6, va + 6 + n) if self._contiguous else vadr
+        self._full = n == g1.NUM_JOINTS
+        self._bias = self.model.actuator_biasprm[:n, :3]
+        """(b0, b1, b2) per motor: a view into the model, rewritten by write_command."""
         self._law = np.zeros((3, g1.NUM_JOINTS))
         self._command = MotorCommand.damping(g1.KD_DEFAULT)
         self.write_command(self._command)
@@ -87,7 +110,7 @@ class MujocoBackend(Backend):
         self._quat = slice(adr[self.model.sensor("imu_quat").id], adr[self.model.sensor("imu_quat").id] + 4)
         # What read_state reports, as views into MjData's arrays (MuJoCo keeps them in place).
         d = self.data
-        self._views = (d.qpos[self._q], d.qvel[self._v], d.actuator_force, d.sensordata[self._quat],
+        self._views = (d.qpos[self._q], d.qvel[self._v], d.actuator_force[:n], d.sensordata[self._quat],
                        d.sensordata[self._gyro], d.sensordata[self._acc], d.qpos[qa:qa + 3], d.qvel[va:va + 3])
         self._temperature = np.full(g1.NUM_JOINTS, float(self.config.motor_temperature_c))
         self._push_force_w = np.zeros(3)
@@ -104,7 +127,7 @@ class MujocoBackend(Backend):
         self.closed = False
 
     def _compile(self) -> mujoco.MjModel:
-        spec = motor_law_scene(self.config.physics_dt_s)
+        spec = motor_law_scene(self.config.physics_dt_s, self.variant, self.config.hands)
         if not self.scene.empty:
             from g1_control.sim.scene import build_scene
 
@@ -117,7 +140,7 @@ class MujocoBackend(Backend):
         mujoco.mj_resetData(self.model, self.data)
         q = g1.DEFAULT_Q_RAD if q_rad is None else np.asarray(q_rad, dtype=float)
         base = self.data.qpos[self._base_q]
-        self.data.qpos[self._q] = q
+        self.data.qpos[self._q] = q[self._active]
         base[3:7] = [np.cos(yaw_rad / 2), 0.0, 0.0, np.sin(yaw_rad / 2)]
         base[0:2] = base_pos_xy_m
         base[2] = 1.0
@@ -138,6 +161,10 @@ class MujocoBackend(Backend):
 
     def read_state(self) -> RobotState:
         q, dq, tau, quat, gyro, acc, pos, vel = self._views
+        if not self._contiguous:  # gathered (fancy indexing made copies, not views, in __init__)
+            q, dq = self.data.qpos[self._q], self.data.qvel[self._v]
+        if not self._full:  # the slots of joints the variant lacks read 0, as on the robot
+            q, dq, tau = (self._scatter(x) for x in (q, dq, tau))
         return RobotState(
             t_s=float(self.data.time),
             q_rad=q.copy(),
@@ -147,7 +174,7 @@ class MujocoBackend(Backend):
             imu_gyro_radps=gyro.copy(),
             imu_acc_mps2=acc.copy(),
             motor_temperature_c=self._temperature.copy(),
-            mode_machine=g1.G1_29DOF.mode_machine,
+            mode_machine=self.variant.mode_machine,
             tick=self._tick,
             base_pos_w_m=pos.copy(),
             base_linvel_w_mps=vel.copy(),
@@ -164,7 +191,13 @@ class MujocoBackend(Backend):
         np.negative(command.kd, out=law[2])
         if not command.enable.all():
             law[:, ~command.enable] = 0.0
-        self._bias[:] = law.T
+        self._bias[:] = law.T if self._full else law[:, self._active].T
+
+    def _scatter(self, values: np.ndarray) -> np.ndarray:
+        """The variant's joint values in the robot's 29 slots (0 where it has no joint)."""
+        out = np.zeros(g1.NUM_JOINTS)
+        out[self._active] = values
+        return out
 
     def step(self, dt_s: float) -> None:
         self._physics_steps(max(1, round(dt_s / self.model.opt.timestep)))

@@ -4,7 +4,7 @@ physics Backend (MockG1 here; the MuJoCo backend for `g1 sim-robot`).
 Like the robot: LowState_ goes out at a fixed rate with a valid CRC and a running tick; a LowCmd_
 with a bad CRC or a mode_machine other than the robot's is dropped without a word; a motor slot
 whose mode is not 1 produces no torque; with no valid command yet, every motor is off.
-Fault switches (publish, freeze_state, corrupt_state_crc) let tests break the stream on purpose.
+Fault switches (publish, freeze_state, corrupt_state_crc, corrupt_next_states) let tests break the stream on purpose.
 
     python -m g1_control.sim.robot_endpoint --interface lo --domain 1 --seconds 5
 """
@@ -76,6 +76,8 @@ class RobotEndpoint:
         self.unset_state_fields = False
         """As Unitree's MuJoCo simulator (g1_control/sim/unitree_mujoco.py): LowState_ with crc, tick and
         mode_machine left at 0, and every LowCmd_ taken whatever its CRC and mode_machine."""
+        self.corrupt_next_states = 0
+        """The next this many states carry a wrong CRC (a burst), counted down as they go out."""
         self._frozen: bytes | None = None
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -90,7 +92,7 @@ class RobotEndpoint:
     def stop(self) -> None:
         self._stop.set()
         if self._thread is not None:
-            self._thread.join(timeout=2.0)
+            self._thread.join(timeout=10.0)  # a busy host: the link is closed only after the thread is out
 
     def run(self, seconds: float | None = None) -> EndpointCounters:
         end = time.monotonic() + seconds if seconds is not None else float("inf")
@@ -186,6 +188,7 @@ class RobotEndpoint:
     def mark_faults_clear(self) -> None:
         """Clear every fault switch and forget the last damping time (start of a fault trial)."""
         self.publish, self.freeze_state, self.corrupt_state_crc = True, False, False
+        self.corrupt_next_states = 0
         self.first_damping_time_s = float("nan")
 
     def _publish_state(self) -> None:
@@ -202,7 +205,10 @@ class RobotEndpoint:
             payload = self.link.encode(msg)
             if self.unset_state_fields:
                 payload = payload[:-4] + bytes(4)  # the CRC word ends both wire forms: crc 0
-            if self.corrupt_state_crc:
+            burst = self.corrupt_next_states > 0
+            if burst:
+                self.corrupt_next_states -= 1
+            if self.corrupt_state_crc or burst:
                 # Flip one bit of the last byte, which lies inside the CRC word on both wire forms.
                 payload = payload[:-1] + bytes([payload[-1] ^ 0x01])
             self._frozen = payload

@@ -64,7 +64,7 @@ def build_scene(spec: mujoco.MjSpec, scene: SceneConfig) -> None:
         return
     if scene.grip_physics:
         grip_physics(spec)
-    if scene.hand_collision:
+    if scene.hand_collision and spec.body(HAND_BODIES[0]) is not None:  # Dex3 hands collide with their own meshes
         add_hand_collision(spec)
     world = spec.worldbody
     for t in scene.tables:

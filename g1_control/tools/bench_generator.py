@@ -54,11 +54,13 @@ def _partial_keyframes(method, windows: E.Windows) -> tuple[float, float, float]
 
 def effector_goals_through_ik(generator_factory, goals: int = 12, seconds: float = 2.0, seed: int = 0) -> dict:
     """Right-hand goals in front of a standing robot, given as Command effector goals: the
-    generator passes them as a partial keyframe and a frame target, the IK retargeter solves
-    (as in the loop, 50 Hz). Returns success within 10 cm and the mean final hand distance."""
+    generator passes them as a partial keyframe and a frame target, the IK stage solves (as in the
+    loop: a launch file's default `ik:` section, 50 Hz). Returns success within 10 cm and the mean
+    final hand distance."""
     from g1_control import rotations as quat
     from g1_control.generator.fk import fk_numpy
-    from g1_control.generator.retarget import GeneratorRetargeter
+    from g1_control.launch.builder import make_ik
+    from g1_control.launch.schema import LaunchFile
     from g1_control.motion.kinematics import default_body_names
     from g1_control.robot import g1
     from g1_control.types import Command, EffectorGoal, RobotState
@@ -68,7 +70,7 @@ def effector_goals_through_ik(generator_factory, goals: int = 12, seconds: float
     dists = []
     for _ in range(goals):
         gen = generator_factory()
-        ik = GeneratorRetargeter()
+        ik = make_ik(LaunchFile("bench_generator"))
         state = RobotState(q_rad=g1.DEFAULT_Q_RAD.copy(), base_pos_w_m=np.array([0.0, 0.0, g1.DEFAULT_PELVIS_HEIGHT_M]))
         gen.reset(state)
         goal = np.array([rng.uniform(0.25, 0.45), rng.uniform(-0.4, -0.1), g1.DEFAULT_PELVIS_HEIGHT_M + rng.uniform(0.0, 0.35)])
@@ -335,8 +337,8 @@ def _models_table(model_path, lmm_dir, runs_dir, figures: dict) -> None:
     from g1_control.generator import skeleton as S
 
     print("models: training time on this CPU and shipped sizes")
-    rows = [("backbone (shared)", Path(model_path).parent, ("backbone.onnx", "backbone.pt", "feedback.npz")),
-            ("learned motion matching", Path(lmm_dir), ("lmm.onnx", "lmm.pt"))]
+    rows = [("backbone (shared)", Path(model_path).parent, ("backbone.onnx", "feedback.npz")),
+            ("learned motion matching", Path(lmm_dir), ("lmm.onnx",))]
     rows += [(f"backbone {sk} only", Path(runs_dir) / f"gen_{sk}", ("backbone.onnx", "backbone.pt"))
              for sk in S.SKELETONS]
     figures["models"] = {}

@@ -78,8 +78,9 @@ def main(args) -> int:
         dyn_samples.append(time.perf_counter() - t0)
 
     # Baseline 2: the very same QPs (recorded every few ticks) solved cold by a fresh solver.
-    import proxsuite
+    from g1_control.ik.solver import import_proxsuite
 
+    proxsuite = import_proxsuite()
     cold_samples = []
     for H, g, A, b, C, l, u in problems:
         t0 = time.perf_counter()

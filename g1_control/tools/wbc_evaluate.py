@@ -64,9 +64,12 @@ Controller = Literal["wbc", "wbt"]
 
 
 def evaluation_launch(reference: str, params: dict | None = None, *, controller: Controller = "wbc",
-                      tracker_hz: float = DEFAULT_TRACKER_HZ, duration_s: float | None = None):
+                      tracker_hz: float = DEFAULT_TRACKER_HZ, duration_s: float | None = None,
+                      variant: str = "g1_29dof"):
     """The evaluation as a launch file: a scripted reference tracked by the WBC (or the WBT policy
-    at its 50 Hz), an idle operator, MuJoCo in lockstep. duration_s: default, the reference's."""
+    at its 50 Hz), an idle operator, MuJoCo in lockstep, on the G1 `variant` (backend.expected_variant:
+    the simulator builds it, the reference is solved and the WBC runs on its model).
+    duration_s: default, the reference's."""
     from g1_control.generator.scripted import build_reference
     from g1_control.launch.schema import LaunchFile
     from g1_control.loop.rates import LoopRates
@@ -76,8 +79,9 @@ def evaluation_launch(reference: str, params: dict | None = None, *, controller:
         raise ValueError(f"controller must be 'wbc' or 'wbt'; got {controller!r}")
     params = dict(params or {})
     if duration_s is None:
-        duration_s = build_reference(reference, **params).duration_s
+        duration_s = build_reference(reference, variant=variant, **params).duration_s
     launch = LaunchFile(name=f"wbc_evaluate_{reference}_{controller}", duration_s=duration_s)
+    launch.backend.expected_variant = variant  # type: ignore[assignment]  # checked by validate() below
     launch.generator.type, launch.generator.reference = "scripted", reference
     launch.generator.reference_params = params
     launch.tracker.type = controller
@@ -91,7 +95,7 @@ def evaluation_launch(reference: str, params: dict | None = None, *, controller:
 
 def run_wbc(reference: str, params: dict | None = None, *, tracker_hz: float = DEFAULT_TRACKER_HZ,
             push_n: float = 0.0, push_at_s: float = 2.0, push_s: float = 0.2, duration_s: float | None = None,
-            controller: Controller = "wbc"):
+            controller: Controller = "wbc", variant: str = "g1_29dof"):
     """Run the scripted `reference` (with `params`) with the WholeBodyTracker (or, controller="wbt",
     holosoma's WBT policy at 50 Hz); returns (TrackingFigures, loop)."""
     from g1_control.generator.scripted import TrajectoryGenerator
@@ -99,7 +103,7 @@ def run_wbc(reference: str, params: dict | None = None, *, tracker_hz: float = D
     from g1_control.sim.mujoco_backend import MujocoBackend
 
     loop = build_loop(evaluation_launch(reference, params, controller=controller, tracker_hz=tracker_hz,
-                                        duration_s=duration_s))
+                                        duration_s=duration_s, variant=variant))
     tracker, generator, sim = loop.tracker, loop.generator, loop.backend
     # What evaluation_launch asks for: a scripted reference on MuJoCo (build_loop's default backend).
     assert isinstance(generator, TrajectoryGenerator) and isinstance(sim, MujocoBackend)
@@ -165,6 +169,7 @@ def _hand_error(trajectory, log) -> float:
 
 def main(argv: list[str] | None = None) -> int:
     from g1_control.generator.scripted import REFERENCES
+    from g1_control.launch.schema import VARIANT_NAMES
 
     parser = argparse.ArgumentParser(prog="python -m g1_control.tools.wbc_evaluate", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -174,6 +179,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--tracker-hz", type=float, default=DEFAULT_TRACKER_HZ)
     parser.add_argument("--compare-wbt", action="store_true",
                         help="also run holosoma's WBT dance policy (ppo) on each reference, for comparison")
+    parser.add_argument("--variant", default="g1_29dof", choices=VARIANT_NAMES,
+                        help="the G1 simulated and modelled (default g1_29dof; g1_23dof: no waist roll/pitch, no "
+                        "wrist pitch/yaw)")
     parser.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
     args = parser.parse_args(argv)
     unknown = [r for r in args.references if r not in REFERENCES]
@@ -186,9 +194,11 @@ def main(argv: list[str] | None = None) -> int:
         controllers: tuple[Controller, ...] = ("wbc", "wbt") if args.compare_wbt else ("wbc",)
         for controller in controllers:
             figures, _ = run_wbc(name, params, tracker_hz=args.tracker_hz, push_n=50.0 if args.push else 0.0,
-                                 controller=controller)
+                                 controller=controller, variant=args.variant)
             if args.push:
                 figures.reference += "+push"
+            if args.variant != "g1_29dof":
+                figures.reference += f"@{args.variant.removeprefix('g1_')}"
             rows.append(figures)
             hand = "" if figures.hand_error_m is None else f"  hand to target {figures.hand_error_m:.3f} m"
             print(figures.row() + hand, flush=True)

@@ -87,7 +87,10 @@ def _pose_fk_torch(y):
     return pos
 
 
-def train_lmm(out_dir: str | Path, config: LmmTrainConfig, library_root=None, progress: bool = True) -> dict:
+def train_lmm(out_dir: str | Path, config: LmmTrainConfig, library_root=None, progress: bool = True,
+              records_dir: str | Path | None = None) -> dict:
+    """out_dir gets what the runtime reads (lmm.onnx, model.json) and train_config.json; records_dir
+    (default: out_dir) the checkpoint lmm.pt, loss_history.json and loss.png."""
     import torch
     from torch import nn
 
@@ -99,6 +102,8 @@ def train_lmm(out_dir: str | Path, config: LmmTrainConfig, library_root=None, pr
     cpu0 = time.process_time()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    records = Path(records_dir) if records_dir is not None else out
+    records.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
     budget = {"decompressor": 0.45, "stepper": 0.3, "projector": 0.25}
     x_np, y_np, runs = build_database(library_root, config.skeleton)
@@ -256,7 +261,7 @@ def train_lmm(out_dir: str | Path, config: LmmTrainConfig, library_root=None, pr
 
     torch.save({"config": asdict(config), "x_mean": x_mean, "x_std": x_std, "y_mean": y_mean, "y_std": y_std,
                 "compressor": compressor.state_dict(), "decompressor": decompressor.state_dict(),
-                "stepper": stepper.state_dict(), "projector": projector.state_dict()}, out / "lmm.pt")
+                "stepper": stepper.state_dict(), "projector": projector.state_dict()}, records / "lmm.pt")
     model = Rollout().eval()
     torch.onnx.export(model, (torch.zeros(2, X_DIM),), str(out / "lmm.onnx"), input_names=["query"],
                       output_names=["poses"], dynamo=False, opset_version=17,
@@ -270,8 +275,8 @@ def train_lmm(out_dir: str | Path, config: LmmTrainConfig, library_root=None, pr
               "timings_s": timings}
     (out / "model.json").write_text(json.dumps({"format": 1, "skeletons": [config.skeleton]}, indent=1))
     (out / "train_config.json").write_text(json.dumps({"train": asdict(config), "result": result}, indent=2))
-    (out / "loss_history.json").write_text(json.dumps(history))
-    _plot(history, out / "loss.png")
+    (records / "loss_history.json").write_text(json.dumps(history))
+    _plot(history, records / "loss.png")
     return result
 
 

@@ -199,9 +199,11 @@ def load_skeletons(skeletons, split: str, library_roots: dict | None = None):
 
 
 def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | dict | None = None,
-          progress: bool = True) -> dict:
+          progress: bool = True, records_dir: str | Path | None = None) -> dict:
     """library_root: one library folder (for a single skeleton), {skeleton: folder}, or None
-    (each skeleton's default library)."""
+    (each skeleton's default library). out_dir gets what the runtime reads (backbone.onnx, model.json,
+    style_stats.json, feedback.npz) and train_config.json; records_dir (default: out_dir) the
+    checkpoint backbone.pt, loss_history.json and loss.png."""
     import torch
     import torch.distributed as dist
 
@@ -218,6 +220,7 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | d
     check_splits(library_root)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    records = Path(records_dir) if records_dir is not None else out
     roots = library_root if isinstance(library_root, dict) else (
         {config.skeletons[0]: library_root} if library_root is not None else {})
     feats, styles, names = load_skeletons(config.skeletons, "train", roots)
@@ -306,11 +309,12 @@ def train(out_dir: str | Path, config: TrainConfig, library_root: str | Path | d
         if best[1] is None:  # every validation loss was NaN
             raise G1ControlError(f"training gave no finite validation loss in {step + 1} steps; nothing saved")
         model.load_state_dict(best[1])
-        save_checkpoint(model, out / "backbone.pt", config)
+        records.mkdir(parents=True, exist_ok=True)
+        save_checkpoint(model, records / "backbone.pt", config)
         (out / "train_config.json").write_text(json.dumps({"train": asdict(config), "model": model_cfg.to_dict(),
                                                            "result": result}, indent=2))
-        (out / "loss_history.json").write_text(json.dumps(history))
-        plot_losses(history, out / "loss.png")
+        (records / "loss_history.json").write_text(json.dumps(history))
+        plot_losses(history, records / "loss.png")
         export_onnx(model, out / "backbone.onnx")
         write_model_dir(out, config.skeletons, roots)
     if world > 1:

@@ -109,7 +109,7 @@ def deploy_paths(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # no launch/ folder here
     given: list[Path] = []
 
-    def fake_deploy(path, options):
+    def fake_deploy(path, options, **_):
         given.append(path)
         raise SystemExit(7)
 

@@ -279,15 +279,36 @@ def test_a_fall_in_the_dry_run_fails_saying_when(launch, dry):
     assert pf.results["dry_run"].reason.startswith(f"FELL in simulation: {WHAT}")
 
 
+def _loop_events(*feed) -> list[dict]:
+    """Events as a run's RunResult holds them: a real SafetyFilter's events, recorded as the loop records
+    them (LoopEvent.of_safety), plus a loop event; `feed(filter)` calls in order."""
+    from g1_control.loop.control_loop import LoopEvent
+    from g1_control.safety import SafetyFilter
+
+    events = [LoopEvent(0.5, "invalid_command", "Command.vx_mps is nan (damping keeps the last command)")]
+    f = SafetyFilter(on_event=lambda e: events.append(LoopEvent.of_safety(e, e.t_s)))
+    for step in feed:
+        step(f)
+    return [dataclasses.asdict(e) for e in events]
+
+
 def test_a_safety_trip_in_the_dry_run_fails(launch, dry):
-    events = [{"kind": "input_stale", "detail": "velocity commands zeroed"},
-              {"kind": "tilt", "detail": "[4.000 s] tilt (damping): pelvis tilted"},
-              {"kind": "estop", "detail": "[5.000 s] estop (damping): later"}]
+    events = _loop_events(lambda f: f.vet_input(Command(vx_mps=0.3), 1.0), lambda f: f.vet_input(None, 1.5),
+                          lambda f: f.report_fall("pelvis tilted 1.10 rad (limit 1.00)", 4.0),
+                          lambda f: f.estop("later", 5.0))
+    assert [e["kind"] for e in events] == ["invalid_command", "input_stale", "fall"]
     dry["result"] = _result(events=events)
     pf = Preflight()
     assert not pf.check_dry_run(launch)
-    assert _only(pf, "dry_run").reason == ("the safety layer tripped in simulation: tilt: [4.000 s] tilt (damping): "
-                                           "pelvis tilted")
+    assert _only(pf, "dry_run").reason == "the safety layer tripped in simulation: fall: pelvis tilted 1.10 rad (limit 1.00)"
+
+
+def test_a_dry_run_whose_events_only_warn_passes(launch, dry):
+    """Events that did not trip (an input gap, a loop event whose text says 'damping') are no fault."""
+    dry["result"] = _result(events=_loop_events(lambda f: f.vet_input(Command(vx_mps=0.3), 1.0),
+                                                lambda f: f.vet_input(None, 1.5)))
+    pf = Preflight()
+    assert pf.check_dry_run(launch) and _only(pf, "dry_run").status == PASS
 
 
 def test_a_dry_run_that_cannot_run_fails(launch, dry):

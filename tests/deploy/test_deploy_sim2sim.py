@@ -173,7 +173,8 @@ def test_the_launch_files_generator_chain_runs_on_the_robot_path_and_styles_foll
                 "--json", str(report_path))
     processes.append(host)
     chain_line = host.wait_for(r"control chain \(as checked by the dry run\)", 120)
-    assert "InbetweeningGenerator [backbone] -> GeneratorRetargeter -> LocomotionPolicyTracker" in chain_line
+    assert "InbetweeningGenerator [backbone] -> IKStage [feasible plans pass; else daqp QP, 1 iteration(s) at 50 Hz, " \
+           "contacts free] -> LocomotionPolicyTracker" in chain_line
     host.wait_for(r"hold -> control: run \(--yes\)", 60)
     time.sleep(3.0)
     robot.ask("press right")  # default -> wave

@@ -5,12 +5,13 @@ import pytest
 
 from g1_control.errors import WbcConfigError
 from g1_control.generator import scripted as R
+from g1_control.ik.whole_body import WholeBodyIK
 from g1_control.robot.dynamics import SOLE_FRAMES
 
 
 @pytest.fixture(scope="module")
 def ik():
-    return R.WholeBodyIK()
+    return WholeBodyIK()
 
 
 def pin_q(j):

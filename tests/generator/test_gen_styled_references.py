@@ -8,9 +8,9 @@ from g1_control.generator.baselines import InterpolationInbetweener
 from g1_control.generator.runtime import InbetweeningGenerator, RuntimeConfig
 from g1_control.generator.style_stats import StyleStats
 from g1_control.generator.styles import ROLLOUT_STYLES
-from g1_control.generator.velocity import CopyRetargeter, VelocityReferenceGenerator
+from g1_control.generator.velocity import VelocityReferenceGenerator
 from g1_control.robot import g1
-from g1_control.types import Command, RobotState
+from g1_control.types import Command, JointReference, RobotState
 
 SHOULDER = g1.JOINT_INDEX["left_shoulder_pitch_joint"]
 PITCH = g1.JOINT_INDEX["waist_pitch_joint"]
@@ -18,7 +18,9 @@ PITCH = g1.JOINT_INDEX["waist_pitch_joint"]
 
 def _step(gen, command, state, t):
     state.t_s = t
-    return CopyRetargeter().solve(gen.update(command, state), state.q_rad)
+    plan = gen.update(command, state).feasible_plan  # feasible by construction: what the IK stage passes on
+    assert plan is not None
+    return JointReference().copy_from(plan)
 
 
 def test_style_change_blends_and_hands_back_after_the_blend():

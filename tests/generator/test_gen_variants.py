@@ -105,7 +105,7 @@ def test_builder_picks_the_skeleton_from_the_launch_file(monkeypatch):
 
     def fake(kind, **kwargs):
         seen.update(kwargs, kind=kind)
-        return None, None
+        return None
 
     monkeypatch.setattr("g1_control.generator.factory.make_generator", fake)
     launch = parse_launch({"name": "x", "generator": {"type": "backbone"}, "backend": {"hands": "dex3"},

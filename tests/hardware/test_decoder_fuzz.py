@@ -114,11 +114,28 @@ def test_deframer_recovers_a_frame_after_noise_and_drops_a_cut_one(noise, cut):
 @given(data=st.binary(max_size=80))
 def test_remote_bytes_of_the_wrong_size_are_refused(data):
     if len(data) == REMOTE_SIZE:
-        reading = decode_wireless_remote(data)
-        assert reading.buttons <= set(reading.buttons)
+        _check_remote_layout(data)
         return
     with pytest.raises(RemoteDecodeError):
         decode_wireless_remote(data)
+
+
+@FUZZ
+@given(data=st.binary(min_size=REMOTE_SIZE, max_size=REMOTE_SIZE))
+def test_any_40_remote_bytes_decode_as_the_documented_layout(data):
+    _check_remote_layout(data)
+
+
+def _check_remote_layout(data: bytes) -> None:
+    """The documented layout read byte by byte (docs/robot_facts.md): bytes 2-3 a little-endian u16 whose
+    bit i is R1, L1, start, select, R2, L2, F1, F2, A, B, X, Y, up, right, down, left; little-endian f32
+    lx [4:8], rx [8:12], ry [12:16], L2 [16:20], ly [20:24] (NaN kept as NaN)."""
+    names = ("R1", "L1", "start", "select", "R2", "L2", "F1", "F2", "A", "B", "X", "Y", "up", "right", "down", "left")
+    bits = data[2] | data[3] << 8
+    reading = decode_wireless_remote(data)
+    assert reading.buttons == {name for i, name in enumerate(names) if bits >> i & 1}
+    sticks = np.frombuffer(data, dtype="<f4", count=5, offset=4).astype(float)
+    np.testing.assert_array_equal([reading.lx, reading.rx, reading.ry, reading.l2, reading.ly], sticks)
 
 
 @FUZZ

@@ -113,6 +113,17 @@ def launch_cases() -> dict[str, str | bytes]:
         "lowlevel_hz_too_high.yaml": b + "rates: {lowlevel_hz: 20000, tracker_hz: 50}\n",
         "input_rate_not_dividing.yaml": b + "rates: {input_hz: 30}\n",
         "estimator_rate_zero.yaml": b + "rates: {estimator_hz: 0}\n",
+        # values that would disable a trip or a start check (issue 26)
+        "safety_tilt_pi.yaml": b + "safety: {max_tilt_rad: 3.1416}\n",
+        "safety_tilt_above_pi.yaml": b + "safety: {max_tilt_rad: 3.5}\n",
+        "limits_tilt_above_pi.yaml": b + "limits: {max_tilt_rad: 3.5}\n",
+        "safety_temperature_over_rating.yaml": b + "safety: {max_motor_temperature_c: 150}\n",
+        "start_temperature_500.yaml": b + "deploy: {max_start_temperature_c: 500}\n",
+        "battery_negative.yaml": b + "deploy: {min_battery_v: -5}\n",
+        "battery_below_empty.yaml": b + "deploy: {min_battery_v: 12}\n",
+        "battery_above_full.yaml": b + "deploy: {min_battery_v: 60}\n",
+        "fall_pelvis_height_zero.yaml": b + "fall: {min_pelvis_height_m: 0}\n",
+        "fall_pelvis_height_above_standing.yaml": b + "fall: {min_pelvis_height_m: 0.9}\n",
     }
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from g1_control.launch.schema import parse_launch
-from tests.launch.launch_schema_data import DDS, launch_data
+from tests.launch.launch_schema_data import DDS, assert_holds, launch_data
 
 
 def _with(**sections) -> dict:
@@ -43,7 +43,9 @@ def _with(**sections) -> dict:
     {"duration_s": 0.001},
 ])
 def test_boundary_values_are_accepted(sections):
-    parse_launch(_with(**sections))
+    """Accepted, and held as given (a schema that clamped or replaced a boundary value would show)."""
+    data = _with(**sections)
+    assert_holds(parse_launch(data), data)
 
 
 def test_total_duration_follows_the_input():

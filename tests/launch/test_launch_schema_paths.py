@@ -144,10 +144,26 @@ def test_a_model_without_a_skeleton_list_serves_the_29dof_robot(tmp_path):
 
 
 def test_motion_matching_models_and_the_shipped_model_are_not_read(tmp_path, monkeypatch):
+    from pathlib import Path
+
     model = _model(tmp_path, ["g1_23dof"])
-    parse_launch(_with(generator={"type": "motion_matching", "model": str(model)}))
+    read: list[Path] = []
+    real_read_text = Path.read_text
+
+    def spy(self, *args, **kwargs):
+        read.append(Path(self).resolve())
+        return real_read_text(self, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "read_text", spy)
+    launch = parse_launch(_with(generator={"type": "motion_matching", "model": str(model)}))
+    assert (launch.generator.type, launch.generator.model) == ("motion_matching", str(model))
     monkeypatch.chdir(model)  # a model.json in the working directory is no model of the launch file
-    parse_launch(_with(generator={"type": "backbone"}))
+    launch = parse_launch(_with(generator={"type": "backbone"}))
+    assert launch.generator.model in ("", None)
+    assert not [p for p in read if p.is_relative_to(model.resolve())], f"model files were read: {read}"
+    # The spy sees the reads it is meant to catch: a backbone model's model.json is read.
+    parse_launch(_with(generator={"type": "backbone", "model": str(model)}, backend={"expected_variant": "g1_23dof"}))
+    assert model.resolve() / "model.json" in read
 
 
 # -- the tracking layer --------------------------------------------------------------------------------

@@ -5,14 +5,15 @@ import time
 import numpy as np
 import pytest
 
-from g1_control.generator.velocity import CopyRetargeter, VelocityReferenceGenerator
+from g1_control.generator.velocity import VelocityReferenceGenerator
+from g1_control.ik.stage import IKStage
 from g1_control.interfaces import Generator, InputDevice
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.robot import g1
 from g1_control.sim.mujoco_backend import MujocoBackend
 from g1_control.trackers.locomotion import LocomotionPolicyTracker
 from g1_control.trackers.policy_spec import load_spec
-from g1_control.types import PHASE_LOCOMOTION, PHASE_WHOLE_BODY, Command, KinematicReference
+from g1_control.types import PHASE_LOCOMOTION, PHASE_WHOLE_BODY, Command, JointReference, KinematicReference
 
 
 class SequenceInput(InputDevice):
@@ -27,7 +28,7 @@ class SequenceInput(InputDevice):
 
 def make_loop(device, generator=None, **kw):
     tracker = LocomotionPolicyTracker(load_spec("holosoma_loco_ppo"))
-    loop = ControlLoop(MujocoBackend(), device, generator or VelocityReferenceGenerator(), CopyRetargeter(),
+    loop = ControlLoop(MujocoBackend(), device, generator or VelocityReferenceGenerator(), IKStage(),
                        tracker, log_capacity=1000, **kw)
     loop.reset()
     return loop
@@ -58,28 +59,23 @@ def test_estop_button_damps_at_once():
 
 
 class WavingArms(Generator):
-    """Stand still while both shoulders swing +-0.4 rad at 0.5 Hz."""
+    """Stand still while both shoulders swing +-0.4 rad at 0.5 Hz: a feasible plan that asks for
+    the upper body."""
 
     def __init__(self):
-        self.ref = KinematicReference(q_rad=g1.DEFAULT_Q_RAD.copy())
+        self.plan = JointReference(q_rad=g1.DEFAULT_Q_RAD.copy(), upper_body_override=True)
+        self.ref = KinematicReference(q_rad=self.plan.q_rad, feasible_plan=self.plan)
 
     def update(self, command, state):
         wave = 0.4 * np.sin(2 * np.pi * 0.5 * state.t_s)
         for name in ("left_shoulder_pitch_joint", "right_shoulder_pitch_joint"):
-            self.ref.q_rad[g1.JOINT_INDEX[name]] = g1.DEFAULT_Q_RAD[g1.JOINT_INDEX[name]] + wave
+            self.plan.q_rad[g1.JOINT_INDEX[name]] = g1.DEFAULT_Q_RAD[g1.JOINT_INDEX[name]] + wave
         return self.ref
-
-
-class OverridingRetargeter(CopyRetargeter):
-    def solve(self, reference, q_prev):
-        out = super().solve(reference, q_prev)
-        out.upper_body_override = True
-        return out
 
 
 def test_upper_body_override_moves_the_arms_while_the_policy_balances():
     tracker = LocomotionPolicyTracker(load_spec("holosoma_loco_ppo"))
-    loop = ControlLoop(MujocoBackend(), SequenceInput([]), WavingArms(), OverridingRetargeter(), tracker,
+    loop = ControlLoop(MujocoBackend(), SequenceInput([]), WavingArms(), IKStage(), tracker,
                        log_capacity=400)
     loop.reset()
     loop.run(6.0)
@@ -107,7 +103,7 @@ def test_wallclock_mode_runs_in_real_time():
 def test_other_builtin_policy_walks(policy):
     device = SequenceInput([Command()] * 100 + [Command(vx_mps=0.4)] * 500)
     tracker = LocomotionPolicyTracker(load_spec(policy))
-    loop = ControlLoop(MujocoBackend(), device, VelocityReferenceGenerator(), CopyRetargeter(), tracker,
+    loop = ControlLoop(MujocoBackend(), device, VelocityReferenceGenerator(), IKStage(), tracker,
                        log_capacity=400)
     loop.reset()
     loop.run(6.0)

@@ -73,6 +73,30 @@ def test_grammar_errors_say_what_is_missing(text, message):
     assert str(info.value) == message
 
 
+NEGATIVE = ("a negative quantity; durations, distances, angles and counts are sizes; say the direction in words "
+            "instead, e.g. \"walk backward 2 meters\", \"turn right 90 degrees\"")
+
+
+@pytest.mark.parametrize("text, quantity", [
+    ("walk forward for -3 seconds", "-3 seconds"),
+    ("walk forward -2 meters", "-2 meters"),
+    ("turn left -90°", "-90°"),
+    ("turn left \u22121.5 turns", "\u22121.5 turns"),
+    ("wave -2 times", "-2 times"),
+    ("walk forward -.5 m then wave", "-.5 m"),
+])
+def test_a_negative_quantity_is_refused_naming_it(text, quantity):
+    with pytest.raises(InstructionError) as info:
+        parse_instruction(text)
+    assert str(info.value) == f"\"{quantity}\": {NEGATIVE}"
+
+
+def test_hyphens_that_join_words_are_no_sign():
+    assert parse_instruction("turn left ninety-degrees").describe() == parse_instruction("turn left 90 degrees").describe()
+    assert parse_instruction("walk forward 2 meters, then turn left 90 degrees").describe() == \
+        parse_instruction("walk forward 2 meters -- then turn left 90 degrees").describe()
+
+
 def test_values_the_program_refuses_are_refused_at_parse_time():
     with pytest.raises(InstructionError, match=r"pelvis_height_m: must be within \[0.3, 0.9\] m; got 2"):
         parse_instruction("lower your pelvis to 2 meters")

@@ -31,11 +31,12 @@ def test_window_mean_removes_a_gait_oscillation():
 
 
 def test_safety_state_from_events():
-    events = [{"t_s": 2.0, "kind": "input_lost", "detail": "no input for 0.3 s"},
-              {"t_s": 5.0, "kind": "tilt", "detail": "tilt 1.1 rad > 1.0; damping"}]
+    events = [{"t_s": 2.0, "kind": "input_stale", "detail": "no input for 0.3 s", "trips": False},
+              {"t_s": 4.0, "kind": "invalid_command", "detail": "says damping in its text"},
+              {"t_s": 5.0, "kind": "tilt", "detail": "tilt 1.1 rad > 1.0", "trips": True}]
     assert safety_state_at(1.0, events) == "ok"
-    assert safety_state_at(2.5, events) == "warning: input_lost"
-    assert safety_state_at(4.5, events) == "ok"
+    assert safety_state_at(2.5, events) == "warning: input_stale"
+    assert safety_state_at(4.5, events) == "warning: invalid_command", "a word in a detail is no trip"
     assert safety_state_at(5.0, events) == "DAMPING (tilt)"
     assert safety_state_at(30.0, events) == "DAMPING (tilt)"
 
@@ -50,7 +51,7 @@ def _fake_run(folder, n=100):
            "q_rad": q, "q_target_rad": q, "tau_nm": np.zeros((n, 29))}
     folder.mkdir()
     np.savez(folder / "log.npz", **log)
-    summary = {"name": "fake", "events": [{"t_s": 1.5, "kind": "tilt", "detail": "tilt; damping"}],
+    summary = {"name": "fake", "events": [{"t_s": 1.5, "kind": "tilt", "detail": "tilt", "trips": True}],
                "segments": [{"label": "forward", "start_s": 0.0, "end_s": 2.0}]}
     (folder / "summary.json").write_text(json.dumps(summary))
     return log

@@ -27,8 +27,16 @@ def _tripped(f: SafetyFilter, kind: SafetyEventKind, detail: str) -> None:
 
 # -- config ---------------------------------------------------------------------------------------------
 def test_config_bounds_that_are_inclusive():
-    SafetyConfig(crc_burst_count=1, overrun_burst_count=1)
-    SafetyConfig(input_zero_velocity_s=0.5, input_lost_s=0.5)
+    """A burst of one is one event; a robot may damp the moment it stops (both watchdogs at 0.5 s)."""
+    crc = SafetyFilter(SafetyConfig(crc_burst_count=1, overrun_burst_count=1))
+    assert crc.report_crc_errors(1, 0.0) is False and crc.trip_event.kind == SafetyEventKind.CRC_BURST
+    overrun = SafetyFilter(SafetyConfig(crc_burst_count=1, overrun_burst_count=1))
+    assert overrun.report_deadline(True, 0.0) is False and overrun.trip_event.kind == SafetyEventKind.DEADLINE_OVERRUNS
+    f = SafetyFilter(SafetyConfig(input_zero_velocity_s=0.5, input_lost_s=0.5))
+    f.vet_input(Command(vx_mps=0.4), 0.0)
+    assert f.vet_input(None, 0.5).vx_mps == 0.4 and f.check(_state(0.5), 0.5), "0.5 s late is not yet late"
+    assert f.vet_input(None, 0.52).vx_mps == 0.0
+    assert not f.check(_state(0.52), 0.52) and f.trip_event.kind == SafetyEventKind.INPUT_LOST
 
 
 def test_a_boolean_is_no_threshold():

@@ -4,6 +4,7 @@ other than the feet on the ground; checked on hand-built cases whose answer is k
 import numpy as np
 import pytest
 
+from g1_control.errors import SafetyConfigError
 from g1_control.estimation.estimator import StateEstimator
 from g1_control.launch.builder import build_loop
 from g1_control.launch.runner import run
@@ -24,6 +25,14 @@ def test_monitor_reports_the_first_sign_and_latches_it():
     tilted = np.array([np.cos(0.6), np.sin(0.6), 0.0, 0.0])  # 1.2 rad about x
     assert mon.update(2.0, tilted, 0.2, ()) is None  # later signs do not replace the first
     assert mon.fall is fall
+
+
+@pytest.mark.parametrize("height", [0.0, -0.1, 0.78, 0.9, float("nan")])
+def test_a_fall_height_that_could_never_or_always_fire_is_refused(height):
+    with pytest.raises(SafetyConfigError) as info:
+        FallConfig(min_pelvis_height_m=height).validate("fall")
+    assert str(info.value) == f"fall.min_pelvis_height_m is {height}; it must lie in (0, 0.78) m"
+    FallConfig(min_pelvis_height_m=0.3).validate("fall")
 
 
 def test_monitor_tilt_and_contacts():

@@ -151,9 +151,23 @@ def test_tilt_of_known_rotations():
     ({"stale_state_s": -1.0}, "stale_state_s is -1.0; it must not be negative"),
     ({"max_tilt_rad": float("nan")}, "max_tilt_rad is nan; it must be a finite number"),
     ({"crc_burst_count": 0}, "crc_burst_count is 0; it must be a whole number >= 1"),
-    ({"input_lost_s": 0.1}, "input_lost_s (0.1) must not be shorter than input_zero_velocity_s (0.2)"),
+    ({"input_lost_s": 0.1}, "input_lost_s (0.1) must not be shorter than input_zero_velocity_s (0.2): the robot "
+                            "stops before it damps"),
     ({"stale_state_s": 0.0}, "stale_state_s is 0; it must be positive"),
+    ({"max_tilt_rad": math.pi}, "max_tilt_rad is 3.141592653589793; it must be below pi (3.1416 rad): no tilt "
+                                "exceeds pi, so the tilt trip could never fire"),
+    ({"max_motor_temperature_c": 120.5}, "max_motor_temperature_c is 120.5 °C; it may be at most the motors' rating, "
+                                         "120 °C (a hotter threshold trips only after the damage)"),
 ])
 def test_bad_config_is_refused_by_name(kwargs, text):
-    with pytest.raises(SafetyConfigError, match=text.replace("(", r"\(").replace(")", r"\)")):
+    with pytest.raises(SafetyConfigError) as info:
         SafetyConfig(**kwargs)
+    assert str(info.value) == f"SafetyConfig.{text}"
+
+
+def test_the_tilt_and_temperature_bounds_are_inclusive_where_a_trip_can_still_fire():
+    """Just below pi a robot lying on its back still trips; the motors' rating itself is a threshold."""
+    below_pi = math.nextafter(math.pi, 0.0)
+    upside_down = np.array([0.0, 1.0, 0.0, 0.0])
+    assert SafetyFilter(SafetyConfig(max_tilt_rad=below_pi)).check(_state(imu_quat_wxyz=upside_down), 0.0) is False
+    SafetyConfig(max_motor_temperature_c=g1.MOTOR_MAX_TEMPERATURE_C)

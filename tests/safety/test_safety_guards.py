@@ -43,8 +43,12 @@ def test_gain_caps_are_validated(kwargs, text):
         SafetyConfig(**kwargs)
 
 
-def test_caps_at_their_bounds_are_accepted():
-    SafetyConfig(max_kp=MAX_KP_CAP, max_kd=MAX_KD_CAP, damping_kd=MAX_KD_CAP)
+def test_caps_at_their_bounds_are_accepted_and_clamp_there():
+    f = SafetyFilter(SafetyConfig(max_kp=MAX_KP_CAP, max_kd=MAX_KD_CAP, damping_kd=MAX_KD_CAP))
+    out = f.filter(_cmd(kp=np.full(29, 5000.0), kd=np.full(29, 500.0)), _state(), 0.0)
+    assert np.all(out.kp == MAX_KP_CAP) and np.all(out.kd == MAX_KD_CAP)
+    damping = f.damping()
+    assert np.all(damping.kp == 0.0) and np.all(damping.kd == MAX_KD_CAP)
 
 
 def test_tilt_trips_just_beyond_the_threshold_and_not_just_inside():

@@ -5,14 +5,14 @@ bad CRC; and once tripped the filter only ever emits damping."""
 from __future__ import annotations
 
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import event, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from g1_control.hardware.unitree.conversions import motor_command_to_lowcmd
 from g1_control.hardware.unitree.messages import LowCmd, verify_crc
 from g1_control.robot import g1
-from g1_control.safety import SafetyConfig, SafetyFilter
+from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter
 from g1_control.types import MotorCommand, RobotState
 
 N = g1.NUM_JOINTS
@@ -23,16 +23,41 @@ vec = arrays(np.float64, N, elements=mostly_sane)
 
 @st.composite
 def commands(draw):
-    return MotorCommand(q_rad=draw(vec), dq_radps=draw(vec), kp=draw(vec), kd=draw(vec), tau_nm=draw(vec),
-                        enable=draw(arrays(np.bool_, N)))
+    """A policy output of one of three kinds, drawn evenly so that each path of the filter is taken often:
+    finite within the limits or beyond them (the clamp path), finite with NaN/inf planted in some
+    fields (the non-finite trip), or anything at all."""
+    kind = draw(st.sampled_from(["clamp", "clamp", "clamp", "nonfinite", "any"]))
+    if kind == "any":
+        fields = {name: draw(vec) for name in ("q_rad", "dq_radps", "kp", "kd", "tau_nm")}
+    else:
+        wide = arrays(np.float64, N, elements=st.one_of(st.floats(-5, 5), st.floats(-1e3, 1e3)))
+        fields = {name: draw(wide) for name in ("q_rad", "dq_radps", "kp", "kd", "tau_nm")}
+        if kind == "nonfinite":
+            for name in draw(st.lists(st.sampled_from(sorted(fields)), min_size=1, max_size=3, unique=True)):
+                j = draw(st.integers(0, N - 1))
+                fields[name][j] = draw(st.sampled_from([np.nan, np.inf, -np.inf]))
+    return kind, MotorCommand(**fields, enable=draw(arrays(np.bool_, N)))
 
 
 @st.composite
 def states(draw):
+    """A healthy robot (near the default pose, upright, cool, the same mode_machine) three times in four,
+    so that commands reach an untripped filter; otherwise anything the sensors might report."""
+    if draw(st.sampled_from([True, True, True, False])):
+        tilt = draw(arrays(np.float64, 2, elements=st.floats(-0.2, 0.2)))
+        quat = np.array([1.0, tilt[0], tilt[1], 0.0])
+        return "healthy", RobotState(
+            t_s=draw(st.floats(-0.04, 0.0)),
+            q_rad=g1.DEFAULT_Q_RAD + draw(arrays(np.float64, N, elements=st.floats(-0.2, 0.2))),
+            dq_radps=draw(arrays(np.float64, N, elements=st.floats(-5, 5))),
+            imu_quat_wxyz=quat / np.linalg.norm(quat),
+            motor_temperature_c=draw(arrays(np.float64, N, elements=st.floats(20, 80))),
+            mode_machine=5,
+        )
     quat = draw(arrays(np.float64, 4, elements=st.floats(-1, 1)))
     if np.linalg.norm(quat) < 1e-3:
         quat = np.array([1.0, 0.0, 0.0, 0.0])
-    return RobotState(
+    return "any", RobotState(
         t_s=draw(st.floats(-0.1, 0.0)),  # now_s is 0: states up to 100 ms old
         q_rad=draw(arrays(np.float64, N, elements=st.floats(-3, 3))),
         dq_radps=draw(arrays(np.float64, N, elements=st.one_of(st.floats(-40, 40), any_float))),
@@ -58,20 +83,33 @@ def assert_safe(cmd: MotorCommand, mode_machine: int) -> None:
     assert np.all(np.abs(tau) <= g1.EFFORT_LIMIT_NM)
 
 
+def _damping(cmd: MotorCommand) -> bool:
+    return bool(np.all(cmd.kp == 0) and np.all(cmd.kd > 0) and np.all(cmd.tau_nm == 0))
+
+
 @settings(max_examples=80, deadline=None)
 @given(steps=st.lists(st.tuples(commands(), states()), min_size=1, max_size=6))
 def test_no_unsafe_command_ever_leaves_the_filter(steps):
     f = SafetyFilter()
-    tripped_before = False
-    for i, (cmd, state) in enumerate(steps):
+    for i, ((_cmd_kind, cmd), (state_kind, state)) in enumerate(steps):
         now = float(i) * 0.02
         state.t_s += now
         state.tick = i
+        tripped_before = f.tripped
         out = f.filter(cmd, state, now)
         assert_safe(out, state.mode_machine)
         if tripped_before:
-            assert np.all(out.kp == 0) and np.all(out.kd > 0) and np.all(out.tau_nm == 0)
-        tripped_before = f.tripped
+            event("tripped before")
+            assert _damping(out)
+        elif state_kind == "healthy" and cmd.is_finite():
+            event("clamp path (untripped filter, finite command)")
+            assert not f.tripped, f.trip_event
+            assert all(np.array_equal(getattr(out, n), np.minimum(np.maximum(getattr(cmd, n), f._lo[k]), f._hi[k]))
+                       for k, n in enumerate(("q_rad", "dq_radps", "tau_nm", "kp", "kd")))
+        elif state_kind == "healthy":
+            event("NaN/inf command into an untripped filter")
+            assert f.trip_event is not None and f.trip_event.kind == SafetyEventKind.NONFINITE_COMMAND
+            assert _damping(out)
 
 
 finite_vec = arrays(np.float64, N, elements=st.one_of(st.floats(-50, 50), st.floats(-1e6, 1e6)))

@@ -36,16 +36,18 @@ def trained(library, tmp_path_factory):
     out = tmp_path_factory.mktemp("run")
     result = train(out, TrainConfig(steps=60, batch=32, eval_every=20, warmup_steps=5, lr=3e-3, model=TINY,
                                     reach_probability=0.0),
-                   library, progress=False)
+                   library, progress=False, records_dir=out / "records")
     return out, result
 
 
 def test_training_writes_checkpoint_onnx_config_plot_and_learns(trained):
     out, result = trained
-    for name in ("backbone.pt", "backbone.onnx", "train_config.json", "loss_history.json", "loss.png", "style_stats.json",
-                 "model.json", "feedback.npz"):
+    for name in ("backbone.onnx", "train_config.json", "style_stats.json", "model.json", "feedback.npz"):
         assert (out / name).is_file(), name
-    history = json.loads((out / "loss_history.json").read_text())
+    # what the runtime never reads goes to the records folder, not next to the model
+    for name in ("backbone.pt", "loss_history.json", "loss.png"):
+        assert (out / "records" / name).is_file() and not (out / name).exists(), name
+    history = json.loads((out / "records" / "loss_history.json").read_text())
     assert len(history) == 60 and sum("val_loss" in h for h in history) == 3
     # held-out loss below the untrained model's, which is plain interpolation
     assert result["best_val_loss"] < 0.95 * result["initial_val_loss"]
@@ -63,7 +65,8 @@ def test_onnx_export_matches_torch_for_any_gap(trained, library, gap):
     mask[:, :9] = True
     goal_mask = rng.random((len(w.frames), gap, F.DIM)) < 0.05
     args = (w.context, w.target, mask, gap, w.style)
-    onnx, torch_model = OnnxInbetweener(out / "backbone.onnx"), TorchInbetweener(load_checkpoint(out / "backbone.pt"))
+    onnx = OnnxInbetweener(out / "backbone.onnx")
+    torch_model = TorchInbetweener(load_checkpoint(out / "records" / "backbone.pt"))
     for m in (onnx, torch_model):
         m.set_goals(w.truth, goal_mask)
     a, b = onnx.infill(*args), torch_model.infill(*args)
@@ -94,7 +97,9 @@ def test_torchrun_ddp_trains_with_two_processes(library, tmp_path):
 
 
 def test_shipped_model_is_small_and_loads():
-    onnx_path, ckpt = SHIPPED_DIR / "backbone.onnx", SHIPPED_DIR / "backbone.pt"
+    from g1_control.training import TRAINING_RECORDS_DIR
+
+    onnx_path, ckpt = SHIPPED_DIR / "backbone.onnx", TRAINING_RECORDS_DIR / "generator" / "backbone.pt"
     assert ckpt.stat().st_size <= 20 * 2**20 and onnx_path.stat().st_size <= 20 * 2**20
     config = json.loads((SHIPPED_DIR / "train_config.json").read_text())
     assert config["result"]["wall_s"] <= 30 * 60
@@ -123,7 +128,7 @@ def test_duration_head_cannot_read_the_gap_from_the_token_layout(trained):
     import torch
 
     out, _ = trained
-    model = load_checkpoint(out / "backbone.pt")
+    model = load_checkpoint(out / "records" / "backbone.pt")
     rng = np.random.default_rng(1)
     ctx = rng.normal(size=(3, 10, F.DIM))
     tgt = rng.normal(size=(3, F.DIM))

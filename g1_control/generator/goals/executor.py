@@ -43,7 +43,7 @@ from g1_control.generator.goals.poses import ReachRefused, flat_soles
 from g1_control.generator.goals.reach import reach
 from g1_control.generator.styles import ROLLOUT_STYLES
 from g1_control.generator.whole_body import keyframe_trajectory
-from g1_control.interfaces import Generator, Retargeter
+from g1_control.interfaces import Generator
 from g1_control.robot import g1
 from g1_control.scene import SceneConfig
 from g1_control.types import (
@@ -257,21 +257,4 @@ class GoalGenerator(Generator):
         self.inner.reset(ctx.state)
 
 
-class GoalRetargeter(Retargeter):
-    """Whole-body phases: the plan's own joint reference (feasible by construction, with exact joint
-    velocities and the hand forces); locomotion: the inner generator's retargeter."""
-
-    def __init__(self, generator: GoalGenerator, inner: Retargeter):
-        self.generator = generator
-        self.inner = inner
-
-    def solve(self, reference: KinematicReference, q_prev: np.ndarray) -> JointReference:
-        if reference.phase == PHASE_WHOLE_BODY:
-            return self.generator.joint_reference(reference.t_s)
-        out = self.inner.solve(reference, q_prev)
-        out.phase = PHASE_LOCOMOTION
-        out.hand_forces_w_n[:] = 0.0
-        return out
-
-
-__all__ = ["FAILED", "REACHED", "GoalConfig", "GoalFailed", "GoalGenerator", "GoalRetargeter", "world_pose_needed"]
+__all__ = ["FAILED", "REACHED", "GoalConfig", "GoalFailed", "GoalGenerator", "world_pose_needed"]

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from g1_control.generator.whole_body import LEG_LIGHT_POSTURE_WEIGHT, WholeBodyIK
+from g1_control.ik.whole_body import LEG_LIGHT_POSTURE_WEIGHT, WholeBodyIK
 from g1_control.robot import g1
 from g1_control.robot.dynamics import HAND_FRAMES, SOLE_FRAMES
 from g1_control.rotations import rot_z

@@ -26,8 +26,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from g1_control.generator.whole_body import WholeBodyIK, WholeBodyTrajectory, smoothstep, trajectory_from_configurations
+from g1_control.generator.whole_body import WholeBodyTrajectory, smoothstep, trajectory_from_configurations
 from g1_control.generator.zmp_preview import ZmpPreviewController
+from g1_control.ik.whole_body import WholeBodyIK
 from g1_control.robot import g1
 from g1_control.robot.dynamics import SOLE_FRAMES
 from g1_control.rotations import rot_z, wrap_angle

@@ -125,6 +125,9 @@ class DdsLink(Link):
         self._peer_lock = threading.Lock()
         """Discovered writers on our two topics and partition: instance handle -> (topic, guid)."""
         self._closed = False
+        self._io_lock = threading.Lock()
+        """Held by send/take and by close: Cyclone frees an entity under a thread still writing to it
+        (a segfault, not an error code), so a link closed from another thread must wait for them."""
 
     @property
     def participant(self):
@@ -136,7 +139,10 @@ class DdsLink(Link):
         return f"DDS ({where}{', partition ' + self.partition if self.partition else ''})"
 
     def send(self, payload: bytes) -> None:
-        ret = self._write(self._writer._ref, payload)
+        with self._io_lock:
+            if self._closed:
+                raise TransportError(f"DDS write on {self.describe()}: the link is closed")
+            ret = self._write(self._writer._ref, payload)
         if ret < 0:
             raise TransportError(f"DDS write on {self.describe()} failed with code {ret}")
         self._count("sent")
@@ -145,10 +151,14 @@ class DdsLink(Link):
         return [payload for payload, _ in self.receive_tagged(timeout_s)]
 
     def receive_tagged(self, timeout_s: float) -> list[tuple[bytes, int | None]]:
-        samples = self._take(self._reader._ref, self._depth)
+        samples = self._take_now()
         if isinstance(samples, int) or not samples:
-            self._waitset.wait(int(timeout_s * 1e9))
-            samples = self._take(self._reader._ref, self._depth)
+            with self._io_lock:
+                if self._closed:
+                    return []
+                waitset = self._waitset
+            waitset.wait(int(timeout_s * 1e9))
+            samples = self._take_now()
             if isinstance(samples, int):
                 return []
         tagged = [(data, info.publication_handle) for data, info in samples if info.valid_data]
@@ -187,10 +197,16 @@ class DdsLink(Link):
             counts[topic] += 1
         return counts
 
+    def _take_now(self):
+        with self._io_lock:
+            return [] if self._closed else self._take(self._reader._ref, self._depth)
+
     def close(self) -> None:
         # Entities are reclaimed with the participant; dropping our references is enough, and the
         # domain (with its interface binding) stays for the rest of the process.
-        if not self._closed:
+        with self._io_lock:
+            if self._closed:
+                return
             self._closed = True
             self._waitset.detach(self._condition)
             del self._writer, self._reader, self._condition, self._waitset, self._participant, self._publications

@@ -23,6 +23,8 @@ from g1_control.program.language import lexicon as L
 
 _WORD_RE = re.compile(r"\d+(?:\.\d+)?|\.\d+|[a-z]+(?:'[a-z]+)?|°|/|[,;.!?]|\S")
 _DIGITS_RE = re.compile(r"^(?:\d+(?:\.\d+)?|\.\d+)$")
+NEGATIVE_RE = re.compile(r"(?<![\w.])[-\u2212]\s*(?:\d+(?:\.\d+)?|\.\d+)(?:\s*(?:°|[a-z]+))?")
+"""A signed number ('-3', '− 2.5 meters'): hyphens are word joints elsewhere ("ninety-degree")."""
 SENTENCE_ENDS = frozenset(";.!?")
 DIRECTIONS = frozenset({"forward", "backward", "left", "right", "up", "down"})
 PREPOSITIONS = frozenset({"to", "toward", "towards", "onto", "on", "into", "in", "at", "from", "off", "of", "for",

@@ -22,7 +22,7 @@ from __future__ import annotations
 from g1_control.program.exceptions import InstructionError, ProgramError
 from g1_control.program.language import lexicon as L
 from g1_control.program.language.build import BuildState, StepBuilder
-from g1_control.program.language.grammar import Grammar, split_words
+from g1_control.program.language.grammar import NEGATIVE_RE, Grammar, split_words
 from g1_control.program.program import Program
 from g1_control.program.steps import Step
 
@@ -49,6 +49,11 @@ class InstructionParser:
     def parse(self, text: str) -> Program:
         """The validated Program for an instruction; InstructionError (or UnknownWordError) if none."""
         grammar, builder = self.grammar, self.builder
+        negative = NEGATIVE_RE.search(text.lower())
+        if negative:
+            raise InstructionError(f"\"{negative.group(0)}\": a negative quantity; durations, distances, angles and "
+                                   "counts are sizes; say the direction in words instead, e.g. \"walk backward 2 "
+                                   "meters\", \"turn right 90 degrees\"")
         words = split_words(text)
         if not words:
             raise InstructionError("empty instruction: say what to do, e.g. \"walk forward two meters\"")

@@ -66,9 +66,9 @@ class IdSolution:
 
 class InverseDynamicsQP:
     def __init__(self, nv: int, config: QpConfig | None = None):
-        import proxsuite
+        from g1_control.ik.solver import import_proxsuite
 
-        self._proxsuite = proxsuite
+        self._proxsuite = import_proxsuite()
         self.config = config or QpConfig()
         self.nv = nv
         self.n = nv + 12

@@ -97,12 +97,13 @@ class WbcDiagnostics:
 
 
 class WholeBodyTracker(Tracker):
-    def __init__(self, config: WbcConfig | None = None):
+    def __init__(self, config: WbcConfig | None = None, variant: g1.Variant = g1.G1_29DOF, hands: str = "none"):
+        """variant, hands: the G1 it controls; its dynamics come from that robot's model (WbcModel)."""
         import pinocchio as pin
 
         self._pin = pin
         self.config = config or WbcConfig()
-        self.dyn = WbcModel()
+        self.dyn = WbcModel(variant, hands)
         self.qp = InverseDynamicsQP(self.dyn.nv, self.config.qp)
         self.estimator = StateEstimator()
         self.odometry = BaseOdometry()

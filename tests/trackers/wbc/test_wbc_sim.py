@@ -56,7 +56,7 @@ def test_steps_in_place_and_contact_switches_do_not_jump(monkeypatch):
 
     created = []
     monkeypatch.setattr(tracker_module, "WholeBodyTracker",
-                        lambda config=None: created.append(RecordingTracker()) or created[-1])
+                        lambda config=None, **_: created.append(RecordingTracker()) or created[-1])
     figures, _ = run_wbc("step_in_place")
     assert not figures.fell and figures.joint_rms_rad < 0.02 and figures.base_drift_max_m < 0.03
     rec = created[0]
