@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from g1_control.errors import InvalidCommandError, InvalidStateError, LaunchFileError
+from g1_control.robot import dex3
 from g1_control.robot.g1 import DEFAULT_PELVIS_HEIGHT_M, NUM_JOINTS
 
 _sum = np.add.reduce
@@ -474,3 +475,60 @@ class MotorCommand:
         to inf also reads as non-finite, which is the safe side for values near 1e308.)"""
         return bool(np.isfinite(self.q_rad.sum() + self.dq_radps.sum() + self.kp.sum() + self.kd.sum()
                                 + self.tau_nm.sum()))
+
+
+NUM_HAND_MOTORS = dex3.NUM_MOTORS
+"""Motors of one Dex3-1 hand (g1_control/robot/dex3.py names them)."""
+
+
+def _hand_zeros() -> np.ndarray:
+    return np.zeros(NUM_HAND_MOTORS)
+
+
+@dataclass
+class FingerCommand:
+    """One Dex3-1 hand's command, (7,) per field in the hand's motor order, same motor law as
+    MotorCommand: tau = tau_nm + kp * (q_rad - q) + kd * (dq_radps - dq), clipped to the motor's effort."""
+
+    q_rad: np.ndarray = field(default_factory=_hand_zeros)
+    dq_radps: np.ndarray = field(default_factory=_hand_zeros)
+    kp: np.ndarray = field(default_factory=_hand_zeros)
+    kd: np.ndarray = field(default_factory=_hand_zeros)
+    tau_nm: np.ndarray = field(default_factory=_hand_zeros)
+    enable: np.ndarray = field(default_factory=lambda: np.ones(NUM_HAND_MOTORS, dtype=bool))
+
+    @classmethod
+    def damping(cls, kd: float = dex3.DAMPING_KD) -> FingerCommand:
+        """The fail-safe command for a hand: no stiffness, velocity damping only."""
+        return cls(kd=np.full(NUM_HAND_MOTORS, float(kd)))
+
+    def copy(self) -> FingerCommand:
+        return FingerCommand(self.q_rad.copy(), self.dq_radps.copy(), self.kp.copy(), self.kd.copy(),
+                             self.tau_nm.copy(), self.enable.copy())
+
+    def is_finite(self) -> bool:
+        return bool(np.isfinite(self.q_rad.sum() + self.dq_radps.sum() + self.kp.sum() + self.kd.sum()
+                                + self.tau_nm.sum()))
+
+    @property
+    def is_damping(self) -> bool:
+        """kp 0 and kd > 0 on every motor."""
+        return bool(np.all(self.kp == 0.0) and np.all(self.kd > 0.0))
+
+
+@dataclass
+class FingerState:
+    """What one Dex3-1 hand reports (HandState_), (7,) per motor field in the hand's motor order."""
+
+    q_rad: np.ndarray = field(default_factory=_hand_zeros)
+    dq_radps: np.ndarray = field(default_factory=_hand_zeros)
+    tau_nm: np.ndarray = field(default_factory=_hand_zeros)
+    """The motors' estimated torque (tau_est): what a force-limited grasp watches."""
+    temperature_c: np.ndarray = field(default_factory=_hand_zeros)
+    """The hotter of each motor's two sensors."""
+    motor_enabled: np.ndarray = field(default_factory=lambda: np.zeros(NUM_HAND_MOTORS, dtype=bool))
+    power_v: float = 0.0
+    power_a: float = 0.0
+    error: tuple[int, int] = (0, 0)
+    t_s: float = 0.0
+    """time.monotonic() when the host received it."""

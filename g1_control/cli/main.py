@@ -26,6 +26,7 @@ SUBCOMMAND_MODULES = (
     "g1_control.cli.bench_cmd",
     "g1_control.cli.input_cmd",
     "g1_control.cli.sim_robot_cmd",
+    "g1_control.cli.hands_cmd",
     "g1_control.cli.retarget_cmd",
     "g1_control.cli.check_cmd",
     "g1_control.cli.deploy_cmd",

@@ -77,6 +77,13 @@ def register(subparsers) -> None:
     parser.add_argument("--rt-priority", type=int, default=30, metavar="N",
                         help="SCHED_RR priority (default 30; 0: normal scheduling): the emulated robot keeps its 500 Hz "
                         "on a busy host, as the robot's own computer would (needs root, else nice -10 with a warning)")
+    parser.add_argument("--hands", choices=("none", "dex3"), default="none",
+                        help="dex3: emulate the two Dex3-1 hands too (HandState_ on rt/dex3/left|right/state at "
+                        "100 Hz, HandCmd_ applied from rt/dex3/left|right/cmd; a per-finger motor model, "
+                        "g1_control/sim/dex3_hands.py), for launch files with backend.hands: dex3")
+    parser.add_argument("--hand-object", type=float, metavar="CLOSURE",
+                        help="with --hands dex3: an object in each hand that every closing finger touches at this "
+                        "fraction of its travel (0 open .. 1 closed), for trying `g1 hands grasp`")
     parser.add_argument("--seconds", type=float, help="stop after this long (default: until Ctrl-C)")
     parser.add_argument("--control-stdin", action="store_true",
                         help="read fault names and remote commands ('press start', 'press A', 'stick ly 0.5', "
@@ -149,6 +156,18 @@ def _run(args) -> int:
         print(f"g1 sim-robot: {exc}", file=sys.stderr)
         return 2
     emulator.start()
+    hands = None
+    if args.hands == "dex3":
+        from g1_control.sim.dex3_hands import Dex3HandsEmulator
+
+        hands = Dex3HandsEmulator(args.interface, args.domain, partition=args.partition).start()
+        if args.hand_object is not None:
+            for side in hands.hands:
+                hands.hold_object(side, args.hand_object)
+    elif args.hand_object is not None:
+        print("g1 sim-robot: --hand-object needs --hands dex3", file=sys.stderr)
+        emulator.close()
+        return 2
     stop = {"now": False}
 
     def _stop(signum, frame):
@@ -157,8 +176,9 @@ def _run(args) -> int:
     signal.signal(signal.SIGTERM, _stop)
     with frozen_heap():  # the 500 Hz robot loop never waits for a full collection of the startup heap
         played = ", as Unitree's unitree_mujoco" if args.mode == "unitree_mujoco" else ""
-        print(f"g1 sim-robot: emulating a G1 ({args.physics}{played}, mode_machine {args.mode_machine}) on interface "
-              f"{args.interface}, domain {args.domain}"
+        print(f"g1 sim-robot: emulating a G1 ({args.physics}{played}, mode_machine {args.mode_machine}"
+              + (", Dex3-1 hands" if hands is not None else "") + f") on interface {args.interface}, "
+              f"domain {args.domain}"
               + (f", partition {args.partition}" if args.partition else ""), file=sys.stderr, flush=True)
         print("ready", flush=True)
         try:
@@ -173,6 +193,11 @@ def _run(args) -> int:
         finally:
             report = emulator.report()
             emulator.close()
+            if hands is not None:
+                hand_states, hand_commands = sum(hands.states_sent.values()), sum(hands.commands_applied.values())
+                hands.close()
+                print(f"g1 sim-robot: hands: {hand_states} HandState_ sent, {hand_commands} HandCmd_ applied",
+                      file=sys.stderr)
     print(f"g1 sim-robot: {report['states_sent']} states sent, {report['commands_applied']} commands applied, "
           f"{report['bad_crc']} bad CRC, {report['wrong_mode_machine']} wrong mode_machine, "
           f"{report['ignored_while_builtin_active']} ignored while the built-in controller ran", file=sys.stderr)

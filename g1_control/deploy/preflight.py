@@ -41,10 +41,15 @@ CHECKS: dict[str, str] = {
     "joint_limits": "every joint reads inside its limits",
     "temperatures": "every motor is cooler than deploy.max_start_temperature_c",
     "battery": "battery voltage above deploy.min_battery_v (when the robot reports it)",
+    "hands_present": "both Dex3-1 hands publish HandState_ (backend.hands: dex3; g1_control/deploy/hands.py)",
+    "hand_state_stream": "each hand's HandState_ arrives at >= 50 Hz and is not frozen",
+    "finger_limits": "every finger joint reads inside its URDF limits",
     "estop_input": "the operator input opens, has an e-stop, and is not lost",
     "dry_run": "a lockstep MuJoCo run of the same launch file does not fall",
 }
 """Check name -> what it asserts (the names --override takes)."""
+OPTIONAL_CHECKS = frozenset({"hands_present", "hand_state_stream", "finger_limits"})
+"""Rows in the table only where they apply (the hand rows: backend.hands dex3, deploy/hands.py)."""
 
 PASS, FAIL, SKIP, NOT_RUN = "pass", "fail", "skip", "not run"
 
@@ -93,7 +98,8 @@ class Preflight:
         if unknown:
             raise G1ControlError(f"--override {', '.join(sorted(unknown))}: no such check; checks: {', '.join(CHECKS)}")
         for name in CHECKS:
-            self.results[name] = CheckResult(name, NOT_RUN, "not run")
+            if name not in OPTIONAL_CHECKS:
+                self.results[name] = CheckResult(name, NOT_RUN, "not run")
 
     def record(self, name: str, status: str, reason: str, *, overridable: bool = True) -> bool:
         result = CheckResult(name, status, reason, overridable)
@@ -104,13 +110,22 @@ class Preflight:
                           name, reason, name)
             else:
                 result.reason += f" (--override {name} refused: this failure cannot be overridden)"
-        self.results[name] = result
+        self._put(result)
         return status != FAIL
+
+    def _put(self, result: CheckResult) -> None:
+        """Store `result`; an optional row new to the table takes its place in CHECKS order (rows of
+        other names, such as g1 doctor's, keep theirs)."""
+        new = result.name not in self.results
+        self.results[result.name] = result
+        if new and result.name in OPTIONAL_CHECKS:
+            order = [n for n in CHECKS if n in self.results] + [n for n in self.results if n not in CHECKS]
+            self.results = {n: self.results[n] for n in order}
 
     def not_run(self, names, why: str) -> None:
         for name in names:
-            if self.results[name].status == NOT_RUN:
-                self.results[name] = CheckResult(name, NOT_RUN, f"not run: {why}")
+            if name not in self.results or self.results[name].status == NOT_RUN:
+                self._put(CheckResult(name, NOT_RUN, f"not run: {why}"))
 
     # -- the checks ----------------------------------------------------------------------------------
     def check_launch_file(self, path: Path) -> LaunchFile | None:

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from g1_control.deploy.preflight import CHECKS, FAIL, Preflight
+from g1_control.deploy.preflight import CHECKS, FAIL, OPTIONAL_CHECKS, Preflight
 from g1_control.deploy.state_machine import DeployState, DeployTracker, OperatorButtons, Transition
 from g1_control.errors import G1ControlError, LaunchFileError
 from g1_control.hardware.links.network import LOOPBACK
@@ -177,7 +177,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             pf.record("launch_file", FAIL, f"command-line override: {exc}", overridable=False)
             launch = None
     if launch is None:
-        pf.not_run([n for n in CHECKS if n != "launch_file"], "no valid launch file")
+        pf.not_run([n for n in CHECKS if n != "launch_file" and n not in OPTIONAL_CHECKS], "no valid launch file")
         return _refuse(pf, report, say)
     if options.program is not None and not _confirm_program(launch, options, say, ask):
         report.refused = True
@@ -185,7 +185,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
         return report
 
     spec, policy_variant = pf.check_policy(launch)
-    backend = device = None
+    backend = device = hands = None
     normal, scheduling = realtime(launch.deploy.realtime_priority)
     say(f"scheduling: {scheduling}")
     try:
@@ -201,6 +201,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             pf.check_robot(backend, launch, policy_variant)
         else:
             pf.not_run(ROBOT_CHECKS, "no link to the robot")
+        hands = _check_hands(pf, launch, backend is not None)
         device, open_error = _open_input(launch, backend, spec)
         if launch.input.type == "unitree_remote" and pf.results["variant"].status == "not run":
             pf.not_run(["estop_input"], "the remote's bytes ride in the robot's LowState_, and none arrived")
@@ -242,9 +243,30 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
     finally:
         if device is not None:
             device.close()
+        if hands is not None:
+            hands.close()
         if backend is not None:
             backend.close()
         normal.restore()
+
+
+def _check_hands(pf: Preflight, launch: LaunchFile, robot_link_open: bool):
+    """The preflight's hand rows (g1_control/deploy/hands.py); the open hand link, or None."""
+    from g1_control.deploy.hands import HAND_CHECKS, check_hands, open_hand_link
+
+    if launch.backend.hands != "dex3":
+        check_hands(pf, launch, None)
+        return None
+    if not robot_link_open:
+        pf.not_run(list(HAND_CHECKS), "no link to the robot")
+        return None
+    try:
+        hands = open_hand_link(launch)
+    except G1ControlError as exc:
+        check_hands(pf, launch, None, str(exc))
+        return None
+    check_hands(pf, launch, hands)
+    return hands
 
 
 def _refuse(pf: Preflight, report: DeployReport, say) -> DeployReport:

@@ -404,7 +404,9 @@ def test_the_table():
     assert pf.table() == format_table(list(pf.results.values()))
     assert pf.as_dict()[0] == {"name": "launch_file", "status": NOT_RUN, "reason": "not run", "overridable": True,
                                "overridden": False}
-    assert list(pf_module.CHECKS) == [r["name"] for r in pf.as_dict()]
+    assert [n for n in pf_module.CHECKS if n not in pf_module.OPTIONAL_CHECKS] == [r["name"] for r in pf.as_dict()]
+    pf.record("finger_limits", PASS, "fine")  # an optional row takes its place in CHECKS order
+    assert [r["name"] for r in pf.as_dict()][-4:] == ["battery", "finger_limits", "estop_input", "dry_run"]
 
 
 def test_the_device_is_polled_throughout_the_window_with_the_time(launch, monkeypatch):
