@@ -114,5 +114,5 @@ if [ -n "$made_venv" ]; then
   echo "   activate it in this shell, then run the command again (setup then only re-checks):" >&2
   echo "       . $made_venv/bin/activate" >&2
 else
-  say "ready: try 'g1 launch sim_walk' (g1 launch --list shows the launch files)"
+  say "ready: try 'g1 launch sim_tour' (the whole chain, ~2 min) or 'g1 launch sim_walk' (the quick one); g1 launch --list shows the launch files"
 fi
