@@ -106,8 +106,9 @@ def test_g1_sim_robot_scene_perception_over_dds_places_the_box_where_the_simulat
     frames = perception.counters.frames
     print(f"\nperception over DDS: {frames} frames, {report['perception']}, box error mean {errors.mean() * 100:.1f} cm")
     rejected = perception.counters.rejected
-    # a loaded host may deliver a frame late past max_age_s: a few stale ones are refused, never placed
-    assert frames > 40 and rejected["no_pose"] == 0 and rejected["stale"] <= 0.1 * frames
+    # a loaded host may deliver a frame late past max_age_s, and the emulator publishes from its start, so a
+    # frame or two can be stamped before the localiser's first pose: refused by name, never placed
+    assert frames > 40 and rejected["no_pose"] <= 2 and rejected["stale"] <= 0.1 * frames
     assert 0.05 < report["perception"]["dropped"] / report["perception"]["measured"] < 0.2
     assert errors.mean() < 0.045  # 2 cm noise per axis: 3.2 cm expected
     assert np.abs(truth[:2] - [1.1, 0.1]).max() < 0.02  # the box stands where the scene put it
