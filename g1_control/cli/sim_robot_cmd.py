@@ -50,24 +50,12 @@ def register(subparsers) -> None:
                         help="also publish a motion-capture pose of the pelvis from the simulator's ground truth "
                         "(geometry_msgs/PoseStamped on rt/<--mocap-topic>, frame 'mocap' = the scene frame), for a "
                         "launch file's estimation.external_pose")
-    parser.add_argument("--mocap-topic", default="mocap/pose", help="its ROS 2 topic (default mocap/pose)")
-    parser.add_argument("--mocap-rate-hz", type=float, default=100.0, help="poses per second (default 100)")
-    parser.add_argument("--mocap-noise-m", type=float, default=0.0, help="position noise, std per axis (m)")
-    parser.add_argument("--mocap-noise-deg", type=float, default=0.0, help="heading noise, std (deg)")
-    parser.add_argument("--mocap-latency-s", type=float, default=0.0, help="each pose is sent this late (s)")
-    parser.add_argument("--mocap-dropout", type=float, default=0.0, help="probability that a pose is lost (0..1)")
-    parser.add_argument("--mocap-seed", type=int, default=0, help="seed of the noise and dropouts")
+    _add_feed_arguments(parser, "mocap", "mocap/pose", 100.0, "pose")
     parser.add_argument("--scene", metavar="FILE",
                         help="build this launch file's scene (tables, platforms, boxes) in the MuJoCo physics and "
                         "publish its boxes as perception sees them (g1_msgs ObjectPoses_ on rt/<--perception-topic>, "
                         "each box in the robot's heading frame); the exit report gives the boxes' ground truth")
-    parser.add_argument("--perception-topic", default="perception/objects", help="default perception/objects")
-    parser.add_argument("--perception-rate-hz", type=float, default=10.0, help="frames per second (default 10)")
-    parser.add_argument("--perception-noise-m", type=float, default=0.0, help="position noise, std per axis (m)")
-    parser.add_argument("--perception-noise-deg", type=float, default=0.0, help="heading noise, std (deg)")
-    parser.add_argument("--perception-latency-s", type=float, default=0.0, help="each frame is sent this late (s)")
-    parser.add_argument("--perception-dropout", type=float, default=0.0, help="probability that a frame is lost")
-    parser.add_argument("--perception-seed", type=int, default=0, help="seed of the noise and dropouts")
+    _add_feed_arguments(parser, "perception", "perception/objects", 10.0, "frame")
     parser.add_argument("--mode-machine", type=int, default=5,
                         help="the G1 variant to emulate and report: 4 = 23-DoF (no waist roll/pitch, no wrist "
                         "pitch/yaw: MuJoCo builds it without those joints), 5 = 29-DoF (default), 6 = 29-DoF with "
@@ -89,6 +77,28 @@ def register(subparsers) -> None:
                         help="read fault names and remote commands ('press start', 'press A', 'stick ly 0.5', "
                         "'press L1+R1') from stdin, answer JSON lines (see g1_control/sim/emulator.py)")
     parser.set_defaults(func=_run)
+
+
+def _add_feed_arguments(parser, name: str, topic: str, rate_hz: float, sample: str) -> None:
+    """--NAME-topic/-rate-hz/-noise-m/-noise-deg/-latency-s/-dropout/-seed of a simulated sensor feed."""
+    parser.add_argument(f"--{name}-topic", default=topic, help=f"its ROS 2 topic (default {topic})")
+    parser.add_argument(f"--{name}-rate-hz", type=float, default=rate_hz, help=f"{sample}s per second (default {rate_hz:g})")
+    parser.add_argument(f"--{name}-noise-m", type=float, default=0.0, help="position noise, std per axis (m)")
+    parser.add_argument(f"--{name}-noise-deg", type=float, default=0.0, help="heading noise, std (deg)")
+    parser.add_argument(f"--{name}-latency-s", type=float, default=0.0, help=f"each {sample} is sent this late (s)")
+    parser.add_argument(f"--{name}-dropout", type=float, default=0.0, help=f"probability that a {sample} is lost (0..1)")
+    parser.add_argument(f"--{name}-seed", type=int, default=0, help="seed of the noise and dropouts")
+
+
+def _feed_config(args, name: str):
+    """The MocapConfig of the feed `name` (its arguments from _add_feed_arguments)."""
+    import math
+
+    from g1_control.sim.mocap import MocapConfig
+
+    a = vars(args)
+    return MocapConfig(a[f"{name}_rate_hz"], a[f"{name}_noise_m"], math.radians(a[f"{name}_noise_deg"]),
+                       a[f"{name}_latency_s"], a[f"{name}_dropout"], a[f"{name}_seed"])
 
 
 def _run(args) -> int:
@@ -139,18 +149,10 @@ def _run(args) -> int:
     emulator = RobotEmulator(physics, args.interface, args.domain, partition=args.partition,
                              builtin_mode="" if args.no_builtin else "ai", mode=args.mode)
     try:
-        import math
-
-        from g1_control.sim.mocap import MocapConfig
-
         if args.mocap:
-            emulator.publish_mocap(MocapConfig(args.mocap_rate_hz, args.mocap_noise_m, math.radians(args.mocap_noise_deg),
-                                               args.mocap_latency_s, args.mocap_dropout, args.mocap_seed),
-                                   args.mocap_topic)
+            emulator.publish_mocap(_feed_config(args, "mocap"), args.mocap_topic)
         if scene is not None:
-            emulator.publish_perception(mujoco, MocapConfig(
-                args.perception_rate_hz, args.perception_noise_m, math.radians(args.perception_noise_deg),
-                args.perception_latency_s, args.perception_dropout, args.perception_seed), args.perception_topic)
+            emulator.publish_perception(mujoco, _feed_config(args, "perception"), args.perception_topic)
     except ValueError as exc:
         emulator.close()
         print(f"g1 sim-robot: {exc}", file=sys.stderr)
