@@ -127,3 +127,27 @@ def standing_state(**changes):
     for k, v in changes.items():
         setattr(state, k, v)
     return state
+
+
+def deploy_to_the_end(partition: str, launch: Path, json_path: Path, out: Path, emulator_flags=(), deploy_flags=(),
+                      waits=((r"control -> damping: control time over", 240), (r"^loop: ", 30))):
+    """`g1 sim-robot` (flags) and `g1 deploy LAUNCH --yes` as two processes, the deploy waited through `waits`
+    (pattern, seconds) to its exit; (the deploy process, the emulator's wire report). Both are ended either way."""
+    from test_deploy_sim2sim import Emulator
+
+    from g1_control.tools.soak import G1Process
+
+    robot = Emulator(partition, *emulator_flags)
+    host = None
+    try:
+        host = G1Process("deploy", str(launch), "--yes", "--partition", partition, "--json", str(json_path),
+                         "--out", str(out), *deploy_flags)
+        for pattern, seconds in waits:
+            host.wait_for(pattern, seconds)
+        assert host.proc.wait(timeout=30) == 0, host.stderr
+        wire = robot.ask("report")
+    finally:
+        if host is not None:
+            host.kill()
+        robot.close()
+    return host, wire

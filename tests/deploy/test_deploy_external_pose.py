@@ -10,8 +10,8 @@ import json
 import math
 
 import pytest
+from deploy_test_helpers import deploy_to_the_end
 
-from g1_control.tools.soak import G1Process as Proc
 from tests.paths import LAUNCH_DIR
 
 pytestmark = pytest.mark.timing
@@ -21,22 +21,9 @@ MOCAP = ("--mocap", "--mocap-noise-m", "0.02", "--mocap-noise-deg", "3", "--moca
 
 
 def test_the_fused_estimate_ends_where_the_simulator_says_the_robot_is(tmp_path, partition):
-    from test_deploy_sim2sim import Emulator
-
-    robot = Emulator(partition, "--lower-gantry-on-policy", *MOCAP)
-    host = None
-    try:
-        report_path = tmp_path / "deploy.json"
-        host = Proc("deploy", str(LAUNCH_DIR / "sim2sim_mocap.yaml"), "--yes", "--partition", partition,
-                    "--json", str(report_path), "--out", str(tmp_path))
-        host.wait_for(r"control -> damping: control time over", 240)
-        host.wait_for(r"^loop: ", 30)
-        assert host.proc.wait(timeout=30) == 0, host.stderr
-        wire = robot.ask("report")
-    finally:
-        if host is not None:
-            host.kill()
-        robot.close()
+    report_path = tmp_path / "deploy.json"
+    host, wire = deploy_to_the_end(partition, LAUNCH_DIR / "sim2sim_mocap.yaml", report_path, tmp_path,
+                                   emulator_flags=("--lower-gantry-on-policy", *MOCAP))
     report = json.loads(report_path.read_text())
     loc = report["localisation"]
     assert loc["source"] == "leg odometry fused with an external pose"

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from deploy_test_helpers import FAST, write_launch
+from deploy_test_helpers import FAST, deploy_to_the_end, write_launch
 
 from g1_control.cli.main import main
 from g1_control.robot import g1
@@ -42,24 +42,9 @@ def _hand_offset_in_heading_frame(q_rad: np.ndarray, quat_wxyz: np.ndarray) -> n
 
 
 def test_every_goal_is_reported_on_the_robot_path_and_the_relative_reach_runs(tmp_path, partition):
-    from test_deploy_sim2sim import Emulator
-
-    from g1_control.tools.soak import G1Process
-
-    robot = Emulator(partition, "--lower-gantry-on-policy")
-    host = None
-    try:
-        report_path = tmp_path / "deploy.json"
-        host = G1Process("deploy", str(LAUNCH_DIR / "sim2sim_goals.yaml"), "--yes", "--partition", partition,
-                         "--json", str(report_path), "--out", str(tmp_path))
-        host.wait_for(r"control -> damping: control time over", 240)
-        host.wait_for(r"^loop: ", 30)
-        assert host.proc.wait(timeout=30) == 0, host.stderr
-        wire = robot.ask("report")
-    finally:
-        if host is not None:
-            host.kill()
-        robot.close()
+    report_path = tmp_path / "deploy.json"
+    host, wire = deploy_to_the_end(partition, LAUNCH_DIR / "sim2sim_goals.yaml", report_path, tmp_path,
+                                   emulator_flags=("--lower-gantry-on-policy",))
     console = "\n".join(host.seen)
     # said before anything moved: the preflight table's launch_file row
     assert ("; note: goal seg2.0 (reach left hand at (0.40, 0.20, 0.95)) is placed by the robot's own estimate (leg "

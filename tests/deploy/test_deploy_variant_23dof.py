@@ -4,7 +4,7 @@ and the preflight accepts it with the model-based controller, whose dry run simu
 from __future__ import annotations
 
 import pytest
-from deploy_test_helpers import FAST, ROOT, preflight_only, write_launch
+from deploy_test_helpers import FAST, ROOT, deploy_to_the_end, preflight_only, write_launch
 
 pytestmark = pytest.mark.timing
 
@@ -64,23 +64,11 @@ def test_g1_deploy_runs_the_23dof_sim_robot_over_dds_with_the_model_based_contro
     processes: the whole state machine, the WBC holding the 23-DoF robot off its gantry, damping at the end."""
     import json
 
-    from test_deploy_sim2sim import Emulator
-
-    from g1_control.tools.soak import G1Process
-
-    robot = Emulator(partition, "--mode-machine", "4", "--lower-gantry-on-policy", "--rt-priority", "0")
-    host = None
-    try:
-        host = G1Process("deploy", str(SIM2SIM_23DOF), "--yes", "--partition", partition, "--duration", "5",
-                         "--json", str(tmp_path / "deploy.json"), "--out", str(tmp_path))
-        host.wait_for(r"zero torque: the robot is limp", 90)
-        host.wait_for(r"control -> damping: control time over", 60)
-        assert host.proc.wait(timeout=30) == 0, host.stderr
-        wire = robot.ask("report")
-    finally:
-        if host is not None:
-            host.kill()
-        robot.close()
+    _, wire = deploy_to_the_end(partition, SIM2SIM_23DOF, tmp_path / "deploy.json", tmp_path,
+                                   emulator_flags=("--mode-machine", "4", "--lower-gantry-on-policy", "--rt-priority", "0"),
+                                   deploy_flags=("--duration", "5"),
+                                   waits=((r"zero torque: the robot is limp", 90),
+                                          (r"control -> damping: control time over", 60)))
     report = json.loads((tmp_path / "deploy.json").read_text())
     assert report["sequence"] == ["zero_torque", "ramp", "hold", "control", "damping"]
     assert {r["name"]: r["reason"] for r in report["preflight"]}["variant"] == "mode_machine 4 (g1_23dof, 23 DoF)"
