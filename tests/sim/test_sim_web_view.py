@@ -122,6 +122,16 @@ def box_pixels(image: np.ndarray) -> int:
 
 
 @pytest.mark.slow
+def _rendered(url: str, out, tries: int = 3) -> np.ndarray:
+    """A screenshot of the page once it has drawn anything: on a loaded host headless Chromium now and
+    then hands back the blank page (every pixel white, seen in CI), which is taken again."""
+    for _ in range(tries):
+        image = screenshot(url, out, wait_ms=20000)
+        if (image < 250).any():
+            return image
+    return image
+
+
 def test_browser_shows_the_box(tmp_path):
     _needs("chromium", CHROMIUM is not None)
     from g1_control.sim.web import WebView
@@ -135,10 +145,10 @@ def test_browser_shows_the_box(tmp_path):
         q[adr:adr + 7] = [0.6, 0.3, 0.9, 1.0, 0.0, 0.0, 0.0]
         view.show(q, "box beside the robot")
         # a longer virtual-time budget than the robot's: under load the page was still blank at 8 s
-        image = screenshot(view.url, tmp_path / "box.png", wait_ms=20000)
+        image = _rendered(view.url, tmp_path / "box.png")
         q[adr:adr + 3] = [60.0, 60.0, 0.15]  # recorded far away: gone from the picture
         view.show(q, "box gone")
-        gone = screenshot(view.url, tmp_path / "gone.png", wait_ms=20000)
+        gone = _rendered(view.url, tmp_path / "gone.png")
     finally:
         view.close()
     assert box_pixels(image) > 500, f"box not in the screenshot ({box_pixels(image)} green pixels)"
