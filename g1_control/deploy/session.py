@@ -516,7 +516,8 @@ def _report_localisation(report: DeployReport, loop) -> None:
     if localiser.fusion is not None:
         c = localiser.fusion.counters
         out["external_pose"] = {"accepted": c.accepted, "rejected": dict(c.rejected), "last_rejection": c.last_rejection,
-                                "max_correction_m": c.max_correction_m}
+                                "max_correction_m": c.max_correction_m, "reacquired": c.reacquired,
+                                "max_reacquire_m": c.max_reacquire_m}
     if localiser.objects is not None:
         p = localiser.objects.counters
         out["perception"] = {"frames": p.frames, "rejected": dict(p.rejected), "last_rejection": p.last_rejection,
