@@ -270,7 +270,7 @@ def test_the_motion_service_is_asked_in_the_preflight_and_a_release_that_would_f
     assert "cannot be overridden" in _reason(report, "motion_service")
     assert robot.service is not None
     robot.service.close()  # the service goes silent: the robot streams its state, nothing answers CheckMode
-    report, refused, text = preflight_only(path, partition)
+    report, refused, _ = preflight_only(path, partition)
     assert refused is not None and _status(report)["motion_service"] == "fail"
     assert _reason(report, "motion_service").startswith(
         "no motion service answered within 1.0 s, and backend.release_motion_service is true: the release would "
