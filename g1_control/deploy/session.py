@@ -203,7 +203,7 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
             if pf.results["state_stream"].status == "pass":
                 pf.check_motion_service(backend, launch)
             else:
-                pf.not_run(["motion_service"], "no robot state: the service is asked only of a robot that answers")
+                pf.not_run(["motion_service"], "no robot state")
         else:
             pf.not_run(ROBOT_CHECKS, "no link to the robot")
         hands = _check_hands(pf, launch, backend is not None)
