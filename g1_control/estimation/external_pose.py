@@ -71,6 +71,9 @@ class ExternalPoseConfig:
     reacquire_tolerance_rad: float = 0.1
     frame: Literal["start", "scene"] = "start"
     """start: align the external frame to the start frame on the first pose; scene: poses are in the scene frame."""
+    start_in_scene: list[float] | None = None
+    """frame scene: the robot's start (x, y, yaw) in the scene's frame, from scene.robot_start
+    (g1_control/launch/start_pose.py); poses are mapped from the scene's frame into the start frame."""
 
     def validate(self, where: str) -> None:
         from g1_control.hardware.ros2.topics import check_topic_name
@@ -98,6 +101,10 @@ class ExternalPoseConfig:
         if self.reacquire_tolerance_m >= self.max_jump_m:
             raise LaunchFileError(f"{where}.reacquire_tolerance_m: {self.reacquire_tolerance_m} m must be below "
                                   f"max_jump_m ({self.max_jump_m} m), or a jumping pose would agree with anything")
+        start = self.start_in_scene
+        if start is not None and (not isinstance(start, list | tuple) or len(start) != 3
+                                  or not all(isinstance(v, int | float) and math.isfinite(v) for v in start)):
+            raise LaunchFileError(f"{where}.start_in_scene: expected [x, y, yaw] (3 finite numbers), got {start!r}")
         if self.frame not in FRAMES:
             raise LaunchFileError(f"{where}.frame: '{self.frame}' is not one of {', '.join(FRAMES)}")
 
@@ -145,6 +152,15 @@ class FusionCounters:
     """The largest such reset."""
 
 
+def _scene_to_start(start: list[float] | None) -> Planar:
+    """The scene frame seen from the start frame of a robot starting at `start` (x, y, yaw) in it."""
+    if start is None:
+        return Planar(0.0, 0.0, 0.0, 0.0)
+    x, y, yaw = (float(v) for v in start)
+    c, s = math.cos(yaw), math.sin(yaw)
+    return Planar(0.0, -(c * x + s * y), -(-s * x + c * y), float(wrap_angle(-yaw)))
+
+
 class PoseFusion:
     """See the module docstring."""
 
@@ -154,7 +170,7 @@ class PoseFusion:
         self._history: deque[Planar] = deque()
         self.fused: Planar | None = None
         self._last_odometry: Planar | None = None
-        self._align: Planar | None = Planar(0.0, 0.0, 0.0, 0.0) if config.frame == "scene" else None
+        self._align: Planar | None = _scene_to_start(config.start_in_scene) if config.frame == "scene" else None
         self._last_accepted_stamp: float | None = None
         self._jumps: list[tuple[float, float, float]] = []
         """Innovations (ex, ey, eyaw) of the consecutive jumping poses since the last accepted one."""
