@@ -3,7 +3,10 @@
 One description serves three readers: the simulator builds it into the MuJoCo model
 (g1_control/sim/scene.py), the goal generator plans against it (where a box is, how high a table
 or platform is: task knowledge, like a map), and launch files write it (`scene:`, validated like
-the rest of the schema, errors naming the key). The robot starts at the origin facing +x.
+the rest of the schema, errors naming the key). The robot starts at the origin facing +x; a launch
+file may give its room in a frame of its own and say where the robot starts in it
+(`scene.robot_start: {xy_m, yaw_rad}`: g1_control/launch/start_pose.py moves everything into the
+start frame when the file is read).
 
     scene:
       tables:    [{name: table_a, center_xy_m: [2.0, 0.0], size_xy_m: [0.5, 0.8], height_m: 0.7}]

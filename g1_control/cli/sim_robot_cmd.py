@@ -108,7 +108,7 @@ def _run(args) -> int:
 
     realtime(args.rt_priority)
     physics: Backend
-    scene = None
+    scene = start_in_scene = None
     if args.scene:
         from g1_control.errors import LaunchFileError
         from g1_control.launch.schema import load_launch
@@ -117,7 +117,11 @@ def _run(args) -> int:
             print("g1 sim-robot: --scene needs --physics mujoco", file=sys.stderr)
             return 2
         try:
-            scene = load_launch(args.scene).scene
+            launch = load_launch(args.scene)
+            scene = launch.scene
+            external = launch.estimation.external_pose
+            # the launch file's scene.robot_start: the mocap speaks the scene's frame, as its calibration would
+            start_in_scene = external.start_in_scene if external is not None and external.frame == "scene" else None
         except LaunchFileError as exc:
             print(f"g1 sim-robot: --scene: {exc}", file=sys.stderr)
             return 2
@@ -150,7 +154,7 @@ def _run(args) -> int:
                              builtin_mode="" if args.no_builtin else "ai", mode=args.mode)
     try:
         if args.mocap:
-            emulator.publish_mocap(_feed_config(args, "mocap"), args.mocap_topic)
+            emulator.publish_mocap(_feed_config(args, "mocap"), args.mocap_topic, start_in_scene)
         if scene is not None:
             emulator.publish_perception(mujoco, _feed_config(args, "perception"), args.perception_topic)
     except ValueError as exc:

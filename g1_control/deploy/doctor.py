@@ -12,12 +12,11 @@ doctor calls healthy is what `g1 deploy` will accept.
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from g1_control.deploy.preflight import FAIL, NOT_RUN, PASS, SKIP, CheckResult, Preflight, format_table
-from g1_control.errors import G1ControlError, MotionServiceError, RobotNotConnectedError
+from g1_control.errors import G1ControlError, RobotNotConnectedError
 from g1_control.hardware.links.network import LOOPBACK, ROBOT_SUBNET, interface_table
 
 if TYPE_CHECKING:
@@ -27,10 +26,6 @@ ROBOT_ROWS = ("state_stream", "variant", "peers", "imu_upright", "joint_limits",
 """The preflight's checks that need nothing but the robot's state (the doctor shows these)."""
 ROWS = ("interface", *ROBOT_ROWS, "motion_service")
 """The doctor's findings, in the order it prints them."""
-DEBUG_MODE = ("put the robot in debug mode with its remote: with the robot hanging in zero-torque mode press "
-              "L2+R2 (then L2+A to damp), or let g1 deploy release the service (backend.release_motion_service: "
-              "true)")
-"""The step people miss (Unitree's deploy guides; unitree_rl_gym's deploy_real README)."""
 OTHER_DOMAINS = (0, 1)
 """Where a robot (0) or a simulator (1) conventionally publishes, tried when the named domain is silent."""
 
@@ -138,28 +133,8 @@ def _no_robot(pf: Preflight, launch: LaunchFile, options: DoctorOptions, say) ->
 
 
 def _check_motion_service(pf: Preflight, launch: LaunchFile, backend) -> bool:
-    """Ask the motion-switcher service which built-in controller runs (CheckMode only; nothing released)."""
-    from g1_control.hardware.links.dds import DdsLink
-    from g1_control.hardware.unitree.motion_service import MotionServiceClient
-
-    b = launch.backend
-    if not isinstance(backend.link, DdsLink):
-        return pf.record("motion_service", SKIP, f"{backend.link.describe()} has no DDS participant to ask")
-    client = MotionServiceClient(backend.link.participant, b.partition, timeout_s=1.0)
-    t0 = time.monotonic()
-    try:
-        name = client.check_mode()
-    except MotionServiceError:
-        return pf.record("motion_service", SKIP, f"no motion service answered within {time.monotonic() - t0:.1f} s: "
-                         "the robot is in debug mode already (then --no-release-motion-service), or this is a "
-                         "simulator without one")
-    if not name:
-        return pf.record("motion_service", PASS, "no built-in controller active: ready for low-level control")
-    if b.release_motion_service:
-        return pf.record("motion_service", PASS, f"built-in controller '{name}' active; g1 deploy will release it "
-                         "(ReleaseMode) before it sends anything")
-    return pf.record("motion_service", FAIL, f"built-in controller '{name}' active and backend.release_motion_service "
-                     f"is false: the robot would mix its own commands with ours. {DEBUG_MODE}")
+    """The deploy preflight's motion_service row (CheckMode only; nothing released)."""
+    return pf.check_motion_service(backend, launch)
 
 
 def table(results: list[CheckResult]) -> str:

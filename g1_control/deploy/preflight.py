@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from g1_control.errors import G1ControlError, RobotNotConnectedError, VariantMismatchError
+from g1_control.errors import G1ControlError, MotionServiceError, RobotNotConnectedError, VariantMismatchError
 from g1_control.launch.schema import EstimationConfig, InputConfig, LaunchFile, Segment
 from g1_control.loop.control_loop import first_fault
 from g1_control.robot import g1
@@ -37,6 +37,8 @@ CHECKS: dict[str, str] = {
     "variant": "the robot's mode_machine is the DoF variant the launch file and policy are for",
     "state_stream": "LowState arrives at >= deploy.min_state_rate_hz with valid CRCs, every value finite",
     "peers": "exactly one publisher of the robot's state (rt/lowstate) and no other writer of its commands",
+    "motion_service": "the built-in controller will let go: released by g1 deploy (backend.release_motion_service) "
+                      "or none active (debug mode); asked with CheckMode only",
     "imu_upright": "the pelvis leans less than deploy.max_start_tilt_rad",
     "joint_limits": "every joint reads inside its limits",
     "temperatures": "every motor is cooler than deploy.max_start_temperature_c",
@@ -52,6 +54,12 @@ OPTIONAL_CHECKS = frozenset({"hands_present", "hand_state_stream", "finger_limit
 """Rows in the table only where they apply (the hand rows: backend.hands dex3, deploy/hands.py)."""
 
 PASS, FAIL, SKIP, NOT_RUN = "pass", "fail", "skip", "not run"
+MOTION_SERVICE_WAIT_S = 1.0
+"""How long the motion_service check waits for the service's CheckMode answer."""
+DEBUG_MODE = ("put the robot in debug mode with its remote: with the robot hanging in zero-torque mode press "
+              "L2+R2 (then L2+A to damp), or let g1 deploy release the service (backend.release_motion_service: "
+              "true)")
+"""The step people miss (Unitree's deploy guides; unitree_rl_gym's deploy_real README)."""
 
 
 def nonfinite_fields(state) -> list[str]:
@@ -314,6 +322,39 @@ class Preflight:
             return self.record("peers", FAIL, f"{command_writers} other writer(s) of rt/lowcmd on {where}: another "
                                "program commands this robot; stop it first", overridable=False)
         return self.record("peers", PASS, f"one publisher on rt/lowstate, no other writer of rt/lowcmd ({where})")
+
+    def check_motion_service(self, backend, launch: LaunchFile) -> bool:
+        """Ask the robot's motion-switcher service which built-in controller runs (CheckMode only: nothing
+        is released here) and whether g1 deploy's release will find it; shared with g1 doctor."""
+        from g1_control.hardware.links.dds import DdsLink
+        from g1_control.hardware.unitree.motion_service import MotionServiceClient
+
+        b, name = launch.backend, "motion_service"
+        if not isinstance(backend.link, DdsLink):
+            return self.record(name, SKIP, f"{backend.link.describe()} has no motion service to ask")
+        if b.simulator is not None:
+            return self.record(name, SKIP, f"backend.simulator {b.simulator}: a simulator runs no motion service; "
+                               "nothing is released")
+        client = MotionServiceClient(backend.link.participant, b.partition, timeout_s=MOTION_SERVICE_WAIT_S)
+        t0 = time.monotonic()
+        try:
+            mode = client.check_mode()
+        except MotionServiceError as exc:
+            silent = f"no motion service answered within {time.monotonic() - t0:.1f} s"
+            if b.release_motion_service:
+                return self.record(name, FAIL, f"{silent}, and backend.release_motion_service is true: the release "
+                                   "would fail before control starts. If the robot is in debug mode already (L2+R2 on "
+                                   "its remote), skip the release: --no-release-motion-service (or "
+                                   f"backend.release_motion_service: false) ({exc})", overridable=False)
+            return self.record(name, SKIP, f"{silent}: debug mode assumed (backend.release_motion_service false)")
+        if not mode:
+            return self.record(name, PASS, "no built-in controller active: ready for low-level control")
+        if b.release_motion_service:
+            return self.record(name, PASS, f"built-in controller '{mode}' active; g1 deploy will release it "
+                               "(ReleaseMode) before it sends anything")
+        return self.record(name, FAIL, f"built-in controller '{mode}' active and backend.release_motion_service "
+                           f"is false: the robot would mix its own commands with ours. {DEBUG_MODE}",
+                           overridable=False)
 
     def check_input(self, device, launch: LaunchFile, open_error: str | None = None) -> bool:
         """The operator's device: opened, bound to an e-stop, not lost while polled."""

@@ -38,7 +38,8 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("g1_control.deploy")
 
-ROBOT_CHECKS = ("variant", "state_stream", "peers", "imu_upright", "joint_limits", "temperatures", "battery")
+ROBOT_CHECKS = ("variant", "state_stream", "peers", "motion_service", "imu_upright", "joint_limits", "temperatures",
+                "battery")
 
 
 @dataclass
@@ -199,6 +200,10 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
         if backend is not None:
             say(f"listening to the robot on {backend.link.describe()} ...")
             pf.check_robot(backend, launch, policy_variant)
+            if pf.results["state_stream"].status == "pass":
+                pf.check_motion_service(backend, launch)
+            else:
+                pf.not_run(["motion_service"], "no robot state")
         else:
             pf.not_run(ROBOT_CHECKS, "no link to the robot")
         hands = _check_hands(pf, launch, backend is not None)
@@ -516,7 +521,8 @@ def _report_localisation(report: DeployReport, loop) -> None:
     if localiser.fusion is not None:
         c = localiser.fusion.counters
         out["external_pose"] = {"accepted": c.accepted, "rejected": dict(c.rejected), "last_rejection": c.last_rejection,
-                                "max_correction_m": c.max_correction_m}
+                                "max_correction_m": c.max_correction_m, "reacquired": c.reacquired,
+                                "max_reacquire_m": c.max_reacquire_m}
     if localiser.objects is not None:
         p = localiser.objects.counters
         out["perception"] = {"frames": p.frames, "rejected": dict(p.rejected), "last_rejection": p.last_rejection,

@@ -12,6 +12,14 @@ counted per reason, with the last reason kept as a message:
   jump      farther than max_jump_m (or max_jump_rad in heading) from the fused pose
   invalid   a non-finite field
 
+Recovery after an outage: while no pose arrives the odometry drifts, and the first poses after the
+outage may all lie farther than max_jump_m from the fused pose; without recovery they would be
+refused for the rest of the run. A single wild pose (a marker swap, a SLAM relocalisation glitch) is
+a jump; `reacquire_poses` consecutive jumping poses that agree with each other (their innovations
+within `reacquire_tolerance_m` / `reacquire_tolerance_rad` of the first one's) are the robot's
+pose, and the fused pose is set to the latest of them (counted as `reacquired`, with the size of the
+correction). `reacquire_poses: 0` never re-acquires.
+
 Frames: `frame: start` (the default) aligns the external frame to the run's start frame on the first
 accepted pose (the external system's origin may be anywhere); `frame: scene` takes the poses as given
 in the launch file's scene frame (motion capture calibrated to the scene).
@@ -57,8 +65,15 @@ class ExternalPoseConfig:
     max_jump_rad: float = 0.5
     correction_tau_s: float = 0.5
     """Time constant of the pull toward the external pose (seconds of poses, not of ticks)."""
+    reacquire_poses: int = 10
+    """After this many consecutive jumping poses that agree with each other, take the latest (0: never)."""
+    reacquire_tolerance_m: float = 0.05
+    reacquire_tolerance_rad: float = 0.1
     frame: Literal["start", "scene"] = "start"
     """start: align the external frame to the start frame on the first pose; scene: poses are in the scene frame."""
+    start_in_scene: list[float] | None = None
+    """frame scene: the robot's start (x, y, yaw) in the scene's frame, from scene.robot_start
+    (g1_control/launch/start_pose.py); poses are mapped from the scene's frame into the start frame."""
 
     def validate(self, where: str) -> None:
         from g1_control.hardware.ros2.topics import check_topic_name
@@ -71,13 +86,25 @@ class ExternalPoseConfig:
             raise LaunchFileError(f"{where}.topic: {problem}")
         if not 0 <= self.domain <= 232:
             raise LaunchFileError(f"{where}.domain: {self.domain} is not a DDS domain id (0..232)")
-        for name in ("max_age_s", "max_jump_m", "max_jump_rad", "correction_tau_s"):
+        if isinstance(self.reacquire_poses, bool) or not isinstance(self.reacquire_poses, int) \
+                or not 0 <= self.reacquire_poses <= 1000:
+            raise LaunchFileError(f"{where}.reacquire_poses: must be a whole number of poses 0..1000 (0: never "
+                                  f"re-acquire after an outage), got {self.reacquire_poses!r}")
+        for name in ("max_age_s", "max_jump_m", "max_jump_rad", "correction_tau_s", "reacquire_tolerance_m",
+                     "reacquire_tolerance_rad"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) or value <= 0:
                 raise LaunchFileError(f"{where}.{name}: must be a positive number, got {value!r}")
         if self.max_age_s > HISTORY_S:
             raise LaunchFileError(f"{where}.max_age_s: {self.max_age_s} s is longer than the {HISTORY_S:g} s of "
                                   "odometry kept to compensate latency")
+        if self.reacquire_tolerance_m >= self.max_jump_m:
+            raise LaunchFileError(f"{where}.reacquire_tolerance_m: {self.reacquire_tolerance_m} m must be below "
+                                  f"max_jump_m ({self.max_jump_m} m), or a jumping pose would agree with anything")
+        start = self.start_in_scene
+        if start is not None and (not isinstance(start, list | tuple) or len(start) != 3
+                                  or not all(isinstance(v, int | float) and math.isfinite(v) for v in start)):
+            raise LaunchFileError(f"{where}.start_in_scene: expected [x, y, yaw] (3 finite numbers), got {start!r}")
         if self.frame not in FRAMES:
             raise LaunchFileError(f"{where}.frame: '{self.frame}' is not one of {', '.join(FRAMES)}")
 
@@ -119,6 +146,19 @@ class FusionCounters:
     """Why the last refused pose was refused (empty: none refused)."""
     max_correction_m: float = 0.0
     """The largest accepted innovation (latency-compensated pose minus fused pose)."""
+    reacquired: int = 0
+    """Times the fused pose was reset to agreeing poses after an outage (see the module docstring)."""
+    max_reacquire_m: float = 0.0
+    """The largest such reset."""
+
+
+def _scene_to_start(start: list[float] | None) -> Planar:
+    """The scene frame seen from the start frame of a robot starting at `start` (x, y, yaw) in it."""
+    if start is None:
+        return Planar(0.0, 0.0, 0.0, 0.0)
+    x, y, yaw = (float(v) for v in start)
+    c, s = math.cos(yaw), math.sin(yaw)
+    return Planar(0.0, -(c * x + s * y), -(-s * x + c * y), float(wrap_angle(-yaw)))
 
 
 class PoseFusion:
@@ -130,8 +170,10 @@ class PoseFusion:
         self._history: deque[Planar] = deque()
         self.fused: Planar | None = None
         self._last_odometry: Planar | None = None
-        self._align: Planar | None = Planar(0.0, 0.0, 0.0, 0.0) if config.frame == "scene" else None
+        self._align: Planar | None = _scene_to_start(config.start_in_scene) if config.frame == "scene" else None
         self._last_accepted_stamp: float | None = None
+        self._jumps: list[tuple[float, float, float]] = []
+        """Innovations (ex, ey, eyaw) of the consecutive jumping poses since the last accepted one."""
 
     def update(self, odometry: Planar) -> Planar:
         """The fused pose after the odometry moved to `odometry` (start frame)."""
@@ -203,9 +245,17 @@ class PoseFusion:
         ex, ey, eyaw = now_x - fused.x_m, now_y - fused.y_m, wrap_angle(now_yaw - fused.yaw_rad)
         distance = math.hypot(ex, ey)
         if distance > cfg.max_jump_m or abs(eyaw) > cfg.max_jump_rad:
+            if self._reacquire(ex, ey, eyaw):
+                self._last_accepted_stamp = sample.stamp_s
+                self.fused = Planar(fused.t_s, now_x, now_y, now_yaw)
+                self.counters.accepted += 1
+                self.counters.reacquired += 1
+                self.counters.max_reacquire_m = max(self.counters.max_reacquire_m, distance)
+                return True
             self._refuse("jump", f"{distance:.3f} m / {math.degrees(eyaw):.1f} deg from the fused pose "
                                  f"(max_jump_m {cfg.max_jump_m:g}, max_jump_rad {cfg.max_jump_rad:g})")
             return False
+        self._jumps.clear()
         gap = cfg.correction_tau_s if self._last_accepted_stamp is None else \
             max(0.0, sample.stamp_s - self._last_accepted_stamp)
         gain = gap / (cfg.correction_tau_s + gap)
@@ -216,10 +266,28 @@ class PoseFusion:
         self.counters.max_correction_m = max(self.counters.max_correction_m, distance)
         return True
 
+    def _reacquire(self, ex: float, ey: float, eyaw: float) -> bool:
+        """Count one jumping pose; True when it completes a run of `reacquire_poses` agreeing ones."""
+        cfg = self.config
+        if cfg.reacquire_poses <= 0:
+            return False
+        if self._jumps:
+            fx, fy, fyaw = self._jumps[0]
+            if math.hypot(ex - fx, ey - fy) > cfg.reacquire_tolerance_m or \
+                    abs(wrap_angle(eyaw - fyaw)) > cfg.reacquire_tolerance_rad:
+                self._jumps.clear()  # disagrees with the run so far: it starts a new one
+        self._jumps.append((ex, ey, eyaw))
+        if len(self._jumps) < cfg.reacquire_poses:
+            return False
+        self._jumps.clear()
+        return True
+
     def describe(self) -> str:
         c = self.counters
         refused = ", ".join(f"{n} {r}" for r, n in c.rejected.items() if n) or "none"
         out = f"external pose: {c.accepted} accepted, refused: {refused}"
+        if c.reacquired:
+            out += f", re-acquired {c.reacquired}x after an outage (largest reset {c.max_reacquire_m:.2f} m)"
         return out + (f" (last: {c.last_rejection})" if c.last_rejection else "")
 
 

@@ -632,8 +632,10 @@ class LaunchFile:
 
 
 def parse_launch(data, source: str = "<launch>") -> LaunchFile:
+    from g1_control.launch.start_pose import to_start_frame
+
     try:
-        return from_dict(LaunchFile, data, "")
+        return from_dict(LaunchFile, to_start_frame(data), "")
     except LaunchFileError as exc:
         raise LaunchFileError(f"{source}: {exc}") from None
     except SafetyConfigError as exc:  # SafetyConfig's own messages, or fall.* (FallConfig, which names its key)

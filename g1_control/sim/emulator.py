@@ -13,6 +13,7 @@ Loopback only: the emulator refuses any interface but `lo` (no robot traffic off
 from __future__ import annotations
 
 import json
+import math
 import sys
 import threading
 import time
@@ -310,10 +311,12 @@ class RobotEmulator:
             p.hot_joint = g1.JOINT_INDEX["waist_yaw_joint"]
         return time.monotonic()
 
-    def publish_mocap(self, config: MocapConfig, topic: str = "mocap/pose") -> SimulatedMocap:
+    def publish_mocap(self, config: MocapConfig, topic: str = "mocap/pose",
+                      start_in_scene: list[float] | None = None) -> SimulatedMocap:
         """Publish a motion-capture pose of the pelvis from the simulator's ground truth on rt/<topic>
-        (geometry_msgs/PoseStamped, frame 'mocap' = the simulator's world = the scene frame), stamped
-        with the wall clock when measured and sent `latency_s` later (sim/mocap.py)."""
+        (geometry_msgs/PoseStamped, frame 'mocap' = the scene frame), stamped with the wall clock when
+        measured and sent `latency_s` later (sim/mocap.py). The simulator's world is the robot's start
+        frame; `start_in_scene` (x, y, yaw: the launch file's scene.robot_start) maps it into the scene's."""
         from g1_control.hardware.ros2.topics import PoseTopicWriter
         from g1_control.sim.mocap import SimulatedMocap
 
@@ -325,6 +328,8 @@ class RobotEmulator:
             if state.base_pos_w_m is None:
                 return
             for stamp, pos, quat in mocap.sample(time.time(), state.base_pos_w_m, state.imu_quat_wxyz):
+                if start_in_scene is not None:
+                    pos, quat = _start_to_scene(start_in_scene, pos, quat)
                 writer.write(stamp, pos, quat)
 
         self.endpoint.state_observers.append(sample)
@@ -428,3 +433,14 @@ class RobotEmulator:
                 except ValueError as exc:
                     reply = {"error": str(exc)}
             print(json.dumps(reply), flush=True)
+
+
+def _start_to_scene(start_in_scene: list[float], pos: np.ndarray, quat_wxyz: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """A pose in the start frame of a robot that started at `start_in_scene` (x, y, yaw), in the scene's frame."""
+    x, y, yaw = (float(v) for v in start_in_scene)
+    c, s = math.cos(yaw), math.sin(yaw)
+    out = np.array([x + c * pos[0] - s * pos[1], y + s * pos[0] + c * pos[1], pos[2]])
+    hc, hs = math.cos(yaw / 2), math.sin(yaw / 2)  # rotate about z by yaw: (hc, 0, 0, hs) * q
+    w, qx, qy, qz = (float(v) for v in quat_wxyz)
+    return out, np.array([hc * w - hs * qz, hc * qx - hs * qy, hc * qy + hs * qx, hc * qz + hs * w])

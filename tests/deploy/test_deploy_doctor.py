@@ -10,7 +10,8 @@ import pytest
 from deploy_test_helpers import SIM2SIM
 
 from g1_control.cli.main import main
-from g1_control.deploy.doctor import DEBUG_MODE, ROWS, DoctorOptions, diagnose, healthy
+from g1_control.deploy.doctor import ROWS, DoctorOptions, diagnose, healthy
+from g1_control.deploy.preflight import DEBUG_MODE
 from g1_control.launch.schema import load_launch
 
 

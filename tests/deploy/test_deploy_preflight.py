@@ -33,7 +33,8 @@ def test_healthy_emulated_robot_passes_and_nothing_is_sent(tmp_path, partition, 
     assert refused is None, text
     status = _status(report)
     assert status.pop("battery") == "skip" and set(status.values()) == {"pass"}, text
-    assert "state_stream  PASS" in text and "dry_run       PASS        no fall" in text
+    assert "state_stream    PASS" in text and "dry_run         PASS        no fall" in text
+    assert "motion_service  PASS        built-in controller 'ai' active; g1 deploy will release it" in text
     assert robot.endpoint.counters.commands_applied == 0 and robot.endpoint.counters.ignored_while_builtin_active == 0
     assert robot.service.active_mode == "ai", "a preflight never releases the built-in controller"
 
@@ -164,7 +165,7 @@ def test_hot_tilted_robot_with_a_joint_past_its_limit_is_refused_then_overridden
     report, refused, text = preflight_only(path, partition, overrides=overrides)
     assert refused is None, text
     assert {n for n, s in _status(report).items() if s == "overridden"} == overrides
-    assert "temperatures  OVERRIDDEN" in text
+    assert "temperatures    OVERRIDDEN" in text
     assert "!!! WARNING: preflight check 'temperatures' FAILED and was OVERRIDDEN" in text
     assert sum("PREFLIGHT OVERRIDE" in r.message for r in caplog.records) == 3
 
@@ -198,7 +199,7 @@ def test_cli_prints_the_table_and_exits_1_when_refused(tmp_path, partition, caps
                  str(tmp_path / "report.json")])
     out, err = capsys.readouterr()
     assert code == 1
-    assert "check         result      reason" in out and "state_stream  FAIL" in out
+    assert "check           result      reason" in out and "state_stream    FAIL" in out
     assert "g1 deploy: error: preflight failed (" in err
     assert '"refused": true' in (tmp_path / "report.json").read_text()
 
@@ -251,3 +252,32 @@ def test_yes_is_refused_off_loopback(tmp_path, partition):
     assert refused is not None and _status(report)["interface"] == "not run"
     assert "--yes answers start and run with nobody watching; it is only for g1 sim-robot on 'lo'" \
         in _reason(report, "launch_file")
+
+
+def test_the_motion_service_is_asked_in_the_preflight_and_a_release_that_would_fail_is_refused(
+        tmp_path, partition, mock_robot):
+    """The release of the built-in controller is a preflight row, asked with CheckMode only: a robot whose
+    service does not answer (debug mode already, or no service) with backend.release_motion_service true
+    is refused before anything moves, with the fix; with the release off it is debug mode, not a fault.
+    An active controller with the release off is refused (it would fight our commands), overrides or not."""
+    robot = mock_robot().start()
+    path = write_launch(tmp_path, FAST)
+    report, refused, _ = preflight_only(path, partition, release_motion_service=False,
+                                        overrides=frozenset({"motion_service"}))
+    assert refused is not None and _status(report)["motion_service"] == "fail"
+    assert _reason(report, "motion_service").startswith("built-in controller 'ai' active and "
+                                                        "backend.release_motion_service is false")
+    assert "cannot be overridden" in _reason(report, "motion_service")
+    assert robot.service is not None
+    robot.service.close()  # the service goes silent: the robot streams its state, nothing answers CheckMode
+    report, refused, _ = preflight_only(path, partition)
+    assert refused is not None and _status(report)["motion_service"] == "fail"
+    assert _reason(report, "motion_service").startswith(
+        "no motion service answered within 1.0 s, and backend.release_motion_service is true: the release would "
+        "fail before control starts. If the robot is in debug mode already (L2+R2 on its remote), skip the release: "
+        "--no-release-motion-service")
+    assert "motion_service" in str(refused) and robot.endpoint.last_command is None
+    report, refused, _ = preflight_only(path, partition, release_motion_service=False)
+    assert refused is None and _status(report)["motion_service"] == "skip"
+    assert robot.service.active_mode == "ai" and set(robot.service.calls) == {1001}  # asked, never released
+    assert robot.endpoint.last_command is None

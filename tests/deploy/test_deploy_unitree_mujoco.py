@@ -66,7 +66,10 @@ def test_with_the_profile_the_preflight_passes_and_its_table_names_the_simulator
     report, refused, text = preflight_only(path, partition)
     assert refused is None, text
     status = _status(report)
-    assert status.pop("battery") == "skip" and set(status.values()) == {"pass"}, text
+    assert status.pop("battery") == "skip" and status.pop("motion_service") == "skip", text
+    assert set(status.values()) == {"pass"}, text
+    assert _reason(report, "motion_service") == ("backend.simulator unitree_mujoco: a simulator runs no motion service; "
+                                                 "nothing is released")
     stream = _reason(report, "state_stream")
     rate = float(stream.split(" Hz")[0])
     assert 150 <= rate <= 230, stream  # the simulator's 200 Hz, accepted below the robot's 400

@@ -66,6 +66,46 @@ def test_stale_future_jumping_and_invalid_poses_are_refused_by_name():
     assert "1 accepted, refused: 1 stale, 1 future, 2 jump, 1 invalid" in fusion.describe()
 
 
+def test_after_an_outage_agreeing_poses_are_reacquired_and_a_lone_wild_pose_is_not():
+    """Odometry reading 70 % of a 0.5 m/s walk; motion capture lost from 1 s to 5 s: 0.6 m of drift, past
+    max_jump_m. The poses after the outage agree with each other, so after `reacquire_poses` of them the
+    fused pose is the true pose again; before that, and for a lone wild pose later, nothing moves it."""
+    fusion = PoseFusion(_config(max_jump_m=0.3, reacquire_poses=5))
+    wild_done = False
+    for t, x, _y, _ in _walk(fusion, 8.0, drift=0.7):
+        tick = round(t * 100)
+        if tick % 5 or 100 < tick < 500:
+            continue
+        if tick == 700 and not wild_done:  # one pose 1 m off, among good ones
+            wild_done = True
+            assert not fusion.measure(PoseSample(t, x + 1.0, 0.0, 0.0))
+            continue
+        before = fusion.fused
+        accepted = fusion.measure(PoseSample(t, x, 0.0, 0.0))
+        if 500 <= tick < 520:  # the first four poses after the outage: refused as jumps, fused pose untouched
+            assert not accepted and fusion.fused == before
+            assert fusion.counters.last_rejection.startswith("jump: ")
+        else:
+            assert accepted, (t, fusion.counters.last_rejection)
+        if tick == 520:  # the fifth agreeing pose: the fused pose is reset onto it
+            assert fusion.fused is not None and fusion.fused.x_m == pytest.approx(x, abs=0.01)
+    assert fusion.counters.reacquired == 1 and fusion.counters.max_reacquire_m == pytest.approx(0.3 * 0.5 * 4.0, abs=0.1)
+    assert fusion.counters.rejected["jump"] == 5  # four while re-acquiring, one wild
+    assert fusion.fused is not None and fusion.fused.x_m == pytest.approx(x, abs=0.03)
+    assert "re-acquired 1x after an outage" in fusion.describe()
+
+
+def test_disagreeing_jumps_and_reacquire_poses_0_never_reset_the_pose():
+    """Jumping poses that scatter (each 0.2 m from the last beyond the tolerance) never add up to a
+    re-acquisition; nor do agreeing ones with reacquire_poses 0."""
+    for changes, scatter in (({"reacquire_poses": 3}, 0.2), ({"reacquire_poses": 0}, 0.0)):
+        fusion = PoseFusion(_config(max_jump_m=0.3, **changes))
+        for k, _ in enumerate(_walk(fusion, 1.0, vx=0.0)):
+            if k % 5 == 0 and k:
+                assert not fusion.measure(PoseSample(k * 0.01, 1.0 + scatter * (k // 5 % 2), 0.0, 0.0))
+        assert fusion.counters.reacquired == 0 and fusion.fused is not None and fusion.fused.x_m == 0.0
+
+
 def test_frame_start_aligns_the_external_frame_at_the_first_pose():
     """Motion capture whose origin is 3 m away and turned 90 deg: the fused pose stays in the start frame,
     and a later pose corrects the odometry's 20 % under-reading there."""
@@ -95,6 +135,9 @@ def test_without_poses_the_fused_pose_is_the_odometry():
     ({"max_jump_m": -1.0}, "estimation.external_pose.max_jump_m: must be a positive number, got -1.0"),
     ({"max_age_s": 5.0}, "estimation.external_pose.max_age_s: 5.0 s is longer than the 2 s of odometry kept"),
     ({"domain": 300}, "estimation.external_pose.domain: 300 is not a DDS domain id"),
+    ({"reacquire_poses": -1}, "estimation.external_pose.reacquire_poses: must be a whole number of poses 0..1000"),
+    ({"reacquire_poses": 2.5}, "estimation.external_pose.reacquire_poses: must be a whole number of poses 0..1000"),
+    ({"reacquire_tolerance_m": 0.5}, "estimation.external_pose.reacquire_tolerance_m: 0.5 m must be below max_jump_m"),
 ])
 def test_bad_settings_are_refused_naming_the_key(changes, message):
     with pytest.raises(LaunchFileError) as err:
