@@ -195,11 +195,15 @@ class TrialOutcome:
     layer_cpu: tuple[np.ndarray, np.ndarray] | None = None
     """The tracking layer's per-tick CPU time and what ran (layer trials)."""
     log: dict[str, np.ndarray] | None = None
+    end_base_pos_m: tuple[float, float, float] = (math.nan, math.nan, math.nan)
+    """Where the pelvis was at the trial's end (simulator ground truth): any difference in the
+    physics along the way shows here."""
 
     def ground_truth(self) -> dict:
         """Everything but the timings: what a run on other machines must reproduce for the same seed."""
         return {"trial": self.name, "ok": self.verdict.ok, "text": self.verdict.text, "values": self.verdict.values,
-                "count": self.verdict.count, "met": self.verdict.met(), "fell": self.fell, "sim_s": self.sim_s}
+                "count": self.verdict.count, "met": self.verdict.met(), "fell": self.fell, "sim_s": self.sim_s,
+                "end_base_pos_m": list(self.end_base_pos_m)}
 
 
 def trial_tasks(chosen: list[Behaviour], seed: int, video: bool = False) -> list[TrialTask]:
@@ -210,8 +214,11 @@ def trial_tasks(chosen: list[Behaviour], seed: int, video: bool = False) -> list
 def trial_outcome(behaviour: Behaviour, trial: Trial, keep_log: bool = False) -> TrialOutcome:
     samples: list[np.ndarray] = []
     result = run_trial(trial, samples=samples if trial.tracker != "layer" else None)
+    pos = result.log.get("base_pos_m") if result.log else None
+    end = (float(pos[-1][0]), float(pos[-1][1]), float(pos[-1][2])) if pos is not None and len(pos) else (math.nan,) * 3
     return TrialOutcome(trial.name, behaviour.judge(result), bool(result.fell), result.sim_s, result.wall_s,
-                        samples[0] if samples else None, result.layer_cpu, result.log if keep_log else None)
+                        samples[0] if samples else None, result.layer_cpu, result.log if keep_log else None,
+                        end)
 
 
 def run_task(task: TrialTask) -> TrialOutcome:
