@@ -4,6 +4,8 @@ one table row per behaviour.
     g1 bench execution                         # the whole suite (~10 min simulated)
     g1 bench execution --only walk.carry       # rows whose name starts with a prefix
     g1 bench execution --json out.json --video videos/
+    g1 bench execution --jobs 2                # trials in 2 processes: the same figures
+    g1 bench execution --ray local             # or on a Ray cluster (local, local:CPUS, HOST:PORT)
 
 Columns (all from the simulator's ground truth, never from the stack's own labels):
   success   trials that met the row's goal / trials
@@ -20,6 +22,10 @@ A row is a Behaviour: a name, a goal, and the trials it runs (g1_control/tools/p
 more rows (reach, box, step) are more entries in `behaviours()`. The last row is the tracking
 layer's cost per 50 Hz tick (p50/p99 over every trial's ticks, and its margin to the tick).
 The bench exits 1 when a trial fell or a row missed its goal.
+
+Every trial is a task (TrialTask: behaviour, seed, trial number) that a worker turns into its
+outcome alone (`run_task`), so `--jobs` and `--ray` (g1_control/fanout.py) change the wall time and
+nothing else; `--json` lists every trial's ground-truth figures under `trials` to compare runs.
 """
 
 from __future__ import annotations

@@ -10,6 +10,7 @@ per step and a table per instruction; exits 1 on a fall or a missed step.
     g1 bench program                 # the 20 instructions below (15 walk/turn/style/height/wait, 5 with goals)
     g1 bench program --only 3,7      # some of them (1-based)
     g1 bench program --json out.json
+    g1 bench program --jobs 2        # instructions in 2 processes, or --ray local / HOST:PORT (the same verdicts)
 """
 
 from __future__ import annotations
