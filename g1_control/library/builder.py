@@ -147,9 +147,10 @@ def build_library(out_dir: str | Path, config: LibraryConfig | None = None, *, f
     sources: list[MotionClip] = []
     infos: list[dict] = []
     tasks = [(s, 100 + k, config.rollout_seconds, config.fps) for s in styles for k in range(config.rollouts_per_style)]
+    rollouts = fan_out(rollout_job, tasks, jobs=jobs, ray=ray)  # a bad --jobs/--ray stops here, before the bar
     bar = tqdm(total=len(tasks) + int(config.dance) + int(config.demo), desc="library sources", unit="src",
                file=sys.stderr, disable=not progress)
-    for clip, info in fan_out(rollout_job, tasks, jobs=jobs, ray=ray):
+    for clip, info in rollouts:
         sources += [clip] if clip is not None else []
         infos.append(info)
         bar.update()
