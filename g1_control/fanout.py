@@ -129,6 +129,27 @@ def _worker_facts() -> str:
     return os.path.dirname(g1_control.__file__)
 
 
+_INIT_QUIET = {"include_dashboard": False, "log_to_driver": False, "logging_level": logging.ERROR}
+LOCAL_START_TRIES = 3
+"""A local Ray's node gives up when its raylet has not registered within 30 s (fixed in Ray), which
+happens on a heavily loaded machine; a fresh start usually comes up."""
+
+
+def start_local_ray(cpus: int | None = None, tries: int = LOCAL_START_TRIES) -> None:
+    """Start a Ray on this machine with `cpus` CPUs (None: every core), bound to loopback (it
+    serves this machine only), quiet (workers' output stays in Ray's logs), and a small store."""
+    ray = _import_ray()
+    for attempt in range(1, tries + 1):
+        try:
+            ray.init(num_cpus=cpus or os.cpu_count(), object_store_memory=LOCAL_OBJECT_STORE_BYTES,
+                     _node_ip_address="127.0.0.1", **_INIT_QUIET)
+            return
+        except Exception as exc:
+            ray.shutdown()
+            if attempt == tries or "timed out during startup" not in str(exc):
+                raise
+
+
 class _RaySession:
     """A connection to a Ray cluster (started here for `local`) for one fan-out; a Ray that the
     caller already initialised is used as it is and left running."""
@@ -141,15 +162,12 @@ class _RaySession:
             check_reachable(cluster)
         self.owned = not self.ray.is_initialized()
         if self.owned:
-            common = {"include_dashboard": False, "log_to_driver": False, "logging_level": logging.ERROR}
             try:
                 if cluster is None:
-                    # Bound to loopback: a local Ray serves this machine only.
-                    self.ray.init(num_cpus=cpus or os.cpu_count(), object_store_memory=LOCAL_OBJECT_STORE_BYTES,
-                                  _node_ip_address="127.0.0.1", **common)
+                    start_local_ray(cpus)
                 else:
-                    self.ray.init(address=cluster, **common)
-            except (ConnectionError, RuntimeError, ValueError) as exc:
+                    self.ray.init(address=cluster, **_INIT_QUIET)
+            except Exception as exc:  # Ray raises bare Exception for a node that did not come up
                 raise FanOutError(f"--ray {address}: Ray could not {'start' if cluster is None else 'join'} "
                                   f"the cluster: {exc}") from exc
         try:

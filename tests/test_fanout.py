@@ -15,7 +15,7 @@ import pytest
 
 from g1_control.cli.main import main as g1
 from g1_control.errors import FanOutError
-from g1_control.fanout import fan_out, parse_address
+from g1_control.fanout import fan_out, parse_address, start_local_ray
 from g1_control.library.builder import rollout_job
 from g1_control.tools import bench_execution as bench
 
@@ -92,12 +92,11 @@ def test_a_local_ray_started_for_the_fan_out_is_stopped_after_it():
 
 @pytest.fixture(scope="module")
 def local_ray():
-    """One local Ray of 2 CPUs for the comparisons below (fan_out uses a Ray the caller started and
-    leaves it running)."""
+    """One local Ray of 2 CPUs for the comparisons below, started as `--ray local:2` starts it (fan_out
+    uses a Ray the caller started and leaves it running)."""
     import ray
 
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, _node_ip_address="127.0.0.1",
-             object_store_memory=256 * 2**20, logging_level="error")
+    start_local_ray(cpus=2)
     yield ray
     ray.shutdown()
 
