@@ -77,6 +77,11 @@ class WbcSolveError(G1ControlError, RuntimeError):
     """The whole-body inverse-dynamics QP found no solution for this tick."""
 
 
+class FanOutError(G1ControlError, RuntimeError):
+    """Work that cannot be fanned out: a bad --jobs or --ray, Ray not installed, a cluster that
+    cannot be reached or whose workers cannot import g1_control."""
+
+
 class Interrupted(KeyboardInterrupt):
     """SIGINT or SIGTERM ended a run (after its run folder was closed); the exit status is 128 + signum."""
 

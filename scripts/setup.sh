@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Install g1-control and everything it needs on Debian/Ubuntu with Python >= 3.11.
 #   scripts/setup.sh          # the package (+ training and browser-view extras), rendering libraries, the policies
-#   scripts/setup.sh --test   # the same plus the test dependencies and test data
+#   scripts/setup.sh --test   # the same plus the test dependencies (Ray among them) and test data
 # Safe to re-run: every step skips what is already there.
 #
 # Where it installs: into the Python that runs `python3` (or $PYTHON), or the active virtual
@@ -13,7 +13,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 PY=${PYTHON:-python3}
 test_extras=""
-[ "${1:-}" = "--test" ] && test_extras=",test"
+# --test: the test extras, and Ray for the test that fans trials out over a local Ray (tests/test_fanout.py)
+[ "${1:-}" = "--test" ] && test_extras=",test,ray"
 
 say() { printf '\n== %s\n' "$*" >&2; }
 is_root() { [ "$(id -u)" = 0 ]; }

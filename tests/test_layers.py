@@ -56,7 +56,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("interfaces",),
     ("types", "scene"),
     ("robot",),
-    ("config", "assets", "rotations", "resources"),
+    ("config", "assets", "rotations", "resources", "fanout"),
     ("errors",),
 )
 """Top to bottom. A unit may import from its own package or from lower layers only."""
@@ -96,6 +96,7 @@ NOTES: dict[str, str] = {
     "assets": "pinned registry wheels fetched into the user cache",
     "rotations": "the one quaternion / yaw module",
     "resources": "launch files and docs that ship with the package",
+    "fanout": "seeded trials over --jobs processes or a --ray cluster, the same results",
     "errors": "named errors",
     "policies": "data, read by any layer: policy specs, the shipped generator models",
 }
@@ -332,7 +333,7 @@ def test_a_deliberate_violation_in_a_copy_of_g1_control_fails(tmp_path):
     rank = layer_of(LAYERS)
     assert violations == [
         f"g1_control/rotations.py:{len(lines) + 4}: g1_control.rotations imports g1_control.launch.builder: upward, "
-        f"from rotations (layer {rank['rotations'] + 1}: config | assets | rotations | resources) to launch "
+        f"from rotations (layer {rank['rotations'] + 1}: {' | '.join(LAYERS[rank['rotations']])}) to launch "
         f"(layer {rank['launch'] + 1}: launch, above it)"]
 
 

@@ -6,6 +6,9 @@ from __future__ import annotations
 import argparse
 import importlib
 
+from g1_control.errors import FanOutError
+from g1_control.fanout import add_arguments as add_fanout_arguments
+
 # name -> "module:function"; the function takes the parsed args and returns an exit code.
 BENCHMARKS = {
     "loop": ("g1_control.tools.bench_loop:main", "full loop in lockstep: real-time factor, per-stage p50/p99"),
@@ -33,6 +36,10 @@ BENCHMARKS = {
                  "the walking tracker's achievable velocity per axis and style; --write ships it as the command limits"),
 }
 
+FANS_OUT = ("execution", "program")
+"""The benchmarks whose trials fan out over --jobs processes or a --ray cluster (g1_control/fanout.py):
+their per-trial work is a function of the trial's task alone, so the figures do not depend on where it ran."""
+
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
@@ -51,9 +58,12 @@ def register(subparsers) -> None:
     parser.add_argument("--video", metavar="DIR", help="execution: a video per behaviour into DIR")
     parser.add_argument("--write", action="store_true", help="envelope: write the measured envelope next to the "
                         "policy spec (the loop builder's command limits)")
+    add_fanout_arguments(parser, what="/".join(FANS_OUT) + " trials")
     parser.set_defaults(func=_run)
 
 
 def _run(args) -> int:
+    if args.name not in FANS_OUT and (args.ray is not None or args.jobs != 1):
+        raise FanOutError(f"--jobs/--ray: {args.name} runs in this process; they apply to {', '.join(FANS_OUT)}")
     module_name, func_name = BENCHMARKS[args.name][0].split(":")
     return int(getattr(importlib.import_module(module_name), func_name)(args) or 0)

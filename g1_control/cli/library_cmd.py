@@ -23,6 +23,8 @@ from __future__ import annotations
 
 import argparse
 
+from g1_control.fanout import add_arguments as add_fanout_arguments
+
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser("library", help="build or show the generator's G1 motion library",
@@ -41,7 +43,7 @@ def register(subparsers) -> None:
                        "the IK or left out, and the build says which and why)")
     build.add_argument("--no-repair", action="store_true",
                        help="leave out a piece that fails `g1 check` instead of repairing it through the IK")
-    build.add_argument("--jobs", type=int, default=2, help="rollout worker processes (default 2)")
+    add_fanout_arguments(build, jobs_default=2, what="rollouts")
     build.add_argument("--variant", default="g1_29dof", choices=("g1_29dof", "g1_23dof", "g1_29dof_with_hand"),
                        help="robot variant (default g1_29dof; the others are derived from the 29-DoF library through "
                             "the IK, see g1_control/library/variants.py)")
@@ -62,13 +64,13 @@ def _build(args) -> int:
     if args.variant != "g1_29dof":
         from g1_control.library.variants import build_variant_library
 
-        base = build_library(default_library_dir(), config, jobs=max(1, args.jobs))  # no-op when cached
+        base = build_library(default_library_dir(), config, jobs=args.jobs, ray=args.ray)  # no-op when cached
         lib = build_variant_library(args.variant, base.root, args.output, force=args.force)
         print(lib.summary())
         print(f"library {args.variant}: {lib.root} (built in {lib.index['build_s']} s from {base.root})")
         return 0
     out = args.output or default_library_dir()
-    lib = build_library(out, config, force=args.force, jobs=max(1, args.jobs))
+    lib = build_library(out, config, force=args.force, jobs=args.jobs, ray=args.ray)
     print(lib.summary())
     print(f"library: {lib.root} (built in {lib.index['build_s']} s)")
     return 0

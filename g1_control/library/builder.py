@@ -9,10 +9,10 @@ import itertools
 import json
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from g1_control.fanout import fan_out
 from g1_control.motion.clip import MotionClip
 from g1_control.motion.library import INDEX_NAME, LibraryError, MotionLibrary
 
@@ -56,7 +56,9 @@ class LibraryConfig:
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
-def _rollout_job(args) -> tuple[MotionClip | None, dict]:
+def rollout_job(args: tuple[str, int, float, float]) -> tuple[MotionClip | None, dict]:
+    """One seeded rollout (style, seed, seconds, fps) -> (its clip, or None; what happened), from
+    its arguments alone (what `--jobs` processes and Ray workers run; g1_control/fanout.py)."""
     from g1_control.generator.styles import ROLLOUT_STYLES
     from g1_control.library.rollouts import RolloutConfig, record_rollout
 
@@ -119,7 +121,9 @@ def gate_piece(piece: MotionClip, repair: bool = True) -> tuple[MotionClip | Non
 
 
 def build_library(out_dir: str | Path, config: LibraryConfig | None = None, *, force: bool = False,
-                  jobs: int = 1, progress: bool = True) -> MotionLibrary:
+                  jobs: int = 1, ray: str | None = None, progress: bool = True) -> MotionLibrary:
+    """Build (or reuse) the library in `out_dir`; the rollouts fan out over `jobs` processes or the
+    Ray cluster at `ray` (g1_control/fanout.py), the same clips either way."""
     from tqdm import tqdm
 
     from g1_control.generator.styles import ROLLOUT_STYLES
@@ -143,20 +147,13 @@ def build_library(out_dir: str | Path, config: LibraryConfig | None = None, *, f
     sources: list[MotionClip] = []
     infos: list[dict] = []
     tasks = [(s, 100 + k, config.rollout_seconds, config.fps) for s in styles for k in range(config.rollouts_per_style)]
+    rollouts = fan_out(rollout_job, tasks, jobs=jobs, ray=ray)  # a bad --jobs/--ray stops here, before the bar
     bar = tqdm(total=len(tasks) + int(config.dance) + int(config.demo), desc="library sources", unit="src",
                file=sys.stderr, disable=not progress)
-    if jobs > 1 and len(tasks) > 1:
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
-            for clip, info in pool.map(_rollout_job, tasks):
-                sources += [clip] if clip is not None else []
-                infos.append(info)
-                bar.update()
-    else:
-        for task in tasks:
-            clip, info = _rollout_job(task)
-            sources += [clip] if clip is not None else []
-            infos.append(info)
-            bar.update()
+    for clip, info in rollouts:
+        sources += [clip] if clip is not None else []
+        infos.append(info)
+        bar.update()
     if config.dance:
         from g1_control.library.dance import extract_dance
 

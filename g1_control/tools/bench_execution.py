@@ -4,6 +4,8 @@ one table row per behaviour.
     g1 bench execution                         # the whole suite (~10 min simulated)
     g1 bench execution --only walk.carry       # rows whose name starts with a prefix
     g1 bench execution --json out.json --video videos/
+    g1 bench execution --jobs 2                # trials in 2 processes: the same figures
+    g1 bench execution --ray local             # or on a Ray cluster (local, local:CPUS, HOST:PORT)
 
 Columns (all from the simulator's ground truth, never from the stack's own labels):
   success   trials that met the row's goal / trials
@@ -20,6 +22,10 @@ A row is a Behaviour: a name, a goal, and the trials it runs (g1_control/tools/p
 more rows (reach, box, step) are more entries in `behaviours()`. The last row is the tracking
 layer's cost per 50 Hz tick (p50/p99 over every trial's ticks, and its margin to the tick).
 The bench exits 1 when a trial fell or a row missed its goal.
+
+Every trial is a task (TrialTask: behaviour, seed, trial number) that a worker turns into its
+outcome alone (`run_task`), so `--jobs` and `--ray` (g1_control/fanout.py) change the wall time and
+nothing else; `--json` lists every trial's ground-truth figures under `trials` to compare runs.
 """
 
 from __future__ import annotations
@@ -28,12 +34,14 @@ import dataclasses
 import json
 import math
 import os
-from collections.abc import Callable
+import time
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from g1_control.fanout import describe, fan_out
 from g1_control.generator.styles import ROLLOUT_STYLES
 from g1_control.report.verdict import Verdict, figures
 from g1_control.teleop.scripted import Segment
@@ -169,40 +177,137 @@ def _worst(values: list[float | None]) -> float | None:
     return max(present) if present else None
 
 
-def run_behaviour(behaviour: Behaviour, seed: int = 0, video_dir: Path | None = None,
-                  timings: list[np.ndarray] | None = None,
-                  layer_cpu: list[tuple[np.ndarray, np.ndarray]] | None = None) -> Row:
-    """Run every trial of `behaviour`; `timings` collects the tracker stage's per-tick seconds (50 Hz
-    trials), `layer_cpu` the tracking layer's per-tick CPU time and what ran (layer trials)."""
-    trials = behaviour.trials(seed)
-    verdicts, sim_s, wall_s, falls = [], 0.0, 0.0, 0
-    video = None
-    for i, trial in enumerate(trials):
-        log_path = video_dir / f"{behaviour.name}.npz" if (video_dir is not None and i == 0) else None
-        result = run_trial(trial, log_path=log_path, samples=timings if trial.tracker != "layer" else None)
-        if layer_cpu is not None and result.layer_cpu is not None:
-            layer_cpu.append(result.layer_cpu)
-        verdicts.append(behaviour.judge(result))
-        sim_s += result.sim_s
-        wall_s += result.wall_s
-        falls += result.fell
-        if log_path is not None:
-            from g1_control.sim.render import render_video
+@dataclass(frozen=True)
+class TrialTask:
+    """One trial of the suite, named so that a worker process or a Ray node rebuilds it: the
+    behaviour's name, the suite's seed and the trial's place in the behaviour's list."""
+    behaviour: str
+    seed: int
+    index: int
+    keep_log: bool = False
+    """Send the trial's log back (the driver writes it and renders the behaviour's video)."""
 
-            out = log_path.with_suffix(".mp4")
-            video = str(out) if render_video(log_path, out, fps=15, size=(480, 360), quiet=True) else None
+
+@dataclass
+class TrialOutcome:
+    """What one trial gives its row: the judge's verdict on ground truth, and the timings."""
+    name: str
+    verdict: Verdict
+    fell: bool
+    sim_s: float
+    wall_s: float
+    tracker_s: np.ndarray | None = None
+    """The tracker stage's per-tick seconds (50 Hz policy trials)."""
+    layer_cpu: tuple[np.ndarray, np.ndarray] | None = None
+    """The tracking layer's per-tick CPU time and what ran (layer trials)."""
+    log: dict[str, np.ndarray] | None = None
+    end_base_pos_m: tuple[float, float, float] = (math.nan, math.nan, math.nan)
+    """Where the pelvis was at the trial's end (simulator ground truth): any difference in the
+    physics along the way shows here."""
+
+    def ground_truth(self) -> dict:
+        """Everything but the timings: what a run on other machines must reproduce for the same seed."""
+        return {"trial": self.name, "ok": self.verdict.ok, "text": self.verdict.text, "values": self.verdict.values,
+                "count": self.verdict.count, "met": self.verdict.met(), "fell": self.fell, "sim_s": self.sim_s,
+                "end_base_pos_m": list(self.end_base_pos_m)}
+
+
+def trial_tasks(chosen: list[Behaviour], seed: int, video: bool = False) -> list[TrialTask]:
+    """Every trial of the chosen behaviours, in the order the rows print them."""
+    return [TrialTask(b.name, seed, i, keep_log=video and i == 0) for b in chosen for i in range(len(b.trials(seed)))]
+
+
+def trial_outcome(behaviour: Behaviour, trial: Trial, keep_log: bool = False) -> TrialOutcome:
+    samples: list[np.ndarray] = []
+    result = run_trial(trial, samples=samples if trial.tracker != "layer" else None)
+    pos = result.log.get("base_pos_m") if result.log else None
+    end = (float(pos[-1][0]), float(pos[-1][1]), float(pos[-1][2])) if pos is not None and len(pos) else (math.nan,) * 3
+    return TrialOutcome(trial.name, behaviour.judge(result), bool(result.fell), result.sim_s, result.wall_s,
+                        samples[0] if samples else None, result.layer_cpu, result.log if keep_log else None,
+                        end)
+
+
+def run_task(task: TrialTask) -> TrialOutcome:
+    """One trial, from its task alone (what `--jobs` processes and Ray workers run)."""
+    by_name = {b.name: b for b in behaviours()}
+    if task.behaviour not in by_name:
+        raise KeyError(f"no behaviour {task.behaviour!r} in the execution suite")
+    behaviour = by_name[task.behaviour]
+    return trial_outcome(behaviour, behaviour.trials(task.seed)[task.index], task.keep_log)
+
+
+def make_row(behaviour: Behaviour, outcomes: list[TrialOutcome], video_dir: Path | None = None) -> Row:
+    """The row of `behaviour` from its trials' outcomes (in trial order); the first trial's log, when
+    it came back, is written into `video_dir` and rendered."""
+    verdicts = [o.verdict for o in outcomes]
+    sim_s = sum(o.sim_s for o in outcomes)
+    wall_s = sum(o.wall_s for o in outcomes)
+    video = None
+    if video_dir is not None and outcomes and outcomes[0].log is not None:
+        from g1_control.sim.render import render_video
+
+        log_path = video_dir / f"{behaviour.name}.npz"
+        log_path.parent.mkdir(parents=True, exist_ok=True)
+        np.savez_compressed(log_path, **outcomes[0].log)  # type: ignore[arg-type]
+        out = log_path.with_suffix(".mp4")
+        video = str(out) if render_video(log_path, out, fps=15, size=(480, 360), quiet=True) else None
     successes = sum(v.met() for v in verdicts)
     count = sum(v.count for v in verdicts)
-    notes = [f"{t.name}: {v.text}" for t, v in zip(trials, verdicts) if v.text and (not v.ok or len(trials) == 1)]
+    notes = [f"{o.name}: {o.verdict.text}" for o in outcomes
+             if o.verdict.text and (not o.verdict.ok or len(outcomes) == 1)]
 
     def worst(name: str) -> float | None:
         return _worst([v.values.get(name) for v in verdicts])
 
     return Row(
-        behaviour.name, behaviour.goal, count, successes, falls,
+        behaviour.name, behaviour.goal, count, successes, sum(o.fell for o in outcomes),
         worst("velocity_error_pct"), worst("drift"), worst("upper_body_rms_rad"), worst("hand_error_m"),
         worst("object_error_m"), sim_s / wall_s if wall_s > 0 else math.inf,
         successes >= math.ceil(behaviour.min_success * count - 1e-9), notes, video)
+
+
+def run_behaviour(behaviour: Behaviour, seed: int = 0, video_dir: Path | None = None,
+                  timings: list[np.ndarray] | None = None,
+                  layer_cpu: list[tuple[np.ndarray, np.ndarray]] | None = None) -> Row:
+    """Run every trial of `behaviour` here, one after another; `timings` collects the tracker
+    stage's per-tick seconds (50 Hz trials), `layer_cpu` the tracking layer's per-tick CPU time and
+    what ran (layer trials)."""
+    outcomes = [trial_outcome(behaviour, trial, keep_log=video_dir is not None and i == 0)
+                for i, trial in enumerate(behaviour.trials(seed))]
+    _collect(outcomes, timings, layer_cpu)
+    return make_row(behaviour, outcomes, video_dir)
+
+
+def _collect(outcomes: list[TrialOutcome], timings: list[np.ndarray] | None,
+             layer_cpu: list[tuple[np.ndarray, np.ndarray]] | None) -> None:
+    for o in outcomes:
+        if timings is not None and o.tracker_s is not None:
+            timings.append(o.tracker_s)
+        if layer_cpu is not None and o.layer_cpu is not None:
+            layer_cpu.append(o.layer_cpu)
+
+
+def run_rows(chosen: list[Behaviour], seed: int = 0, *, jobs: int = 1, ray: str | None = None,
+             video_dir: Path | None = None, timings: list[np.ndarray] | None = None,
+             layer_cpu: list[tuple[np.ndarray, np.ndarray]] | None = None,
+             outcomes: list[TrialOutcome] | None = None) -> Iterator[Row]:
+    """The rows of `chosen`, each as soon as its trials are done, with every trial fanned out over
+    `jobs` processes or the Ray cluster at `ray` (g1_control/fanout.py); the same rows for the same
+    seed however they ran (timings aside). `outcomes` gets every trial's outcome, in order."""
+    tasks = trial_tasks(chosen, seed, video_dir is not None)
+    counts = {b.name: 0 for b in chosen}
+    for task in tasks:
+        counts[task.behaviour] += 1
+    by_name = {b.name: b for b in chosen}
+    pending: list[TrialOutcome] = []
+    for task, outcome in zip(tasks, fan_out(run_task, tasks, jobs=jobs, ray=ray), strict=True):
+        pending.append(outcome)
+        if outcomes is not None:
+            outcomes.append(outcome)
+        if len(pending) == counts[task.behaviour]:
+            _collect(pending, timings, layer_cpu)
+            yield make_row(by_name[task.behaviour], pending, video_dir)
+            pending = []
 
 
 def _fmt(value: float | None, spec: str) -> str:
@@ -275,6 +380,7 @@ def layer_cost(repeats: int = 3) -> dict:
 
 
 def main(args) -> int:
+    started = time.perf_counter()
     only = getattr(args, "only", None)
     seed = int(getattr(args, "seed", 0) or 0)
     video_dir = Path(args.video) if getattr(args, "video", None) else None
@@ -282,15 +388,20 @@ def main(args) -> int:
     if not chosen:
         print(f"g1 bench execution: no behaviour starts with {only!r}")
         return 2
-    print(f"g1 bench execution: {len(chosen)} behaviours, seed {seed}; figures from the simulator's ground truth")
+    jobs, ray = int(getattr(args, "jobs", 1) or 1), getattr(args, "ray", None)
+    print(f"g1 bench execution: {len(chosen)} behaviours, {sum(len(b.trials(seed)) for b in chosen)} trials, seed "
+          f"{seed}, {describe(jobs, ray)}; figures from the simulator's ground truth")
     print(HEADER)
     rows: list[Row] = []
     samples: list[np.ndarray] = []
     layer_cpu: list[tuple[np.ndarray, np.ndarray]] = []
-    for behaviour in chosen:
-        row = run_behaviour(behaviour, seed, video_dir, samples, layer_cpu)
+    trials: list[TrialOutcome] = []
+    for row in run_rows(chosen, seed, jobs=jobs, ray=ray, video_dir=video_dir, timings=samples, layer_cpu=layer_cpu,
+                        outcomes=trials):
         rows.append(row)
         print(format_row(row), flush=True)
+    sweep_s = time.perf_counter() - started
+    print(f"{len(trials)} trials in {sweep_s:.1f} s wall, {describe(jobs, ray)}")
     cost = cost_summary(samples)
     sim = sum(r.trials for r in rows)
     rtf = [r.real_time_factor for r in rows]
@@ -318,6 +429,8 @@ def main(args) -> int:
     missed = [r.behaviour for r in rows if not r.met]
     if args.json:
         Path(args.json).write_text(json.dumps({"seed": seed, "rows": [dataclasses.asdict(r) for r in rows],
+                                               "trials": [t.ground_truth() for t in trials],
+                                               "run": {"jobs": jobs, "ray": ray, "wall_s": sweep_s},
                                                "tracking_cost": cost, "layer_cost": layer,
                                                "goal_layer_cost": goal_layer,
                                                "load_average_1min": os.getloadavg()[0]}, indent=1))

@@ -10,6 +10,7 @@ per step and a table per instruction; exits 1 on a fall or a missed step.
     g1 bench program                 # the 20 instructions below (15 walk/turn/style/height/wait, 5 with goals)
     g1 bench program --only 3,7      # some of them (1-based)
     g1 bench program --json out.json
+    g1 bench program --jobs 2        # instructions in 2 processes, or --ray local / HOST:PORT (the same verdicts)
 """
 
 from __future__ import annotations
@@ -79,14 +80,30 @@ def run_instruction(text: str, launch_name: str | None = None,
             "sim_s": result.duration_s, "wall_s": result.wall_s}
 
 
+def run_numbered(index: int) -> dict:
+    """Instruction `index` (1-based) run and judged, from the number alone (what `--jobs` processes
+    and Ray workers run; g1_control/fanout.py)."""
+    row = run_instruction(INSTRUCTIONS[index - 1])
+    row["index"] = index
+    return row
+
+
+def ground_truth(row: dict) -> dict:
+    """A row without its timings (parse CPU, wall time): what a run elsewhere reproduces."""
+    return {k: v for k, v in row.items() if k not in ("parse_cpu_ms", "wall_s")}
+
+
 def main(args) -> int:
+    from g1_control.fanout import describe, fan_out
+
     only = {int(x) for x in args.only.split(",")} if getattr(args, "only", None) else None
+    chosen = [i for i in range(1, len(INSTRUCTIONS) + 1) if not only or i in only]
+    jobs, ray = int(getattr(args, "jobs", 1) or 1), getattr(args, "ray", None)
+    print(f"g1 bench program: {len(chosen)} instructions, {describe(jobs, ray)}; every step judged from ground truth")
+    started = time.perf_counter()
     rows = []
-    for i, text in enumerate(INSTRUCTIONS, 1):
-        if only and i not in only:
-            continue
-        row = run_instruction(text)
-        row["index"] = i
+    for row in fan_out(run_numbered, chosen, jobs=jobs, ray=ray):
+        i, text = row["index"], row["instruction"]
         rows.append(row)
         met = sum(s.get("verdict", {}).get("ok", False) for s in row["steps"])
         print(f"\n[{i}] {text}\n    {len(row['steps'])} steps ran of {row['primitives']}, {met} met by ground truth; "
@@ -95,6 +112,7 @@ def main(args) -> int:
             v = s.get("verdict", {})
             print(f"    {s['label']:>6}. {s['description'][:44]:<44} {s['status']:<9} "
                   f"{v.get('text', '')[:60]:<60} {'OK' if v.get('ok') else 'MISSED'}")
+    sweep_s = time.perf_counter() - started
     by_kind: Counter = Counter()
     met_kind: Counter = Counter()
     for row in rows:
@@ -108,6 +126,7 @@ def main(args) -> int:
     print(f"\n{len(rows)} instructions, {planned} steps planned, {steps} ran, {met} met by ground truth "
           f"({100 * met / max(1, steps):.1f} %); falls: {falls}; unfinished programs: "
           f"{sum(not r['finished'] for r in rows)}")
+    print(f"{len(rows)} instructions in {sweep_s:.1f} s wall, {describe(jobs, ray)}")
     print("per kind: " + ", ".join(f"{k} {met_kind[k]}/{n}" for k, n in sorted(by_kind.items())))
     walks = [s["verdict"]["values"]["error_rel"] for r in rows for s in r["steps"]
              if "error_rel" in s.get("verdict", {}).get("values", {})]
@@ -122,6 +141,7 @@ def main(args) -> int:
         print(f"turn error: mean |e| {math.degrees(sum(map(abs, turns)) / len(turns)):.1f} deg, max "
               f"{math.degrees(max(map(abs, turns))):.1f} deg over {len(turns)} turns")
     if getattr(args, "json", None):
-        Path(args.json).write_text(json.dumps({"rows": rows, "steps": steps, "met": met, "falls": falls},
+        Path(args.json).write_text(json.dumps({"rows": rows, "steps": steps, "met": met, "falls": falls,
+                                               "run": {"jobs": jobs, "ray": ray, "wall_s": sweep_s}},
                                               indent=2, default=float) + "\n")
     return 0 if falls == 0 and met == steps == planned else 1

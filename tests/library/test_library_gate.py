@@ -30,7 +30,7 @@ def _sunk(clip: MotionClip) -> MotionClip:
 @pytest.fixture(scope="module")
 def rollout():
     """One short physics rollout of the walking policy (default style), shared by the builds below."""
-    return builder._rollout_job(("default", 100, 5.0, 30.0))
+    return builder.rollout_job(("default", 100, 5.0, 30.0))
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +38,7 @@ def libraries(rollout, tmp_path_factory):
     clip, info = rollout
     assert clip is not None
     patch = pytest.MonkeyPatch()
-    patch.setattr(builder, "_rollout_job", lambda task: (_sunk(clip), info))
+    patch.setattr(builder, "rollout_job", lambda task: (_sunk(clip), info))
     try:
         base = dict(rollout_seconds=5.0, rollouts_per_style=1, rollout_styles=("default",), dance=False, demo=False,
                     clip_seconds=1.0)
