@@ -138,11 +138,9 @@ def _feed_config(args, name: str):
 
 
 def _run(args) -> int:
-    from g1_control.errors import G1ControlError
+    from g1_control.errors import G1ControlError, LaunchFileError
     from g1_control.loop.priority import frozen_heap, realtime
     from g1_control.sim.emulator import RobotEmulator
-
-    from g1_control.errors import LaunchFileError
 
     physics: Backend
     scene = None
