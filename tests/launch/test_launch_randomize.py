@@ -25,7 +25,7 @@ def _walk(overrides: list[str], seconds: float = 2.5):
 
 def test_the_loop_runs_on_the_drawn_robot_and_the_same_seed_repeats_the_run():
     loop, sim, q = _walk(["backend.randomize.seed=4"])
-    _, again, q_again = _walk(["backend.randomize.seed=4"])
+    _, _, q_again = _walk(["backend.randomize.seed=4"])
     _, nominal, q_nominal = _walk([])
     assert sim.draw is not None and sim.draw.seed == 4 and nominal.draw is None
     assert loop.chain["backend"].startswith("MujocoBackend randomised (seed 4: ")
