@@ -15,6 +15,12 @@ tests/sim/test_mujoco_motor_law.py holds both to motor_law.py. State comes out a
 reports it (IMU quaternion/gyro/accelerometer at the pelvis, joint q/dq/tau), plus ground truth
 that only a simulator has (base position and velocity), for tests and logs.
 
+Randomised robot (MujocoConfig.randomize, g1_control/sim/randomize.py): the compiled model's link
+masses, CoMs, foot friction and torque limits are the draw's; each driver law is scaled by its
+motor's drawn strength and reaches the drivers the drawn latency (in whole physics steps) after
+write_command, so a lockstep batch of ticks switches law inside the batch. reset() and close()
+apply their command at once and drop any still on its way.
+
 Lockstep mode: physics advances only in step(dt) - deterministic and faster than real time.
 Wall-clock mode is the same object with `lockstep=False`: the loop paces step() to the wall clock.
 """
