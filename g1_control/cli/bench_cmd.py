@@ -32,6 +32,10 @@ BENCHMARKS = {
     "locomotion": ("g1_control.tools.bench_locomotion:main",
                    "walking from ground truth: model-based WBC vs holosoma ppo and fastsac per axis and speed "
                    "(achieved vs commanded, off-axis, falls, act() CPU p50/p99 vs RNEA+CRBA); exits 1 on a fall"),
+    "robust": ("g1_control.tools.bench_robust:main",
+               "wbc vs ppo walking 0.6 m/s and the step (sim_step) on --draws seeded randomised robots (link mass, "
+               "CoM, motor strength, latency, foot friction): falls, achieved vs commanded from ground truth; exits 1 "
+               "on a fall"),
     "envelope": ("g1_control.tools.bench_envelope:main",
                  "the walking tracker's achievable velocity per axis and style; --write ships it as the command limits"),
 }
@@ -54,7 +58,9 @@ def register(subparsers) -> None:
     parser.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
     parser.add_argument("--only", metavar="PREFIXES", help="execution/envelope/locomotion: only rows (styles, controller/case) starting with these "
                         "comma-separated prefixes; program: instruction numbers (1,5)")
-    parser.add_argument("--seed", type=int, default=0, help="execution: the suite's seed (push timing; default 0)")
+    parser.add_argument("--seed", type=int, default=0, help="execution: the suite's seed (push timing; default 0); "
+                        "robust: the first draw's seed")
+    parser.add_argument("--draws", type=int, default=10, help="robust: how many seeded randomised robots (default 10)")
     parser.add_argument("--video", metavar="DIR", help="execution: a video per behaviour into DIR")
     parser.add_argument("--write", action="store_true", help="envelope: write the measured envelope next to the "
                         "policy spec (the loop builder's command limits)")

@@ -91,7 +91,9 @@ def _run(args) -> int:
         else:
             check_tracker_fits(launch)
             what = f"tracker {launch.tracker.type}"
-        print(f"{args.file}: OK ({launch.name}: {launch.backend.type} {launch.backend.mode}, "
+        randomized = (f", randomised (seed {launch.backend.randomize.seed})" if launch.backend.randomize is not None
+                      else "")
+        print(f"{args.file}: OK ({launch.name}: {launch.backend.type} {launch.backend.mode}{randomized}, "
               f"{launch.backend.expected_variant}, {what}, {launch.total_duration_s:.1f} s, input {launch.input.type})")
         return 0
     from g1_control.launch.runner import run

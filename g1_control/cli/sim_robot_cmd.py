@@ -26,6 +26,8 @@ def register(subparsers) -> None:
         "  g1 sim-robot --lower-gantry-on-policy   # sim2sim with g1 deploy launch/sim2sim.yaml --yes\n"
         "  g1 sim-robot --mode-machine 4 --lower-gantry-on-policy   # the 23-DoF G1 (g1 deploy launch/sim2sim_23dof.yaml)\n"
         "  g1 sim-robot --lower-gantry-on-policy --mocap --mocap-noise-m 0.02 --mocap-latency-s 0.1   # sim2sim_mocap.yaml\n"
+        "  g1 sim-robot --lower-gantry-on-policy --randomize 3   # a randomised G1 (masses, CoM, motor strength, "
+        "latency, foot friction; drawn from seed 3)\n"
         "  g1 sim-robot --lower-gantry-on-policy --scene launch/sim2sim_box.yaml --perception-noise-m 0.02 "
         "--perception-latency-s 0.1 --perception-dropout 0.1",
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -60,6 +62,7 @@ def register(subparsers) -> None:
                         help="the G1 variant to emulate and report: 4 = 23-DoF (no waist roll/pitch, no wrist "
                         "pitch/yaw: MuJoCo builds it without those joints), 5 = 29-DoF (default), 6 = 29-DoF with "
                         "the waist locked (--physics mock reports any value)")
+    _add_randomize_arguments(parser)
     parser.add_argument("--no-builtin", action="store_true",
                         help="start with no built-in controller (as after debug mode on the remote)")
     parser.add_argument("--rt-priority", type=int, default=30, metavar="N",
@@ -90,6 +93,39 @@ def _add_feed_arguments(parser, name: str, topic: str, rate_hz: float, sample: s
     parser.add_argument(f"--{name}-seed", type=int, default=0, help="seed of the noise and dropouts")
 
 
+def _add_randomize_arguments(parser) -> None:
+    """--randomize SEED and the ranges it draws from (g1_control/sim/randomize.py; defaults as there)."""
+    from g1_control.sim.randomize import RandomizeConfig
+
+    d = RandomizeConfig()
+    parser.add_argument("--randomize", type=int, metavar="SEED",
+                        help="MuJoCo: a domain-randomised G1 drawn from SEED (link masses, CoM offsets, motor "
+                        "strength, command latency, foot friction), printed at start and in the exit report; the "
+                        "same seed gives the same robot (as a launch file's backend.randomize)")
+    for flag, default, what in (("mass-scale", d.mass_scale, "factor on each link's mass"),
+                                ("motor-strength", d.motor_strength, "factor on each motor's torque and limit"),
+                                ("latency-s", d.latency_s, "command latency (s)"),
+                                ("foot-friction", d.foot_friction, "sliding friction of the feet")):
+        parser.add_argument(f"--randomize-{flag}", type=float, nargs=2, metavar=("LOW", "HIGH"), default=list(default),
+                            help=f"with --randomize: range of the {what} (default {default[0]:g} {default[1]:g})")
+    parser.add_argument("--randomize-com-offset-m", type=float, default=d.com_offset_m, metavar="M",
+                        help=f"with --randomize: largest CoM offset per link (default {d.com_offset_m:g} m)")
+
+
+def _randomize_config(args):
+    """The RandomizeConfig of --randomize (None without it); LaunchFileError on a bad range."""
+    from g1_control.sim.randomize import RandomizeConfig
+
+    if args.randomize is None:
+        return None
+    config = RandomizeConfig(seed=args.randomize, mass_scale=tuple(args.randomize_mass_scale),
+                             com_offset_m=args.randomize_com_offset_m,
+                             motor_strength=tuple(args.randomize_motor_strength),
+                             latency_s=tuple(args.randomize_latency_s), foot_friction=tuple(args.randomize_foot_friction))
+    config.validate("--randomize")
+    return config
+
+
 def _feed_config(args, name: str):
     """The MocapConfig of the feed `name` (its arguments from _add_feed_arguments)."""
     import math
@@ -102,15 +138,24 @@ def _feed_config(args, name: str):
 
 
 def _run(args) -> int:
-    from g1_control.errors import G1ControlError
+    from g1_control.errors import G1ControlError, LaunchFileError
     from g1_control.loop.priority import frozen_heap, realtime
     from g1_control.sim.emulator import RobotEmulator
 
-    realtime(args.rt_priority)
     physics: Backend
     scene = start_in_scene = None
+    try:
+        randomize = _randomize_config(args)
+    except LaunchFileError as exc:  # "--randomize.mass_scale: ..." names the flag --randomize-mass-scale
+        key, _, problem = str(exc).partition(": ")
+        flag = "--randomize" if key.endswith(".seed") else key.replace(".", "-").replace("_", "-")
+        print(f"g1 sim-robot: {flag}: {problem}", file=sys.stderr)
+        return 2
+    if randomize is not None and args.physics != "mujoco":
+        print("g1 sim-robot: --randomize needs --physics mujoco", file=sys.stderr)
+        return 2
+    realtime(args.rt_priority)
     if args.scene:
-        from g1_control.errors import LaunchFileError
         from g1_control.launch.schema import load_launch
 
         if args.physics != "mujoco":
@@ -137,10 +182,13 @@ def _run(args) -> int:
         if args.mode == "unitree_mujoco":
             from g1_control.sim.unitree_mujoco import PHYSICS_DT_S, HeldTorqueMujoco
 
-            physics = mujoco = HeldTorqueMujoco(MujocoConfig(lockstep=True, physics_dt_s=PHYSICS_DT_S, variant=variant),
-                                                scene=scene)
+            physics = mujoco = HeldTorqueMujoco(MujocoConfig(lockstep=True, physics_dt_s=PHYSICS_DT_S, variant=variant,
+                                                             randomize=randomize), scene=scene)
         else:
-            physics = mujoco = MujocoBackend(MujocoConfig(lockstep=True, variant=variant), scene=scene)
+            physics = mujoco = MujocoBackend(MujocoConfig(lockstep=True, variant=variant, randomize=randomize),
+                                             scene=scene)
+        if mujoco.draw is not None:
+            print(f"g1 sim-robot: {mujoco.describe()}", file=sys.stderr, flush=True)
         if args.gantry or args.lower_gantry_on_policy:
             from g1_control.sim.emulator import Gantry
 

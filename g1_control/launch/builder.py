@@ -183,7 +183,8 @@ def make_sim_backend(launch: LaunchFile) -> MujocoBackend:
     from g1_control.sim.mujoco_backend import MujocoBackend, MujocoConfig
 
     return MujocoBackend(MujocoConfig(physics_dt_s=launch.backend.physics_dt_s, lockstep=True,
-                                      variant=launch.backend.expected_variant, hands=launch.backend.hands),
+                                      variant=launch.backend.expected_variant, hands=launch.backend.hands,
+                                      randomize=launch.backend.randomize),
                          scene=launch.scene)
 
 

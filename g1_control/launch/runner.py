@@ -52,6 +52,8 @@ def run(launch: LaunchFile, *, out_root: Path | None = None, video: bool | None 
     """
     segments = timeline_of(launch)
     sim = make_sim_backend(launch)
+    if sim.draw is not None and progress:  # recorded too: the run summary's chain.backend
+        print(f"randomised robot (backend.randomize): {sim.draw.summary()}", flush=True)
     loop = build_loop(launch, backend=sim, input_device=input_device)
     folder = RunFolder.create(Path(out_root), launch) if out_root is not None else None
     if folder is None:

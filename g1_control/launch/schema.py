@@ -20,6 +20,7 @@ from g1_control.robot import g1
 from g1_control.safety.config import SafetyConfig
 from g1_control.safety.fall import FallConfig
 from g1_control.scene import FLOOR, SceneConfig
+from g1_control.sim.randomize import RandomizeConfig
 from g1_control.teleop.scripted import RandomTimelineConfig, Segment
 
 ROBOT_BACKENDS = ("unitree_dds", "can", "serial")
@@ -75,6 +76,10 @@ class BackendConfig:
     baudrate: int = 921600
     simulator: str | None = None
     """None: a robot (or g1 sim-robot), every LowState_ field checked; unitree_mujoco: Unitree's simulator."""
+    randomize: RandomizeConfig | None = None
+    """mujoco only: a seeded domain randomisation of the simulated robot (link masses, CoM offsets,
+    motor strength, command latency, foot friction; g1_control/sim/randomize.py). Absent: the
+    nominal robot. The robot path is randomised in `g1 sim-robot --randomize SEED`."""
 
     def validate(self, where: str) -> None:
         self._validate_simulator(where)
@@ -86,6 +91,9 @@ class BackendConfig:
                                   f"expected_variant is {self.expected_variant}")
         if self.type == "mujoco":
             return
+        if self.randomize is not None:
+            raise LaunchFileError(f"{where}.randomize: only the simulator (type mujoco) is randomised here; a "
+                                  f"{self.type} backend drives a robot (randomise g1 sim-robot with --randomize SEED)")
         if self.type == "unitree_dds":
             if not self.interface:
                 raise LaunchFileError(f"{where}.interface: a unitree_dds backend must name its network interface "

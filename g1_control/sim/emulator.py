@@ -404,11 +404,26 @@ class RobotEmulator:
             float(np.max(last.motor_kp_nm_per_rad)) == 0.0
             and float(np.min(last.motor_kd_nms_per_rad[:g1.NUM_JOINTS][motors])) > 0)
         gantry = self.physics.inner
+        self._report_randomization(out, gantry.inner if isinstance(gantry, Gantry) else gantry)
         if isinstance(gantry, Gantry):
             out["gantry_lowered_at_s"] = gantry.lowered_at_s
             out["gantry_lowered_base_pos_w_m"] = (None if gantry.lowered_base_pos_m is None
                                                   else [float(v) for v in gantry.lowered_base_pos_m])
         return out
+
+    @staticmethod
+    def _report_randomization(out: dict, physics: Backend) -> None:
+        """The simulated robot's randomisation (sim/randomize.py) as drawn and as its model holds it."""
+        from g1_control.sim.mujoco_backend import MujocoBackend
+
+        if not isinstance(physics, MujocoBackend) or physics.draw is None:
+            return
+        m = physics.model
+        robot = m.body(g1.BASE_BODY).id
+        out["randomize"] = {**physics.draw.as_dict(), "latency_applied_s": physics.latency_s,
+                            "describe": physics.describe(),
+                            "robot_mass_kg": float(sum(m.body_mass[b] for b in range(1, m.nbody)
+                                                       if m.body_rootid[b] == robot))}
 
     def serve_stdin(self) -> None:
         """Line protocol for test harnesses: '<fault>' -> {'fault', 't_s'}; a remote command (see

@@ -15,12 +15,19 @@ tests/sim/test_mujoco_motor_law.py holds both to motor_law.py. State comes out a
 reports it (IMU quaternion/gyro/accelerometer at the pelvis, joint q/dq/tau), plus ground truth
 that only a simulator has (base position and velocity), for tests and logs.
 
+Randomised robot (MujocoConfig.randomize, g1_control/sim/randomize.py): the compiled model's link
+masses, CoMs, foot friction and torque limits are the draw's; each driver law is scaled by its
+motor's drawn strength and reaches the drivers the drawn latency (in whole physics steps) after
+write_command, so a lockstep batch of ticks switches law inside the batch. reset() and close()
+apply their command at once and drop any still on its way.
+
 Lockstep mode: physics advances only in step(dt) - deterministic and faster than real time.
 Wall-clock mode is the same object with `lockstep=False`: the loop paces step() to the wall clock.
 """
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass
 
 import mujoco
@@ -30,6 +37,7 @@ from g1_control.errors import RobotDescriptionError
 from g1_control.interfaces import Backend
 from g1_control.robot import description, g1
 from g1_control.scene import SceneConfig
+from g1_control.sim.randomize import RandomizeConfig, RobotDraw, draw
 from g1_control.types import MotorCommand, RobotState
 
 
@@ -65,6 +73,9 @@ class MujocoConfig:
     """Which G1 is built (g1.VARIANTS by name; a launch file's backend.expected_variant): a variant
     without some joints has no such joints and motors in the model, and its state reports them as 0
     (q, dq, tau), as the robot's LowState_ does for the slots it has no motor behind."""
+    randomize: RandomizeConfig | None = None
+    """A seeded domain randomisation of the robot (g1_control/sim/randomize.py): link masses, CoM
+    offsets, motor strength, command latency, foot friction. None: the nominal robot."""
 
 
 class MujocoBackend(Backend):
@@ -81,6 +92,14 @@ class MujocoBackend(Backend):
             raise RobotDescriptionError(f"MujocoConfig.variant: {exc}") from None
         self.model = self._compile()
         self.data = mujoco.MjData(self.model)
+        self.draw: RobotDraw | None = None
+        """The randomisation this robot runs with (None: nominal)."""
+        self._strength: np.ndarray | None = None
+        """Per model actuator: the drawn motor strength (None: 1)."""
+        self._latency_steps = 0
+        self._pending: deque[tuple[int, np.ndarray]] = deque()
+        """Driver laws written but not yet applied: (physics step they apply at, bias parameters)."""
+        self._steps = 0
         m = self.model
         base = m.joint(0)  # the robot's floating base is the model's first joint
         qa, va = int(m.jnt_qposadr[base.id]), int(m.jnt_dofadr[base.id])
@@ -101,8 +120,10 @@ class MujocoBackend(Backend):
         self._bias = self.model.actuator_biasprm[:n, :3]
         """(b0, b1, b2) per motor: a view into the model, rewritten by write_command."""
         self._law = np.zeros((3, g1.NUM_JOINTS))
+        if self.config.randomize is not None:
+            self._randomize(self.config.randomize)
         self._command = MotorCommand.damping(g1.KD_DEFAULT)
-        self.write_command(self._command)
+        self._apply_now(self._command)
         self._tick = 0
         adr = self.model.sensor_adr
         self._gyro = slice(adr[self.model.sensor("imu_gyro").id], adr[self.model.sensor("imu_gyro").id] + 3)
@@ -152,7 +173,7 @@ class MujocoBackend(Backend):
             if m.geom_conaffinity[i] and m.geom_bodyid[i] != 0 and m.body_rootid[m.geom_bodyid[i]] == robot
         )
         base[2] += -lowest + self.config.init_height_clearance_m
-        self.write_command(MotorCommand(q_rad=q.copy(), kp=g1.KP_DEFAULT.copy(), kd=g1.KD_DEFAULT.copy()))
+        self._apply_now(MotorCommand(q_rad=q.copy(), kp=g1.KP_DEFAULT.copy(), kd=g1.KD_DEFAULT.copy()))
         self._tick = 0
         self._push_until_s = -1.0
         self._pushing = False
@@ -191,7 +212,51 @@ class MujocoBackend(Backend):
         np.negative(command.kd, out=law[2])
         if not command.enable.all():
             law[:, ~command.enable] = 0.0
-        self._bias[:] = law.T if self._full else law[:, self._active].T
+        bias = law.T if self._full else law[:, self._active].T
+        if self._strength is not None:
+            bias = bias * self._strength[:, None]
+        if self._latency_steps:  # the drivers get it this many physics steps from now
+            self._pending.append((self._steps + self._latency_steps, np.array(bias)))
+        else:
+            self._bias[:] = bias
+
+    def _apply_now(self, command: MotorCommand) -> None:
+        """`command` at the drivers at once, and any command still on its way dropped (reset, close)."""
+        self._pending.clear()
+        self.write_command(command)
+        if self._pending:
+            self._bias[:] = self._pending.pop()[1]
+
+    def _randomize(self, config: RandomizeConfig) -> None:
+        """Apply the draw of `config` to the compiled model (sim/randomize.py)."""
+        m = self.model
+        robot = m.body(g1.BASE_BODY).id
+        ids = [b for b in range(1, m.nbody) if m.body_rootid[b] == robot]
+        d = draw(config, tuple(m.body(b).name for b in ids), g1.NUM_JOINTS)
+        m.body_mass[ids] *= d.mass_scale
+        m.body_inertia[ids] *= d.mass_scale[:, None]
+        m.body_ipos[ids] += d.com_offset_m
+        self._strength = d.motor_strength[self._active].copy()
+        m.actuator_forcerange[: len(self._strength)] *= self._strength[:, None]
+        feet = {m.body(name).id for name in g1.FOOT_BODIES}
+        for geom in range(m.ngeom):
+            if m.geom_bodyid[geom] in feet and m.geom_conaffinity[geom]:
+                m.geom_friction[geom, 0] = d.foot_friction
+                m.geom_priority[geom] = 1  # the feet's friction, not the larger of the two geoms'
+        self._latency_steps = max(0, round(d.latency_s / m.opt.timestep))
+        mujoco.mj_setConst(m, self.data)
+        self.draw = d
+
+    @property
+    def latency_s(self) -> float:
+        """The command latency this robot applies (the drawn value rounded to physics steps)."""
+        return self._latency_steps * float(self.model.opt.timestep)
+
+    def describe(self) -> str:
+        if self.draw is None:
+            return type(self).__name__
+        return (f"{type(self).__name__} randomised ({self.draw.summary()}; latency applied "
+                f"{1000 * self.latency_s:.0f} ms = {self._latency_steps} physics steps)")
 
     def _scatter(self, values: np.ndarray) -> np.ndarray:
         """The variant's joint values in the robot's 29 slots (0 where it has no joint)."""
@@ -213,20 +278,24 @@ class MujocoBackend(Backend):
     def _physics_steps(self, n: int) -> None:
         m, d = self.model, self.data
         self._tick += n
-        # A push acts on every physics step that starts before it ends.
-        while n > 0 and d.time < self._push_until_s:
-            d.xfrc_applied[self._push_body, :3] = self._push_force_w
-            mujoco.mj_step(m, d)
-            n -= 1
-        if n > 0:
-            if self._pushing:
+        pending = self._pending
+        while n > 0:
+            while pending and pending[0][0] <= self._steps:  # commands that reach the drivers now
+                self._bias[:] = pending.popleft()[1]
+            k = n if not pending else min(n, pending[0][0] - self._steps)
+            if d.time < self._push_until_s:  # a push acts on every physics step that starts before it ends
+                d.xfrc_applied[self._push_body, :3] = self._push_force_w
+                k = 1
+            elif self._pushing:
                 d.xfrc_applied[self._push_body, :3] = 0.0
                 self._pushing = False
-            mujoco.mj_step(m, d, n)
+            mujoco.mj_step(m, d, k)
+            self._steps += k
+            n -= k
 
     def close(self) -> None:
         # A simulated robot left alone is damped, like the real one after close().
-        self.write_command(MotorCommand.damping(g1.KD_DEFAULT))
+        self._apply_now(MotorCommand.damping(g1.KD_DEFAULT))
         self.closed = True
 
     def ground_contacts(self) -> tuple[str, ...]:

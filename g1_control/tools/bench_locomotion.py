@@ -38,6 +38,7 @@ from g1_control.teleop.scripted import Segment
 
 if TYPE_CHECKING:
     from g1_control.sim.mujoco_backend import MujocoBackend
+    from g1_control.sim.randomize import RandomizeConfig
 
 CONTROLLERS: dict[str, tuple[str, str, float]] = {
     "wbc": ("wbc", "", 250.0),
@@ -121,6 +122,8 @@ class Row:
     pushes: int = 0
     pushes_survived: int = 0
     """Pushes after which the robot was still up 2 s later."""
+    backend: str = ""
+    """The simulated robot (loop.chain's backend: nominal, or the randomisation drawn)."""
 
     @property
     def name(self) -> str:
@@ -137,7 +140,8 @@ def steady_velocity(log: dict[str, np.ndarray], t_from_s: float, t_to_s: float, 
     return log["velocity_true"][window].mean(axis=0)
 
 
-def case_launch(controller: str, case: Case, walk_s: float):
+def case_launch(controller: str, case: Case, walk_s: float, randomize: RandomizeConfig | None = None):
+    """The launch of one row; `randomize`: on a randomised robot (g1_control/sim/randomize.py)."""
     from g1_control.launch.schema import LaunchFile
 
     kind, policy, hz = CONTROLLERS[controller]
@@ -157,16 +161,19 @@ def case_launch(controller: str, case: Case, walk_s: float):
     launch.limits.max_vx_mps = max(launch.limits.max_vx_mps, abs(vx))
     launch.limits.max_vy_mps = max(launch.limits.max_vy_mps, abs(vy))
     launch.limits.max_wz_radps = max(launch.limits.max_wz_radps, abs(wz))
+    launch.backend.randomize = randomize
     launch.validate("locomotion")
     launch.output.video, launch.output.plot, launch.viewer = False, False, False
     return launch
 
 
-def run_case(controller: str, case: Case, walk_s: float, states: list | None = None) -> Row:
-    """One row. `states`: gets (q, v) samples of the run appended (the RNEA + CRBA baseline)."""
+def run_case(controller: str, case: Case, walk_s: float, states: list | None = None,
+             randomize: RandomizeConfig | None = None) -> Row:
+    """One row. `states`: gets (q, v) samples of the run appended (the RNEA + CRBA baseline);
+    `randomize`: on a randomised robot."""
     from g1_control.launch.builder import build_loop
 
-    loop = build_loop(case_launch(controller, case, walk_s))
+    loop = build_loop(case_launch(controller, case, walk_s, randomize))
     loop.reset()
     tracker = loop.tracker
     cpu: list[int] = []
@@ -201,7 +208,8 @@ def run_case(controller: str, case: Case, walk_s: float, states: list | None = N
         wall = time.perf_counter() - t0
         loop.backend.close()
     log = loop.log.arrays()
-    row = Row(controller, case.name, list(case.command), sim_s=float(loop.time_s), wall_s=wall)
+    row = Row(controller, case.name, list(case.command), sim_s=float(loop.time_s), wall_s=wall,
+              backend=loop.chain["backend"])
     row.fell = loop.fell
     row.fall = str(loop.fall) if loop.fall else ""
     row.min_pelvis_m = float(log["base_pos_m"][:, 2].min())

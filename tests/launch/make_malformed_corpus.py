@@ -124,6 +124,14 @@ def launch_cases() -> dict[str, str | bytes]:
         "battery_above_full.yaml": b + "deploy: {min_battery_v: 60}\n",
         "fall_pelvis_height_zero.yaml": b + "fall: {min_pelvis_height_m: 0}\n",
         "fall_pelvis_height_above_standing.yaml": b + "fall: {min_pelvis_height_m: 0.9}\n",
+        # domain randomisation (issue 23): ranges inside their bounds, low <= high, the simulator only
+        "randomize_mass_scale_reversed.yaml": b + "backend: {randomize: {mass_scale: [1.1, 0.9]}}\n",
+        "randomize_strength_above_bound.yaml": b + "backend: {randomize: {motor_strength: [0.85, 1.5]}}\n",
+        "randomize_latency_negative.yaml": b + "backend: {randomize: {latency_s: [-0.005, 0.015]}}\n",
+        "randomize_friction_zero.yaml": b + "backend: {randomize: {foot_friction: [0.0, 1.2]}}\n",
+        "randomize_com_offset_too_large.yaml": b + "backend: {randomize: {com_offset_m: 0.5}}\n",
+        "randomize_range_one_item.yaml": b + "backend: {randomize: {foot_friction: [0.5]}}\n",
+        "randomize_on_robot.yaml": b + "backend: {type: unitree_dds, interface: lo, randomize: {seed: 1}}\n",
     }
 
 

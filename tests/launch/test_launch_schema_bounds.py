@@ -41,6 +41,10 @@ def _with(**sections) -> dict:
     {"input": {"type": "gamepad", "device": {"mapping": {"buttons": {"LB+RB": "estop"}}}}},
     {"input": {"type": "random", "random": {"style": "wave"}}},
     {"duration_s": 0.001},
+    {"backend": {"randomize": {"seed": 0, "mass_scale": [0.5, 2.0], "com_offset_m": 0.0, "motor_strength": [0.3, 1.2],
+                               "latency_s": [0.0, 0.1], "foot_friction": [0.05, 3.0]}}},
+    {"backend": {"randomize": {"seed": 7, "mass_scale": [1.0, 1.0], "com_offset_m": 0.1, "motor_strength": [1.0, 1.0],
+                               "latency_s": [0.01, 0.01], "foot_friction": [0.8, 0.8]}}},
 ])
 def test_boundary_values_are_accepted(sections):
     """Accepted, and held as given (a schema that clamped or replaced a boundary value would show)."""
