@@ -53,7 +53,7 @@ def register(subparsers) -> None:
     _add_feed_arguments(parser, "mocap", "mocap/pose", 100.0, "pose")
     parser.add_argument("--scene", metavar="FILE",
                         help="build this launch file's scene (tables, platforms, boxes) in the MuJoCo physics and "
-                        "publish its boxes as perception sees them (g1_msgs ObjectPoses_ on rt/<--perception-topic>, "
+                        "publish its boxes (if any) as perception sees them (g1_msgs ObjectPoses_ on rt/<--perception-topic>, "
                         "each box in the robot's heading frame); the exit report gives the boxes' ground truth")
     _add_feed_arguments(parser, "perception", "perception/objects", 10.0, "frame")
     parser.add_argument("--record", metavar="FILE", help="write the ground truth (hand points, sole points, boxes; "
@@ -157,7 +157,7 @@ def _run(args) -> int:
     try:
         if args.mocap:
             emulator.publish_mocap(_feed_config(args, "mocap"), args.mocap_topic)
-        if scene is not None:
+        if scene is not None and scene.boxes:  # a scene of tables and platforms only: nothing to perceive
             emulator.publish_perception(mujoco, _feed_config(args, "perception"), args.perception_topic)
     except ValueError as exc:
         emulator.close()

@@ -1,15 +1,16 @@
 """The goal planner's own process (generator/goals/planner.py): the same plan as inline, the skill's
-own refusal comes back as itself, the process runs one real-time priority below the thread that
-started it, and a planner that died fails the goal that waited for it (the robot keeps its reference)."""
+own refusal comes back as itself, beside a real-time thread the process runs at ordinary scheduling
+in a scheduling group of its own that outweighs ordinary work, and a planner that died fails the goal that waited for it (the robot keeps its reference)."""
 
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from g1_control.generator.goals.approach import plan_steps
 from g1_control.generator.goals.context import GoalConfig, GoalContext, GoalFailed
-from g1_control.generator.goals.planner import PlannerProcess
+from g1_control.generator.goals.planner import AUTOGROUP_NICE, PlannerProcess
 from g1_control.generator.goals.poses import PosePlanner, ReachRefused, flat_soles
 from g1_control.generator.goals.reach import reach_pose
 from g1_control.generator.goals.stepping import Stance, SteppingConfig, walk_steps
@@ -40,7 +41,7 @@ def test_a_plan_made_in_the_planner_process_is_the_plan_made_inline(poses):
     np.testing.assert_allclose(there.feet_w_m, here.feet_w_m, atol=1e-9)
 
 
-def test_the_planner_process_runs_below_the_real_time_thread_that_starts_it():
+def test_beside_a_real_time_thread_the_planner_runs_at_ordinary_scheduling_in_a_heavy_group_of_its_own():
     before = os.sched_getscheduler(0), os.sched_getparam(0)
     os.sched_setscheduler(0, os.SCHED_RR, os.sched_param(12))  # as g1 deploy runs its threads (root here)
     try:
@@ -50,7 +51,9 @@ def test_the_planner_process_runs_below_the_real_time_thread_that_starts_it():
         os.sched_setscheduler(0, *before)
     try:
         pid = planner.started.result(timeout=60)
-        assert (os.sched_getscheduler(pid), os.sched_getparam(pid).sched_priority) == (os.SCHED_RR, 11)
+        assert os.sched_getscheduler(pid) == os.SCHED_OTHER  # every real-time thread preempts it
+        assert os.getsid(pid) != os.getsid(0)
+        assert Path(f"/proc/{pid}/autogroup").read_text().endswith(f" nice {AUTOGROUP_NICE}\n")
     finally:
         planner.close()
 

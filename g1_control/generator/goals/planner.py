@@ -1,15 +1,20 @@
 """The goal planner's own process: where whole-body plans are made beside a wall-clock loop.
 
-A plan (footsteps for a carry, a grasp's four poses, a reach) takes 0.1-2 s of CPU. Made in a
+A plan (footsteps for a carry, a grasp's four poses, a reach) takes 0.1-3 s of CPU. Made in a
 thread beside the control loop, it shares the interpreter's lock with the loop and, where the
 deploy runs every thread of its process at SCHED_RR (loop/priority.py), the loop's priority too:
 measured over DDS against `g1 sim-robot` on 2 cores, the loop then waited up to 100 ms (one
 round-robin time slice of the planner thread) and the safety layer tripped on "10 deadline
 overruns within 1.0 s" as a pick's plans started. Here the planning runs in a process of its own,
-started afresh (not forked: the parent runs DDS threads) one real-time priority below the thread that
-starts it (the loop's, in a deploy), with its own PosePlanner: the loop preempts it whenever a tick
-is due and never waits for its lock, and ordinary work on the host does not starve it.
-It stops when its parent closes the socket (or dies).
+started afresh (not forked: the parent runs DDS threads) with its own PosePlanner, at ordinary
+scheduling (SCHED_OTHER), so that every real-time thread (the loop, the link's writer) preempts it
+at once and it never holds the loop's interpreter lock. Beside a real-time loop its session, and so
+its autogroup, is its own with nice AUTOGROUP_NICE: ordinary work on a busy host (other sessions
+weigh as much as ours) does not starve a plan (measured: a pick's plans took ~30 s of wall time at
+nice 0 in the deploy's group on a shared 2-core host), and it stays out of the kernel's real-time
+budget (sched_rt_runtime_us: 95 %), which a planner one real-time priority below the loop used up
+(measured: the loop stalled 43 ms once, 2.6 s into a 3 s plan). It stops when its parent closes the
+socket (or dies).
 
 A job is a function at a module's top level (or a PosePlanner method) called as fn(poses, *args)
 with picklable arguments (arrays, footsteps, configs); its result (arrays, plans) or its exception
@@ -63,24 +68,35 @@ def _pid(_poses) -> int:
     return os.getpid()
 
 
+AUTOGROUP_NICE = -20
+"""The planner's scheduling group's nice value beside a real-time loop (module docstring)."""
+
+
+def _real_time() -> bool:
+    return os.sched_getscheduler(0) in (os.SCHED_RR, os.SCHED_FIFO)
+
+
 @contextlib.contextmanager
-def _scheduling_below_this_thread() -> Iterator[None]:
-    """This thread one real-time priority lower for the block, so that a process started in it runs
-    below the loop (which preempts it at once) but above ordinary work (which would otherwise starve
-    a plan on a busy host: measured, a pick's plans took ~30 s of wall time at ordinary priority
-    beside the emulator). At ordinary scheduling (or the lowest real-time priority) the process starts
-    at ordinary scheduling, with this thread's nice value."""
+def _ordinary_scheduling() -> Iterator[None]:
+    """This thread at SCHED_OTHER for the block, so that a process started in it does not inherit a
+    real-time policy."""
     policy, param = os.sched_getscheduler(0), os.sched_getparam(0)
-    if policy not in (os.SCHED_RR, os.SCHED_FIFO):
+    if policy == os.SCHED_OTHER:
         yield
         return
-    below = param.sched_priority - 1
-    os.sched_setscheduler(0, *((policy, os.sched_param(below)) if below >= 1 else (os.SCHED_OTHER, os.sched_param(0))))
+    os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
     try:
         yield
     finally:
         with contextlib.suppress(OSError):
             os.sched_setscheduler(0, policy, param)
+
+
+def _above_ordinary_work() -> None:
+    """In the planner process (a session, hence a scheduling autogroup, of its own): its group's nice
+    value to AUTOGROUP_NICE, where the OS allows it (root or CAP_SYS_NICE); otherwise as it is."""
+    with contextlib.suppress(OSError), open("/proc/self/autogroup", "w") as group:
+        group.write(str(AUTOGROUP_NICE))
 
 
 class PlannerProcess:
@@ -92,9 +108,10 @@ class PlannerProcess:
         parent, child = socket.socketpair()
         package_root = str(Path(__file__).resolve().parents[3])  # the g1_control the parent runs
         env = dict(os.environ, PYTHONPATH=os.pathsep.join([package_root, *filter(None, [os.environ.get("PYTHONPATH")])]))
-        with _scheduling_below_this_thread():
-            self._process = subprocess.Popen([sys.executable, "-m", __name__, str(child.fileno())],
-                                             pass_fds=[child.fileno()], env=env, stdin=subprocess.DEVNULL)
+        argv = [sys.executable, "-m", __name__, str(child.fileno())] + (["--above-ordinary-work"] if _real_time() else [])
+        with _ordinary_scheduling():
+            self._process = subprocess.Popen(argv, pass_fds=[child.fileno()], env=env, stdin=subprocess.DEVNULL,
+                                             start_new_session=True)
         child.close()
         self._conn = Connection(parent.detach())
         self._jobs: dict[int, Future] = {}
@@ -153,4 +170,6 @@ class PlannerProcess:
 __all__ = ["PlannerDied", "PlannerProcess"]
 
 if __name__ == "__main__":  # the planner process (PlannerProcess): its end of the socket pair
+    if "--above-ordinary-work" in sys.argv:
+        _above_ordinary_work()
     _serve(Connection(int(sys.argv[1])))
