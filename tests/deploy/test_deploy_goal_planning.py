@@ -35,9 +35,9 @@ SHORT_BOX = {
 def test_the_loop_keeps_its_deadlines_while_a_box_pick_is_planned_and_the_box_goes_back(tmp_path, partition):
     launch = write_launch(tmp_path, SHORT_BOX, base=LAUNCH_DIR / "sim2sim_box.yaml")
     truth_path, report_path = tmp_path / "truth.npz", tmp_path / "deploy.json"
-    host, _ = deploy_to_the_end(partition, launch, report_path, tmp_path,
-                                emulator_flags=("--lower-gantry-on-policy", "--scene", str(launch),
-                                                "--record", str(truth_path)))
+    deploy_to_the_end(partition, launch, report_path, tmp_path,
+                      emulator_flags=("--lower-gantry-on-policy", "--scene", str(launch),
+                                      "--record", str(truth_path)))
     report = json.loads(report_path.read_text())
     assert report["error"] == "" and not report["fault"], report["end_reason"]  # no deadline trip, no fall
     planning = report["loop"]["while_planning"]
