@@ -172,6 +172,12 @@ class Generator(ABC):
     it after the run (g1_control/report/outcomes.py)."""
     goal_log: Sequence[tuple[float, str]] = ()
     """(t_s, text) notes of the execution layer as they came (goal started, failed and why), for reports."""
+    plan_windows: Sequence[tuple[str, float, float]] = ()
+    """(what, start t_s, end t_s) of each plan the execution layer made, in the state's time: on a wall
+    clock, the stretches of loop ticks that ran while a plan was being made beside them (reports)."""
+
+    def close(self) -> None:
+        """Release what the generator holds beyond the loop (a goal planner's process)."""
 
     @abstractmethod
     def update(self, command: Command, state: RobotState) -> KinematicReference: ...

@@ -55,9 +55,12 @@ def register(subparsers) -> None:
     _add_feed_arguments(parser, "mocap", "mocap/pose", 100.0, "pose")
     parser.add_argument("--scene", metavar="FILE",
                         help="build this launch file's scene (tables, platforms, boxes) in the MuJoCo physics and "
-                        "publish its boxes as perception sees them (g1_msgs ObjectPoses_ on rt/<--perception-topic>, "
+                        "publish its boxes (if any) as perception sees them (g1_msgs ObjectPoses_ on rt/<--perception-topic>, "
                         "each box in the robot's heading frame); the exit report gives the boxes' ground truth")
     _add_feed_arguments(parser, "perception", "perception/objects", 10.0, "frame")
+    parser.add_argument("--record", metavar="FILE", help="write the ground truth (hand points, sole points, boxes; "
+                        "50 Hz, stamped with the host's monotonic clock) to this .npz at exit, for judging the goals of a "
+                        "deploy's report against it (python -m g1_control.tools.judge_sim2sim); --physics mujoco")
     parser.add_argument("--mode-machine", type=int, default=5,
                         help="the G1 variant to emulate and report: 4 = 23-DoF (no waist roll/pitch, no wrist "
                         "pitch/yaw: MuJoCo builds it without those joints), 5 = 29-DoF (default), 6 = 29-DoF with "
@@ -142,6 +145,9 @@ def _run(args) -> int:
     from g1_control.loop.priority import frozen_heap, realtime
     from g1_control.sim.emulator import RobotEmulator
 
+    if args.record and args.physics != "mujoco":
+        print("g1 sim-robot: --record needs --physics mujoco (the ground truth is MuJoCo's)", file=sys.stderr)
+        return 2
     physics: Backend
     scene = start_in_scene = None
     try:
@@ -203,12 +209,13 @@ def _run(args) -> int:
     try:
         if args.mocap:
             emulator.publish_mocap(_feed_config(args, "mocap"), args.mocap_topic, start_in_scene)
-        if scene is not None:
+        if scene is not None and scene.boxes:  # a scene of tables and platforms only: nothing to perceive
             emulator.publish_perception(mujoco, _feed_config(args, "perception"), args.perception_topic)
     except ValueError as exc:
         emulator.close()
         print(f"g1 sim-robot: {exc}", file=sys.stderr)
         return 2
+    recorder = emulator.record_ground_truth(mujoco) if args.record else None
     emulator.start()
     hands = None
     if args.hands == "dex3":
@@ -247,6 +254,10 @@ def _run(args) -> int:
         finally:
             report = emulator.report()
             emulator.close()
+            if recorder is not None:
+                import numpy as np
+
+                np.savez_compressed(args.record, **recorder.arrays())  # type: ignore[arg-type]
             if hands is not None:
                 hand_states, hand_commands = sum(hands.states_sent.values()), sum(hands.commands_applied.values())
                 hands.close()

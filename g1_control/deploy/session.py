@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from g1_control.deploy.preflight import CHECKS, FAIL, OPTIONAL_CHECKS, Preflight
 from g1_control.deploy.state_machine import DeployState, DeployTracker, OperatorButtons, Transition
 from g1_control.errors import G1ControlError, LaunchFileError
@@ -433,6 +435,7 @@ class _RobotControl:
         """The log, the report and the run folder's summary; then the error that ended the run, if any."""
         folder, report = self.folder, self.report
         assert folder is not None  # open_run_folder ran
+        self.loop.generator.close()  # a goal planner's process: no plan is made past the control phase
         log = folder.close_log(self.loop)
         _fill_report(report, log, self.loop, self.tracker, self.backend, self.safety, self.t_loop0, self.device)
         _report_goals(report, self.loop, self.launch, folder)
@@ -487,6 +490,25 @@ def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTr
                    "lateness_p99_ms": late["p99_us"] / 1000, "lateness_max_ms": loop.scheduler.max_lateness_s * 1000,
                    "misses_over_period": loop.scheduler.misses_over_period,
                    "clamped_commands": safety.clamps.commands}
+    if loop.generator.plan_windows:
+        report.loop["while_planning"] = lateness_while(log_arrays, t_loop0, loop.generator.plan_windows,
+                                                       1.0 / loop.rates.tracker_hz, safety.config.overrun_lateness_s)
+
+
+def lateness_while(log: dict, t_loop0: float, windows, row_period_s: float, allowance_s: float) -> dict:
+    """How late the loop's ticks were while plans were made beside it: the log's rows (late_s) within the
+    plans' windows (Generator.plan_windows, in the states' monotonic time) and one row after each. Windows
+    are listed from the loop's start (the log's t_s)."""
+    t_mono = t_loop0 + log["t_s"]
+    rows = np.zeros(len(t_mono), dtype=bool)
+    for _, start, end in windows:
+        rows |= (t_mono >= start) & (t_mono <= end + row_period_s)
+    late = log["late_s"][rows]
+    return {"plans": len(windows), "seconds": float(sum(end - start for _, start, end in windows)),
+            "rows": int(rows.sum()), "lateness_p99_ms": float(np.percentile(late, 99) * 1000) if late.size else 0.0,
+            "lateness_max_ms": float(late.max() * 1000) if late.size else 0.0,
+            "rows_late": int((late > allowance_s).sum()), "allowance_ms": allowance_s * 1000,
+            "windows": [{"what": what, "start_s": start - t_loop0, "seconds": end - start} for what, start, end in windows]}
 
 
 def _report_goals(report: DeployReport, loop, launch: LaunchFile, folder: RunFolder) -> None:
@@ -569,6 +591,12 @@ def _print_summary(report: DeployReport, say) -> None:
     say(f"loop: {report.loop['ticks']} ticks, {report.loop['deadline_misses']} deadline misses (worst "
         f"{report.loop['lateness_max_ms']:.1f} ms late, p99 {report.loop['lateness_p99_ms']:.1f} ms), "
         f"{report.loop['clamped_commands']} commands clamped by the safety layer")
+    planning = report.loop.get("while_planning")
+    if planning:
+        say(f"loop while goals were planned ({planning['plans']} plans, {planning['seconds']:.1f} s): "
+            f"{planning['rows']} logged ticks, worst {planning['lateness_max_ms']:.1f} ms late, p99 "
+            f"{planning['lateness_p99_ms']:.1f} ms, {planning['rows_late']} late by more than "
+            f"{planning['allowance_ms']:.0f} ms")
 
 
 def write_report(report: DeployReport, path: Path) -> None:

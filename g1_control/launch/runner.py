@@ -139,6 +139,7 @@ def _run_loop(launch: LaunchFile, sim: MujocoBackend, loop: ControlLoop, segment
         if web is not None:
             web.close()
         loop.input.close()
+        loop.generator.close()
         loop.backend.close()
     log = folder.close_log(loop) if folder is not None else loop.log.arrays()
     result = run_result(launch.name, loop, segments, wall, log)

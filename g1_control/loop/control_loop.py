@@ -72,6 +72,7 @@ class RunLog:
     q_target_rad: np.ndarray = field(init=False)     # what the motors were sent (after the safety filter)
     q_ref_rad: np.ndarray = field(init=False)        # the tracker's reference posture (the plan after the IK)
     tau_nm: np.ndarray = field(init=False)
+    late_s: np.ndarray = field(init=False)           # worst lateness of the wall-clock ticks since the last row
     style_id: np.ndarray = field(init=False)         # index into style_names of the operator's style
     style_names: list[str] = field(default_factory=list)
 
@@ -85,9 +86,10 @@ class RunLog:
         self.style_id = np.full(c, -1, dtype=np.int16)
         self.yaw_rad = np.full(c, np.nan)
         self.tilt_rad = np.full(c, np.nan)
+        self.late_s = np.zeros(c)
 
     NAMES = ("t_s", "command", "policy_command", "velocity_est", "velocity_true", "base_pos_m", "base_quat_wxyz",
-             "yaw_rad", "tilt_rad", "q_rad", "q_target_rad", "q_ref_rad", "tau_nm", "style_id")
+             "yaw_rad", "tilt_rad", "q_rad", "q_target_rad", "q_ref_rad", "tau_nm", "late_s", "style_id")
     """The per-tick arrays (style_names, the names behind style_id, is not per tick)."""
 
     def arrays(self) -> dict[str, np.ndarray]:
@@ -340,6 +342,7 @@ class ControlLoop:
         s, est = self.state, self.estimator.estimate
         quat = s.imu_quat_wxyz
         log.t_s[i] = self.time_s
+        log.late_s[i] = self.scheduler.take_log_lateness()
         command = log.command[i]
         command[:] = (self.command.vx_mps, self.command.vy_mps, self.command.wz_radps)
         policy_command = self.tracker.policy_command

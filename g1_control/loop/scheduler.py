@@ -93,6 +93,7 @@ class Scheduler:
         self.misses_over_period = 0
         """Ticks that finished more than a whole tick period late (the next tick's deadline passed too)."""
         self._late_since_take = 0.0
+        self._late_since_log = 0.0
         self._t0: float | None = None
         self._timed = [(s.period_ticks, s.fn, self.times[s.name]) for s in stages]
         every_tick = [s for s in stages if s.period_ticks == 1]
@@ -140,12 +141,18 @@ class Scheduler:
                 if late > self.dt_s:
                     self.misses_over_period += 1
                 self._late_since_take = max(self._late_since_take, late)
+                self._late_since_log = max(self._late_since_log, late)
             else:
                 self.sleep(-late)
 
     def take_lateness(self) -> float:
         """The worst lateness since the previous call (0 when every tick was on time)."""
         late, self._late_since_take = self._late_since_take, 0.0
+        return late
+
+    def take_log_lateness(self) -> float:
+        """As take_lateness, for the run log (its own account: the safety layer takes the other)."""
+        late, self._late_since_log = self._late_since_log, 0.0
         return late
 
     def _batchable(self, limit: int) -> int:

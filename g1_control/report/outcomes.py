@@ -23,9 +23,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from g1_control.robot import g1
-from g1_control.robot.dynamics import HAND_OFFSET_M, SOLE_OFFSET_M
-
 if TYPE_CHECKING:
     from g1_control.interfaces import Generator
     from g1_control.loop.control_loop import ControlLoop
@@ -39,39 +36,23 @@ class GoalWatcher:
     """Records ground truth while a loop runs (MuJoCo backends only) and judges its goals."""
 
     def __init__(self, loop: ControlLoop, record_hz: float = 50.0):
+        from g1_control.sim.ground_truth import GroundTruthRecorder
         from g1_control.sim.mujoco_backend import MujocoBackend
 
         sim = loop.backend
         if not isinstance(sim, MujocoBackend):
             raise TypeError(f"GoalWatcher records MuJoCo's ground truth; the loop's backend is {sim.describe()}")
         self.loop, self.sim = loop, sim
-        self.model, self.data = sim.model, sim.data
-        m = self.model
         self.every = max(1, round(loop.rates.lowlevel_hz / record_hz))
-        self.hands = [m.body(n).id for n in g1.HAND_BODIES]
-        self.feet = [m.body(n).id for n in g1.FOOT_BODIES]
-        self.boxes = [b.name for b in sim.scene.boxes]
-        self.t: list[float] = []
-        self.hand_w: list[np.ndarray] = []
-        self.sole_w: list[np.ndarray] = []
-        self.box_w: dict[str, list[np.ndarray]] = {b: [] for b in self.boxes}
+        self.recorder = GroundTruthRecorder(sim)
 
     def tick(self, i: int) -> None:
         if i % self.every:
             return
-        d = self.data
-        self.t.append(float(d.time))
-        self.hand_w.append(np.array([d.xpos[b] + d.xmat[b].reshape(3, 3) @ HAND_OFFSET_M for b in self.hands]))
-        self.sole_w.append(np.array([d.xpos[b] + d.xmat[b].reshape(3, 3) @ SOLE_OFFSET_M for b in self.feet]))
-        for name in self.boxes:
-            pos, quat = self.sim.object_pose(name)
-            self.box_w[name].append(np.concatenate([pos, quat]))
+        self.recorder.sample(float(self.sim.data.time))
 
     def arrays(self) -> dict[str, np.ndarray]:
-        out = {"t_s": np.array(self.t), "hands_w_m": np.array(self.hand_w), "soles_w_m": np.array(self.sole_w)}
-        for name, rows in self.box_w.items():
-            out[f"box_{name}"] = np.array(rows)
-        return out
+        return self.recorder.arrays()
 
     def outcomes(self) -> list[dict]:
         gen = self.loop.generator  # what it recorded per goal (Generator.goal_info, goal_messages)
@@ -141,15 +122,32 @@ def judge_goal(goal_id: str, info: dict, a: dict[str, np.ndarray]) -> dict:
 def goal_reports(generator: Generator, planned: Sequence[TaskGoal] = ()) -> list[dict]:
     """Every goal's status and message as the execution layer (GoalGenerator) reports them, without
     ground truth (the robot path): the goals that started, in order, then those `planned` (a launch
-    file's timeline) that never started, as 'not started'. Each dict as judge_goal's, plus message."""
+    file's timeline) that never started, as 'not started'. Each dict as judge_goal's, plus message and,
+    for a goal that started, `record`: the execution layer's record of it (GoalGenerator.goal_info: its
+    times, target, box), from which judge_goal judges it against a simulator's ground truth later
+    (g1_control/tools/judge_sim2sim.py)."""
     info, messages = generator.goal_info, generator.goal_messages
-    out = [dict(judge_goal(gid, dict(i), {"t_s": np.zeros(0)}), message=messages.get(gid)) for gid, i in info.items()]
+    out = [dict(judge_goal(gid, dict(i), {"t_s": np.zeros(0)}), message=messages.get(gid), record=_plain(i))
+           for gid, i in info.items()]
     for goal in planned:
         if goal.goal_id not in info:
             out.append({"goal_id": goal.goal_id, "kind": goal.kind, "describe": goal.describe(),
                         "status": "not started", "start_s": None, "end_s": None,
                         "message": "control ended before the goal's turn came"})
     return out
+
+
+def _plain(value):
+    """A goal record as JSON holds it (arrays and tuples as lists)."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
 
 
 def outcome_line(o: dict) -> str:

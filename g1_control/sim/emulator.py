@@ -34,6 +34,7 @@ from g1_control.types import MotorCommand, RobotState
 
 if TYPE_CHECKING:
     from g1_control.hardware.ros2.topics import ObjectPosesWriter, PoseTopicWriter
+    from g1_control.sim.ground_truth import GroundTruthRecorder
     from g1_control.sim.mocap import MocapConfig, SimulatedMocap, SimulatedPerception
     from g1_control.sim.mujoco_backend import MujocoBackend
 
@@ -360,6 +361,24 @@ class RobotEmulator:
         self.endpoint.state_observers.append(sample)
         self.perception, self.scene_sim = perception, sim
         return perception
+
+    def record_ground_truth(self, sim: MujocoBackend, rate_hz: float = 50.0) -> GroundTruthRecorder:
+        """Record where the hands, soles and boxes really are (sim/ground_truth.py) at `rate_hz` of the
+        published states, stamped with the host's monotonic clock (as the robot path stamps its states
+        and goal records): judge_goal(goal, the deploy's goal record, recorder.arrays()) judges each goal."""
+        from g1_control.sim.ground_truth import GroundTruthRecorder
+
+        recorder = GroundTruthRecorder(sim)
+        every = max(1, round(1.0 / (self.endpoint.period_s * rate_hz)))
+        count = [0]
+
+        def sample(state: RobotState) -> None:
+            if count[0] % every == 0:
+                recorder.sample(time.monotonic())
+            count[0] += 1
+
+        self.endpoint.state_observers.append(sample)
+        return recorder
 
     def start(self) -> RobotEmulator:
         self.endpoint.start()

@@ -112,3 +112,19 @@ def test_g1_sim_robot_scene_perception_over_dds_places_the_box_where_the_simulat
     assert 0.05 < report["perception"]["dropped"] / report["perception"]["measured"] < 0.2
     assert errors.mean() < 0.045  # 2 cm noise per axis: 3.2 cm expected
     assert np.abs(truth[:2] - [1.1, 0.1]).max() < 0.02  # the box stands where the scene put it
+
+
+def test_a_box_that_stays_put_is_where_its_frames_average_and_one_moved_away_is_where_it_went():
+    rng = np.random.default_rng(3)
+    pose = WorldPose(0.0, 0.0, 0.0, 0.75, 0.0)
+    truth = np.array([0.6, 0.1, -0.3])
+    frames = [(0.9, {"box": (tuple(truth + rng.normal(0.0, 0.02, 3)), (1.0, 0.0, 0.0, 0.0))}) for _ in range(40)]
+    perception = ObjectPerception(PerceptionConfig(interface="lo", max_age_s=0.5), Frames(frames))
+    perception.update(1.0, lambda t: pose)
+    here = np.array([0.6, 0.1, 0.45])
+    single = np.array([np.linalg.norm(np.array(f["box"][0]) + [0, 0, 0.75] - here) for _, f in frames])
+    assert np.linalg.norm(perception.positions["box"] - here) < single.mean() / 2.5  # ~4.5x less noise
+    moved = (tuple(truth + [0.4, 0.0, 0.0]), (1.0, 0.0, 0.0, 0.0))
+    perception.source = Frames([(0.95, {"box": moved})])
+    perception.update(1.0, lambda t: pose)
+    assert perception.positions["box"] == pytest.approx([1.0, 0.1, 0.45])

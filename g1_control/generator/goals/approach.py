@@ -16,11 +16,26 @@ import numpy as np
 
 from g1_control.generator.goals.box import Approach
 from g1_control.generator.goals.context import GoalContext, GoalFailed
-from g1_control.generator.goals.poses import flat_soles
-from g1_control.generator.goals.stepping import Stance, SteppingConfig, stepping_trajectory, walk_steps
+from g1_control.generator.goals.poses import PosePlanner, flat_soles
+from g1_control.generator.goals.stepping import (
+    Footstep,
+    Stance,
+    SteppingConfig,
+    SteppingPlan,
+    stepping_trajectory,
+    walk_steps,
+)
 from g1_control.generator.whole_body import keyframe_trajectory
 from g1_control.robot import g1
 from g1_control.rotations import wrap_angle, yaw_of
+
+
+def plan_steps(poses: PosePlanner, q0: np.ndarray, steps: list[Footstep], cfg: SteppingConfig,
+               posture: np.ndarray | None = None, forces: np.ndarray | None = None,
+               com_shift: np.ndarray | None = None, name: str = "steps") -> SteppingPlan:
+    """The whole-body reference of `steps` from q0 (stepping_trajectory; a planner job: GoalContext.compute)."""
+    return stepping_trajectory(poses.ik, q0, steps, cfg, posture=posture, hand_forces=forces,
+                               com_offset_h_m=com_shift, name=name)
 
 
 def enter_whole_body(ctx: GoalContext) -> Iterator[None]:
@@ -32,8 +47,8 @@ def enter_whole_body(ctx: GoalContext) -> Iterator[None]:
     lift = min(p[2] - g for (p, _), g in zip(soles, ground))
     q[2] -= lift  # the lower sole exactly on its ground
     soles = [(np.array([p[0], p[1], g]), r) for (p, r), g in zip(soles, ground)]
-    q_stand = yield from ctx.compute("stand", lambda: ctx.poses.stand(
-        q, soles, min(ground) + ctx.poses.nominal_pelvis_m, g1.DEFAULT_Q_RAD))
+    q_stand = yield from ctx.compute("stand", PosePlanner.stand, q, soles, min(ground) + ctx.poses.nominal_pelvis_m,
+                                     g1.DEFAULT_Q_RAD)
     ctx.note("hand over to the whole-body controller")
     yield from ctx.run(keyframe_trajectory("stand", [(0.0, q), (ctx.config.stand_s, q_stand)]))
 
@@ -93,8 +108,7 @@ def step_to(ctx: GoalContext, mid_xy: np.ndarray, heading: float, cfg: SteppingC
     steps += walk_steps(stance, mid_xy, heading, cfg, lambda xy: ground(xy), then=steps)
     if not steps:
         return
-    plan = yield from ctx.compute(name, lambda: stepping_trajectory(
-        ctx.ik, q0, steps, cfg, posture=posture, hand_forces=forces, com_offset_h_m=com_shift, name=name))
+    plan = yield from ctx.compute(name, plan_steps, q0, steps, cfg, posture, forces, com_shift, name)
     ctx.last_steps = plan
     if plan.sole_error_m > 0.03:
         raise GoalFailed(f"{name}: the footsteps are out of the legs' reach (plan off by "

@@ -13,12 +13,12 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Generator, Iterator
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
 import numpy as np
 
+from g1_control.generator.goals.planner import PlannerDied, PlannerProcess
 from g1_control.generator.goals.poses import PosePlanner
 from g1_control.generator.goals.stepping import SteppingConfig
 from g1_control.generator.styles import UpperBodyStyle
@@ -98,9 +98,9 @@ class GoalConfig:
     """Pelvis heights the walking policy holds (its envelope); others stand under the WBC."""
     height_min_m: float = 0.45
     plan_in_background: bool = False
-    """Plan in a worker thread while the robot holds its current reference (wall-clock runs: a
-    carry's footstep plan takes ~1-2 s of CPU, which would stall the loop). Off in lockstep, where
-    planning inline keeps runs deterministic (simulated time waits for it)."""
+    """Plan in the planner's own process (planner.py) while the robot holds its current reference
+    (wall-clock runs: a carry's footstep plan takes ~1-2 s of CPU, which would stall the loop). Off
+    in lockstep, where planning inline keeps runs deterministic (simulated time waits for it)."""
 
 
 @dataclass
@@ -119,6 +119,8 @@ class GoalContext:
         self.poses = PosePlanner()
         self.ik = self.poses.ik
         self.plan_cpu_s: dict[str, float] = {}
+        self.plan_windows: list[tuple[str, float, float]] = []
+        """(what, start, end) of every plan, in the state's time (Generator.plan_windows)."""
         self.goal_info: dict[str, dict] = {}
         """Per goal, for judging it from outside: kind, start/end time, the hold window of a reach,
         its target in the world (reach point, box, where the box goes, platform)."""
@@ -127,14 +129,10 @@ class GoalContext:
         """The current goal's entry of goal_info."""
         self.last_steps: Any = None
         """The last footstep plan (stepping.StepPlan), for inspection."""
-        self._pool: ThreadPoolExecutor | None = None
+        self.planner: PlannerProcess | None = None
+        """Where plans are made beside a wall-clock loop (None: inline)."""
         if self.config.plan_in_background:
-            import sys
-
-            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="goal-planner")
-            # The planner and the control thread share the GIL: switch often, so a tick waits
-            # at most ~1 ms for the planner's Python (default 5 ms).
-            sys.setswitchinterval(min(sys.getswitchinterval(), 0.001))
+            self.planner = PlannerProcess()
         self.reset()
 
     def reset(self) -> None:
@@ -216,23 +214,35 @@ class GoalContext:
         while self.t - self.plan_t0 < traj.duration_s:
             yield
 
-    def compute(self, what: str, fn: Callable[[], T]) -> Generator[None, None, T]:
-        """fn() inline, or in the planner thread while the loop keeps ticking (the robot holds its
-        reference meanwhile); returns its result (use with `yield from`). Records the planning CPU
-        (inline) or wall time (background) under `what`."""
-        if self._pool is None:
+    def compute(self, what: str, fn: Callable[..., T], *args: Any) -> Generator[None, None, T]:
+        """fn(poses, *args) inline, or in the planner process while the loop keeps ticking (the robot
+        holds its reference meanwhile); returns its result (use with `yield from`). fn is a function at
+        a module's top level (or a PosePlanner method) and args are picklable: the same call runs in
+        either place. Records the planning CPU (inline) or wall time (in the planner) under `what`, and
+        the plan's window in the loop's time (the goal's `plans`: what, start, end)."""
+        t_start = self.t
+        if self.planner is None:
             t0 = time.process_time()
-            out = fn()
-            self._cpu(what, t0)
+            out = fn(self.poses, *args)
+            self._record(what, time.process_time() - t0, t_start)
             return out
         start = time.perf_counter()
-        future = self._pool.submit(fn)
+        future = self.planner.submit(fn, *args)
         while not future.done():
             yield
-        key = f"{self.goal.goal_id if self.goal else ''} {what} (background, wall)".strip()
-        self.plan_cpu_s[key] = self.plan_cpu_s.get(key, 0.0) + time.perf_counter() - start
-        return future.result()
+        self._record(f"{what} (planner process, wall)", time.perf_counter() - start, t_start)
+        try:
+            return future.result()
+        except PlannerDied as exc:  # the robot holds its reference; this goal (and later ones) fail
+            raise GoalFailed(f"{what}: {exc}") from exc
 
-    def _cpu(self, what: str, t0: float) -> None:
+    def _record(self, what: str, seconds: float, t_start: float) -> None:
         key = f"{self.goal.goal_id if self.goal else ''} {what}".strip()
-        self.plan_cpu_s[key] = self.plan_cpu_s.get(key, 0.0) + time.process_time() - t0
+        self.plan_cpu_s[key] = self.plan_cpu_s.get(key, 0.0) + seconds
+        self.plan_windows.append((key, t_start, self.t))
+
+    def close(self) -> None:
+        """Stop the planner process (if any)."""
+        if self.planner is not None:
+            self.planner.close()
+            self.planner = None

@@ -42,7 +42,7 @@ from g1_control.generator.goals.approach import enter_whole_body
 from g1_control.generator.goals.context import ARMS, GoalConfig, GoalContext, GoalFailed, world_pose_needed
 from g1_control.generator.goals.handling import pick, place
 from g1_control.generator.goals.platform import step_down, step_up
-from g1_control.generator.goals.poses import ReachRefused, flat_soles
+from g1_control.generator.goals.poses import PosePlanner, ReachRefused, flat_soles
 from g1_control.generator.goals.reach import reach
 from g1_control.generator.styles import ROLLOUT_STYLES
 from g1_control.generator.whole_body import keyframe_trajectory
@@ -85,6 +85,7 @@ class GoalGenerator(Generator):
         """Per goal, for judging it from outside: kind, start/end time, the hold window of a reach,
         its target in the world (reach point, box, where the box goes, platform)."""
         self.log = self.goal_log = self.ctx.log
+        self.plan_windows = self.ctx.plan_windows
         self.estimate: WorldPoseEstimate | None = None
         """Where the robot is for the goals (steer_by); None: the state's own base pose (ground truth)."""
         self._ref = KinematicReference()
@@ -113,6 +114,10 @@ class GoalGenerator(Generator):
         self.reset_state()
         self.inner.reset(state)
         self.walker.reset(state)
+
+    def close(self) -> None:
+        self.ctx.close()
+        self.inner.close()
 
     def steer_by(self, estimate: WorldPoseEstimate) -> None:
         """Goals are placed by the robot's own estimate (the state the skills see carries it as its
@@ -270,8 +275,7 @@ class GoalGenerator(Generator):
         soles = flat_soles(self.ik, q0)
         ground = min(s[0][2] for s in soles)
         mean_pose = np.mean([style.pose(t) for t in np.linspace(0.0, 5.0, 26)], axis=0) if style.wave_hz else style.pose(0.0)
-        q_goal = yield from ctx.compute(f"height {height:.2f}", lambda: self.poses.stand(
-            q0, soles, ground + height, mean_pose))
+        q_goal = yield from ctx.compute(f"height {height:.2f}", PosePlanner.stand, q0, soles, ground + height, mean_pose)
         duration = self.config.move_s * max(1.0, abs(q_goal[2] - q0[2]) / 0.15)
         self._height, self._style = height, style_name
         yield from ctx.run(keyframe_trajectory("height", [(0.0, q0), (duration, q_goal)]), keep=True)
@@ -284,8 +288,8 @@ class GoalGenerator(Generator):
         q0 = ctx.hold_q()
         soles = flat_soles(self.ik, q0)
         ground = min(s[0][2] for s in soles)
-        q_goal = yield from ctx.compute("stand up", lambda: self.poses.stand(
-            q0, soles, ground + self.poses.nominal_pelvis_m, g1.DEFAULT_Q_RAD))
+        q_goal = yield from ctx.compute("stand up", PosePlanner.stand, q0, soles, ground + self.poses.nominal_pelvis_m,
+                                        g1.DEFAULT_Q_RAD)
         duration = self.config.move_s * max(0.6, abs(q_goal[2] - q0[2]) / 0.15)
         yield from ctx.run(keyframe_trajectory("stand", [(0.0, q0), (duration, q_goal)]))
         ctx.note("hand back to the walking policy")

@@ -24,8 +24,15 @@ from g1_control.generator.goals.box import (
     place_target,
 )
 from g1_control.generator.goals.context import GoalContext, GoalFailed, Held
-from g1_control.generator.goals.poses import ReachRefused, flat_soles, stance_heading
-from g1_control.generator.goals.stepping import Stance, stepping_trajectory, walk_steps
+from g1_control.generator.goals.poses import PosePlanner, ReachRefused, Sole, flat_soles, stance_heading
+from g1_control.generator.goals.stepping import (
+    Footstep,
+    Stance,
+    SteppingConfig,
+    SteppingPlan,
+    stepping_trajectory,
+    walk_steps,
+)
 from g1_control.generator.whole_body import keyframe_trajectory, smoothstep
 from g1_control.robot import g1
 from g1_control.rotations import wrap_angle, yaw_of
@@ -42,6 +49,55 @@ for _side in ("left", "right"):
 RAISE_AHEAD_M = 0.10
 """Hands rise (and come back) this far ahead of the pelvis, above the box, on their way to it."""
 GRAVITY = 9.81
+HandPoints = tuple[np.ndarray, np.ndarray]
+"""Left and right hand-frame points (box.hand_points)."""
+
+
+# -- planner jobs (GoalContext.compute: inline, or in the planner process) ---------------------------
+def grasp_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float,
+                points: tuple[HandPoints, HandPoints, HandPoints, HandPoints], lift_shift: np.ndarray,
+                box_name: str) -> list[np.ndarray]:
+    """The via, pre-grasp, contact and lift poses (each from the one before), the CoM shifted by
+    `lift_shift` for the lift; ReachRefused when the hands cannot get within 3 cm of a point."""
+    out = []
+    q = q0
+    for name, targets, com_shift in zip(("via", "pre-grasp", "contact", "lift"), points,
+                                        (None, None, None, lift_shift)):
+        res = poses.hands_on(q, soles, targets, heading, com_shift)
+        if res.residual_m > 0.01:  # a poor warm start (the pose before): again from the stance
+            again = poses.hands_on(q0, soles, targets, heading, com_shift)
+            res = again if again.residual_m < res.residual_m else res
+        if res.residual_m > 0.03 and name != "via":
+            raise ReachRefused(f"box '{box_name}': the hands get only within {res.residual_m * 100:.1f} cm "
+                               f"of the {name} points (out of reach)")
+        q = res.q
+        out.append(q)
+    return out
+
+
+def release_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float,
+                  points: tuple[HandPoints, HandPoints, HandPoints], shift: np.ndarray):
+    """The box set down, the hands opened, the hands out, standing: (PoseResult, q, q, q)."""
+    down, opened, out = points
+    down_pose = poses.hands_on(q0, soles, down, heading, shift)
+    if down_pose.residual_m > 0.03:
+        raise ReachRefused(f"the hands get only within {down_pose.residual_m * 100:.1f} cm of where the box "
+                           "goes (out of reach)")
+    q_open = poses.hands_on(down_pose.q, soles, opened, heading).q
+    q_out = poses.hands_on(q_open, soles, out, heading).q
+    ground = min(p[2] for p, _ in soles)
+    return down_pose, q_open, q_out, poses.stand(q_out, soles, ground + poses.nominal_pelvis_m, g1.DEFAULT_Q_RAD)
+
+
+def carry_plan(poses: PosePlanner, q0: np.ndarray, steps: list[Footstep], cfg: SteppingConfig, posture: np.ndarray,
+               com_offset_h_m: np.ndarray, squeeze_n: float, weight_n: float) -> SteppingPlan:
+    """The carry's footsteps with the box's hand forces per sample, turned with the pelvis's heading."""
+    forces = hand_forces(stance_heading(flat_soles(poses.ik, q0)), squeeze_n, weight_n)
+    plan = stepping_trajectory(poses.ik, q0, steps, cfg, posture=posture, hand_forces=forces,
+                               com_offset_h_m=com_offset_h_m, name="carry")
+    traj = plan.trajectory
+    traj.hand_forces_w_n = np.array([hand_forces(y, squeeze_n, weight_n) for y in traj.root_rpy_rad[:, 2]])
+    return plan
 
 
 def find_box(ctx: GoalContext, name: str | None) -> Box:
@@ -100,23 +156,8 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     con = hand_points(c, heading, width, -cfg.press_m)
     lift = hand_points(c, heading, width, -cfg.press_m, dz_m=cfg.lift_m)
     shift = np.array([-box.mass_kg / ctx.poses.mass_kg * GRASP_DISTANCE_M, 0.0])
-    def solve():
-        poses = []
-        q = q0
-        for name, targets, com_shift in (("via", via, None), ("pre-grasp", pre, None), ("contact", con, None),
-                                          ("lift", lift, shift)):
-            res = ctx.poses.hands_on(q, soles, targets, heading, com_shift)
-            if res.residual_m > 0.01:  # a poor warm start (the pose before): again from the stance
-                again = ctx.poses.hands_on(q0, soles, targets, heading, com_shift)
-                res = again if again.residual_m < res.residual_m else res
-            if res.residual_m > 0.03 and name != "via":
-                raise ReachRefused(f"box '{box.name}': the hands get only within {res.residual_m * 100:.1f} cm "
-                                   f"of the {name} points (out of reach)")
-            q = res.q
-            poses.append(q)
-        return poses
-
-    q_via, q_pre, q_con, q_lift = yield from ctx.compute("grasp", solve)
+    q_via, q_pre, q_con, q_lift = yield from ctx.compute("grasp", grasp_poses, q0, soles, heading,
+                                                         (via, pre, con, lift), shift, box.name)
     t = {"via": 1.2, "pre": 2.2, "con": 3.0, "squeeze": 3.5, "lift": 4.7, "end": 5.7}
     full = hand_forces(heading, cfg.squeeze_n, weight)
     squeeze_only = hand_forces(heading, cfg.squeeze_n, 0.0)
@@ -181,18 +222,8 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     down = hand_points(c, heading, width, -cfg.press_m, dz_m=0.005)
     opened = hand_points(c, heading, width, cfg.pre_gap_m, dz_m=0.005)
     out = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.08, ahead_m=-(GRASP_DISTANCE_M - RAISE_AHEAD_M))
-    def solve():
-        down_pose = ctx.poses.hands_on(q0, soles, down, heading, shift)
-        if down_pose.residual_m > 0.03:
-            raise ReachRefused(f"the hands get only within {down_pose.residual_m * 100:.1f} cm of where the box "
-                               "goes (out of reach)")
-        q_open = ctx.poses.hands_on(down_pose.q, soles, opened, heading).q
-        q_out = ctx.poses.hands_on(q_open, soles, out, heading).q
-        ground = min(p[2] for p, _ in soles)
-        return down_pose, q_open, q_out, ctx.poses.stand(q_out, soles, ground + ctx.poses.nominal_pelvis_m,
-                                                         g1.DEFAULT_Q_RAD)
-
-    q_down, q_open, q_out, q_stand = yield from ctx.compute("release", solve)
+    q_down, q_open, q_out, q_stand = yield from ctx.compute("release", release_poses, q0, soles, heading,
+                                                            (down, opened, out), shift)
     t = {"down": 1.5, "release": 2.2, "open": 3.0, "out": 4.0, "stand": 5.5, "end": 6.0}
     full = hand_forces(heading, cfg.squeeze_n, weight)
     squeeze_only = hand_forces(heading, cfg.squeeze_n, 0.0)
@@ -223,15 +254,10 @@ def carry(ctx: GoalContext, mid_xy: np.ndarray, heading: float, posture: np.ndar
     for st in steps:
         stance = stance.apply(st)
     steps += walk_steps(stance, mid_xy, heading, cfg.carry, lambda xy: ground(xy), then=steps)
-    forces = hand_forces(stance_heading(flat_soles(ctx.ik, q0)), cfg.squeeze_n, weight)
-    plan = yield from ctx.compute("carry", lambda: stepping_trajectory(
-        ctx.ik, q0, steps, cfg.carry, posture=posture, hand_forces=forces,
-        com_offset_h_m=ctx.poses.com_offset_m + com_shift, name="carry"))
+    plan = yield from ctx.compute("carry", carry_plan, q0, steps, cfg.carry, posture, ctx.poses.com_offset_m + com_shift,
+                                  cfg.squeeze_n, weight)
     ctx.last_steps = plan
     traj = plan.trajectory
-    # hand forces per sample, turned with the pelvis's heading
-    yaws = traj.root_rpy_rad[:, 2]
-    traj.hand_forces_w_n = np.array([hand_forces(y, cfg.squeeze_n, weight) for y in yaws])
     if plan.sole_error_m > 0.03:
         raise GoalFailed(f"carry: the footsteps are out of the legs' reach (plan off by "
                          f"{plan.sole_error_m * 100:.0f} cm)")

@@ -9,10 +9,10 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from g1_control.generator.goals.approach import correct_stance, enter_whole_body, step_to, walk_to
+from g1_control.generator.goals.approach import correct_stance, enter_whole_body, plan_steps, step_to, walk_to
 from g1_control.generator.goals.box import Approach
 from g1_control.generator.goals.context import GoalContext, GoalFailed
-from g1_control.generator.goals.stepping import SOLE_HALF_LENGTH_M, Stance, level_steps, stepping_trajectory
+from g1_control.generator.goals.stepping import SOLE_HALF_LENGTH_M, Stance, level_steps
 from g1_control.scene import Block
 from g1_control.types import PHASE_WHOLE_BODY, TaskGoal
 
@@ -66,8 +66,7 @@ def step_up(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     stance = Stance.of(ctx.ik, q0)
     forward = SOLE_HALF_LENGTH_M + cfg.toe_gap_m + cfg.past_edge_m
     steps = level_steps(stance, forward, block.height_m, cfg.steps)
-    plan = yield from ctx.compute("step up", lambda: stepping_trajectory(ctx.ik, q0, steps, cfg.steps,
-                                                                        name="step up"))
+    plan = yield from ctx.compute("step up", plan_steps, q0, steps, cfg.steps, None, None, None, "step up")
     yield from ctx.run(plan.trajectory)
     ctx.on_platform = block.name
     ctx.step_back = (forward, 0.0)
@@ -87,8 +86,7 @@ def step_down(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     if level > 0.0:
         level = 0.0
     steps = level_steps(stance, -forward, level, cfg.steps)
-    plan = yield from ctx.compute("step down", lambda: stepping_trajectory(ctx.ik, q0, steps, cfg.steps,
-                                                                          name="step down"))
+    plan = yield from ctx.compute("step down", plan_steps, q0, steps, cfg.steps, None, None, None, "step down")
     yield from ctx.run(plan.trajectory)
     block = ctx.scene.block(ctx.on_platform)
     ctx.on_platform = None
