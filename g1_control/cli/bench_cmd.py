@@ -32,7 +32,7 @@ BENCHMARKS = {
     "stairs": ("g1_control.tools.bench_stairs:main",
                "WBC walking into stairs (3 x 0.15 m up, landing, down) and a 0.20 m platform found in the scene, seeded "
                "approach angles/offsets: top reached, across, falls (ground truth); --seed first seed, --trials count, "
-               "--only stairs|platform; exits 1 on a fall"),
+               "--only stairs|platform|step; exits 1 on a fall"),
     "envelope": ("g1_control.tools.bench_envelope:main",
                  "the walking tracker's achievable velocity per axis and style; --write ships it as the command limits"),
 }

@@ -6,7 +6,8 @@ Courses (the structure's near edge 1.0 m ahead of the robot's start, turned by t
 about the point on that edge in front of the drawn offset; the robot walks +x and knows only what
 the scene says):
   stairs    three 0.15 m treads up (0.45 m deep), a 1.2 m landing at 0.45 m, three treads down;
-  platform  one 0.20 m platform, 1.2 m deep, up and down the far side.
+  platform  one 0.20 m platform, 1.2 m deep, up and down the far side;
+  step      one 0.15 m platform, 1.2 m deep, up and down (what the gait does today).
 
 Per trial: fell (the pelvis below 0.45 m above the ground under it, a fall the loop saw, or any
 safety trip: a trip counts as a failure), top (both soles on the structure's highest level at
@@ -15,6 +16,7 @@ once), across (both soles back on the floor beyond the structure). Draws: angle 
 
     g1 bench stairs --seed 100 --trials 10              # seeds 100..109, both courses
     g1 bench stairs --only platform --seed 100 --trials 5
+    g1 bench stairs --only step --seed 100 --trials 10
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ import numpy as np
 
 from g1_control.scene import Platform, SceneConfig
 
-COURSES = ("stairs", "platform")
+COURSES = ("stairs", "platform", "step")
 NEAR_EDGE_M = 1.0
 MAX_ANGLE_DEG = 25.0
 MAX_OFFSET_M = 0.3
@@ -46,8 +48,8 @@ def course_scene(course: str, angle_rad: float, offset_m: float) -> tuple[SceneC
         # (centre along the axis from the near edge, depth, height)
         treads = [(0.225, 0.45, 0.15), (0.675, 0.45, 0.30), (1.5, 1.2, 0.45), (2.325, 0.45, 0.30), (2.775, 0.45, 0.15)]
         far = 3.0
-    elif course == "platform":
-        treads = [(0.6, 1.2, 0.20)]
+    elif course in ("platform", "step"):
+        treads = [(0.6, 1.2, 0.20 if course == "platform" else 0.15)]
         far = 1.2
     else:
         raise ValueError(f"unknown course {course!r}; known: {', '.join(COURSES)}")

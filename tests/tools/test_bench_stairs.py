@@ -34,5 +34,5 @@ def test_draws_repeat_per_seed_within_bounds():
 
 
 def test_unknown_course_is_named():
-    with pytest.raises(ValueError, match="unknown course 'ramp'; known: stairs, platform"):
+    with pytest.raises(ValueError, match="unknown course 'ramp'; known: stairs, platform, step"):
         course_scene("ramp", 0.0, 0.0)
