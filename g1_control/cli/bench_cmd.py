@@ -36,6 +36,10 @@ BENCHMARKS = {
                "wbc vs ppo walking 0.6 m/s and the step (sim_step) on --draws seeded randomised robots (link mass, "
                "CoM, motor strength, latency, foot friction): falls, achieved vs commanded from ground truth; exits 1 "
                "on a fall"),
+    "stairs": ("g1_control.tools.bench_stairs:main",
+               "WBC walking into stairs (3 x 0.15 m up, landing, down) and a 0.20 m platform found in the scene, seeded "
+               "approach angles/offsets: top reached, across, falls (ground truth); --seed first seed, --trials count, "
+               "--only stairs|platform|step; exits 1 on a fall"),
     "envelope": ("g1_control.tools.bench_envelope:main",
                  "the walking tracker's achievable velocity per axis and style; --write ships it as the command limits"),
 }
@@ -59,8 +63,9 @@ def register(subparsers) -> None:
     parser.add_argument("--only", metavar="PREFIXES", help="execution/envelope/locomotion: only rows (styles, controller/case) starting with these "
                         "comma-separated prefixes; program: instruction numbers (1,5)")
     parser.add_argument("--seed", type=int, default=0, help="execution: the suite's seed (push timing; default 0); "
-                        "robust: the first draw's seed")
+                        "robust: the first draw's seed; stairs: the first seed of the draws")
     parser.add_argument("--draws", type=int, default=10, help="robust: how many seeded randomised robots (default 10)")
+    parser.add_argument("--trials", type=int, default=5, help="stairs: seeded draws per course (default 5)")
     parser.add_argument("--video", metavar="DIR", help="execution: a video per behaviour into DIR")
     parser.add_argument("--write", action="store_true", help="envelope: write the measured envelope next to the "
                         "policy spec (the loop builder's command limits)")

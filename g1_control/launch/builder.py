@@ -65,13 +65,15 @@ def make_tracker(launch: LaunchFile) -> Tracker:
         return LocomotionPolicyTracker(load_spec(cfg.policy), VelocityCorrectionConfig(enabled=cfg.velocity_correction),
                                        envelope_limits=cfg.envelope_limits)
     if cfg.type == "wbc":
+        from g1_control.trackers.wbc.terrain import Terrain
         from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
 
         # a scripted reference plans the feet; any other generator gives a root twist to walk
         config = (WbcConfig(rate_hz=launch.rates.tracker_hz, footsteps="plan") if launch.generator.type == "scripted"
                   else WbcConfig(rate_hz=launch.rates.tracker_hz, footsteps="velocity"))
-        return WholeBodyTracker(config,
-                                variant=robot_variant(launch), hands=launch.backend.hands)
+        # its own gait steps onto the scene's platforms and stairs (a map, like the goals' scene)
+        return WholeBodyTracker(config, variant=robot_variant(launch), hands=launch.backend.hands,
+                                terrain=Terrain.of_scene(launch.scene))
     if cfg.type == "wbt":
         from g1_control.trackers.wbt import WbtPolicyTracker
 

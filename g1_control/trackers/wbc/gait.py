@@ -35,6 +35,7 @@ controller's odometry frame.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -43,6 +44,7 @@ import numpy as np
 from g1_control.errors import WbcConfigError
 from g1_control.rotations import wrap_angle
 from g1_control.trackers.wbc import capture_point as cp
+from g1_control.trackers.wbc.terrain import Terrain
 
 LEFT, RIGHT = 0, 1
 _SIDE = (1.0, -1.0)
@@ -102,6 +104,26 @@ class GaitConfig:
     for the step adjustment that balance needs)."""
     stop_tolerance_m: float = 0.05
     """Stopping needs the feet side by side within this (else it steps once more)."""
+    terrain_clearance_m: float = 0.07
+    """Over a step (the terrain under the swing's path not one level), the swing foot's apex clears
+    the highest point under its path by this much."""
+    terrain_hold: float = 0.4
+    """... and the foot rises this fraction of the single support before it moves across (its toe
+    would catch the riser), and comes down only once across."""
+    terrain_single_support_s: float = 0.42
+    """Near a step (as for terrain_speed_mps), every step's single support lasts this long: the swing
+    foot goes up, across, then down. The DCM plan is the periodic one of these longer steps (one
+    longer step alone made the DCM run sideways past the stance foot, measured)."""
+    step_change_m: float = 0.03
+    terrain_speed_mps: float = 0.15
+    """Walking towards a step (a level change within `terrain_look_ahead_m` of the feet, along the
+    motion), the gait walks at most this fast: a step up or down from a slow DCM (at 0.3 m/s the
+    body ran ahead of the long step up, measured)."""
+    terrain_look_ahead_m: float = 0.6
+    min_advance_m: float = 0.1
+    """A foothold snapped back to this little ahead of the stance foot is moved forward instead
+    (onto the tread): walking slowly at a riser, the feet otherwise shuffle in front of it."""
+    """A landing this much above or below the stance sole is a step up or down."""
 
     def __post_init__(self) -> None:
         for name in ("single_support_s", "double_support_s", "start_s", "stop_s", "step_width_m", "swing_height_m"):
@@ -139,6 +161,8 @@ class GaitTargets:
     swing_yaw_rate_radps: float = 0.0
     landing_m: np.ndarray = field(default_factory=lambda: np.zeros(3))
     """Where the swing foot (or, in double support, the next one) is to land."""
+    swing_progress: float = 0.0
+    """Fraction of this step's swing done (0 in double support)."""
     mode: str = "stand"
 
 
@@ -204,8 +228,11 @@ def _min_jerk(x0: float, v0: float, a0: float, x1: float, T: float, t: float) ->
 class VelocityGait:
     """The gait's state machine: stand -> start (weight shift) -> walk (steps) -> stop -> stand."""
 
-    def __init__(self, config: GaitConfig | None = None):
+    def __init__(self, config: GaitConfig | None = None, terrain: Terrain | None = None):
+        """terrain: heights of what the feet stand on (terrain.py); None: flat ground."""
         self.config = config or GaitConfig()
+        self.terrain = terrain or Terrain()
+        self._terrain_cfg: GaitConfig | None = None
         self.targets = GaitTargets()
         self.reset()
 
@@ -220,6 +247,10 @@ class VelocityGait:
         self._swing_yaw_from = 0.0
         self._landing = np.zeros(3)
         self._landing_yaw = 0.0
+        self._path_top = 0.0
+        self.active = self.config
+        """The configuration of the step under way: near a step, the one with longer single support."""
+        """The highest point under the swing's path, relative to the stance sole (terrain)."""
         self._ref = np.zeros((4, 3))
         """Swing reference (x, y, yaw) rows: position, velocity, acceleration; row 3 unused."""
         self._dcm_from = np.zeros(2)
@@ -250,7 +281,7 @@ class VelocityGait:
         walked = self.command_h
         if self.mode == "walk":
             step = np.asarray(cfg.max_accel) * dt
-            walked += np.clip(self.feasible(command_h) - walked, -step, step)
+            walked += np.clip(self._terrain_limited(self.feasible(command_h), soles_m) - walked, -step, step)
         else:
             walked[:] = 0.0
         command_h = walked
@@ -269,6 +300,8 @@ class VelocityGait:
         if self.mode == "start" and t_s - self._t0 >= cfg.start_s:
             # straight into single support: the stance foot's touchdown is dated a double support ago
             self.mode, self._t0 = "walk", t_s - cfg.double_support_s
+            self.active = self._timing_for(soles_m)
+            self.step_T = self.active.step_s
             self._lift(soles_m, sole_yaws)
         if self.mode == "walk":
             if t_s - self._t0 >= self.step_T:
@@ -278,7 +311,8 @@ class VelocityGait:
                 self.steps += 1
                 self.stance = 1 - self.stance
                 self._t0 += self.step_T
-                self.step_T = cfg.step_s
+                self.active = self._timing_for(soles_m)
+                self.step_T = self.active.step_s
                 if not moving and self._side_by_side(soles_m, sole_yaws):
                     self.mode, self._t0 = "stop", t_s
                     self._dcm_from = np.array(dcm_xy, dtype=float)
@@ -312,6 +346,32 @@ class VelocityGait:
             out /= load
         return out
 
+    def _timing_for(self, soles_m: np.ndarray) -> GaitConfig:
+        """The step timing for the coming step: longer single support near a step."""
+        cfg = self.config
+        if self.terrain.flat:
+            return cfg
+        direction = self.heading + math.atan2(self.command_h[1], self.command_h[0])
+        if not self.terrain.level_change_ahead(soles_m[:, :2].mean(axis=0), direction, cfg.terrain_look_ahead_m):
+            return cfg
+        if self._terrain_cfg is None:
+            self._terrain_cfg = dataclasses.replace(cfg, single_support_s=cfg.terrain_single_support_s)
+        return self._terrain_cfg
+
+    def _terrain_limited(self, command_h: np.ndarray, soles_m: np.ndarray) -> np.ndarray:
+        """`command_h` slowed to GaitConfig.terrain_speed_mps while a step is ahead of the feet."""
+        cfg = self.config
+        speed = float(np.hypot(command_h[0], command_h[1]))
+        if self.terrain.flat or speed <= cfg.terrain_speed_mps:
+            return command_h
+        direction = self.heading + math.atan2(command_h[1], command_h[0])
+        mid = soles_m[:, :2].mean(axis=0)
+        if not self.terrain.level_change_ahead(mid, direction, cfg.terrain_look_ahead_m):
+            return command_h
+        out = command_h.copy()
+        out[:2] *= cfg.terrain_speed_mps / speed
+        return out
+
     def _correct_speed(self, t_s: float, foot: int, landed_xy: np.ndarray) -> None:
         """A foot has landed: compare the stride since its last touchdown with the command walked."""
         cfg = self.config
@@ -331,7 +391,7 @@ class VelocityGait:
                      command_h: np.ndarray) -> tuple[float, np.ndarray, float]:
         """(heading at touchdown, unclipped landing relative to the stance sole in that heading
         frame, how far (m) it lies beyond the step limits) for a touchdown t_r from now."""
-        cfg = self.config
+        cfg = self.active
         heading_td = self.heading + float(command_h[2]) * t_r
         xi_td = p + (dcm_xy - p) * math.exp(omega * t_r)
         b_next = _rot2(heading_td) @ nominal_dcm_offset(cfg, f, command_h[:2], omega)
@@ -340,8 +400,23 @@ class VelocityGait:
         excess = max(rel[0] - cfg.max_forward_m, -cfg.max_backward_m - rel[0], side_out - cfg.max_width_m, 0.0)
         return heading_td, rel, float(excess)
 
+    def _on_terrain(self, u: np.ndarray, stance_yaw: float, heading_td: float) -> None:
+        """The landing point snapped onto one tread (terrain.py), its height from the terrain relative
+        to the stance sole's (odometry's height drifts; the map's steps do not), and the highest point
+        under the swing's path."""
+        terrain = self.terrain
+        ground_s = terrain.height(u[:2])  # where it stands (with the margin, a toe near a riser reads the tread above)
+        xy, ground_l = terrain.snap(self._landing[:2], self._landing_yaw, heading_td)
+        forward = np.array([math.cos(heading_td), math.sin(heading_td)])
+        if float((xy - u[:2]) @ forward) < self.config.min_advance_m < float((self._landing[:2] - u[:2]) @ forward):
+            xy, ground_l = terrain.snap(self._landing[:2], self._landing_yaw, heading_td, forward_only=True)
+        self._landing[:2] = xy
+        self._landing[2] = u[2] + ground_l - ground_s
+        start = self._swing_from[:2] if self._swinging else self._landing[:2]
+        self._path_top = terrain.max_height_along(start, xy, self._landing_yaw) - ground_s
+
     def _in_swing(self, t_s: float) -> bool:
-        return t_s - self._t0 >= self.config.double_support_s
+        return t_s - self._t0 >= self.active.double_support_s
 
     @property
     def _swinging(self) -> bool:
@@ -367,12 +442,13 @@ class VelocityGait:
                dcm_xy: np.ndarray, omega: float) -> GaitTargets:
         """The CoP, heading and swing-foot targets for this tick (call schedule() first; the
         command walked is schedule()'s, rate limited)."""
-        cfg, out = self.config, self.targets
+        cfg, out = self.active, self.targets
         command_h = self.command_h.copy()
         command_h[:2] += self.speed_correction_h
         out.heading_rad = self.heading
         out.yaw_rate_radps = 0.0 if self.mode == "stand" else float(command_h[2])
         out.swing_foot = -1
+        out.swing_progress = 0.0
         mid = soles_m[:, :2].mean(axis=0)
         centre = mid + _rot2(self.heading) @ np.array([cfg.com_offset_x_m, 0.0])
         if self.mode in ("stand", "start", "stop"):
@@ -446,6 +522,8 @@ class VelocityGait:
             dyaw = float(wrap_angle(heading_td - yaw_s))
             lim = cfg.max_relative_yaw_rad
             self._landing_yaw = yaw_s + min(max(dyaw, -lim), lim)
+            if not self.terrain.flat:
+                self._on_terrain(u, yaw_s, heading_td)
         out.landing_m[:] = self._landing
         if not self._swinging:
             return out
@@ -456,16 +534,23 @@ class VelocityGait:
         Tsw = self.step_T - Tds  # this step's swing (shorter when its timing was adjusted)
         t_sw = t_in - Tds
         ref = self._ref
-        if t_sw >= cfg.swing_hold_s * Tss:
+        z0, z1 = self._swing_from[2], self._landing[2]
+        stepping = self._path_top > max(z0, z1) - u[2] + cfg.step_change_m or abs(z1 - z0) > cfg.step_change_m
+        hold = cfg.terrain_hold if stepping else cfg.swing_hold_s
+        out.swing_progress = min(max(t_sw / max(Tsw, 1e-6), 0.0), 1.0)
+        if t_sw >= hold * Tss:
             goals = (self._landing[0], self._landing[1],
                      self._swing_yaw_from + float(wrap_angle(self._landing_yaw - self._swing_yaw_from)))
-            h = max(Tsw - cfg.swing_arrive_early_s - t_sw, 0.0)
+            arrive = cfg.swing_arrive_early_s + (min(cfg.swing_fall * Tss, 0.5 * Tsw) * 0.6 if stepping else 0.0)
+            h = max(Tsw - arrive - t_sw, 0.0)
             for k in range(3):
                 x, v, acc = _min_jerk(ref[0, k], ref[1, k], ref[2, k], goals[k], h + dt_s, dt_s)
                 ref[0, k], ref[1, k], ref[2, k] = x, v, acc
-        z0, z1 = self._swing_from[2], self._landing[2]
         apex = max(z0, z1) + cfg.swing_height_m
-        up = _smooth(t_sw / (cfg.swing_rise * Tss), cfg.swing_rise * Tss)
+        if stepping:
+            apex = max(apex, u[2] + self._path_top + cfg.terrain_clearance_m)
+        rise = min(cfg.swing_rise, hold) if stepping else cfg.swing_rise
+        up = _smooth(t_sw / (rise * Tss), rise * Tss)
         fall = min(cfg.swing_fall * Tss, 0.5 * Tsw)
         down = _smooth((t_sw - (Tsw - fall)) / fall, fall)
         out.swing_pos_m[:] = (ref[0, 0], ref[0, 1], z0 + up[0] * (apex - z0) + down[0] * (z1 - apex))

@@ -45,6 +45,7 @@ from g1_control.trackers.wbc.tasks import (
     position_task,
     posture_task,
 )
+from g1_control.trackers.wbc.terrain import Terrain
 from g1_control.types import JointReference, MotorCommand, RobotState
 
 
@@ -90,6 +91,18 @@ class WbcConfig:
     0.77 m/s the trailing knee straightened in double support, then overspeeds at lift-off, measured)."""
     walking_com_weight: tuple[float, float] = (1000.0, 1000.0)
     """QP weights of the CoM task's horizontal and vertical rows when walking by the gait."""
+    ground_follow_s: float = 0.12
+    """Walking on steps, the height the CoM is held above follows the stance feet's with this time
+    constant (a foot landing a tread higher moves it smoothly, not at once)."""
+    step_down_lead: float = 0.5
+    """Stepping down, the body lowers during the swing by this fraction of the step's drop, so the
+    swing leg reaches the lower tread before the stance knee is straight."""
+    terrain_com_accel_mps2: float = 2.0
+    """On steps, the CoM's vertical acceleration asked for is clipped to this (m/s^2): asked to rise a
+    tread at once, the QP lifted the CoM by kicking the swing leg up (measured) rather than with the
+    bent stance knee, which is near its torque limit."""
+    terrain_swing_weight: float = 1000.0
+    """On steps, the swing foot's task weight (the flat gait's is `swing_foot`'s)."""
     walking_leg_posture_weight: float = 0.05
     """Walking by its own gait, the legs' posture task is only a regulariser (relative to `posture`)."""
 
@@ -121,8 +134,10 @@ class WbcDiagnostics:
 
 
 class WholeBodyTracker(Tracker):
-    def __init__(self, config: WbcConfig | None = None, variant: g1.Variant = g1.G1_29DOF, hands: str = "none"):
-        """variant, hands: the G1 it controls; its dynamics come from that robot's model (WbcModel)."""
+    def __init__(self, config: WbcConfig | None = None, variant: g1.Variant = g1.G1_29DOF, hands: str = "none",
+                 terrain: Terrain | None = None):
+        """variant, hands: the G1 it controls; its dynamics come from that robot's model (WbcModel).
+        terrain: the heights of the steps and platforms its own gait walks onto (None: flat ground)."""
         import pinocchio as pin
 
         self._pin = pin
@@ -145,7 +160,7 @@ class WholeBodyTracker(Tracker):
         """This tick's sole positions (world, after the odometry step), left then right."""
         self._sole_yaw = np.zeros(2)
         self._dcm_xy = np.zeros(2)
-        self.gait = VelocityGait(self.config.gait) if self.config.footsteps == "velocity" else None
+        self.gait = VelocityGait(self.config.gait, terrain) if self.config.footsteps == "velocity" else None
         self._com_height_m, self._pelvis_height_m = self._standing_heights()
         self._posture_weights = np.ones(self.dyn.nv - 6)
         self._posture_weights[list(g1.LEG_JOINTS)] = self.config.walking_leg_posture_weight
@@ -173,6 +188,7 @@ class WholeBodyTracker(Tracker):
         self._com_vel_ref_prev: np.ndarray | None = None
         self._com_acc_ref = np.zeros(3)
         self._frame_vel_ref_prev: dict[int, np.ndarray] = {}
+        self._ground_ref_m: float | None = None
         self.diagnostics = WbcDiagnostics()
         if self.gait is not None:
             self.gait.reset()
@@ -384,7 +400,7 @@ class WholeBodyTracker(Tracker):
         assert self.gait is not None
         com = dyn.com_m + shift
         com_vel = dyn.com_vel_mps
-        ground_z = float(np.mean(self._sole_pos[stance, 2]))
+        ground_z = self._ground_reference(stance, dt)
         omega = cp.lipm_frequency(max(com[2] - ground_z, 0.2))
         self._dcm_xy = cp.capture_point(com[:2], com_vel[:2], omega)
         gt = self.gait.update(state.t_s, dt, self._sole_pos, self._sole_yaw,
@@ -397,6 +413,9 @@ class WholeBodyTracker(Tracker):
         a_com = np.empty(3)
         a_com[:2] = omega**2 * (com[:2] - gt.cop_xy_m)
         a_com[2] = h.kp * (ground_z + height - com[2]) - h.kd * com_vel[2]
+        terrain = not self.gait.terrain.flat
+        if terrain:
+            a_com[2] = min(max(a_com[2], -cfg.terrain_com_accel_mps2), cfg.terrain_com_accel_mps2)
         diag = self.diagnostics
         diag.com_m, diag.cop_des_xy_m = com, gt.cop_xy_m.copy()
         diag.com_ref_m = np.array([*self._dcm_xy, ground_z + height])
@@ -414,14 +433,32 @@ class WholeBodyTracker(Tracker):
         f = gt.swing_foot
         if f >= 0 and not stance[f]:
             ft = dyn.frame(dyn.sole_ids[f])
+            swing = cfg.swing_foot if not terrain else TaskGains(cfg.swing_foot.kp, cfg.swing_foot.kd,
+                                                                 cfg.terrain_swing_weight)
             tasks.append(position_task("swing_foot", ft.jac_w[:3], ft.drift_w[:3], ft.pos_w_m + shift, ft.vel_w[:3],
-                                       gt.swing_pos_m, gt.swing_vel_mps, gt.swing_acc_mps2, cfg.swing_foot))
+                                       gt.swing_pos_m, gt.swing_vel_mps, gt.swing_acc_mps2, swing))
             tasks.append(orientation_task("swing_foot_rot", ft.jac_w[3:], ft.drift_w[3:], ft.rot_w, ft.vel_w[3:],
                                           yaw_rotation(gt.swing_yaw_rad), np.array([0.0, 0.0, gt.swing_yaw_rate_radps]),
-                                          cfg.swing_foot))
+                                          swing))
         tasks.append(posture_task(dyn.nv, state.q_rad, state.dq_radps, reference.q_rad, reference.dq_radps,
                                   cfg.posture, self._posture_weights))
         return tasks
+
+    def _ground_reference(self, stance: np.ndarray, dt: float) -> float:
+        """The height the CoM is held above when walking by the gait: the stance soles' mean, lowered
+        towards a lower landing during the swing (WbcConfig.step_down_lead), low-pass filtered
+        (WbcConfig.ground_follow_s). On flat ground it is the stance soles' height."""
+        cfg = self.config
+        assert self.gait is not None
+        target = float(np.mean(self._sole_pos[stance, 2]))
+        gt = self.gait.targets
+        if gt.swing_foot >= 0 and not stance[gt.swing_foot]:
+            drop = min(float(gt.landing_m[2]) - target, 0.0)
+            target += cfg.step_down_lead * drop * min(1.0, 1.5 * gt.swing_progress)
+        if self._ground_ref_m is None:
+            self._ground_ref_m = target
+        self._ground_ref_m += min(1.0, dt / max(cfg.ground_follow_s, 1e-6)) * (target - self._ground_ref_m)
+        return self._ground_ref_m
 
     def _solve(self, tasks: list[AccelerationTask], stance: np.ndarray, load: np.ndarray, dq_radps: np.ndarray,
                dt: float) -> IdSolution | None:

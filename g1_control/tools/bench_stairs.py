@@ -1,0 +1,167 @@
+"""`g1 bench stairs`: the whole-body controller (tracker.type wbc, its own gait from a velocity
+command) walking straight into stairs and a platform it finds in the scene, approached at seeded
+angles and side offsets. Every figure is from the simulator's ground truth.
+
+Courses (the structure's near edge 1.0 m ahead of the robot's start, turned by the drawn angle
+about the point on that edge in front of the drawn offset; the robot walks +x and knows only what
+the scene says):
+  stairs    three 0.15 m treads up (0.45 m deep), a 1.2 m landing at 0.45 m, three treads down;
+  platform  one 0.20 m platform, 1.2 m deep, up and down the far side;
+  step      one 0.15 m platform, 1.2 m deep, up and down (what the gait does today).
+
+Per trial: fell (the pelvis below 0.45 m above the ground under it, a fall the loop saw, or any
+safety trip: a trip counts as a failure), top (both soles on the structure's highest level at
+once), across (both soles back on the floor beyond the structure). Draws: angle uniform in
++-25 deg, offset uniform in +-0.3 m, from numpy's default_rng(seed).
+
+    g1 bench stairs --seed 100 --trials 10              # seeds 100..109, both courses
+    g1 bench stairs --only platform --seed 100 --trials 5
+    g1 bench stairs --only step --seed 100 --trials 10
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from g1_control.scene import Platform, SceneConfig
+
+COURSES = ("stairs", "platform", "step")
+NEAR_EDGE_M = 1.0
+MAX_ANGLE_DEG = 25.0
+MAX_OFFSET_M = 0.3
+WIDTH_M = 1.4
+FALL_PELVIS_M = 0.45
+"""Pelvis above the ground under it, below which the robot has fallen (it walks at ~0.70 m)."""
+SOLE_BELOW_ANKLE_M = 0.034
+"""The ankle-roll body's origin above the sole, standing (measured in the G1 model)."""
+
+
+def course_scene(course: str, angle_rad: float, offset_m: float) -> tuple[SceneConfig, float, float]:
+    """(scene, top height, far end along the course's axis from its near edge)."""
+    if course == "stairs":
+        # (centre along the axis from the near edge, depth, height)
+        treads = [(0.225, 0.45, 0.15), (0.675, 0.45, 0.30), (1.5, 1.2, 0.45), (2.325, 0.45, 0.30), (2.775, 0.45, 0.15)]
+        far = 3.0
+    elif course in ("platform", "step"):
+        treads = [(0.6, 1.2, 0.20 if course == "platform" else 0.15)]
+        far = 1.2
+    else:
+        raise ValueError(f"unknown course {course!r}; known: {', '.join(COURSES)}")
+    c, s = math.cos(angle_rad), math.sin(angle_rad)
+    origin = np.array([NEAR_EDGE_M, offset_m])
+    platforms = []
+    for i, (along, depth, height) in enumerate(treads):
+        centre = origin + along * np.array([c, s])
+        platforms.append(Platform(f"{course}_{i}", (float(centre[0]), float(centre[1])), (depth, WIDTH_M), height,
+                                  yaw_rad=angle_rad))
+    return SceneConfig(platforms=platforms), max(t[2] for t in treads), far
+
+
+@dataclass
+class StairsTrial:
+    course: str
+    seed: int
+    angle_deg: float
+    offset_m: float
+    fell: bool
+    top: bool
+    across: bool
+    detail: str
+    sim_s: float
+    wall_s: float
+
+    @property
+    def success(self) -> bool:
+        return self.top and self.across and not self.fell
+
+
+def draw(seed: int) -> tuple[float, float]:
+    rng = np.random.default_rng(seed)
+    return float(rng.uniform(-MAX_ANGLE_DEG, MAX_ANGLE_DEG)), float(rng.uniform(-MAX_OFFSET_M, MAX_OFFSET_M))
+
+
+def run_course(course: str, seed: int, *, speed_mps: float = 0.3, duration_s: float = 40.0) -> StairsTrial:
+    """Stand 1 s, then walk +x at speed_mps until the robot is across (or falls, or duration_s)."""
+    import mujoco
+
+    from g1_control.launch.builder import build_loop
+    from g1_control.teleop.scripted import Segment
+    from g1_control.tools.physics_trials import Trial, trial_launch
+
+    angle_deg, offset_m = draw(seed)
+    scene, top_m, far_m = course_scene(course, math.radians(angle_deg), offset_m)
+    trial = Trial(f"stairs_{course}_{seed}", [Segment(1.0, label="stand"),
+                                              Segment(duration_s - 1.0, vx_mps=speed_mps, label="walk")],
+                  tracker="wbc", tracker_hz=250.0, scene=scene)
+    loop = build_loop(trial_launch(trial))
+    loop.reset()
+    sim = loop.backend
+    m, d = sim.model, sim.data  # type: ignore[attr-defined]
+    feet = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, f"{side}_ankle_roll_link") for side in ("left", "right")]
+    axis = np.array([math.cos(math.radians(angle_deg)), math.sin(math.radians(angle_deg))])
+    origin = np.array([NEAR_EDGE_M, offset_m])
+    top = across = fell = False
+    detail = ""
+    t0 = time.perf_counter()
+    try:
+        while loop.time_s < duration_s - 1e-9:
+            loop.run(0.02)
+            soles = np.array([d.xpos[f] for f in feet])
+            soles[:, 2] -= SOLE_BELOW_ANKLE_M
+            on_top = all(abs(z - top_m) < 0.03 for z in soles[:, 2])
+            top = top or on_top
+            beyond = all(float((p[:2] - origin) @ axis) > far_m for p in soles)
+            if top and beyond and all(abs(z) < 0.03 for z in soles[:, 2]):
+                across = True
+            ground = _ground_under(scene, d.qpos[:2])
+            if loop.fell or loop.faulted or d.qpos[2] - ground < FALL_PELVIS_M:
+                fell = True
+                detail = str(loop.fall) if loop.fall is not None else (
+                    "safety trip" if loop.faulted else f"pelvis {d.qpos[2] - ground:.2f} m above the ground")
+                if loop.faulted and loop.fall is None:
+                    trips = [e for e in loop.events if getattr(e, "trips", False)]
+                    detail = trips[0].detail if trips else detail
+                break
+            if across:
+                break
+    finally:
+        wall = time.perf_counter() - t0
+        sim.close()
+    return StairsTrial(course, seed, angle_deg, offset_m, fell, top, across, detail, float(loop.time_s), wall)
+
+
+def _ground_under(scene: SceneConfig, xy: np.ndarray) -> float:
+    return scene.ground_height(np.asarray(xy, dtype=float))
+
+
+def main(args) -> int:
+    courses = [c for c in COURSES if not args.only or any(c.startswith(p) for p in args.only.split(","))]
+    first = int(args.seed)
+    count = int(getattr(args, "trials", 5) or 5)
+    rows: list[StairsTrial] = []
+    print(f"g1 bench stairs: tracker wbc, vx 0.3 m/s, seeds {first}..{first + count - 1}, angle +-{MAX_ANGLE_DEG:.0f} deg, "
+          f"offset +-{MAX_OFFSET_M} m (ground truth)")
+    print(f"{'course':9s} {'seed':>4s} {'angle':>7s} {'offset':>7s} {'top':>4s} {'across':>6s} {'fell':>4s}  detail")
+    for course in courses:
+        for seed in range(first, first + count):
+            r = run_course(course, seed)
+            rows.append(r)
+            print(f"{r.course:9s} {r.seed:4d} {r.angle_deg:6.1f}° {r.offset_m:6.2f}m {str(r.top)[0]:>4s} "
+                  f"{str(r.across)[0]:>6s} {str(r.fell)[0]:>4s}  {r.detail}  ({r.sim_s:.1f} s sim, {r.wall_s:.0f} s wall)",
+                  flush=True)
+    for course in courses:
+        sel = [r for r in rows if r.course == course]
+        print(f"{course}: {sum(r.success for r in sel)}/{len(sel)} up and down, top reached {sum(r.top for r in sel)}/"
+              f"{len(sel)}, falls {sum(r.fell for r in sel)}/{len(sel)}")
+    if args.json:
+        Path(args.json).write_text(json.dumps([{**asdict(r), "success": r.success} for r in rows], indent=1))
+    return 1 if any(r.fell for r in rows) else 0
+
+
+__all__ = ["COURSES", "StairsTrial", "course_scene", "draw", "main", "run_course"]

@@ -1,0 +1,152 @@
+"""What the feet stand on, for the gait: heights of the scene's platforms and steps (a map, like
+the scene's other task knowledge), footholds snapped onto one tread and swing clearance.
+
+The scene's platforms (g1_control/scene.py) are boxes standing on the floor; a stair is several of
+them side by side (or one inside another), each its tread's height. The height at a point is the
+highest top over it, the floor (0) elsewhere. Positions are the controller's odometry frame, which
+starts at the world's origin as the scene does (the robot spawns there facing +x).
+
+A foothold is snapped so the whole sole, with a margin, lies on one level: a sole across a tread's
+edge tips over it. The landing point moves along the walking heading to the nearest place where
+it does (forward or back, whichever is nearer), within `max_shift_m`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from g1_control.errors import WbcConfigError
+from g1_control.scene import SceneConfig
+
+
+@dataclass(frozen=True)
+class TerrainConfig:
+    sole_half_length_m: float = 0.11
+    """Half the sole's length, toe and heel pads included (contact spheres reach x -0.05..0.12 in the
+    ankle-roll link, the sole frame at 0.035; plus their radius)."""
+    sole_half_width_m: float = 0.04
+    edge_margin_m: float = 0.025
+    """A snapped sole keeps this far from a tread's edge, all round."""
+    riser_gap_m: float = 0.08
+    """Nothing higher than the sole may stand within this ahead of its toe: the stance shin leans
+    forward over the toe as the body passes (it caught a riser's edge 3.5 cm ahead, measured)."""
+    max_shift_m: float = 0.25
+    """Snapping moves a landing point at most this far; past it the point stays where it was."""
+    shift_step_m: float = 0.01
+    level_tolerance_m: float = 0.01
+    """Heights within this count as one level."""
+
+    def __post_init__(self) -> None:
+        for name in ("sole_half_length_m", "sole_half_width_m", "shift_step_m"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise WbcConfigError(f"TerrainConfig.{name} must be a finite number > 0; got {value}")
+        for name in ("edge_margin_m", "riser_gap_m", "max_shift_m", "level_tolerance_m"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise WbcConfigError(f"TerrainConfig.{name} must be a finite number >= 0; got {value}")
+
+
+class Terrain:
+    """Heights of boxes standing on a flat floor at z = 0."""
+
+    def __init__(self, blocks: list[tuple[np.ndarray, np.ndarray, float, float]] | None = None,
+                 config: TerrainConfig | None = None):
+        """blocks: (centre xy, half sizes xy, yaw rad, top height m) each."""
+        self.config = config or TerrainConfig()
+        self._centres = np.array([b[0] for b in blocks or []], dtype=float).reshape(-1, 2)
+        self._halves = np.array([b[1] for b in blocks or []], dtype=float).reshape(-1, 2)
+        yaws = np.array([b[2] for b in blocks or []], dtype=float)
+        self._cos, self._sin = np.cos(yaws), np.sin(yaws)
+        self._tops = np.array([b[3] for b in blocks or []], dtype=float)
+        if np.any(self._halves <= 0) or not np.all(np.isfinite(self._tops)):
+            raise WbcConfigError("Terrain blocks need half sizes > 0 and finite heights")
+        c = self.config
+        u = np.array([-1.0, -0.5, 0.0, 0.5, 1.0])
+        gx, gy = np.meshgrid(u * (c.sole_half_length_m + c.edge_margin_m), u[::2] * (c.sole_half_width_m + c.edge_margin_m))
+        self._sole_points = np.stack([gx.ravel(), gy.ravel()], axis=1)
+        """Points of the sole (with its margin) in sole axes, sampled: its outline and middle."""
+        ahead = c.sole_half_length_m + np.linspace(c.edge_margin_m, max(c.riser_gap_m, c.edge_margin_m), 4)
+        gx, gy = np.meshgrid(ahead, u[::2] * (c.sole_half_width_m + c.edge_margin_m))
+        self._toe_points = np.stack([gx.ravel(), gy.ravel()], axis=1)
+        """Points ahead of the toe (sole axes) that may not stand higher than the sole."""
+
+    @classmethod
+    def of_scene(cls, scene: SceneConfig, config: TerrainConfig | None = None) -> Terrain:
+        """The scene's platforms (tables are not stood on: their tops hang over one leg)."""
+        return cls([(p.center, p.half, p.yaw_rad, p.height_m) for p in scene.platforms], config)
+
+    @property
+    def flat(self) -> bool:
+        return self._tops.size == 0
+
+    def heights(self, xy_m: np.ndarray) -> np.ndarray:
+        """Height (m) at each of the points xy_m (n, 2): the highest top over it, else 0."""
+        xy = np.asarray(xy_m, dtype=float).reshape(-1, 2)
+        if self.flat:
+            return np.zeros(len(xy))
+        d = xy[:, None, :] - self._centres[None, :, :]
+        lx = self._cos * d[..., 0] + self._sin * d[..., 1]
+        ly = -self._sin * d[..., 0] + self._cos * d[..., 1]
+        inside = (np.abs(lx) <= self._halves[:, 0]) & (np.abs(ly) <= self._halves[:, 1])
+        return np.max(np.where(inside, self._tops, 0.0), axis=1, initial=0.0)
+
+    def height(self, xy_m: np.ndarray) -> float:
+        return float(self.heights(np.asarray(xy_m, dtype=float)[:2])[0])
+
+    def _sole_heights(self, xy_m: np.ndarray, yaw_rad: float, points: np.ndarray | None = None) -> np.ndarray:
+        c, s = math.cos(yaw_rad), math.sin(yaw_rad)
+        pts = (self._sole_points if points is None else points) @ np.array([[c, s], [-s, c]])
+        return self.heights(pts + np.asarray(xy_m, dtype=float)[:2])
+
+    def sole_height(self, xy_m: np.ndarray, yaw_rad: float) -> float:
+        """The highest point under a sole (with its margin) centred at xy_m, turned yaw_rad."""
+        return float(self._sole_heights(xy_m, yaw_rad).max())
+
+    def is_level(self, xy_m: np.ndarray, yaw_rad: float) -> bool:
+        """Whether a sole there lies on one level, clear of its edges and of a riser ahead of it."""
+        h = self._sole_heights(xy_m, yaw_rad)
+        tol = self.config.level_tolerance_m
+        if h.max() - h.min() > tol:
+            return False
+        return bool(self._sole_heights(xy_m, yaw_rad, self._toe_points).max() <= h.max() + tol)
+
+    def snap(self, xy_m: np.ndarray, yaw_rad: float, heading_rad: float,
+             forward_only: bool = False) -> tuple[np.ndarray, float]:
+        """(foothold xy, its height): xy_m moved along heading_rad to the nearest place where the
+        sole lies on one level (module docstring); unchanged when it does or none is in reach.
+        forward_only: only along heading_rad, not against it."""
+        xy = np.asarray(xy_m, dtype=float)[:2]
+        if self.flat or self.is_level(xy, yaw_rad):
+            return xy.copy(), self.sole_height(xy, yaw_rad)
+        c = self.config
+        direction = np.array([math.cos(heading_rad), math.sin(heading_rad)])
+        n = int(c.max_shift_m / c.shift_step_m)
+        for k in range(1, n + 1):
+            for sign in ((1.0,) if forward_only else (1.0, -1.0)):
+                p = xy + sign * k * c.shift_step_m * direction
+                if self.is_level(p, yaw_rad):
+                    return p, self.sole_height(p, yaw_rad)
+        return xy.copy(), self.sole_height(xy, yaw_rad)
+
+    def level_change_ahead(self, xy_m: np.ndarray, heading_rad: float, distance_m: float, samples: int = 12) -> bool:
+        """Whether the height changes on the straight line from xy_m distance_m along heading_rad."""
+        if self.flat:
+            return False
+        direction = np.array([math.cos(heading_rad), math.sin(heading_rad)])
+        pts = np.asarray(xy_m, dtype=float)[:2] + np.linspace(0.0, distance_m, samples)[:, None] * direction
+        h = self.heights(pts)
+        return bool(h.max() - h.min() > self.config.level_tolerance_m)
+
+    def max_height_along(self, a_xy: np.ndarray, b_xy: np.ndarray, yaw_rad: float, samples: int = 8) -> float:
+        """The highest point under a sole moving straight from a_xy to b_xy (clearance for a swing)."""
+        if self.flat:
+            return 0.0
+        a, b = np.asarray(a_xy, dtype=float)[:2], np.asarray(b_xy, dtype=float)[:2]
+        return max(self.sole_height(a + (b - a) * s, yaw_rad) for s in np.linspace(0.0, 1.0, samples))
+
+
+__all__ = ["Terrain", "TerrainConfig"]

@@ -1,0 +1,38 @@
+"""`g1 bench stairs` courses and draws, without physics: the scene holds the treads where the
+course says (turned and offset as drawn), draws repeat per seed and stay within their bounds."""
+
+import math
+
+import numpy as np
+import pytest
+
+from g1_control.tools.bench_stairs import MAX_ANGLE_DEG, MAX_OFFSET_M, NEAR_EDGE_M, course_scene, draw
+
+
+def test_stairs_go_up_three_treads_to_the_landing_and_down_along_the_turned_axis():
+    angle, offset = math.radians(20.0), 0.2
+    scene, top, far = course_scene("stairs", angle, offset)
+    axis = np.array([math.cos(angle), math.sin(angle)])
+    origin = np.array([NEAR_EDGE_M, offset])
+    heights = [scene.ground_height(origin + s * axis) for s in (-0.05, 0.1, 0.6, 1.0, 1.5, 2.3, 2.7, 3.1)]
+    assert heights == pytest.approx([0.0, 0.15, 0.30, 0.45, 0.45, 0.30, 0.15, 0.0])
+    assert top == pytest.approx(0.45) and far == pytest.approx(3.0)
+    scene.validate("scene")  # nothing within reach of the robot's start
+
+
+def test_platform_is_020_m():
+    scene, top, far = course_scene("platform", 0.0, 0.0)
+    assert far == pytest.approx(1.2)
+    assert top == pytest.approx(0.20) and scene.ground_height(np.array([NEAR_EDGE_M + 0.6, 0.0])) == pytest.approx(0.20)
+
+
+def test_draws_repeat_per_seed_within_bounds():
+    assert draw(7) == draw(7) and draw(7) != draw(8)
+    for seed in range(50):
+        a, o = draw(seed)
+        assert abs(a) <= MAX_ANGLE_DEG and abs(o) <= MAX_OFFSET_M
+
+
+def test_unknown_course_is_named():
+    with pytest.raises(ValueError, match="unknown course 'ramp'; known: stairs, platform, step"):
+        course_scene("ramp", 0.0, 0.0)

@@ -1,0 +1,72 @@
+"""The gait's terrain map: heights of the scene's platforms, footholds snapped onto one tread (clear
+of edges and of a riser ahead), clearance over a swing's path, named configuration errors."""
+
+import math
+
+import numpy as np
+import pytest
+
+from g1_control.errors import WbcConfigError
+from g1_control.scene import Platform, SceneConfig
+from g1_control.trackers.wbc.terrain import Terrain, TerrainConfig
+
+
+def stairs() -> Terrain:
+    """Two 0.15 m treads, 0.4 m deep, from x = 1.0 (the upper one a platform inside the lower)."""
+    return Terrain.of_scene(SceneConfig(platforms=[Platform("s1", (1.6, 0.0), (1.2, 1.2), 0.15),
+                                                   Platform("s2", (1.8, 0.0), (0.8, 1.2), 0.30)]))
+
+
+def test_heights_are_the_highest_top_over_a_point():
+    t = stairs()
+    np.testing.assert_allclose(t.heights(np.array([[0.5, 0.0], [1.1, 0.0], [1.5, 0.3], [2.3, 0.0], [1.5, 0.7]])),
+                               [0.0, 0.15, 0.30, 0.0, 0.0])
+    assert Terrain().flat and Terrain().height(np.array([3.0, 1.0])) == 0.0
+
+
+def test_turned_platform_is_turned():
+    t = Terrain.of_scene(SceneConfig(platforms=[Platform("p", (2.0, 0.0), (1.0, 0.4), 0.2, yaw_rad=math.pi / 2)]))
+    assert t.height(np.array([2.0, 0.45])) == pytest.approx(0.2)  # its long side now along y
+    assert t.height(np.array([2.45, 0.0])) == 0.0
+
+
+def test_a_sole_across_an_edge_is_snapped_onto_one_tread_along_the_heading():
+    t = stairs()
+    c = t.config
+    xy, h = t.snap(np.array([1.02, 0.1]), 0.0, 0.0)
+    assert not t.is_level(np.array([1.02, 0.1]), 0.0)
+    assert t.is_level(xy, 0.0) and xy[1] == pytest.approx(0.1)
+    # the nearer of the two: forward onto the first tread, its heel clear of the edge
+    assert h == pytest.approx(0.15)
+    assert xy[0] - c.sole_half_length_m - c.edge_margin_m >= 1.0 - 1e-9
+    assert xy[0] + c.sole_half_length_m + c.riser_gap_m <= 1.4 + 1e-9  # the riser ahead stays clear
+    # well before the edge: back, the toe clear of the riser by riser_gap_m
+    xy, h = t.snap(np.array([0.88, 0.0]), 0.0, 0.0)
+    assert h == 0.0 and xy[0] + c.sole_half_length_m + c.riser_gap_m <= 1.0 + 1e-9
+    # a level foothold is left alone
+    xy, h = t.snap(np.array([1.6, 0.0]), 0.0, 0.0)
+    assert xy == pytest.approx([1.6, 0.0]) and h == pytest.approx(0.30)
+
+
+def test_a_riser_close_ahead_of_the_toe_is_not_level_but_an_edge_behind_the_heel_going_down_is():
+    t = stairs()
+    c = t.config
+    toe_gap = 0.05  # < riser_gap_m
+    assert not t.is_level(np.array([1.0 - c.sole_half_length_m - toe_gap, 0.0]), 0.0)
+    # walking down (facing -x) a lower tread ahead of the toe is fine
+    assert t.is_level(np.array([1.0 + c.sole_half_length_m + c.edge_margin_m + 0.01, 0.0]), math.pi)
+
+
+def test_clearance_along_a_swing_path_sees_the_tread_in_between():
+    t = stairs()
+    assert t.max_height_along(np.array([0.8, 0.0]), np.array([1.5, 0.0]), 0.0) == pytest.approx(0.30)
+    assert t.max_height_along(np.array([0.2, 0.0]), np.array([0.6, 0.0]), 0.0) == 0.0
+
+
+def test_named_errors():
+    with pytest.raises(WbcConfigError, match="TerrainConfig.sole_half_length_m must be a finite number > 0"):
+        TerrainConfig(sole_half_length_m=0.0)
+    with pytest.raises(WbcConfigError, match="TerrainConfig.riser_gap_m must be a finite number >= 0"):
+        TerrainConfig(riser_gap_m=-0.1)
+    with pytest.raises(WbcConfigError, match="half sizes > 0"):
+        Terrain([(np.zeros(2), np.array([0.0, 0.3]), 0.0, 0.1)])
