@@ -45,7 +45,7 @@ from g1_control.trackers.wbc.tasks import (
     position_task,
     posture_task,
 )
-from g1_control.types import JointReference, MotorCommand, RobotState
+from g1_control.types import PHASE_WHOLE_BODY, JointReference, MotorCommand, RobotState
 
 
 @dataclass(frozen=True)
@@ -174,6 +174,7 @@ class WholeBodyTracker(Tracker):
         self._com_acc_ref = np.zeros(3)
         self._frame_vel_ref_prev: dict[int, np.ndarray] = {}
         self.diagnostics = WbcDiagnostics()
+        self._following_plan = False
         if self.gait is not None:
             self.gait.reset()
 
@@ -211,7 +212,9 @@ class WholeBodyTracker(Tracker):
             self._start(reference, state)
         dt = 1.0 / self.config.rate_hz if self._last_t is None else max(1e-4, state.t_s - self._last_t)
         self._last_t = state.t_s
-        if self.gait is not None:
+        walking = self._walking(reference, state)
+        if walking:
+            assert self.gait is not None
             schedule = self.gait.schedule(state.t_s, self._walk_command(reference), self._sole_pos, self._sole_yaw,
                                           self._dcm_xy)
         else:
@@ -219,7 +222,7 @@ class WholeBodyTracker(Tracker):
         scheduled, stance, load = self._contact_state(schedule, state.t_s)
         shift = self._estimate_base(state, reference, scheduled, stance, dt)
         com_ref, com_vel_ref = self._reference_kinematics(reference, dt)
-        if self.gait is None:
+        if not walking:
             tasks = [self._balance_task(com_ref, com_vel_ref, stance, shift)]
             tasks += self._motion_tasks(reference, state, stance, shift, dt)
         else:
@@ -228,6 +231,23 @@ class WholeBodyTracker(Tracker):
         if sol is None:
             return self._command if self.diagnostics.solution is not None else self._hold(state)
         return self._motor_command(sol, state, dt)
+
+    def _walking(self, reference: JointReference, state: RobotState) -> bool:
+        """Whether this tick walks by the gait: footsteps "velocity" and a reference that is not a
+        whole-body plan. A whole-body plan (a goal's pick, place, steps) is followed by its own contact
+        schedule; on the switch into one the odometry restarts at the plan's root (the plan starts at the
+        measured pose, as on the tracking layer's hand-over), out of one the gait starts standing."""
+        if self.gait is None:
+            return False
+        plan = reference.phase == PHASE_WHOLE_BODY
+        if plan != self._following_plan:
+            if plan:
+                self.reset(state)
+                self._start(reference, state)
+            else:
+                self.gait.reset()
+            self._following_plan = plan
+        return not plan
 
     def _contact_state(self, schedule: np.ndarray, t_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(scheduled, stance, load): the schedule's stance feet (the reference's, or the gait's); the feet the QP treats as contacts
@@ -384,18 +404,35 @@ class WholeBodyTracker(Tracker):
         assert self.gait is not None
         com = dyn.com_m + shift
         com_vel = dyn.com_vel_mps
+        # a held load (the hand forces' downward part, as a mass at the hands) walks with the body:
+        # the pendulum is the robot and the load together
+        load_kg = max(0.0, -float(dyn.hand_forces_w_n[:, 2].sum()) / cp.GRAVITY_MPS2)
+        com_xy, com_vel_xy = com[:2].copy(), com_vel[:2].copy()
+        if load_kg > 0.0:
+            share = load_kg / (dyn.mass_kg + load_kg)
+            hands = [dyn.frame(fid) for fid in dyn.hand_ids]
+            hand_xy = np.mean([ft.pos_w_m[:2] for ft in hands], axis=0) + shift[:2]
+            hand_vel_xy = np.mean([ft.vel_w[:2] for ft in hands], axis=0)
+            com_xy += share * (hand_xy - com_xy)
+            com_vel_xy += share * (hand_vel_xy - com_vel_xy)
         ground_z = float(np.mean(self._sole_pos[stance, 2]))
         omega = cp.lipm_frequency(max(com[2] - ground_z, 0.2))
-        self._dcm_xy = cp.capture_point(com[:2], com_vel[:2], omega)
+        self._dcm_xy = cp.capture_point(com_xy, com_vel_xy, omega)
         gt = self.gait.update(state.t_s, dt, self._sole_pos, self._sole_yaw,
                               self._dcm_xy, omega)
         h = cfg.com_height
         speed = float(np.hypot(*self.gait.command_h[:2]))
-        height = self._com_height_m - cfg.walking_com_lower_m - cfg.walking_com_lower_per_mps * speed
+        lower = cfg.walking_com_lower_m + cfg.walking_com_lower_per_mps * speed
+        height = self._com_height_m - lower
         if reference.pelvis_height_m is not None:
-            height += reference.pelvis_height_m - self._pelvis_height_m
+            # the pelvis held at the height asked (at most the walking height: knees stay bent), by the
+            # CoM's height above the pelvis now (the posture sets it: crouched, the trunk leans and the
+            # pelvis drops further than the CoM)
+            pelvis_z = float(self._q[2])  # after this tick's odometry step, as com
+            pelvis = min(reference.pelvis_height_m, self._pelvis_height_m - lower)
+            height = pelvis + (com[2] - pelvis_z)
         a_com = np.empty(3)
-        a_com[:2] = omega**2 * (com[:2] - gt.cop_xy_m)
+        a_com[:2] = omega**2 * (com_xy - gt.cop_xy_m)
         a_com[2] = h.kp * (ground_z + height - com[2]) - h.kd * com_vel[2]
         diag = self.diagnostics
         diag.com_m, diag.cop_des_xy_m = com, gt.cop_xy_m.copy()
