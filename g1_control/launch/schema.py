@@ -567,9 +567,9 @@ class LaunchFile:
         for i, seg in enumerate(self.input.timeline):
             for j, goal in enumerate(seg.goals):
                 where = f"input.timeline[{i}].goals[{j}]"
-                if self.tracker.type != "layer":
+                if not self.executes_goals:
                     raise LaunchFileError(f"{where}: goals are executed by tracker.type layer (got "
-                                          f"{self.tracker.type})")
+                                          f"{self.tracker.type}; or wbc with a scene and a generator other than scripted)")
                 if goal.object is not None and sc.box(goal.object) is None:
                     raise LaunchFileError(f"{where}.object: '{goal.object}' is not a box of the scene; known: "
                                           f"{', '.join(b.name for b in sc.boxes) or 'none (scene.boxes is empty)'}")
@@ -615,6 +615,14 @@ class LaunchFile:
         except SkeletonError as exc:
             raise LaunchFileError(f"generator.model: {exc} (backend.expected_variant "
                                   f"{self.backend.expected_variant}, backend.hands {self.backend.hands})") from None
+
+    @property
+    def executes_goals(self) -> bool:
+        """Whether task goals run (the generator inside a GoalGenerator, g1_control/generator/goals/):
+        tracker.type layer, or wbc walking by its own gait (a generator other than scripted) in a
+        scene with objects, where it walks with a held box too."""
+        return self.tracker.type == "layer" or (self.tracker.type == "wbc" and self.generator.type != "scripted"
+                                                and not self.scene.empty)
 
     @property
     def total_duration_s(self) -> float:
