@@ -39,6 +39,7 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from g1_control.generator.goals.approach import enter_whole_body
+from g1_control.generator.goals.box import GRASP_DISTANCE_M
 from g1_control.generator.goals.context import ARMS, GoalConfig, GoalContext, GoalFailed, world_pose_needed
 from g1_control.generator.goals.handling import held_forces, pick, place
 from g1_control.generator.goals.platform import step_down, step_up
@@ -322,16 +323,25 @@ class GoalGenerator(Generator):
                 still_since = ctx.t
             elif ctx.t - still_since >= cfg.settle_s:
                 break
+        # from the measured pose (the held arms) to a clean standing one at the nominal height, the
+        # box's weight ahead balanced: a place's footsteps start from it (its steps from the walking
+        # height rose 5 cm at once, and the robot fell with the box, measured)
         q = ctx.measured_q()
         q[7:] = np.concatenate([q[7:7 + len(g1.LEG_JOINTS)], self._carry_q[len(g1.LEG_JOINTS):]])
         soles = flat_soles(self.ik, q)
         ground = [ctx.scene.ground_height(p[:2]) if ctx.localised else 0.0 for p, _ in soles]
         q[2] -= min(p[2] - g for (p, _), g in zip(soles, ground))  # the lower sole on its ground
+        soles = [(np.array([p[0], p[1], g]), r) for (p, r), g in zip(soles, ground)]
         forces = held_forces(ctx, stance_heading(soles))
+        box = ctx.held.box
+        shift = np.array([-box.mass_kg / self.poses.mass_kg * GRASP_DISTANCE_M, 0.0])
+        posture = q[7:].copy()
+        q_stand = yield from ctx.compute("stand holding", lambda: self.poses.stand(
+            q, soles, min(ground) + self.poses.nominal_pelvis_m, posture, shift))
         self._carry_q = None
-        ctx.note(f"stand holding '{ctx.held.box.name}'")
-        yield from ctx.run(keyframe_trajectory("hold", [(0.0, q), (cfg.stand_s, q)], hand_forces=lambda tk: forces),
-                           keep=True)
+        ctx.note(f"stand holding '{box.name}'")
+        yield from ctx.run(keyframe_trajectory("hold", [(0.0, q), (cfg.move_s, q_stand)],
+                                               hand_forces=lambda tk: forces), keep=True)
 
     def _stand_at(self, height: float, style_name: str) -> Iterator[None]:
         ctx = self.ctx

@@ -97,6 +97,10 @@ class WbcConfig:
     """QP weights of the CoM task's horizontal and vertical rows when walking by the gait."""
     walking_leg_posture_weight: float = 0.05
     """Walking by its own gait, the legs' posture task is only a regulariser (relative to `posture`)."""
+    walking_crouch_lean_per_m: float = 2.5
+    """Walking by its own gait below its nominal pelvis height, the pelvis and trunk pitch forward by
+    this much (rad) per metre lower: an upright pelvis that low keeps the hips over the ankles, and the
+    shanks' forward tilt ran the ankles into their dorsiflexion limit (pelvis 0.55 m, measured)."""
     walking_held_hands: TaskGains = field(default_factory=lambda: TaskGains(400.0, 40.0, 300.0))
     """Walking by its own gait with a held load, the hands are held where the reference's posture puts
     them relative to the pelvis (its heading and position; level in the world): the squeeze tilts
@@ -440,6 +444,7 @@ class WholeBodyTracker(Tracker):
         speed = float(np.hypot(*self.gait.command_h[:2]))
         lower = cfg.walking_com_lower_m + cfg.walking_com_lower_per_mps * speed
         height = self._com_height_m - lower
+        lean = 0.0
         if reference.pelvis_height_m is not None:
             # the pelvis held at the height asked (at most the walking height: knees stay bent), by the
             # CoM's height above the pelvis now (the posture sets it: crouched, the trunk leans and the
@@ -447,6 +452,7 @@ class WholeBodyTracker(Tracker):
             pelvis_z = float(self._q[2])  # after this tick's odometry step, as com
             pelvis = min(reference.pelvis_height_m, self._pelvis_height_m - lower)
             height = pelvis + (com[2] - pelvis_z)
+            lean = cfg.walking_crouch_lean_per_m * (self._pelvis_height_m - lower - pelvis)
         a_com = np.empty(3)
         a_com[:2] = omega**2 * (com_xy - gt.cop_xy_m)
         a_com[2] = h.kp * (ground_z + height - com[2]) - h.kd * com_vel[2]
@@ -456,6 +462,9 @@ class WholeBodyTracker(Tracker):
         wxy, wz = cfg.walking_com_weight
         tasks = [AccelerationTask("com", dyn.com_jac, a_com - dyn.com_drift, np.array([wxy, wxy, wz]))]
         heading_rot = yaw_rotation(gt.heading_rad)
+        if lean > 0.0:
+            c, sn = np.cos(lean), np.sin(lean)
+            heading_rot = heading_rot @ np.array([[c, 0.0, sn], [0.0, 1.0, 0.0], [-sn, 0.0, c]])
         yaw_rate = np.array([0.0, 0.0, gt.yaw_rate_radps])
         pelvis_ref = rd.oMf[dyn.pelvis_id].rotation
         for fid, gains in ((dyn.pelvis_id, cfg.pelvis_orientation), (dyn.torso_id, cfg.torso_orientation)):
