@@ -192,7 +192,9 @@ class TrackerConfig:
     upper-body override and closed-loop velocity correction; wbc: the model-based whole-body
     controller (needs rates.tracker_hz >= 100): with generator.type scripted its feet follow the
     reference's contact schedule, with any other generator it walks by its own gait from the
-    reference's root twist (g1_control/trackers/wbc/gait.py); wbt: holosoma's whole-body-tracking policy (50 Hz), kept as
+    reference's root twist (g1_control/trackers/wbc/gait.py), at the pelvis height a command asks, and
+    in a scene it executes goals too (LaunchFile.executes_goals: it follows their whole-body plans and
+    walks with a held box by its gait); wbt: holosoma's whole-body-tracking policy (50 Hz), kept as
     a comparison baseline for the WBC; layer: the tracking layer that executes goals - the walking
     policy while the plan walks, the WBC for whole-body phases (manipulation, stepping onto
     platforms, standing heights the policy cannot hold), with a blended hand-over
