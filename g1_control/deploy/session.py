@@ -518,7 +518,7 @@ def _report_goals(report: DeployReport, loop, launch: LaunchFile, folder: RunFol
     from g1_control.report.outcomes import goal_reports
     from g1_control.teleop.scripted import timeline_goals
 
-    if launch.tracker.type != "layer":  # only the tracking layer executes goals
+    if not launch.executes_goals:
         return
     for t_s, text in loop.generator.goal_log:
         folder.event({"type": "goal_note", "t_s": t_s, "text": text})

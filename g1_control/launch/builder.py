@@ -119,8 +119,8 @@ def make_ik(launch: LaunchFile) -> IKStage:
 
 def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
                    tracker: Tracker | None = None) -> Generator:
-    """The generator; with tracker.type layer, the launch file's generator inside a GoalGenerator
-    that executes task goals against the scene (g1_control/generator/goals/)."""
+    """The generator; where the launch file executes goals (LaunchFile.executes_goals), the launch file's
+    generator inside a GoalGenerator that executes task goals against the scene (g1_control/generator/goals/)."""
     cfg = launch.generator
     if cfg.type == "scripted":
         from g1_control.generator.scripted import TrajectoryGenerator, build_reference
@@ -135,16 +135,19 @@ def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
 
         skeleton = skeleton_for_robot(launch.backend.expected_variant, launch.backend.hands)
     generator = make_named(cfg.type, model=cfg.model or None, limits=limits, skeleton=skeleton, feedback=cfg.feedback)
-    if launch.tracker.type != "layer":
+    if not launch.executes_goals:
         return generator
     from g1_control.generator.goals.executor import GoalConfig, GoalGenerator
-    from g1_control.trackers.layer import TrackingLayer
+    from g1_control.trackers.layer import WBC_MIN_PELVIS_HEIGHT_M, TrackingLayer
 
     config = GoalConfig()
     # wall clock (a robot, a viewer): plans are made beside the loop; lockstep: inline (deterministic)
     config.plan_in_background = launch.backend.mode == "wallclock" or launch.backend.type != "mujoco"
     if isinstance(tracker, TrackingLayer):  # the walking policy's own height range (its envelope)
         config.policy_height_m = tracker.policy.command_limits.pelvis_height_m
+    if launch.tracker.type == "wbc":  # its gait walks at the heights asked, and with a held box
+        config.policy_height_m = (WBC_MIN_PELVIS_HEIGHT_M, config.policy_height_m[1])
+        config.walk_while_holding = True
     return GoalGenerator(generator, launch.scene, config)
 
 

@@ -84,7 +84,7 @@ def _run_loop(launch: LaunchFile, sim: MujocoBackend, loop: ControlLoop, segment
         bar = tqdm(total=round(duration, 1), unit="sim s", desc=launch.name, bar_format="{l_bar}{bar}| {n:.1f}/{total} sim s [{elapsed}<{remaining}]")
     ticks_per_update = int(loop.rates.lowlevel_hz)
     watcher = None
-    if launch.tracker.type == "layer":  # goals: judged from ground truth (g1_control/report/outcomes.py)
+    if launch.executes_goals:  # goals: judged from ground truth (g1_control/report/outcomes.py)
         from g1_control.report.outcomes import GoalWatcher
 
         watcher = GoalWatcher(loop)  # the run folder saves what it saw

@@ -200,7 +200,9 @@ class TrackerConfig:
     upper-body override and closed-loop velocity correction; wbc: the model-based whole-body
     controller (needs rates.tracker_hz >= 100): with generator.type scripted its feet follow the
     reference's contact schedule, with any other generator it walks by its own gait from the
-    reference's root twist (g1_control/trackers/wbc/gait.py); wbt: holosoma's whole-body-tracking policy (50 Hz), kept as
+    reference's root twist (g1_control/trackers/wbc/gait.py), at the pelvis height a command asks, and
+    in a scene it executes goals too (LaunchFile.executes_goals: it follows their whole-body plans and
+    walks with a held box by its gait); wbt: holosoma's whole-body-tracking policy (50 Hz), kept as
     a comparison baseline for the WBC; layer: the tracking layer that executes goals - the walking
     policy while the plan walks, the WBC for whole-body phases (manipulation, stepping onto
     platforms, standing heights the policy cannot hold), with a blended hand-over
@@ -575,9 +577,9 @@ class LaunchFile:
         for i, seg in enumerate(self.input.timeline):
             for j, goal in enumerate(seg.goals):
                 where = f"input.timeline[{i}].goals[{j}]"
-                if self.tracker.type != "layer":
+                if not self.executes_goals:
                     raise LaunchFileError(f"{where}: goals are executed by tracker.type layer (got "
-                                          f"{self.tracker.type})")
+                                          f"{self.tracker.type}; or wbc with a scene and a generator other than scripted)")
                 if goal.object is not None and sc.box(goal.object) is None:
                     raise LaunchFileError(f"{where}.object: '{goal.object}' is not a box of the scene; known: "
                                           f"{', '.join(b.name for b in sc.boxes) or 'none (scene.boxes is empty)'}")
@@ -623,6 +625,14 @@ class LaunchFile:
         except SkeletonError as exc:
             raise LaunchFileError(f"generator.model: {exc} (backend.expected_variant "
                                   f"{self.backend.expected_variant}, backend.hands {self.backend.hands})") from None
+
+    @property
+    def executes_goals(self) -> bool:
+        """Whether task goals run (the generator inside a GoalGenerator, g1_control/generator/goals/):
+        tracker.type layer, or wbc walking by its own gait (a generator other than scripted) in a
+        scene with objects, where it walks with a held box too."""
+        return self.tracker.type == "layer" or (self.tracker.type == "wbc" and self.generator.type != "scripted"
+                                                and not self.scene.empty)
 
     @property
     def total_duration_s(self) -> float:

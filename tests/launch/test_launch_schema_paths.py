@@ -219,7 +219,7 @@ def test_goal_errors_name_the_key_and_what_the_scene_has(goal, scene, message):
 
 def test_goals_name_their_tracker_and_reach_any_scene_name():
     _refused(_goals([{"kind": "pick", "object": "box"}], tracker="policy"),
-             f"{G}: goals are executed by tracker.type layer (got policy)")
+             f"{G}: goals are executed by tracker.type layer (got policy; or wbc with a scene and a generator other than scripted)")
     reach = {"kind": "reach", "hand": "left", "target": "box", "offset_h_m": [0.2, 0, 0]}
     assert parse_launch(_goals([reach])).input.timeline[1].goals[0].target == "box"
     assert parse_launch(_goals([{"kind": "step_down", "target": "step"}])).input.timeline[1].goals[0].kind == "step_down"

@@ -70,7 +70,8 @@ class GoalConfig:
     """Joint-space moves of the arms and the body (reach, height)."""
     reach_hold_s: float = 1.5
     squeeze_n: float = 20.0
-    """Per hand: twice the Coulomb minimum for a 2 kg box at mu 1 (m g / 2 mu = 9.8 N)."""
+    """Per hand, at least: twice the Coulomb minimum for a 2 kg box at mu 1 (m g / 2 mu = 9.8 N);
+    a heavier or more slippery box is squeezed with 1.3 times its own minimum (Held.squeeze_n)."""
     lift_m: float = 0.10
     pre_gap_m: float = 0.065
     press_m: float = 0.01
@@ -97,6 +98,10 @@ class GoalConfig:
     policy_height_m: tuple[float, float] = (0.63, 0.78)
     """Pelvis heights the walking policy holds (its envelope); others stand under the WBC."""
     height_min_m: float = 0.45
+    walk_while_holding: bool = False
+    """A velocity command while a box is held walks with it: the tracker walks by its own gait with
+    the held upper-body posture and the box's forces on the hands (the whole-body controller with
+    footsteps 'velocity'). Off (a walking policy would drop the box), the robot stands holding it."""
     plan_in_background: bool = False
     """Plan in the planner's own process (planner.py) while the robot holds its current reference
     (wall-clock runs: a carry's footstep plan takes ~1-2 s of CPU, which would stall the loop). Off
@@ -108,6 +113,8 @@ class Held:
     box: Box
     forces: np.ndarray
     """(2, 3) hand forces while held (world axes at the time of the grasp's heading)."""
+    squeeze_n: float = 20.0
+    """The squeeze per hand it is held with."""
 
 
 class GoalContext:

@@ -39,15 +39,17 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from g1_control.generator.goals.approach import enter_whole_body
+from g1_control.generator.goals.box import GRASP_DISTANCE_M
 from g1_control.generator.goals.context import ARMS, GoalConfig, GoalContext, GoalFailed, world_pose_needed
-from g1_control.generator.goals.handling import pick, place
+from g1_control.generator.goals.handling import held_forces, pick, place
 from g1_control.generator.goals.platform import step_down, step_up
-from g1_control.generator.goals.poses import PosePlanner, ReachRefused, flat_soles
+from g1_control.generator.goals.poses import PosePlanner, ReachRefused, flat_soles, stance_heading
 from g1_control.generator.goals.reach import reach
 from g1_control.generator.styles import ROLLOUT_STYLES
 from g1_control.generator.whole_body import keyframe_trajectory
 from g1_control.interfaces import Generator, WorldPoseEstimate
 from g1_control.robot import g1
+from g1_control.rotations import yaw_of
 from g1_control.scene import SceneConfig
 from g1_control.types import (
     PHASE_LOCOMOTION,
@@ -109,6 +111,8 @@ class GoalGenerator(Generator):
         self._style = "default"
         self._command = Command()
         self.walking_to_goal = False
+        self._carry_q: np.ndarray | None = None
+        """The held upper-body posture while walking with a box (GoalConfig.walk_while_holding); None otherwise."""
 
     def reset(self, state: RobotState) -> None:
         self.reset_state()
@@ -189,6 +193,8 @@ class GoalGenerator(Generator):
 
     def _reference(self, command: Command, state: RobotState) -> KinematicReference:
         ctx = self.ctx
+        if self._carry_q is not None:
+            return self._holding_reference(command, state)
         if ctx.phase == PHASE_WHOLE_BODY:
             assert ctx.plan is not None
             j = ctx.plan.sample(ctx.t - ctx.plan_t0, self._joint)
@@ -215,6 +221,31 @@ class GoalGenerator(Generator):
             self.walking_to_goal = False
             ref = self.inner.update(command, state)
         ref.phase = PHASE_LOCOMOTION
+        return ref
+
+    def _holding_reference(self, command: Command, state: RobotState) -> KinematicReference:
+        """Walking with a box: the operator's velocity (the walker's limits) for the tracker's own gait,
+        the held upper-body posture, the box's forces on the hands turned with the robot's heading."""
+        assert self._carry_q is not None
+        walk = self.walker.update(Command(vx_mps=command.vx_mps, vy_mps=command.vy_mps,
+                                          wz_radps=command.wz_radps), state)
+        j = self._joint
+        j.t_s = state.t_s
+        j.q_rad[:] = self._carry_q
+        j.dq_radps[:] = 0.0
+        j.root_pos_w_m[:] = walk.root_pos_w_m
+        j.root_quat_wxyz[:] = walk.root_quat_wxyz
+        j.root_linvel_h_mps[:] = walk.root_linvel_h_mps
+        j.root_angvel_h_radps[:] = walk.root_angvel_h_radps
+        j.contacts[:] = True
+        j.phase = PHASE_LOCOMOTION
+        j.upper_body_override = True
+        j.pelvis_height_m = command.pelvis_height_m
+        j.hand_forces_w_n[:] = held_forces(self.ctx, yaw_of(state.imu_quat_wxyz))
+        ref = self._ref.set_from(j)
+        ref.upper_body_override = True
+        ref.pelvis_height_m = command.pelvis_height_m
+        ref.style = command.style
         return ref
 
     def joint_reference(self, t_s: float) -> JointReference:
@@ -247,11 +278,18 @@ class GoalGenerator(Generator):
         ctx.info["status"] = self.goal_status.get(gid)
 
     # -- idle: heights the policy cannot hold, handing back -----------------------------------------
+    @staticmethod
+    def _moving(command: Command) -> bool:
+        return abs(command.vx_mps) > 0.02 or abs(command.vy_mps) > 0.02 or abs(command.wz_radps) > 0.02
+
     def _idle(self, command: Command) -> Iterator[None] | None:
         cfg = self.config
         ctx = self.ctx
         height = command.pelvis_height_m
-        moving = abs(command.vx_mps) > 0.02 or abs(command.vy_mps) > 0.02 or abs(command.wz_radps) > 0.02
+        moving = self._moving(command)
+        if moving and ctx.held is not None and cfg.walk_while_holding and ctx.phase == PHASE_WHOLE_BODY \
+                and ctx.plan is not None and ctx.t - ctx.plan_t0 >= ctx.plan.duration_s:
+            return self._walk_holding()
         low = height is not None and height < cfg.policy_height_m[0] - 1e-3 and not moving
         if low:
             assert height is not None
@@ -265,6 +303,50 @@ class GoalGenerator(Generator):
                 and (moving or not ctx.keep or self._height is not None):
             return self._hand_back()
         return None
+
+    def _walk_holding(self) -> Iterator[None]:
+        """Walk with the box held while the operator commands motion (GoalConfig.walk_while_holding);
+        once the command is zero and the robot has settled, hold it under a whole-body plan again
+        from the measured pose, where a place (or the next walk) starts."""
+        ctx, cfg = self.ctx, self.config
+        assert ctx.held is not None
+        self._carry_q = ctx.hold_q()[7:].copy()
+        ctx.note(f"walk holding '{ctx.held.box.name}'")
+        ctx.phase = PHASE_LOCOMOTION
+        ctx.plan = None
+        assert ctx.state is not None
+        self.walker.reset(ctx.state)
+        still_since: float | None = None
+        while True:
+            yield
+            s = ctx.state
+            assert s is not None
+            speed = float(np.hypot(*s.base_linvel_w_mps[:2])) if s.base_linvel_w_mps is not None else 0.0
+            if self._moving(self._command) or speed > cfg.settle_speed_mps:
+                still_since = None
+            elif still_since is None:
+                still_since = ctx.t
+            elif ctx.t - still_since >= cfg.settle_s:
+                break
+        # from the measured pose (the held arms) to a clean standing one at the nominal height, the
+        # box's weight ahead balanced: a place's footsteps start from it (its steps from the walking
+        # height rose 5 cm at once, and the robot fell with the box, measured)
+        q = ctx.measured_q()
+        q[7:] = np.concatenate([q[7:7 + len(g1.LEG_JOINTS)], self._carry_q[len(g1.LEG_JOINTS):]])
+        soles = flat_soles(self.ik, q)
+        ground = [ctx.scene.ground_height(p[:2]) if ctx.localised else 0.0 for p, _ in soles]
+        q[2] -= min(p[2] - g for (p, _), g in zip(soles, ground))  # the lower sole on its ground
+        soles = [(np.array([p[0], p[1], g]), r) for (p, r), g in zip(soles, ground)]
+        forces = held_forces(ctx, stance_heading(soles))
+        box = ctx.held.box
+        shift = np.array([-box.mass_kg / self.poses.mass_kg * GRASP_DISTANCE_M, 0.0])
+        posture = q[7:].copy()
+        q_stand = yield from ctx.compute("stand holding", PosePlanner.stand, q, soles,
+                                         min(ground) + self.poses.nominal_pelvis_m, posture, shift)
+        self._carry_q = None
+        ctx.note(f"stand holding '{box.name}'")
+        yield from ctx.run(keyframe_trajectory("hold", [(0.0, q), (cfg.move_s, q_stand)],
+                                               hand_forces=lambda tk: forces), keep=True)
 
     def _stand_at(self, height: float, style_name: str) -> Iterator[None]:
         ctx = self.ctx

@@ -100,6 +100,21 @@ def carry_plan(poses: PosePlanner, q0: np.ndarray, steps: list[Footstep], cfg: S
     return plan
 
 
+def squeeze_for(ctx: GoalContext, box: Box) -> float:
+    """The squeeze per hand for `box`: GoalConfig.squeeze_n, or 1.3 times the Coulomb minimum
+    (m g / (2 mu) per hand) where that is more. Not more than needed: a 3 kg box squeezed with twice
+    its minimum (29 N) rolled about the forward axis in the hands while held (measured)."""
+    return max(ctx.config.squeeze_n, 1.3 * box.mass_kg * GRAVITY / (2.0 * box.friction))
+
+
+def held_forces(ctx: GoalContext, heading: float) -> np.ndarray:
+    """(2, 3) the held box's forces on the hands with the robot facing `heading` (zeros: none held)."""
+    held = ctx.held
+    if held is None:
+        return np.zeros((2, 3))
+    return hand_forces(heading, held.squeeze_n, held.box.mass_kg * GRAVITY)
+
+
 def find_box(ctx: GoalContext, name: str | None) -> Box:
     if name is not None:
         box = ctx.scene.box(name)
@@ -149,6 +164,7 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     c = center + np.append(ctx.offset(), 0.0)
     width = grasp_width(box, heading)
     weight = box.mass_kg * GRAVITY
+    squeeze = squeeze_for(ctx, box)
     # the hands rise close to the body first (a table's edge is ~0.22 m ahead of the pelvis:
     # moving them straight to the box dragged them over the table top, measured)
     via = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.08, ahead_m=-(GRASP_DISTANCE_M - RAISE_AHEAD_M))
@@ -159,8 +175,8 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     q_via, q_pre, q_con, q_lift = yield from ctx.compute("grasp", grasp_poses, q0, soles, heading,
                                                          (via, pre, con, lift), shift, box.name)
     t = {"via": 1.2, "pre": 2.2, "con": 3.0, "squeeze": 3.5, "lift": 4.7, "end": 5.7}
-    full = hand_forces(heading, cfg.squeeze_n, weight)
-    squeeze_only = hand_forces(heading, cfg.squeeze_n, 0.0)
+    full = hand_forces(heading, squeeze, weight)
+    squeeze_only = hand_forces(heading, squeeze, 0.0)
 
     def forces(tk: float) -> np.ndarray:
         a = float(smoothstep((tk - t["con"] + 0.1) / (t["squeeze"] - t["con"] + 0.1)))
@@ -172,7 +188,7 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     ctx.info.update(box=box.name, box_start_w_m=center.tolist(), lift_m=cfg.lift_m,
                     held_from_s=ctx.t + t["lift"])
     yield from ctx.run(keyframe_trajectory("pick", keys, hand_forces=forces))
-    ctx.held = Held(box, full)
+    ctx.held = Held(box, full, squeeze)
     ctx.box_positions[box.name] = None
 
 
@@ -202,6 +218,7 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     q0 = ctx.hold_q()
     posture = q0[7:].copy()
     weight = box.mass_kg * GRAVITY
+    squeeze = ctx.held.squeeze_n
     shift = np.array([-box.mass_kg / ctx.poses.mass_kg * GRASP_DISTANCE_M, 0.0])
     stance = Stance.of(ctx.ik, q0)
     far = float(np.hypot(*(approach.mid_xy - stance.mid_xy))) > 0.05 or \
@@ -212,7 +229,7 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
         # the robot's frame (the squeeze across it, the weight down)
         yield from carry(ctx, approach.mid_xy + off, approach.heading, posture, weight, shift)
         yield from correct_stance(ctx, approach.mid_xy, approach.heading, cfg.carry, posture=posture,
-                              forces=hand_forces(approach.heading, cfg.squeeze_n, weight),
+                              forces=hand_forces(approach.heading, squeeze, weight),
                               com_shift=ctx.poses.com_offset_m + shift)
     q0 = ctx.hold_q()
     soles = flat_soles(ctx.ik, q0)
@@ -225,8 +242,8 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     q_down, q_open, q_out, q_stand = yield from ctx.compute("release", release_poses, q0, soles, heading,
                                                             (down, opened, out), shift)
     t = {"down": 1.5, "release": 2.2, "open": 3.0, "out": 4.0, "stand": 5.5, "end": 6.0}
-    full = hand_forces(heading, cfg.squeeze_n, weight)
-    squeeze_only = hand_forces(heading, cfg.squeeze_n, 0.0)
+    full = hand_forces(heading, squeeze, weight)
+    squeeze_only = hand_forces(heading, squeeze, 0.0)
 
     def forces(tk: float) -> np.ndarray:
         b = 1.0 - float(smoothstep((tk - t["down"] + cfg.force_ramp_s) / cfg.force_ramp_s))
@@ -254,8 +271,10 @@ def carry(ctx: GoalContext, mid_xy: np.ndarray, heading: float, posture: np.ndar
     for st in steps:
         stance = stance.apply(st)
     steps += walk_steps(stance, mid_xy, heading, cfg.carry, lambda xy: ground(xy), then=steps)
+    held = ctx.held  # the box's squeeze (squeeze_for) and weight on the hands; none held: no forces
+    squeeze, load = (held.squeeze_n, held.box.mass_kg * GRAVITY) if held is not None else (0.0, 0.0)
     plan = yield from ctx.compute("carry", carry_plan, q0, steps, cfg.carry, posture, ctx.poses.com_offset_m + com_shift,
-                                  cfg.squeeze_n, weight)
+                                  squeeze, load)
     ctx.last_steps = plan
     traj = plan.trajectory
     if plan.sole_error_m > 0.03:

@@ -17,8 +17,13 @@ Per tick (act() calls one method per step; _contact_state first turns the schedu
 Contact flags come from the reference (JointReference.contacts: the contact schedule), or, with
 WbcConfig.footsteps "velocity", from the controller's own gait (gait.py), which walks the
 reference's root twist: then steps 3-4 are _walking_tasks (CoM from the gait's CoP, pelvis at the
-gait's heading, the gait's swing foot, the reference's upper-body posture). A foot that touches
-down takes load gradually (contact_ramp_s), so torques do not jump.
+gait's heading and at the reference's pelvis height when it asks one, the gait's swing foot, the
+reference's upper-body posture). With footsteps "velocity" a whole-body plan (JointReference.phase
+PHASE_WHOLE_BODY: a goal's pick, place, steps) is still followed by its own contact schedule, so one
+controller both walks and handles objects. Walking with a held load (hand forces in the
+reference), the load's weight joins the pendulum's CoM at the hands and the hands are held where
+the posture puts them. A foot that touches down takes load gradually (contact_ramp_s), so torques
+do not jump.
 """
 
 from __future__ import annotations
@@ -46,7 +51,7 @@ from g1_control.trackers.wbc.tasks import (
     posture_task,
 )
 from g1_control.trackers.wbc.terrain import Terrain
-from g1_control.types import JointReference, MotorCommand, RobotState
+from g1_control.types import PHASE_WHOLE_BODY, JointReference, MotorCommand, RobotState
 
 
 @dataclass(frozen=True)
@@ -105,6 +110,19 @@ class WbcConfig:
     """On steps, the swing foot's task weight (the flat gait's is `swing_foot`'s)."""
     walking_leg_posture_weight: float = 0.05
     """Walking by its own gait, the legs' posture task is only a regulariser (relative to `posture`)."""
+    walking_crouch_lean_per_m: float = 2.5
+    """Walking by its own gait below its nominal pelvis height, the pelvis and trunk pitch forward by
+    this much (rad) per metre lower: an upright pelvis that low keeps the hips over the ankles, and the
+    shanks' forward tilt ran the ankles into their dorsiflexion limit (pelvis 0.55 m, measured)."""
+    walking_held_hands: TaskGains = field(default_factory=lambda: TaskGains(400.0, 40.0, 300.0))
+    """Walking by its own gait with a held load, the hands are held where the reference's posture puts
+    them relative to the pelvis (its heading and position; level in the world): the squeeze tilts
+    with a rolling box and pushes one hand down and the other up (with the arms' joint posture
+    alone, a 3 kg box squeezed with 29 N rolled 19 degrees in 6 s of walking, measured)."""
+    walking_held_upper_weight: float = 30.0
+    """Walking by its own gait with a held load (hand forces), the waist's and arms' posture weight
+    (relative to `posture`): the arms keep the box's pose (at 1 they served the balance, sagged and
+    tilted, and a 3 kg box rolled out of the hands after 8 s, measured)."""
 
     def __post_init__(self) -> None:
         if self.footsteps not in ("plan", "velocity"):
@@ -164,6 +182,8 @@ class WholeBodyTracker(Tracker):
         self._com_height_m, self._pelvis_height_m = self._standing_heights()
         self._posture_weights = np.ones(self.dyn.nv - 6)
         self._posture_weights[list(g1.LEG_JOINTS)] = self.config.walking_leg_posture_weight
+        self._held_posture_weights = self._posture_weights.copy()
+        self._held_posture_weights[list(g1.UPPER_BODY_JOINTS)] = self.config.walking_held_upper_weight
         self.reset()
 
     def _standing_heights(self) -> tuple[float, float]:
@@ -190,6 +210,7 @@ class WholeBodyTracker(Tracker):
         self._frame_vel_ref_prev: dict[int, np.ndarray] = {}
         self._ground_ref_m: float | None = None
         self.diagnostics = WbcDiagnostics()
+        self._following_plan = False
         if self.gait is not None:
             self.gait.reset()
 
@@ -227,7 +248,9 @@ class WholeBodyTracker(Tracker):
             self._start(reference, state)
         dt = 1.0 / self.config.rate_hz if self._last_t is None else max(1e-4, state.t_s - self._last_t)
         self._last_t = state.t_s
-        if self.gait is not None:
+        walking = self._walking(reference, state)
+        if walking:
+            assert self.gait is not None
             schedule = self.gait.schedule(state.t_s, self._walk_command(reference), self._sole_pos, self._sole_yaw,
                                           self._dcm_xy)
         else:
@@ -235,7 +258,7 @@ class WholeBodyTracker(Tracker):
         scheduled, stance, load = self._contact_state(schedule, state.t_s)
         shift = self._estimate_base(state, reference, scheduled, stance, dt)
         com_ref, com_vel_ref = self._reference_kinematics(reference, dt)
-        if self.gait is None:
+        if not walking:
             tasks = [self._balance_task(com_ref, com_vel_ref, stance, shift)]
             tasks += self._motion_tasks(reference, state, stance, shift, dt)
         else:
@@ -244,6 +267,23 @@ class WholeBodyTracker(Tracker):
         if sol is None:
             return self._command if self.diagnostics.solution is not None else self._hold(state)
         return self._motor_command(sol, state, dt)
+
+    def _walking(self, reference: JointReference, state: RobotState) -> bool:
+        """Whether this tick walks by the gait: footsteps "velocity" and a reference that is not a
+        whole-body plan. A whole-body plan (a goal's pick, place, steps) is followed by its own contact
+        schedule; on the switch into one the odometry restarts at the plan's root (the plan starts at the
+        measured pose, as on the tracking layer's hand-over), out of one the gait starts standing."""
+        if self.gait is None:
+            return False
+        plan = reference.phase == PHASE_WHOLE_BODY
+        if plan != self._following_plan:
+            if plan:
+                self.reset(state)
+                self._start(reference, state)
+            else:
+                self.gait.reset()
+            self._following_plan = plan
+        return not plan
 
     def _contact_state(self, schedule: np.ndarray, t_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(scheduled, stance, load): the schedule's stance feet (the reference's, or the gait's); the feet the QP treats as contacts
@@ -400,18 +440,37 @@ class WholeBodyTracker(Tracker):
         assert self.gait is not None
         com = dyn.com_m + shift
         com_vel = dyn.com_vel_mps
+        # a held load (the hand forces' downward part, as a mass at the hands) walks with the body:
+        # the pendulum is the robot and the load together
+        load_kg = max(0.0, -float(dyn.hand_forces_w_n[:, 2].sum()) / cp.GRAVITY_MPS2)
+        com_xy, com_vel_xy = com[:2].copy(), com_vel[:2].copy()
+        if load_kg > 0.0:
+            share = load_kg / (dyn.mass_kg + load_kg)
+            hands = [dyn.frame(fid) for fid in dyn.hand_ids]
+            hand_xy = np.mean([ft.pos_w_m[:2] for ft in hands], axis=0) + shift[:2]
+            hand_vel_xy = np.mean([ft.vel_w[:2] for ft in hands], axis=0)
+            com_xy += share * (hand_xy - com_xy)
+            com_vel_xy += share * (hand_vel_xy - com_vel_xy)
         ground_z = self._ground_reference(stance, dt)
         omega = cp.lipm_frequency(max(com[2] - ground_z, 0.2))
-        self._dcm_xy = cp.capture_point(com[:2], com_vel[:2], omega)
+        self._dcm_xy = cp.capture_point(com_xy, com_vel_xy, omega)
         gt = self.gait.update(state.t_s, dt, self._sole_pos, self._sole_yaw,
                               self._dcm_xy, omega)
         h = cfg.com_height
         speed = float(np.hypot(*self.gait.command_h[:2]))
-        height = self._com_height_m - cfg.walking_com_lower_m - cfg.walking_com_lower_per_mps * speed
+        lower = cfg.walking_com_lower_m + cfg.walking_com_lower_per_mps * speed
+        height = self._com_height_m - lower
+        lean = 0.0
         if reference.pelvis_height_m is not None:
-            height += reference.pelvis_height_m - self._pelvis_height_m
+            # the pelvis held at the height asked (at most the walking height: knees stay bent), by the
+            # CoM's height above the pelvis now (the posture sets it: crouched, the trunk leans and the
+            # pelvis drops further than the CoM)
+            pelvis_z = float(self._q[2])  # after this tick's odometry step, as com
+            pelvis = min(reference.pelvis_height_m, self._pelvis_height_m - lower)
+            height = pelvis + (com[2] - pelvis_z)
+            lean = cfg.walking_crouch_lean_per_m * (self._pelvis_height_m - lower - pelvis)
         a_com = np.empty(3)
-        a_com[:2] = omega**2 * (com[:2] - gt.cop_xy_m)
+        a_com[:2] = omega**2 * (com_xy - gt.cop_xy_m)
         a_com[2] = h.kp * (ground_z + height - com[2]) - h.kd * com_vel[2]
         terrain = not self.gait.terrain.flat
         if terrain:
@@ -422,6 +481,9 @@ class WholeBodyTracker(Tracker):
         wxy, wz = cfg.walking_com_weight
         tasks = [AccelerationTask("com", dyn.com_jac, a_com - dyn.com_drift, np.array([wxy, wxy, wz]))]
         heading_rot = yaw_rotation(gt.heading_rad)
+        if lean > 0.0:
+            c, sn = np.cos(lean), np.sin(lean)
+            heading_rot = heading_rot @ np.array([[c, 0.0, sn], [0.0, 1.0, 0.0], [-sn, 0.0, c]])
         yaw_rate = np.array([0.0, 0.0, gt.yaw_rate_radps])
         pelvis_ref = rd.oMf[dyn.pelvis_id].rotation
         for fid, gains in ((dyn.pelvis_id, cfg.pelvis_orientation), (dyn.torso_id, cfg.torso_orientation)):
@@ -440,8 +502,27 @@ class WholeBodyTracker(Tracker):
             tasks.append(orientation_task("swing_foot_rot", ft.jac_w[3:], ft.drift_w[3:], ft.rot_w, ft.vel_w[3:],
                                           yaw_rotation(gt.swing_yaw_rad), np.array([0.0, 0.0, gt.swing_yaw_rate_radps]),
                                           swing))
+        if load_kg > 0.0:
+            tasks += self._held_hand_tasks(shift)
+        weights = self._held_posture_weights if load_kg > 0.0 else self._posture_weights
         tasks.append(posture_task(dyn.nv, state.q_rad, state.dq_radps, reference.q_rad, reference.dq_radps,
-                                  cfg.posture, self._posture_weights))
+                                  cfg.posture, weights))
+        return tasks
+
+    def _held_hand_tasks(self, shift: np.ndarray) -> list[AccelerationTask]:
+        """The hands where the reference's posture puts them relative to the pelvis, turned with the
+        pelvis's heading only (WbcConfig.walking_held_hands)."""
+        dyn, rd = self.dyn, self.ref_data
+        pelvis = dyn.frame(dyn.pelvis_id)
+        pelvis_ref = rd.oMf[dyn.pelvis_id]
+        turn = yaw_rotation(float(yaw_of_matrix(pelvis.rot_w))) @ yaw_rotation(-float(yaw_of_matrix(pelvis_ref.rotation)))
+        base = pelvis.pos_w_m + shift
+        tasks = []
+        for fid in dyn.hand_ids:
+            ft = dyn.frame(fid)
+            target = base + turn @ (rd.oMf[fid].translation - pelvis_ref.translation)
+            tasks.append(position_task("hand", ft.jac_w[:3], ft.drift_w[:3], ft.pos_w_m + shift, ft.vel_w[:3],
+                                       target, pelvis.vel_w[:3], np.zeros(3), self.config.walking_held_hands))
         return tasks
 
     def _ground_reference(self, stance: np.ndarray, dt: float) -> float:

@@ -13,12 +13,12 @@ FALL_HEIGHT_M = 0.6
 """Pelvis height (ground truth) the robot never goes below while walking (it walks at ~0.72 m)."""
 
 
-def walk(command, seconds, start_s=0.5):
+def walk(command, seconds, start_s=0.5, pelvis_height_m=None, fall_height_m=FALL_HEIGHT_M):
     backend = MujocoBackend()
     state = backend.reset()
     tracker = WholeBodyTracker(WbcConfig(footsteps="velocity"))
     tracker.reset(state)
-    ref = JointReference(q_rad=g1.DEFAULT_Q_RAD.copy())
+    ref = JointReference(q_rad=g1.DEFAULT_Q_RAD.copy(), pelvis_height_m=pelvis_height_m)
     trace = []
     for _ in range(round(seconds / 0.004)):
         state = backend.read_state()
@@ -28,7 +28,7 @@ def walk(command, seconds, start_s=0.5):
         backend.write_command(tracker.act(ref, state))
         backend.step(0.004)
         trace.append((state.t_s, *state.base_pos_w_m, yaw_of(state.imu_quat_wxyz)))
-        if state.base_pos_w_m[2] < FALL_HEIGHT_M:
+        if state.base_pos_w_m[2] < fall_height_m:
             break
     return tracker, np.array(trace)
 
@@ -53,3 +53,15 @@ def test_stands_still_without_a_command():
     tracker, trace = walk((0.0, 0.0, 0.0), 2.0)
     assert tracker.gait is not None and tracker.gait.steps == 0 and tracker.gait.mode == "stand"
     assert np.linalg.norm(trace[-1, 1:3] - trace[0, 1:3]) < 0.03
+
+
+def test_walks_at_the_commanded_pelvis_height():
+    """Pelvis 0.60 m asked while walking 0.4 m/s: held (ground truth), at the speed asked."""
+    tracker, trace = walk((0.4, 0.0, 0.0), 6.5, pelvis_height_m=0.60, fall_height_m=0.4)
+    assert tracker.diagnostics.unsolved_ticks == 0
+    t, pos = trace[:, 0], trace[:, 1:4]
+    assert t[-1] > 6.4, f"fell at {t[-1]:.2f} s"
+    a = np.searchsorted(t, 3.0)
+    assert abs(pos[a:, 2].mean() - 0.60) < 0.025, f"pelvis at {pos[a:, 2].mean():.3f} m for 0.60"
+    speed = (pos[-1, 0] - pos[a, 0]) / (t[-1] - t[a])
+    assert abs(speed - 0.4) < 0.04, f"walked {speed:.3f} m/s for 0.4"
