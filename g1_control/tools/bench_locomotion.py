@@ -198,14 +198,11 @@ def run_case(controller: str, case: Case, walk_s: float, states: list | None = N
     shifted = tuple((t + case.push_stride_fraction * stride, f) for t, f in case.pushes)
     marks = sorted({t for t, _ in shifted if t < duration} | {duration})
     pushes = dict(shifted)
-
-    def stop() -> bool:  # a push run ends at a trip: the damped robot's controller has lost already
-        return loop.fell or bool(case.pushes and loop.faulted)
     t0 = time.perf_counter()
     try:
         for mark in marks:
-            loop.scheduler.run(round((mark - loop.time_s) * loop.rates.lowlevel_hz), stop=stop)
-            if stop():
+            loop.scheduler.run(round((mark - loop.time_s) * loop.rates.lowlevel_hz), stop=lambda: loop.fell)
+            if loop.fell:
                 break
             if mark in pushes:
                 from g1_control.tools.physics_trials import heading_to_world
