@@ -60,11 +60,6 @@ class GaitConfig:
     """Sole centre to sole centre, side to side, walking straight."""
     min_width_m: float = 0.16
     max_width_m: float = 0.45
-    """Walking straight, a landing lies at most this far out (sole centre to sole centre); walking
-    sideways, the limit grows with the nominal width (nominal_step) up to max_sideways_width_m."""
-    max_sideways_width_m: float = 0.6
-    """The widest step at all: sets the sideways speed the gait walks (GaitConfig.speed_margin of it).
-    (0.45 capped sideways walking at 0.27 m/s, measured.)"""
     max_forward_m: float = 0.42
     """Landing sole ahead of the stance sole, at most (heading frame of the step)."""
     max_backward_m: float = 0.32
@@ -113,10 +108,9 @@ class GaitConfig:
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
                 raise WbcConfigError(f"GaitConfig.{name} must be a finite number > 0; got {value}")
-        if not 0 < self.min_width_m <= self.step_width_m <= self.max_width_m <= self.max_sideways_width_m:
-            raise WbcConfigError(f"GaitConfig needs 0 < min_width_m <= step_width_m <= max_width_m <= "
-                                 f"max_sideways_width_m; got {self.min_width_m}, {self.step_width_m}, "
-                                 f"{self.max_width_m}, {self.max_sideways_width_m}")
+        if not 0 < self.min_width_m <= self.step_width_m <= self.max_width_m:
+            raise WbcConfigError(f"GaitConfig needs 0 < min_width_m <= step_width_m <= max_width_m; got "
+                                 f"{self.min_width_m}, {self.step_width_m}, {self.max_width_m}")
         if not 0 <= self.freeze_landing_after <= 1:
             raise WbcConfigError(f"GaitConfig.freeze_landing_after must be in [0, 1]; got {self.freeze_landing_after}")
         if not 0 <= self.swing_arrive_early_s < self.single_support_s:
@@ -299,14 +293,14 @@ class VelocityGait:
         self.targets.mode = self.mode
         return contacts
 
-    def feasible(self, command_h: np.ndarray, margin: float | None = None) -> np.ndarray:
-        """`command_h` within what the step limits allow (`margin`, default GaitConfig.speed_margin,
-        of them), each axis and together (the three axes' fractions of their limits add up to at most one)."""
+    def feasible(self, command_h: np.ndarray) -> np.ndarray:
+        """`command_h` within what the step limits allow (GaitConfig.speed_margin of them), each axis
+        and together (the three axes' fractions of their limits add up to at most one)."""
         cfg = self.config
-        T, m = cfg.step_s, cfg.speed_margin if margin is None else margin
+        T, m = cfg.step_s, cfg.speed_margin
         out = np.array(command_h, dtype=float)
         out[0] = min(max(out[0], -m * cfg.max_backward_m / T), m * cfg.max_forward_m / T)
-        vy = m * (cfg.max_sideways_width_m - cfg.step_width_m) / (2 * T)
+        vy = m * (cfg.max_width_m - cfg.step_width_m) / (2 * T)
         out[1] = min(max(out[1], -vy), vy)
         wz = m * cfg.max_relative_yaw_rad / T
         out[2] = min(max(out[2], -wz), wz)
@@ -328,8 +322,7 @@ class VelocityGait:
             c = self.speed_correction_h
             c += cfg.speed_feedback_gain * (self.command_h[:2] - v_h)
             np.clip(c, -cfg.max_speed_correction_mps, cfg.max_speed_correction_mps, out=c)
-            # no wind-up: the corrected command stays within the step limits (with their margin: walking
-            # 1.0 m/s on steps up to the limits themselves tripped an ankle over-speed, measured)
+            # no wind-up: the corrected command stays within the step limits
             c[:] = self.feasible(np.array([*(self.command_h[:2] + c), 0.0]))[:2] - self.command_h[:2]
         self._td_pos[foot] = landed_xy
         self._td_t[foot] = t_s
@@ -344,18 +337,8 @@ class VelocityGait:
         b_next = _rot2(heading_td) @ nominal_dcm_offset(cfg, f, command_h[:2], omega)
         rel = _rot2(heading_td).T @ (xi_td - b_next - u[:2])
         side_out = _SIDE[f] * rel[1]
-        # inward too: a DCM pushed towards the stance foot's side wants the swing foot across it,
-        # which it cannot reach; the sooner it lands, the sooner the stance foot can step out
-        excess = max(rel[0] - cfg.max_forward_m, -cfg.max_backward_m - rel[0], side_out - self._max_width(f, command_h),
-                     cfg.min_width_m - side_out, 0.0)
+        excess = max(rel[0] - cfg.max_forward_m, -cfg.max_backward_m - rel[0], side_out - cfg.max_width_m, 0.0)
         return heading_td, rel, float(excess)
-
-    def _max_width(self, foot: int, command_h: np.ndarray) -> float:
-        """How far out `foot` may land: as far beyond its nominal width (walking sideways, wider on
-        the side of the motion) as max_width_m is beyond step_width_m, at most max_sideways_width_m."""
-        cfg = self.config
-        nominal = abs(float(nominal_step(cfg, foot, command_h[:2])[1]))
-        return min(nominal + cfg.max_width_m - cfg.step_width_m, cfg.max_sideways_width_m)
 
     def _in_swing(self, t_s: float) -> bool:
         return t_s - self._t0 >= self.config.double_support_s
@@ -456,7 +439,7 @@ class VelocityGait:
                         break
             side = _SIDE[f]
             rel[0] = min(max(rel[0], -cfg.max_backward_m), cfg.max_forward_m)
-            rel[1] = side * min(max(side * rel[1], cfg.min_width_m), self._max_width(f, command_h))
+            rel[1] = side * min(max(side * rel[1], cfg.min_width_m), cfg.max_width_m)
             self._landing[:2] = u[:2] + _rot2(heading_td) @ rel
             self._landing[2] = u[2]
             yaw_s = float(sole_yaws[s])
