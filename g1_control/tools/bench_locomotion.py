@@ -4,8 +4,9 @@ what was commanded, falls, and the CPU cost of each tracker's act().
 
 Every row is one launch through the one loop builder in lockstep MuJoCo: the velocity generator,
 1 s standing, then the command for --seconds (rows forward/backward/sideways/turning);
-then pushes (push_*: PUSH_N for PUSH_S on the pelvis while walking, 4 directions x 5 points of
-the gait, one run per direction) and 10 seeded random velocity timelines (random_s*: 1-5 s
+then pushes (push_<direction>_<k>: PUSH_N for PUSH_S on the pelvis while walking, 4 directions x
+PUSH_PHASES points of the stride, one run per push; a push is survived when neither a fall nor a
+safety trip follows it within PUSH_SETTLE_S) and 10 seeded random velocity timelines (random_s*: 1-5 s
 segments, reversals, combined axes, stops; 30 s each); the WBC (tracker.type wbc, its own gait) at 250 Hz,
 the policies (tracker.type policy, their trained command range, not the shipped envelope) at their
 50 Hz. Figures, all from the simulator's ground truth:
@@ -59,6 +60,8 @@ class Case:
     """Instead of standing then `command`: this timeline (no steady-state figures then)."""
     pushes: tuple[tuple[float, tuple[float, float, float]], ...] = ()
     """(time s, force N in the heading frame at that time) pushes on the pelvis, PUSH_S each."""
+    push_stride_fraction: float = 0.0
+    """The pushes come this fraction of the controller's stride later (the point of the gait)."""
 
 
 CASES = (
@@ -76,6 +79,8 @@ PUSH_S = 0.2
 PUSH_N = 150.0
 PUSH_SPEED_MPS = 0.5
 PUSH_PHASES = 5
+PUSH_AT_S = 4.0
+PUSH_SETTLE_S = 2.5
 
 
 def random_cases(n: int = 10, duration_s: float = 30.0) -> tuple[Case, ...]:
@@ -90,17 +95,20 @@ def random_cases(n: int = 10, duration_s: float = 30.0) -> tuple[Case, ...]:
     return tuple(out)
 
 
-def push_cases(walk_s: float) -> tuple[Case, ...]:
-    """Walking forward at PUSH_SPEED_MPS, PUSH_N for PUSH_S on the pelvis from each of 4 directions,
-    PUSH_PHASES pushes per run 2.5 s apart, each at a later point of the gait (a fifth of a step on)."""
+def push_cases(walk_s: float | None = None) -> tuple[Case, ...]:
+    """Walking forward at PUSH_SPEED_MPS, one push of PUSH_N for PUSH_S on the pelvis per run, from
+    each of 4 directions (named by the side pushed: front pushes backwards) at PUSH_PHASES points of
+    the stride (k / PUSH_PHASES of the controller's stride after PUSH_AT_S); each run ends
+    PUSH_SETTLE_S after its push (walk_s is not used: the grid's runs are short by design)."""
     out = []
+    duration = PUSH_AT_S + 1.0 + PUSH_S + PUSH_SETTLE_S  # the push's latest start is a stride (<= 1 s) on
     for name, force in (("front", (-PUSH_N, 0.0, 0.0)), ("back", (PUSH_N, 0.0, 0.0)),
                         ("left", (0.0, -PUSH_N, 0.0)), ("right", (0.0, PUSH_N, 0.0))):
-        times = tuple(4.0 + k * (2.5 + 0.45 / PUSH_PHASES) for k in range(PUSH_PHASES))
-        duration = max(walk_s, times[-1] + 2.5)
-        out.append(Case(f"push_{name}", (PUSH_SPEED_MPS, 0.0, 0.0),
-                        timeline=(Segment(1.0, label="stand"), Segment(duration, vx_mps=PUSH_SPEED_MPS, label="walk")),
-                        pushes=tuple((t, force) for t in times)))
+        for k in range(PUSH_PHASES):
+            out.append(Case(f"push_{name}_{k}", (PUSH_SPEED_MPS, 0.0, 0.0),
+                            timeline=(Segment(1.0, label="stand"),
+                                      Segment(duration - 1.0, vx_mps=PUSH_SPEED_MPS, label="walk")),
+                            pushes=((PUSH_AT_S, force),), push_stride_fraction=k / PUSH_PHASES))
     return tuple(out)
 
 
@@ -121,7 +129,9 @@ class Row:
     wall_s: float = 0.0
     pushes: int = 0
     pushes_survived: int = 0
-    """Pushes after which the robot was still up 2 s later."""
+    """Pushes followed by neither a fall nor a safety trip within PUSH_SETTLE_S."""
+    trip: str = ""
+    """The safety layer's first trip (damping), if any: a joint over-speed, say."""
     backend: str = ""
     """The simulated robot (loop.chain's backend: nominal, or the randomisation drawn)."""
 
@@ -191,8 +201,10 @@ def run_case(controller: str, case: Case, walk_s: float, states: list | None = N
 
     tracker.act = timed_act  # type: ignore[method-assign]
     duration = sum(seg.duration_s for seg in case.timeline) if case.timeline else 1.0 + walk_s
-    marks = sorted({t for t, _ in case.pushes if t < duration} | {duration})
-    pushes = dict(case.pushes)
+    stride = 2 * tracker.config.gait.step_s if controller == "wbc" else POLICY_GAIT_PERIOD_S  # type: ignore[attr-defined]
+    shifted = tuple((t + case.push_stride_fraction * stride, f) for t, f in case.pushes)
+    marks = sorted({t for t, _ in shifted if t < duration} | {duration})
+    pushes = dict(shifted)
     t0 = time.perf_counter()
     try:
         for mark in marks:
@@ -212,12 +224,15 @@ def run_case(controller: str, case: Case, walk_s: float, states: list | None = N
               backend=loop.chain["backend"])
     row.fell = loop.fell
     row.fall = str(loop.fall) if loop.fall else ""
+    trip = next((e for e in loop.events if e.trips and e.kind != "fall"), None)
+    row.trip = str(trip) if trip else ""
     row.min_pelvis_m = float(log["base_pos_m"][:, 2].min())
     samples = np.asarray(cpu, dtype=float) / 1e3
     row.act_cpu_p50_us, row.act_cpu_p99_us = (float(v) for v in np.percentile(samples, [50, 99]))
     if case.pushes:
-        t_fall = loop.fall.t_s if loop.fall else math.inf
-        row.pushes_survived = sum(1 for t, _ in case.pushes if t + 2.0 < t_fall and t < duration)
+        # a safety trip (damping) ends the controller's run as surely as a fall
+        t_end = min([math.inf] + ([loop.fall.t_s] if loop.fall else []) + [e.t_s for e in loop.events if e.trips])
+        row.pushes_survived = sum(1 for t, _ in shifted if t + PUSH_SETTLE_S <= t_end and t < duration)
         row.pushes = len(case.pushes)
     if not row.fell and not case.timeline:
         period = 2 * tracker.config.gait.step_s if controller == "wbc" else POLICY_GAIT_PERIOD_S  # type: ignore[attr-defined]
@@ -277,7 +292,7 @@ def format_row(row: Row) -> str:
         cmd = "random timeline"
     pushes = f"{row.pushes_survived}/{row.pushes}" if row.pushes else "-"
     return (f"{row.name:<24} {cmd:>17} {got:>23} {row.error_pct:8.1f} {row.off_axis:8.3f} "
-            f"{'FELL' if row.fell else 'no':>5} {row.min_pelvis_m:7.3f} {pushes:>6} "
+            f"{'FELL' if row.fell else 'TRIP' if row.trip else 'no':>5} {row.min_pelvis_m:7.3f} {pushes:>6} "
             f"{row.act_cpu_p50_us:9.0f}/{row.act_cpu_p99_us:<9.0f}")
 
 
