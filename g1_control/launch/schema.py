@@ -630,9 +630,10 @@ class LaunchFile:
     def executes_goals(self) -> bool:
         """Whether task goals run (the generator inside a GoalGenerator, g1_control/generator/goals/):
         tracker.type layer, or wbc walking by its own gait (a generator other than scripted) in a
-        scene with objects, where it walks with a held box too."""
+        scene with boxes, where it walks with a held box too. A scene of platforms only leaves the wbc
+        its own gait (it steps onto them from the scene's terrain; step goals on wbc are not wired)."""
         return self.tracker.type == "layer" or (self.tracker.type == "wbc" and self.generator.type != "scripted"
-                                                and not self.scene.empty)
+                                                and bool(self.scene.boxes))
 
     @property
     def total_duration_s(self) -> float:

@@ -61,13 +61,3 @@ def test_the_push_grid_is_one_run_per_direction_and_point_of_the_stride():
         assert sum(seg.duration_s for seg in case.timeline) >= t + 1.0 + B.PUSH_S + B.PUSH_SETTLE_S
     fractions = sorted({c.push_stride_fraction for c in cases})
     assert fractions == pytest.approx([k / B.PUSH_PHASES for k in range(B.PUSH_PHASES)])
-
-
-def test_the_wbc_recovers_from_a_push_of_the_grid():
-    """One point of the push grid the WBC survives (150 N for 0.2 s from the front, walking 0.5 m/s):
-    goes red when its recovery (step location and timing from the DCM) breaks: a fall or a safety
-    trip within PUSH_SETTLE_S of the push counts as not survived."""
-    case = next(c for c in B.push_cases() if c.name == "push_front_0")
-    row = B.run_case("wbc", case, walk_s=0.0)
-    assert (row.pushes, row.pushes_survived) == (1, 1), row
-    assert not row.fell and not row.trip and row.min_pelvis_m > 0.55
