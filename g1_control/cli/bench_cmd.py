@@ -32,6 +32,9 @@ BENCHMARKS = {
     "locomotion": ("g1_control.tools.bench_locomotion:main",
                    "walking from ground truth: model-based WBC vs holosoma ppo and fastsac per axis and speed "
                    "(achieved vs commanded, off-axis, falls, act() CPU p50/p99 vs RNEA+CRBA); exits 1 on a fall"),
+    "objects": ("g1_control.tools.bench_objects:main",
+                "pick a box (floor/low/table/high support, 0.15-0.45 m, 0.2-6 kg, any yaw) and put it on another "
+                "support, --trials drawn scenes judged from ground truth; a table per bucket, every refusal's reason"),
     "robust": ("g1_control.tools.bench_robust:main",
                "wbc vs ppo walking 0.6 m/s and the step (sim_step) on --draws seeded randomised robots (link mass, "
                "CoM, motor strength, latency, foot friction): falls, achieved vs commanded from ground truth; exits 1 "
@@ -44,7 +47,7 @@ BENCHMARKS = {
                  "the walking tracker's achievable velocity per axis and style; --write ships it as the command limits"),
 }
 
-FANS_OUT = ("execution", "program")
+FANS_OUT = ("execution", "objects", "program")
 """The benchmarks whose trials fan out over --jobs processes or a --ray cluster (g1_control/fanout.py):
 their per-trial work is a function of the trial's task alone, so the figures do not depend on where it ran."""
 
@@ -63,9 +66,10 @@ def register(subparsers) -> None:
     parser.add_argument("--only", metavar="PREFIXES", help="execution/envelope/locomotion: only rows (styles, controller/case) starting with these "
                         "comma-separated prefixes; program: instruction numbers (1,5)")
     parser.add_argument("--seed", type=int, default=0, help="execution: the suite's seed (push timing; default 0); "
-                        "robust: the first draw's seed; stairs: the first seed of the draws")
+                        "robust: the first draw's seed; stairs: the first seed of the draws; objects: the scenes' seed")
     parser.add_argument("--draws", type=int, default=10, help="robust: how many seeded randomised robots (default 10)")
-    parser.add_argument("--trials", type=int, default=5, help="stairs: seeded draws per course (default 5)")
+    parser.add_argument("--trials", type=int, default=None,
+                        help="stairs: seeded draws per course (default 5); objects: drawn scenes (default 10)")
     parser.add_argument("--video", metavar="DIR", help="execution: a video per behaviour into DIR")
     parser.add_argument("--write", action="store_true", help="envelope: write the measured envelope next to the "
                         "policy spec (the loop builder's command limits)")

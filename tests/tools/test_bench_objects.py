@@ -1,0 +1,73 @@
+"""g1 bench objects without physics: scenes drawn from (seed, index) alone and within the stated
+ranges, and the ground-truth judge (a box placed, one dropped, one never lifted, a fall)."""
+
+import math
+
+import numpy as np
+
+from g1_control.tools.bench_objects import HEIGHT_BUCKETS_M, draw_scene, height_bucket, judge, summary
+
+
+def test_scenes_are_a_function_of_seed_and_index_within_the_ranges():
+    a, b = draw_scene(3, 4), draw_scene(3, 4)
+    assert a["scene"] == b["scene"] and a["target_xyz_m"] == b["target_xyz_m"]
+    assert draw_scene(3, 5)["scene"] != a["scene"]
+    buckets = set()
+    for i in range(24):
+        d = draw_scene(11, i)
+        box = d["scene"].boxes[0]
+        assert all(0.15 <= s <= 0.45 for s in box.size_m) and 0.2 <= box.mass_kg <= 6.0
+        assert height_bucket(d["source"]["height_m"]) == d["source"]["bucket"]
+        lo, hi = HEIGHT_BUCKETS_M[d["target"]["bucket"]]
+        assert lo <= d["target"]["height_m"] <= hi
+        d["scene"].validate("scene")
+        buckets.add(d["source"]["bucket"])
+    assert buckets == set(HEIGHT_BUCKETS_M)
+
+
+def _arrays(box_z, hands_z, final_xy, tilt_rad=0.0):
+    n = len(box_z)
+    t = np.arange(n) * 0.1
+    box = np.zeros((n, 7))
+    box[:, 2] = box_z
+    box[:, 3] = 1.0
+    box[-1, :2] = final_xy
+    box[-1, 3:7] = [math.cos(tilt_rad / 2), math.sin(tilt_rad / 2), 0.0, 0.0]
+    hands = np.zeros((n, 2, 3))
+    hands[:, :, 2] = np.asarray(hands_z)[:, None]
+    return {"t_s": t, "box_box": box, "hands_w_m": hands}
+
+
+DRAWN = {"target_xyz_m": [1.0, 1.0, 0.2], "source": {"bucket": "floor", "height_m": 0.0},
+         "target": {"bucket": "low", "height_m": 0.05}, "mass_kg": 4.0, "size_m": [0.3, 0.3, 0.3], "box_yaw_deg": 0.0}
+INFO = {"g0": {"kind": "pick", "status": "reached", "end_s": 0.45}, "g1": {"kind": "place", "status": "reached",
+                                                                          "released_s": 0.85}}
+
+
+def test_judge_a_carried_and_placed_box_succeeds():
+    z = [0.15, 0.15, 0.2, 0.3, 0.3, 0.3, 0.3, 0.3, 0.25, 0.2, 0.2]
+    hands = [0.5, 0.3, 0.2, 0.3, 0.3, 0.3, 0.3, 0.3, 0.25, 0.2, 0.3]
+    r = judge(DRAWN, _arrays(z, hands, [1.03, 1.0]), INFO, {}, 0.7, False, index=0)
+    assert r["success"] and r["lifted"] and r["held"] and r["placed"] and not r["dropped"]
+    assert r["weight"] == "heavy" and abs(r["place_error_xy_m"] - 0.03) < 1e-9
+    assert summary([r])["from floor"] == {"success": 1, "trials": 1}
+
+
+def test_judge_sees_a_drop_a_tilt_a_miss_and_a_fall():
+    z = [0.15, 0.15, 0.2, 0.3, 0.3, 0.15, 0.15, 0.15, 0.15, 0.2, 0.2]  # fell out of the hands at 0.5 s
+    hands = [0.5, 0.3, 0.2, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3, 0.3]
+    r = judge(DRAWN, _arrays(z, hands, [1.0, 1.0]), INFO, {}, 0.7, False, index=0)
+    assert r["dropped"] and not r["success"]
+    tilted = judge(DRAWN, _arrays([0.15, 0.3, 0.3, 0.2], [0.3, 0.3, 0.3, 0.2], [1.0, 1.0], tilt_rad=0.5),
+                   {"g1": {"kind": "place", "status": "reached"}}, {}, 0.7, False, index=0)
+    assert not tilted["upright"] and not tilted["success"]
+    missed = judge(DRAWN, _arrays([0.15, 0.3, 0.3, 0.2], [0.3, 0.3, 0.3, 0.2], [1.2, 1.0]), {}, {}, 0.7, False,
+                   index=0)
+    assert not missed["placed"]
+    fell = judge(DRAWN, _arrays([0.15, 0.3, 0.3, 0.2], [0.3, 0.3, 0.3, 0.2], [1.0, 1.0]), {}, {}, 0.25, False,
+                 index=0)
+    assert fell["fell"] and not fell["success"]
+    refused = judge(DRAWN, _arrays([0.15] * 4, [0.5] * 4, [3.0, 0.0]),
+                    {"g0": {"kind": "pick", "status": "failed"}}, {"g0": "no stance can pick it up"}, 0.7, False,
+                    index=0)
+    assert refused["refused"] == ["pick: no stance can pick it up"] and not refused["lifted"]
