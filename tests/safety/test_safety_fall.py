@@ -94,3 +94,48 @@ def test_standing_run_reports_no_fall_and_summary_names_a_fall():
     assert "no fall" in format_summary(result)
     result.fall, result.fell = {"t_s": 1.5, "kind": "body_contact", "detail": "left_knee_link on the ground"}, True
     assert "FELL at 1.50 s: left_knee_link on the ground" in format_summary(result)
+
+
+def test_the_fall_judges_bounds_and_words_exactly():
+    """At the limits (tilt exactly max_tilt_rad, pelvis exactly min_pelvis_height_m) the robot has not
+    fallen; just past them it has, at that tick, with the words the summary shows; bodies on the
+    ground are all named; a bad height names the `fall.` key by default."""
+    import math
+
+    from g1_control.errors import SafetyConfigError
+    from g1_control.safety.fall import FallConfig, FallMonitor
+
+    def tilted(angle: float) -> np.ndarray:
+        return np.array([math.cos(angle / 2), math.sin(angle / 2), 0.0, 0.0])
+
+    from g1_control.rotations import tilt_rad
+
+    upright = np.array([1.0, 0.0, 0.0, 0.0])
+    limit = float(tilt_rad(tilted(0.5)))  # 0.5 rad, as the monitor computes it
+    monitor = FallMonitor(FallConfig(min_pelvis_height_m=0.4), max_tilt_rad=limit)
+    assert monitor.update(1.0, tilted(0.5), 0.4, ()) is None  # both exactly at their limits
+    fall = monitor.update(1.5, tilted(0.5 + 1e-4), 0.7, None)
+    assert fall is not None and (fall.t_s, fall.kind) == (1.5, "tilt")
+    assert fall.detail == "pelvis tilted 0.50 rad (limit 0.50)" and str(fall) == f"{fall.detail} at 1.50 s"
+    monitor = FallMonitor(FallConfig(min_pelvis_height_m=0.4), max_tilt_rad=0.5)
+    fall = monitor.update(2.25, upright, 0.3999, None)
+    assert fall is not None and (fall.t_s, fall.kind, fall.detail) == (2.25, "pelvis_low", "pelvis at 0.40 m (limit 0.40)")
+    monitor = FallMonitor(FallConfig(allowed_contacts=("left_hand",)))
+    assert monitor.update(3.0, upright, 0.7, ("left_hand",)) is None
+    fall = monitor.update(3.5, upright, 0.7, ("left_knee_link", "left_hand", "right_knee_link"))
+    assert fall is not None and (fall.t_s, fall.kind) == (3.5, "body_contact")
+    assert fall.detail == "left_knee_link, right_knee_link on the ground"
+    with pytest.raises(SafetyConfigError, match=r"^fall\.min_pelvis_height_m is 0.0; it must lie in"):
+        FallConfig(min_pelvis_height_m=0.0).validate()
+
+
+def test_first_fault_is_the_first_unplanned_trip():
+    """Planned trips (stop, control time over, a signal) and events that trip nothing are passed over."""
+    from g1_control.loop.control_loop import first_fault
+
+    stop = {"kind": "estop", "trips": True, "planned": True}
+    note = {"kind": "clamp", "trips": False, "planned": False}
+    crc = {"kind": "crc_burst", "trips": True, "planned": False}
+    assert first_fault([stop, note, crc, dict(crc, kind="later")]) is crc
+    assert first_fault([stop, note]) is None
+    assert first_fault([{"kind": "old", "trips": True}]) == {"kind": "old", "trips": True}  # planned absent: a fault
