@@ -114,20 +114,29 @@ def test_web_view_draws_the_scene_and_moves_its_box():
 
 def box_pixels(image: np.ndarray) -> int:
     """Pixels of the boxes' green (sim/scene.py BOX_RGBA, shaded) in the 3D canvas's middle (not
-    the page's green "connected" icon or axis gizmo)."""
+    the page's green "connected" icon or axis gizmo). By hue, not saturation: software WebGL draws the
+    box pale (180, 222, 179), and the floor and robot are grey or blue."""
     h, w, _ = image.shape
     middle = image[h // 5: h, w // 5: 4 * w // 5]
     r, g, b = (middle[..., k].astype(int) for k in range(3))
-    return int(((g > 60) & (g > 1.6 * r) & (g > 1.6 * b)).sum())
+    return int(((g > 60) & (g > r + 25) & (g > b + 25)).sum())
 
 
-@pytest.mark.slow
-def _rendered(url: str, out, tries: int = 3) -> np.ndarray:
-    """A screenshot of the page once it has drawn anything: on a loaded host headless Chromium now and
-    then hands back the blank page (every pixel white, seen in CI), which is taken again."""
+def _drawn(image: np.ndarray) -> bool:
+    """Whether the 3D canvas has drawn its scene: the floor and the robot cover much of the picture's
+    middle (the page's text and icons alone do not)."""
+    h, w, _ = image.shape
+    middle = image[h // 5: h, w // 5: 4 * w // 5]
+    return float((middle < 250).any(axis=2).mean()) > 0.05
+
+
+def _rendered(url: str, out, tries: int = 4) -> np.ndarray:
+    """A screenshot of the page once its 3D canvas has drawn: on a loaded host headless Chromium now
+    and then hands back the page before WebGL drew (the middle white; seen in CI twice, once with the
+    page's text already there), which is taken again."""
     for _ in range(tries):
         image = screenshot(url, out, wait_ms=20000)
-        if (image < 250).any():
+        if _drawn(image):
             return image
     return image
 
