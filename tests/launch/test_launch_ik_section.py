@@ -60,10 +60,19 @@ def test_settings_and_the_tracker_rate_reach_the_solver():
     ({"velocity_limit_scale": 1.5}, r"ik.velocity_limit_scale: 1.5 is outside \(0, 1\]"),
     ({"joint_margin_rad": -0.1}, r"ik.joint_margin_rad: -0.1 is outside \[0, 0.2\) rad"),
     ({"hold_contact": True}, "ik: unknown key 'hold_contact'; allowed: backend, iterations"),
+    # every cost named by its own key, and the bounds at their edges (mutation survivors, issue 26)
+    ({"com_cost": [1, -1, 1]}, r"ik.com_cost: \[1.0, -1.0, 1.0\] has a negative cost"),
+    ({"default_frame_cost": [1, -2]}, r"ik.default_frame_cost: \[1.0, -2.0\] has a negative cost"),
+    ({"damping_cost": -0.5}, r"ik.damping_cost: -0.5 has a negative cost"),
+    ({"smoothness_cost": -2}, r"ik.smoothness_cost: -2.0 has a negative cost"),
+    ({"velocity_limit_scale": 0.0}, r"^x.yaml: ik.velocity_limit_scale: 0.0 is outside \(0, 1\] \(a fraction of the "
+                                    r"motors' velocity limits\)$"),
+    ({"joint_margin_rad": 0.2}, r"ik.joint_margin_rad: 0.2 is outside \[0, 0.2\) rad"),
+    ({"joint_margin_rad": 1.0}, r"ik.joint_margin_rad: 1.0 is outside \[0, 0.2\) rad"),
 ])
 def test_bad_settings_are_refused_with_the_key(ik, message):
     with pytest.raises(LaunchFileError, match=message):
-        parse_launch(minimal(ik=ik))
+        parse_launch(minimal(ik=ik), "x.yaml")
 
 
 def test_an_unknown_frame_is_refused_when_the_stage_is_built():
