@@ -84,32 +84,6 @@ GROUPS: dict[str, dict[str, list[str]]] = {
         "tests": ["tests/loop/test_control_loop.py", "tests/safety/test_safety_fall.py",
                   "tests/launch/test_launch_trips.py", "tests/deploy/test_deploy_state_machine.py"],
     },
-    "loop-dds": {
-        # The loop group with the robot path's deploys over DDS too (hours; a machine with nothing else on it).
-        # The robot path's runtime trips (issue 26): the loop's CRC, peer and fall checks, the fall
-        # judge, the deploy's state machine and its run's end. Its tests include deploys over DDS
-        # (~10 s each): every mutant of these files (1,900) is about 4.5 hours on 2 cores, so only the
-        # functions on the trip path run (`select`, ~450 mutants, about an hour): the loop's safety,
-        # state reading, fall and event code, the fall judge, the deploy state machine, and the deploy
-        # session's end of run (how a trip ends in damping and in the report). The loop's logging,
-        # construction and the session's printing are left out.
-        "mutate": ["g1_control/loop/control_loop.py", "g1_control/safety/fall.py",
-                   "g1_control/deploy/state_machine.py", "g1_control/deploy/session.py"],
-        "select": ["g1_control.loop.control_loop.x_first_fault*", "g1_control.loop.control_loop.xǁLoopEventǁ*",
-                   *(f"g1_control.loop.control_loop.xǁControlLoopǁ{f}__mutmut_*" for f in (
-                       "_safety", "_on_safety_event", "_check_fall", "_read_state", "_fault", "_event", "faulted",
-                       "fall", "fell", "_feed_back")),
-                   "g1_control.safety.fall.*", "g1_control.deploy.state_machine.*",
-                   *(f"g1_control.deploy.session.*{f}__mutmut_*" for f in (
-                       "_end_in_damping", "_on_signal", "finish", "_fill_report", "_state_machine"))],
-        # Lockstep tests only: the deploys over DDS run on the wall clock, and under mutmut (nice 19,
-        # beside other work) their loop misses deadlines and trips, which fails mutmut's clean run.
-        # Their mutants: group loop-dds, on a quiet machine.
-        "tests": ["tests/loop/test_control_loop.py", "tests/safety/test_safety_fall.py",
-                  "tests/launch/test_launch_trips.py", "tests/deploy/test_deploy_state_machine.py",
-                  "tests/deploy/test_deploy_runtime_trips.py", "tests/deploy/test_deploy_state_validation.py",
-                  "tests/deploy/test_deploy_run_folder.py"],
-    },
     "velocity": {
         # locomotion.py is mutated whole; only VelocityCorrector's mutants are counted (the tracker's
         # other code is covered by physics tests that are too slow to run per mutant).
@@ -119,6 +93,10 @@ GROUPS: dict[str, dict[str, list[str]]] = {
         "only": ["VelocityCorrector"],
     },
 }
+# The loop group with the robot path's deploys over DDS too (hours; a machine with nothing else on it).
+GROUPS["loop-dds"] = {**GROUPS["loop"], "tests": [*GROUPS["loop"]["tests"], "tests/deploy/test_deploy_runtime_trips.py",
+                                                  "tests/deploy/test_deploy_state_validation.py",
+                                                  "tests/deploy/test_deploy_run_folder.py"]}
 
 
 def export(rev: str, dest: Path) -> None:
