@@ -472,9 +472,8 @@ class RobotEmulator:
 def _start_to_scene(start_in_scene: list[float], pos: np.ndarray, quat_wxyz: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray]:
     """A pose in the start frame of a robot that started at `start_in_scene` (x, y, yaw), in the scene's frame."""
+    from g1_control.sim.mocap import _rot_z
+
     x, y, yaw = (float(v) for v in start_in_scene)
     c, s = math.cos(yaw), math.sin(yaw)
-    out = np.array([x + c * pos[0] - s * pos[1], y + s * pos[0] + c * pos[1], pos[2]])
-    hc, hs = math.cos(yaw / 2), math.sin(yaw / 2)  # rotate about z by yaw: (hc, 0, 0, hs) * q
-    w, qx, qy, qz = (float(v) for v in quat_wxyz)
-    return out, np.array([hc * w - hs * qz, hc * qx - hs * qy, hc * qy + hs * qx, hc * qz + hs * w])
+    return np.array([x + c * pos[0] - s * pos[1], y + s * pos[0] + c * pos[1], pos[2]]), _rot_z(quat_wxyz, yaw)
