@@ -18,6 +18,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from g1_control.scene import Platform
 from g1_control.types import (
     NO_GOALS,
     PHASE_LOCOMOTION,
@@ -151,6 +152,10 @@ class WorldPoseEstimate(Protocol):
 
     def object_positions(self) -> Mapping[str, np.ndarray]:
         """Named objects (boxes) seen by perception, their centres in the scene frame ({} without perception)."""
+        ...
+
+    def platforms_seen(self) -> Mapping[str, Platform]:
+        """Platforms seen by perception, where it sees them in the scene frame ({} without perception)."""
         ...
 
 

@@ -55,8 +55,10 @@ def register(subparsers) -> None:
     _add_feed_arguments(parser, "mocap", "mocap/pose", 100.0, "pose")
     parser.add_argument("--scene", metavar="FILE",
                         help="build this launch file's scene (tables, platforms, boxes) in the MuJoCo physics and "
-                        "publish its boxes (if any) as perception sees them (g1_msgs ObjectPoses_ on rt/<--perception-topic>, "
-                        "each box in the robot's heading frame); the exit report gives the boxes' ground truth")
+                        "publish its boxes and platforms (if any) as perception sees them (g1_msgs ObjectPoses_ on "
+                        "rt/<--perception-topic>, PlatformPoses_ on rt/<--perception-topic>/platforms, each in the robot's "
+                        "heading frame; the --perception-* noise, latency and dropouts apply to both); the exit report "
+                        "gives the boxes' and platforms' ground truth")
     _add_feed_arguments(parser, "perception", "perception/objects", 10.0, "frame")
     parser.add_argument("--record", metavar="FILE", help="write the ground truth (hand points, sole points, boxes; "
                         "50 Hz, stamped with the host's monotonic clock) to this .npz at exit, for judging the goals of a "
@@ -209,7 +211,7 @@ def _run(args) -> int:
     try:
         if args.mocap:
             emulator.publish_mocap(_feed_config(args, "mocap"), args.mocap_topic, start_in_scene)
-        if scene is not None and scene.boxes:  # a scene of tables and platforms only: nothing to perceive
+        if scene is not None and (scene.boxes or scene.platforms):  # tables only: nothing to perceive
             emulator.publish_perception(mujoco, _feed_config(args, "perception"), args.perception_topic)
     except ValueError as exc:
         emulator.close()
@@ -268,7 +270,10 @@ def _run(args) -> int:
           f"{report['ignored_while_builtin_active']} ignored while the built-in controller ran", file=sys.stderr)
     if "boxes_w_m" in report:
         boxes = ", ".join(f"{name} ({x:+.3f}, {y:+.3f}, {z:+.3f})" for name, (x, y, z) in report["boxes_w_m"].items())
-        print(f"g1 sim-robot: ground truth at exit: boxes {boxes}; pelvis {report['base_pos_w_m']}", file=sys.stderr)
+        platforms = "".join(f"; platform {name} at ({p['center_xy_m'][0]:+.3f}, {p['center_xy_m'][1]:+.3f}), "
+                            f"{p['height_m']:.2f} m high" for name, p in report["platforms_w_m"].items())
+        print(f"g1 sim-robot: ground truth at exit: boxes {boxes or 'none'}{platforms}; pelvis {report['base_pos_w_m']}",
+              file=sys.stderr)
     if "mocap" in report:
         m = report["mocap"]
         print(f"g1 sim-robot: motion capture: {m['sent']} poses sent, {m['dropped']} of {m['measured']} dropped",

@@ -547,8 +547,13 @@ def _report_localisation(report: DeployReport, loop) -> None:
                                 "max_reacquire_m": c.max_reacquire_m}
     if localiser.objects is not None:
         p = localiser.objects.counters
-        out["perception"] = {"frames": p.frames, "rejected": dict(p.rejected), "last_rejection": p.last_rejection,
-                             "objects_w_m": {n: [float(v) for v in xyz] for n, xyz in localiser.objects.positions.items()}}
+        out["perception"] = {"frames": p.frames, "platform_frames": p.platform_frames, "rejected": dict(p.rejected),
+                             "last_rejection": p.last_rejection,
+                             "objects_w_m": {n: [float(v) for v in xyz] for n, xyz in localiser.objects.positions.items()},
+                             "platforms_w_m": {n: {"center_xy_m": [float(v) for v in b.center_xy_m],
+                                                   "size_xy_m": [float(v) for v in b.size_xy_m],
+                                                   "height_m": float(b.height_m), "yaw_rad": float(b.yaw_rad)}
+                                               for n, b in localiser.objects.platforms.items()}}
     report.localisation = out
     localiser.close()
 

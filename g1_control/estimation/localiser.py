@@ -30,6 +30,7 @@ from g1_control.estimation.external_pose import Planar, PoseFusion, PoseSample
 from g1_control.estimation.perception import ObjectPerception
 from g1_control.estimation.pose import LegOdometry
 from g1_control.rotations import wrap_angle, yaw_of
+from g1_control.scene import Platform
 from g1_control.types import RobotState, WorldPose
 
 TRACK_PERIOD_S = 0.05
@@ -123,6 +124,10 @@ class Localiser:
     def object_positions(self) -> dict[str, np.ndarray]:
         """Objects seen by perception (estimation/perception.py), in the scene frame; {} without one."""
         return self.objects.positions if self.objects is not None else {}
+
+    def platforms_seen(self) -> dict[str, Platform]:
+        """Platforms seen by perception (estimation/perception.py), in the scene frame; {} without one."""
+        return self.objects.platforms if self.objects is not None else {}
 
     def scene_state(self, state: RobotState) -> RobotState:
         """`state` with this estimate as its base pose in the scene frame: base_pos_w_m, the IMU's

@@ -11,6 +11,15 @@ than MOVED_M from that mean starts the average over (it was moved).
     perception = ObjectPerception(PerceptionConfig(interface="lo", max_age_s=0.5), source)
     perception.update(now_s, localiser.pose_at)     # every estimator tick, after the localiser
     perception.positions["box"]                      # (x, y, z) in the scene frame
+
+Platforms (steps) arrive the same way on a topic of their own (the perception topic + /platforms:
+PlatformPoses_, the centre of each top face with its yaw, and its footprint and height), stamped,
+refused by the same rules, averaged the same way, and kept as scene Platforms (`platforms`) in the
+scene frame; a sighting that is not a platform the scene could hold (a size or height out of range, a
+bad name, a number that is not finite) is refused by name as invalid.
+
+    perception = ObjectPerception(config, source, DdsPlatformSource(reader))
+    perception.platforms["step"]                     # scene.Platform where perception sees it
 """
 
 from __future__ import annotations
@@ -23,12 +32,15 @@ from typing import Protocol
 import numpy as np
 
 from g1_control.errors import LaunchFileError
+from g1_control.rotations import wrap_angle, yaw_of
+from g1_control.scene import Platform
 from g1_control.types import WorldPose
 
 
 @dataclass
 class PerceptionConfig:
-    """launch file `estimation.perception`: the topic of object poses (g1 sim-robot --scene publishes one)."""
+    """launch file `estimation.perception`: the topic of object poses (g1 sim-robot --scene publishes one),
+    and beside it the topic of platforms (`platform_topic`)."""
 
     topic: str = "perception/objects"
     interface: str | None = None
@@ -36,6 +48,13 @@ class PerceptionConfig:
     partition: str | None = None
     """Default: the robot link's (backend.partition)."""
     max_age_s: float = 0.5
+
+    @property
+    def platform_topic(self) -> str:
+        """Where platforms arrive: the topic + /platforms (PlatformPoses_, hardware/ros2/messages.py)."""
+        from g1_control.hardware.ros2.topics import PLATFORMS_SUFFIX
+
+        return self.topic + PLATFORMS_SUFFIX
 
     def validate(self, where: str) -> None:
         from g1_control.hardware.ros2.topics import check_topic_name
@@ -59,11 +78,21 @@ MOVED_M = 0.25
 box 21 cm sideways at 4 m)."""
 
 Objects = dict[str, tuple[tuple[float, float, float], tuple[float, float, float, float]]]
+Platforms = dict[str, tuple[tuple[float, float, float], tuple[float, float, float, float], tuple[float, float, float]]]
+"""name -> (top centre xyz, quat wxyz, size: footprint x, y and height above the floor), heading frame."""
 
 
 class ObjectSource(Protocol):
     def take(self, now_s: float) -> list[tuple[float, Objects]]:
         """Frames that arrived: (stamp on the loop's clock, name -> (xyz, quat wxyz) in the heading frame)."""
+        ...
+
+    def close(self) -> None: ...
+
+
+class PlatformSource(Protocol):
+    def take(self, now_s: float) -> list[tuple[float, Platforms]]:
+        """Frames that arrived: (stamp on the loop's clock, name -> platform in the heading frame)."""
         ...
 
     def close(self) -> None: ...
@@ -82,29 +111,74 @@ class DdsObjectSource:
         self.reader.close()
 
 
+class DdsPlatformSource:
+    """PlatformPoses_ from a DDS topic (hardware/ros2/topics.py), stamps moved onto the loop's clock by age."""
+
+    def __init__(self, reader) -> None:
+        self.reader = reader
+
+    def take(self, now_s: float) -> list[tuple[float, Platforms]]:
+        return [(now_s - r.age_s, r.platforms) for r in self.reader.take()]
+
+    def close(self) -> None:
+        self.reader.close()
+
+
 @dataclass
 class PerceptionCounters:
     frames: int = 0
-    rejected: dict[str, int] = field(default_factory=lambda: {"stale": 0, "no_pose": 0})
+    platform_frames: int = 0
+    rejected: dict[str, int] = field(default_factory=lambda: {"stale": 0, "no_pose": 0, "invalid": 0})
     last_rejection: str = ""
 
 
 class ObjectPerception:
-    """See the module docstring."""
+    """See the module docstring. platform_source: where platforms arrive (None: boxes only)."""
 
-    def __init__(self, config: PerceptionConfig, source: ObjectSource):
+    def __init__(self, config: PerceptionConfig, source: ObjectSource, platform_source: PlatformSource | None = None):
         self.config = config
         self.source = source
+        self.platform_source = platform_source
         self.positions: dict[str, np.ndarray] = {}
         """name -> the object's centre in the scene frame (the mean of its recent placements)."""
         self.seen_s: dict[str, float] = {}
         self._frames: dict[str, int] = {}
         """name -> placements in its running mean (at most AVERAGE_FRAMES)."""
+        self.platforms: dict[str, Platform] = {}
+        """name -> the platform where perception sees it, in the scene frame (the mean of its recent placements)."""
+        self._platform_means: dict[str, np.ndarray] = {}
+        """name -> (x, y, yaw, size x, size y, height): the running mean behind `platforms`."""
         self.counters = PerceptionCounters()
 
     def update(self, now_s: float, pose_at: Callable[[float], WorldPose | None]) -> None:
+        for stamp, pose, objects in self._placeable(now_s, self.source.take(now_s), pose_at):
+            cy, sy = math.cos(pose.yaw_rad), math.sin(pose.yaw_rad)
+            for name, (p, _) in objects.items():
+                x, y, z = p
+                self._place(name, np.array([pose.x_m + cy * x - sy * y, pose.y_m + sy * x + cy * y, pose.z_m + z]))
+                self.seen_s[name] = stamp
+            self.counters.frames += 1
+        if self.platform_source is None:
+            return
+        for stamp, pose, platforms in self._placeable(now_s, self.platform_source.take(now_s), pose_at):
+            cy, sy = math.cos(pose.yaw_rad), math.sin(pose.yaw_rad)
+            for name, (p, quat, size) in platforms.items():
+                if not np.all(np.isfinite([*p, *quat, *size])):
+                    self._invalid(f"platform '{name}': not finite: position {list(p)}, orientation {list(quat)}, "
+                                  f"size {list(size)}")
+                    continue
+                x, y, _ = p
+                placed = np.array([pose.x_m + cy * x - sy * y, pose.y_m + sy * x + cy * y,
+                                   pose.yaw_rad + yaw_of(np.asarray(quat, dtype=float)), *size], dtype=float)
+                if self._place_platform(name, placed):
+                    self.seen_s[name] = stamp
+            self.counters.platform_frames += 1
+
+    def _placeable(self, now_s: float, frames, pose_at: Callable[[float], WorldPose | None]):
+        """(stamp, the robot's estimated pose at it, contents) of the frames that can be placed; stale
+        frames and frames without a pose counted and refused by name."""
         c = self.counters
-        for stamp, objects in self.source.take(now_s):
+        for stamp, contents in frames:
             age = now_s - stamp
             if age > self.config.max_age_s:
                 c.rejected["stale"] += 1
@@ -115,12 +189,7 @@ class ObjectPerception:
                 c.rejected["no_pose"] += 1
                 c.last_rejection = f"no_pose: no estimate of the robot's pose at the stamp ({age:.3f} s ago)"
                 continue
-            cy, sy = math.cos(pose.yaw_rad), math.sin(pose.yaw_rad)
-            for name, (p, _) in objects.items():
-                x, y, z = p
-                self._place(name, np.array([pose.x_m + cy * x - sy * y, pose.y_m + sy * x + cy * y, pose.z_m + z]))
-                self.seen_s[name] = stamp
-            c.frames += 1
+            yield stamp, pose, contents
 
     def _place(self, name: str, placed: np.ndarray) -> None:
         mean = self.positions.get(name)
@@ -131,8 +200,38 @@ class ObjectPerception:
         self.positions[name] = mean + (placed - mean) / n
         self._frames[name] = n
 
+    def _place_platform(self, name: str, placed: np.ndarray) -> bool:
+        """Fold one placement (x, y, yaw, size x, size y, height; scene frame) into `name`'s running mean
+        (as _place: a jump past MOVED_M starts it over); False, counted as invalid, for a sighting that
+        is not a platform the scene could hold."""
+        try:
+            Platform(name, (placed[0], placed[1]), (placed[3], placed[4]), float(placed[5]), float(placed[2])).validate(
+                f"platform '{name}'")
+        except LaunchFileError as exc:
+            self._invalid(str(exc))
+            return False
+        mean = self._platform_means.get(name)
+        if mean is None or float(np.linalg.norm(placed[:2] - mean[:2])) > MOVED_M:
+            mean, self._frames[name] = placed, 1
+        else:
+            placed[2] = mean[2] + wrap_angle(placed[2] - mean[2])  # the yaw near the mean's, not 2 pi away
+            n = min(self._frames[name] + 1, AVERAGE_FRAMES)
+            mean = mean + (placed - mean) / n
+            self._frames[name] = n
+        self._platform_means[name] = mean
+        self.platforms[name] = Platform(name, (float(mean[0]), float(mean[1])), (float(mean[3]), float(mean[4])),
+                                        float(mean[5]), float(wrap_angle(mean[2])))
+        return True
+
+    def _invalid(self, why: str) -> None:
+        self.counters.rejected["invalid"] += 1
+        self.counters.last_rejection = f"invalid: {why}"
+
     def close(self) -> None:
         self.source.close()
+        if self.platform_source is not None:
+            self.platform_source.close()
 
 
-__all__ = ["DdsObjectSource", "ObjectPerception", "ObjectSource", "PerceptionConfig", "PerceptionCounters"]
+__all__ = ["DdsObjectSource", "DdsPlatformSource", "ObjectPerception", "ObjectSource", "PerceptionConfig",
+           "PerceptionCounters", "PlatformSource"]

@@ -172,12 +172,14 @@ def make_localiser(launch: LaunchFile, estimator: StateEstimator) -> Localiser |
         source = DdsPoseSource(PoseTopicReader(ext.interface, ext.domain, ext.topic,
                                                ext.partition or launch.backend.partition))
     if seen is not None:
-        from g1_control.estimation.perception import DdsObjectSource, ObjectPerception
-        from g1_control.hardware.ros2.topics import ObjectPosesReader
+        from g1_control.estimation.perception import DdsObjectSource, DdsPlatformSource, ObjectPerception
+        from g1_control.hardware.ros2.topics import ObjectPosesReader, PlatformPosesReader
 
         assert seen.interface is not None  # validated: always named
-        objects = ObjectPerception(seen, DdsObjectSource(ObjectPosesReader(
-            seen.interface, seen.domain, seen.topic, seen.partition or launch.backend.partition)))
+        partition = seen.partition or launch.backend.partition
+        objects = ObjectPerception(
+            seen, DdsObjectSource(ObjectPosesReader(seen.interface, seen.domain, seen.topic, partition)),
+            DdsPlatformSource(PlatformPosesReader(seen.interface, seen.domain, seen.platform_topic, partition)))
     return Localiser(LegOdometry(estimator, shared=True), fusion=fusion, source=source, objects=objects)
 
 

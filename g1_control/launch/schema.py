@@ -413,7 +413,9 @@ class EstimationConfig:
     external_pose: ExternalPoseConfig | None = None
     perception: PerceptionConfig | None = None
     """Object poses arriving at run time (g1_control/estimation/perception.py; g1 sim-robot --scene):
-    the scene's boxes move to where perception sees them, placed with the estimate."""
+    the scene's boxes move to where perception sees them, placed with the estimate, and the platforms
+    it sees (on the topic + /platforms) take the place of the scene's or join it; a step goal may then
+    name a platform the scene does not list."""
 
 
 @dataclass
@@ -583,18 +585,21 @@ class LaunchFile:
                 if goal.object is not None and sc.box(goal.object) is None:
                     raise LaunchFileError(f"{where}.object: '{goal.object}' is not a box of the scene; known: "
                                           f"{', '.join(b.name for b in sc.boxes) or 'none (scene.boxes is empty)'}")
+                # a platform perception may see at run time need not be in the scene (a goal whose platform
+                # is never seen refuses then, before anything moves: generator/goals/platform.py)
+                perceived = self.estimation.perception is not None and goal.kind in ("step_up", "step_down")
                 if goal.target is not None:
                     known = [p.name for p in sc.platforms] if goal.kind in ("step_up", "step_down") else \
                         sc.block_names() + [FLOOR]
                     if goal.kind == "reach":
                         known = sc.names()
-                    if goal.target not in known:
+                    if goal.target not in known and not (perceived and goal.target not in sc.names()):
                         what = "a platform" if goal.kind in ("step_up", "step_down") else "a place"
                         raise LaunchFileError(f"{where}.target: '{goal.target}' is not {what} of the scene; known: "
                                               f"{', '.join(known) or 'none'}")
                 if goal.kind in ("pick", "place") and not sc.boxes:
                     raise LaunchFileError(f"{where}: a {goal.kind} goal needs a box in scene.boxes")
-                if goal.kind == "step_up" and not sc.platforms:
+                if goal.kind == "step_up" and not sc.platforms and not perceived:
                     raise LaunchFileError(f"{where}: a step_up goal needs a platform in scene.platforms")
 
     def program_world(self):

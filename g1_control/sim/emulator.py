@@ -33,7 +33,7 @@ from g1_control.sim.robot_endpoint import RobotEndpoint
 from g1_control.types import MotorCommand, RobotState
 
 if TYPE_CHECKING:
-    from g1_control.hardware.ros2.topics import ObjectPosesWriter, PoseTopicWriter
+    from g1_control.hardware.ros2.topics import ObjectPosesWriter, PlatformPosesWriter, PoseTopicWriter
     from g1_control.sim.ground_truth import GroundTruthRecorder
     from g1_control.sim.mocap import MocapConfig, SimulatedMocap, SimulatedPerception
     from g1_control.sim.mujoco_backend import MujocoBackend
@@ -249,6 +249,7 @@ class RobotEmulator:
         self.scene_sim: MujocoBackend | None = None
         """The MuJoCo physics holding a launch file's scene (publish_perception), for its ground truth."""
         self._perception_writer: ObjectPosesWriter | None = None
+        self._platform_writer: PlatformPosesWriter | None = None
 
     @staticmethod
     def _unitree_mujoco_traits() -> tuple[float, str]:
@@ -339,24 +340,40 @@ class RobotEmulator:
 
     def publish_perception(self, sim: MujocoBackend, config: MocapConfig, topic: str = "perception/objects"
                            ) -> SimulatedPerception:
-        """Publish the scene's boxes as a perception system on the robot sees them (ObjectPoses_ on
-        rt/<topic>, each box in the robot's heading frame), from `sim`'s ground truth (sim/mocap.py)."""
-        from g1_control.hardware.ros2.topics import ObjectPosesWriter
+        """Publish the scene's boxes and platforms as a perception system on the robot sees them, from
+        `sim`'s ground truth (sim/mocap.py): boxes as ObjectPoses_ on rt/<topic>, platforms (the centre of
+        the top face, its yaw, footprint and height) as PlatformPoses_ on rt/<topic>/platforms, each in the
+        robot's heading frame. One camera: a frame's noise, latency and dropout are shared by both."""
+        from g1_control.hardware.ros2.topics import PLATFORMS_SUFFIX, ObjectPosesWriter, PlatformPosesWriter
         from g1_control.sim.mocap import SimulatedPerception
 
-        names = [b.name for b in sim.scene.boxes]
-        if not names:
-            raise ValueError("perception: the scene has no boxes to publish")
+        boxes = [b.name for b in sim.scene.boxes]
+        platforms = {p.name: p for p in sim.scene.platforms}
+        if not boxes and not platforms:
+            raise ValueError("perception: the scene has no boxes or platforms to publish")
         perception = SimulatedPerception(config)
-        writer = ObjectPosesWriter(self.link.interface, self.link.domain_id, topic, self.link.partition)
-        self._perception_writer = writer
+        if boxes:
+            self._perception_writer = ObjectPosesWriter(self.link.interface, self.link.domain_id, topic,
+                                                        self.link.partition)
+        if platforms:
+            self._platform_writer = PlatformPosesWriter(self.link.interface, self.link.domain_id,
+                                                        topic + PLATFORMS_SUFFIX, self.link.partition)
+        # platforms stand still: their top faces' poses once (yaw as a quaternion about z)
+        tops = {name: (np.array([p.center_xy_m[0], p.center_xy_m[1], p.height_m], dtype=float),
+                       np.array([math.cos(p.yaw_rad / 2), 0.0, 0.0, math.sin(p.yaw_rad / 2)]))
+                for name, p in platforms.items()}
+        sizes = {name: (p.size_xy_m[0], p.size_xy_m[1], p.height_m) for name, p in platforms.items()}
 
         def sample(state: RobotState) -> None:
             if state.base_pos_w_m is None:
                 return
-            objects = {name: sim.object_pose(name) for name in names}
+            objects = {name: sim.object_pose(name) for name in boxes}
+            objects.update(tops)
             for stamp, seen in perception.sample(time.time(), state.base_pos_w_m, state.imu_quat_wxyz, objects):
-                writer.write(stamp, seen)
+                if self._perception_writer is not None:
+                    self._perception_writer.write(stamp, {name: seen[name] for name in boxes})
+                if self._platform_writer is not None:
+                    self._platform_writer.write(stamp, {name: (*seen[name], sizes[name]) for name in platforms})
 
         self.endpoint.state_observers.append(sample)
         self.perception, self.scene_sim = perception, sim
@@ -386,7 +403,7 @@ class RobotEmulator:
 
     def close(self) -> None:
         self.endpoint.stop()
-        for writer in (self._mocap_writer, self._perception_writer):
+        for writer in (self._mocap_writer, self._perception_writer, self._platform_writer):
             if writer is not None:
                 writer.close()
         if self.service is not None:
@@ -409,12 +426,16 @@ class RobotEmulator:
         if self.mocap is not None and self._mocap_writer is not None:
             out["mocap"] = {"measured": self.mocap.measured, "dropped": self.mocap.dropped,
                             "sent": self._mocap_writer.sent}
-        if self.perception is not None and self._perception_writer is not None:
+        if self.perception is not None:
             out["perception"] = {"measured": self.perception.measured, "dropped": self.perception.dropped,
-                                 "sent": self._perception_writer.sent}
+                                 "sent": 0 if self._perception_writer is None else self._perception_writer.sent,
+                                 "platform_frames_sent": 0 if self._platform_writer is None else self._platform_writer.sent}
         sim = self.scene_sim
         if sim is not None:  # the ground-truth outcome, for judging: where the boxes and the feet are
             out["boxes_w_m"] = {b.name: [float(v) for v in sim.object_pose(b.name)[0]] for b in sim.scene.boxes}
+            out["platforms_w_m"] = {p.name: {"center_xy_m": [float(v) for v in p.center_xy_m],
+                                             "size_xy_m": [float(v) for v in p.size_xy_m], "height_m": float(p.height_m),
+                                             "yaw_rad": float(p.yaw_rad)} for p in sim.scene.platforms}
         out["first_damping_base_pos_w_m"] = self.endpoint.first_damping_base_pos_w_m
         last = self.endpoint.last_command
         # damping on every motor the robot has (a 23-DoF G1's empty slots go out disabled, gains 0)

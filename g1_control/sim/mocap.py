@@ -1,7 +1,7 @@
 """A motion-capture system and a perception system played from the simulator's ground truth, sampled
 at `rate_hz`, with Gaussian noise, a latency and random dropouts, seeded. SimulatedMocap: the pelvis
-pose in the world; SimulatedPerception: the scene's boxes in the robot's heading frame (origin at the
-pelvis, x along its heading), as a camera on the robot sees them.
+pose in the world; SimulatedPerception: the scene's boxes (and platforms' top faces) in the robot's
+heading frame (origin at the pelvis, x along its heading), as a camera on the robot sees them.
 
     mocap = SimulatedMocap(MocapConfig(rate_hz=100, noise_m=0.01, latency_s=0.05, dropout=0.1))
     for stamp_s, position_m, quat_wxyz in mocap.sample(t_s, base_pos_w_m, imu_quat_wxyz):
@@ -85,7 +85,7 @@ class SimulatedMocap:
 
 
 class SimulatedPerception:
-    """Boxes seen from the robot: name -> (position, quat wxyz) in the heading frame, each frame
+    """Objects (boxes, platforms' top faces) seen from the robot: name -> (position, quat wxyz) in the heading frame, each frame
     stamped when seen and released `latency_s` later; a dropped frame loses every object in it."""
 
     def __init__(self, config: MocapConfig):

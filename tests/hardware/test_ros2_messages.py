@@ -52,3 +52,15 @@ def test_pose_stamped_is_ros2s_and_object_poses_is_our_own_type():
     seen = m.ObjectPoses_(m.Header_(m.Time_(1, 0), "heading"), ["box"], [m.Pose_()])
     assert m.ObjectPoses_.deserialize(seen.serialize()) == seen
     assert m.seconds(m.stamp(12.25)) == 12.25
+
+
+def test_platform_poses_is_our_own_type_beside_object_poses_on_a_topic_of_its_own():
+    from g1_control.hardware.ros2.topics import PLATFORMS_SUFFIX
+
+    assert m.PlatformPoses_.__idl_typename__ == "g1_msgs::msg::dds_::PlatformPoses_"
+    assert [f for f in m.ObjectPoses_.__annotations__] == ["header", "names", "poses"]  # boxes' type unchanged
+    seen = m.PlatformPoses_(m.Header_(m.Time_(1, 5), "heading"), ["step"],
+                            [m.Pose_(m.Point_(1.0, 0.2, -0.6), m.Quaternion_(0.0, 0.0, 0.1, 0.995))],
+                            [m.Vector3_(0.7, 1.2, 0.15)])
+    assert m.PlatformPoses_.deserialize(seen.serialize()) == seen
+    assert PLATFORMS_SUFFIX == "/platforms"

@@ -225,6 +225,17 @@ def test_goals_name_their_tracker_and_reach_any_scene_name():
     assert parse_launch(_goals([{"kind": "step_down", "target": "step"}])).input.timeline[1].goals[0].kind == "step_down"
 
 
+def test_with_perception_a_step_goal_may_name_a_platform_the_scene_does_not_list_but_not_a_table():
+    seen = {"steer_by": "estimate", "perception": {"interface": "lo", "domain": 1}}
+    unseen = _goals([{"kind": "step_up", "target": "stage"}], scene={})
+    _refused(unseen, f"{G}.target: 'stage' is not a platform of the scene; known: none")
+    launch = parse_launch({**unseen, "estimation": seen})
+    assert launch.input.timeline[1].goals[0].target == "stage" and not launch.scene.platforms
+    assert parse_launch({**_goals([{"kind": "step_up"}], scene={}), "estimation": seen}).scene.empty
+    _refused({**_goals([{"kind": "step_up", "target": "table_a"}]), "estimation": seen},
+             f"{G}.target: 'table_a' is not a platform of the scene; known: step")
+
+
 # -- load_launch: overrides ----------------------------------------------------------------------------
 def test_overrides_are_applied_before_validation_and_their_errors_name_the_file():
     path = LAUNCH_DIR / "sim_walk.yaml"

@@ -11,6 +11,7 @@ requires it).
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable, Generator, Iterator
 from dataclasses import dataclass, field
@@ -24,7 +25,7 @@ from g1_control.generator.goals.stepping import SteppingConfig
 from g1_control.generator.styles import UpperBodyStyle
 from g1_control.generator.whole_body import WholeBodyTrajectory
 from g1_control.robot import g1
-from g1_control.scene import Box, SceneConfig
+from g1_control.scene import Box, Platform, SceneConfig
 from g1_control.types import PHASE_LOCOMOTION, PHASE_WHOLE_BODY, RobotState, TaskGoal
 
 ARMS = np.array(g1.ARM_JOINTS)
@@ -95,6 +96,9 @@ class GoalConfig:
     0.16 m from the edge), and the walking policy turning in place there put a sole centre 4 cm
     from the edge and the shin on the platform's top edge (measured: program 20 of g1 bench
     program, a fall). The walking policy knows nothing of the platform."""
+    sight_wait_s: float = 2.0
+    """A step goal whose platform the scene does not hold waits this long, standing (nothing moves), for
+    perception to see it (a 10 Hz perception with dropouts: a few frames), then refuses, naming it."""
     policy_height_m: tuple[float, float] = (0.63, 0.78)
     """Pelvis heights the walking policy holds (its envelope); others stand under the WBC."""
     height_min_m: float = 0.45
@@ -121,7 +125,10 @@ class GoalContext:
     """The state the goal skills and the executor share (module docstring)."""
 
     def __init__(self, scene: SceneConfig, config: GoalConfig):
-        self.scene = scene
+        self.scene = dataclasses.replace(scene, platforms=list(scene.platforms))
+        """The launch file's scene, its platforms where perception last saw them (see_platform): a copy,
+        so what perception sees stays with the goals and leaves the launch file's scene as written."""
+        self._listed_platforms = list(scene.platforms)
         self.config = config
         self.poses = PosePlanner()
         self.ik = self.poses.ik
@@ -151,6 +158,9 @@ class GoalContext:
         """The walking command (vx, vy, wz) of an approach (approach.walk_to)."""
         self.held: Held | None = None
         self.on_platform: str | None = None
+        self.scene.platforms[:] = self._listed_platforms
+        self.platforms_seen: set[str] = set()
+        """Platforms perception has seen since the reset (see_platform)."""
         self.box_positions: dict[str, np.ndarray | None] = {b.name: self.scene.box_center(b) for b in self.scene.boxes}
         self.overlay: tuple[UpperBodyStyle, float] | None = None
         """An upper-body style waving the arms over the plan (style, its start time)."""
@@ -162,6 +172,21 @@ class GoalContext:
 
     def note(self, text: str) -> None:
         self.log.append((self.t, text))
+
+    def see_platform(self, platform: Platform) -> None:
+        """Perception sees `platform` (scene frame): it takes the place of the scene's platform of that name
+        (the launch file's may be missing or misplaced), or joins the scene. A name the scene gives a table or
+        a box stays theirs."""
+        platforms = self.scene.platforms
+        for i, p in enumerate(platforms):
+            if p.name == platform.name:
+                platforms[i] = platform
+                break
+        else:
+            if platform.name in self.scene.names():
+                return
+            platforms.append(platform)
+        self.platforms_seen.add(platform.name)
 
     # -- where the robot is -------------------------------------------------------------------------
     @property

@@ -74,10 +74,11 @@ class GoalGenerator(Generator):
 
     def __init__(self, inner: Generator, scene: SceneConfig, config: GoalConfig | None = None):
         self.inner = inner
-        self.scene = scene
         self.config = config or GoalConfig()
         self.ctx = GoalContext(scene, self.config)
         """What the skills share (context.py)."""
+        self.scene = self.ctx.scene
+        """The goals' scene: the launch file's, with the platforms where perception sees them."""
         self.poses = self.ctx.poses
         self.ik = self.poses.ik
         self.goal_status: dict[str, str] = {}
@@ -180,16 +181,19 @@ class GoalGenerator(Generator):
     def _located(self, state: RobotState) -> RobotState:
         if self.estimate is None:
             return state
-        self._perceive(self.estimate.object_positions())
+        self._perceive(self.estimate.object_positions(), self.estimate.platforms_seen())
         return self.estimate.scene_state(state)
 
-    def _perceive(self, seen) -> None:
-        """Boxes where perception last saw them (scene frame), except the one in the hands."""
+    def _perceive(self, seen, platforms=None) -> None:
+        """Boxes where perception last saw them (scene frame), except the one in the hands; platforms
+        where it sees them (GoalContext.see_platform)."""
         ctx = self.ctx
         held = ctx.held.box.name if ctx.held is not None else None
         for name, position in seen.items():
             if name in ctx.box_positions and name != held:
                 ctx.box_positions[name] = position
+        for platform in (platforms or {}).values():
+            ctx.see_platform(platform)
 
     def _reference(self, command: Command, state: RobotState) -> KinematicReference:
         ctx = self.ctx

@@ -109,6 +109,22 @@ class ObjectPoses_(IdlStruct, typename="g1_msgs::msg::dds_::ObjectPoses_"):
 @dataclass
 @final
 @autoid("sequential")
+class PlatformPoses_(IdlStruct, typename="g1_msgs::msg::dds_::PlatformPoses_"):
+    """This project's own type, beside ObjectPoses_ (which it leaves as it was, so publishers and readers
+    of boxes alone keep working; platforms go on a topic of their own: topics.PLATFORMS_SUFFIX): platforms
+    (steps) seen at the header's stamp, in the robot's heading frame (frame_id 'heading'). poses[i]: the
+    centre of names[i]'s top face and its yaw; sizes[i]: its footprint along its own x and y, and in z
+    its height above the floor it stands on (m)."""
+
+    header: Header_ = field(default_factory=Header_)
+    names: sequence[str] = field(default_factory=list)
+    poses: sequence[Pose_] = field(default_factory=list)
+    sizes: sequence[Vector3_] = field(default_factory=list)
+
+
+@dataclass
+@final
+@autoid("sequential")
 class PoseWithCovariance_(IdlStruct, typename=dds_type("geometry_msgs", "PoseWithCovariance")):
     pose: Pose_ = field(default_factory=Pose_)
     covariance: array[float64, 36] = field(default_factory=lambda: [0.0] * 36)

@@ -1,5 +1,6 @@
 """geometry_msgs/PoseStamped over Cyclone DDS: a reader (the external pose input) and a writer
-(g1 sim-robot's motion capture, tests).
+(g1 sim-robot's motion capture, tests); perception's ObjectPoses_ (boxes) and PlatformPoses_
+(platforms, on the perception topic + PLATFORMS_SUFFIX), read and written the same way.
 
 Stamps are the publisher's wall clock (ROS time: seconds since the epoch). The reader hands each
 pose on with the wall-clock age it had when it was read, so a consumer can place it on its own clock
@@ -18,6 +19,8 @@ from typing import Any
 
 HISTORY_DEPTH = 64
 """Poses a reader keeps between takes (0.64 s of a 100 Hz motion capture, read every loop tick)."""
+PLATFORMS_SUFFIX = "/platforms"
+"""PlatformPoses_ go on the perception topic with this appended (perception/objects -> perception/objects/platforms)."""
 TOPIC_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*$")
 
 
@@ -140,24 +143,67 @@ class ObjectsReading:
     objects: dict[str, tuple[tuple[float, float, float], tuple[float, float, float, float]]]
 
 
+@dataclass(frozen=True)
+class PlatformsReading:
+    """One PlatformPoses as read: stamp (publisher's wall clock), its age when read, name -> (top centre xyz,
+    quat wxyz, size: footprint x, y and height) in the robot's heading frame."""
+
+    stamp_s: float
+    age_s: float
+    platforms: dict[str, tuple[tuple[float, float, float], tuple[float, float, float, float],
+                               tuple[float, float, float]]]
+
+
+def _perception_reader(interface: str, domain: int, topic: str, partition: str | None, message):
+    """(participant, DataReader) of `message` samples on rt/<topic> (keeps HISTORY_DEPTH between takes)."""
+    from cyclonedds.qos import Policy, Qos
+    from cyclonedds.sub import DataReader, Subscriber
+    from cyclonedds.topic import Topic
+
+    from g1_control.hardware.links.dds import domain_participant
+    from g1_control.hardware.ros2 import messages as m
+
+    problem = check_topic_name(topic)
+    if problem:
+        raise ValueError(f"perception topic: {problem}")
+    participant = domain_participant(interface, domain)
+    reader = DataReader(Subscriber(participant, qos=_group_qos(partition)),
+                        Topic(participant, m.TOPIC_PREFIX + topic, message), qos=Qos(Policy.History.KeepLast(HISTORY_DEPTH)))
+    return participant, reader
+
+
+def _perception_writer(interface: str, domain: int, topic: str, partition: str | None, message):
+    """(participant, DataWriter) of `message` samples on rt/<topic>."""
+    from cyclonedds.pub import DataWriter, Publisher
+    from cyclonedds.topic import Topic
+
+    from g1_control.hardware.links.dds import domain_participant
+    from g1_control.hardware.ros2 import messages as m
+
+    problem = check_topic_name(topic)
+    if problem:
+        raise ValueError(f"perception topic: {problem}")
+    participant = domain_participant(interface, domain)
+    return participant, DataWriter(Publisher(participant, qos=_group_qos(partition)),
+                                   Topic(participant, m.TOPIC_PREFIX + topic, message))
+
+
+def _xyz(p) -> tuple[float, float, float]:
+    return (p.x, p.y, p.z)
+
+
+def _wxyz(q) -> tuple[float, float, float, float]:
+    return (q.w, q.x, q.y, q.z)
+
+
 class ObjectPosesReader:
     """Takes ObjectPoses samples from rt/<topic> (perception: objects in the robot's heading frame)."""
 
     def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
-        from cyclonedds.qos import Policy, Qos
-        from cyclonedds.sub import DataReader, Subscriber
-        from cyclonedds.topic import Topic
-
-        from g1_control.hardware.links.dds import domain_participant
         from g1_control.hardware.ros2 import messages as m
 
-        problem = check_topic_name(topic)
-        if problem:
-            raise ValueError(f"perception topic: {problem}")
-        self._participant: Any = domain_participant(interface, domain)
-        self._reader = DataReader(Subscriber(self._participant, qos=_group_qos(partition)),
-                                  Topic(self._participant, m.TOPIC_PREFIX + topic, m.ObjectPoses_),
-                                  qos=Qos(Policy.History.KeepLast(HISTORY_DEPTH)))
+        self._participant: Any
+        self._participant, self._reader = _perception_reader(interface, domain, topic, partition, m.ObjectPoses_)
         self._seconds = m.seconds
 
     def take(self) -> list[ObjectsReading]:
@@ -167,10 +213,37 @@ class ObjectPosesReader:
             if not hasattr(msg, "poses"):
                 continue
             stamp = self._seconds(msg.header.stamp)
-            objects = {name: ((p.position.x, p.position.y, p.position.z),
-                              (p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z))
-                       for name, p in zip(msg.names, msg.poses)}
+            objects = {name: (_xyz(p.position), _wxyz(p.orientation)) for name, p in zip(msg.names, msg.poses)}
             out.append(ObjectsReading(stamp, now - stamp, objects))
+        return out
+
+    def close(self) -> None:
+        if self._participant is not None:
+            del self._reader
+            self._participant = None
+
+
+class PlatformPosesReader:
+    """Takes PlatformPoses samples from rt/<topic> (perception: platforms in the robot's heading frame;
+    `topic` is the perception topic with PLATFORMS_SUFFIX)."""
+
+    def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
+        from g1_control.hardware.ros2 import messages as m
+
+        self._participant: Any
+        self._participant, self._reader = _perception_reader(interface, domain, topic, partition, m.PlatformPoses_)
+        self._seconds = m.seconds
+
+    def take(self) -> list[PlatformsReading]:
+        now = time.time()
+        out = []
+        for msg in self._reader.take(HISTORY_DEPTH):
+            if not hasattr(msg, "sizes"):
+                continue
+            stamp = self._seconds(msg.header.stamp)
+            platforms = {name: (_xyz(p.position), _wxyz(p.orientation), _xyz(size))
+                         for name, p, size in zip(msg.names, msg.poses, msg.sizes)}
+            out.append(PlatformsReading(stamp, now - stamp, platforms))
         return out
 
     def close(self) -> None:
@@ -183,19 +256,11 @@ class ObjectPosesWriter:
     """Writes ObjectPoses samples to rt/<topic> (g1 sim-robot --scene's perception)."""
 
     def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
-        from cyclonedds.pub import DataWriter, Publisher
-        from cyclonedds.topic import Topic
-
-        from g1_control.hardware.links.dds import domain_participant
         from g1_control.hardware.ros2 import messages as m
 
-        problem = check_topic_name(topic)
-        if problem:
-            raise ValueError(f"perception topic: {problem}")
         self._m = m
-        self._participant: Any = domain_participant(interface, domain)
-        self._writer = DataWriter(Publisher(self._participant, qos=_group_qos(partition)),
-                                  Topic(self._participant, m.TOPIC_PREFIX + topic, m.ObjectPoses_))
+        self._participant: Any
+        self._participant, self._writer = _perception_writer(interface, domain, topic, partition, m.ObjectPoses_)
         self.sent = 0
 
     def write(self, stamp_s: float, objects: dict) -> None:
@@ -203,10 +268,8 @@ class ObjectPosesWriter:
         m = self._m
         names, poses = [], []
         for name, (pos, quat) in objects.items():
-            x, y, z = (float(v) for v in pos)
-            w, qx, qy, qz = (float(v) for v in quat)
             names.append(name)
-            poses.append(m.Pose_(m.Point_(x, y, z), m.Quaternion_(qx, qy, qz, w)))
+            poses.append(_pose(m, pos, quat))
         self._writer.write(m.ObjectPoses_(m.Header_(m.stamp(stamp_s), "heading"), names, poses))
         self.sent += 1
 
@@ -216,5 +279,39 @@ class ObjectPosesWriter:
             self._participant = None
 
 
-__all__ = ["ObjectPosesReader", "ObjectPosesWriter", "ObjectsReading", "PoseReading", "PoseTopicReader",
-           "PoseTopicWriter", "check_topic_name"]
+class PlatformPosesWriter:
+    """Writes PlatformPoses samples to rt/<topic> (g1 sim-robot --scene's perception of the scene's platforms)."""
+
+    def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
+        from g1_control.hardware.ros2 import messages as m
+
+        self._m = m
+        self._participant: Any
+        self._participant, self._writer = _perception_writer(interface, domain, topic, partition, m.PlatformPoses_)
+        self.sent = 0
+
+    def write(self, stamp_s: float, platforms: dict) -> None:
+        """platforms: name -> (top centre xyz, quat wxyz, size: footprint x, y and height) in the heading frame."""
+        m = self._m
+        names, poses, sizes = [], [], []
+        for name, (pos, quat, size) in platforms.items():
+            names.append(name)
+            poses.append(_pose(m, pos, quat))
+            sizes.append(m.Vector3_(*(float(v) for v in size)))
+        self._writer.write(m.PlatformPoses_(m.Header_(m.stamp(stamp_s), "heading"), names, poses, sizes))
+        self.sent += 1
+
+    def close(self) -> None:
+        if self._participant is not None:
+            del self._writer
+            self._participant = None
+
+
+def _pose(m, pos, quat):
+    x, y, z = (float(v) for v in pos)
+    w, qx, qy, qz = (float(v) for v in quat)
+    return m.Pose_(m.Point_(x, y, z), m.Quaternion_(qx, qy, qz, w))
+
+
+__all__ = ["PLATFORMS_SUFFIX", "ObjectPosesReader", "ObjectPosesWriter", "ObjectsReading", "PlatformPosesReader",
+           "PlatformPosesWriter", "PlatformsReading", "PoseReading", "PoseTopicReader", "PoseTopicWriter", "check_topic_name"]
