@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.interpolate import CubicSpline
 
 from g1_control.errors import WbcConfigError
 from g1_control.robot import g1
@@ -42,8 +43,6 @@ class WholeBodyTrajectory:
     between samples; None: no hand forces."""
 
     def __post_init__(self) -> None:
-        from scipy.interpolate import CubicSpline
-
         n = len(self.t_s)
         shapes = {"root_pos_w_m": (n, 3), "root_rpy_rad": (n, 3), "q_rad": (n, g1.NUM_JOINTS), "contacts": (n, 2)}
         for name, shape in shapes.items():
