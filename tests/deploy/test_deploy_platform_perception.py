@@ -2,7 +2,8 @@
 launch/sim2sim_step.yaml` (its world holds the 0.15 m platform and its perception topic reports it, with
 2 cm / 3 deg noise, 0.1 s latency and 10 % dropouts) and `g1 deploy launch/sim2sim_step_seen.yaml` (whose
 scene lists no platform) as two processes over DDS on lo. Judged by the emulator's ground truth: both soles
-on the platform's top at the end of the step up, both back on the floor at the end of the step down. With
+on the platform's top (height and footprint) at the end of the step up, both back on the floor and off its
+footprint at the end of the step down. With
 the perceived platforms ignored the step up refuses (the platform was never seen) and this goes red."""
 
 from __future__ import annotations
@@ -44,5 +45,9 @@ def test_a_step_known_only_from_perception_is_stepped_onto_and_off_over_dds(tmp_
     assert record["platform"] == "step" and record["platform_from"] == "perception"
     assert (up["status"], down["status"]) == ("reached", "reached"), (up.get("message"), down.get("message"))
     assert up["on_top_at_end"] and up["both_feet_on_top_s"] > 1.0 and down["on_floor_at_end"]
-    soles = truth["soles_w_m"][-1]
-    assert np.all(soles[:, 2] < 0.015)  # on the floor at exit
+    # where the soles stood (ground truth) when each goal ended: over the platform's top, then off it
+    half = np.array(real["size_xy_m"]) / 2
+    for goal, over in ((report["goals"][0], True), (report["goals"][1], False)):
+        row = int(np.searchsorted(truth["t_s"], goal["record"]["end_s"])) - 1
+        inside = np.all(np.abs(truth["soles_w_m"][row][:, :2] - real["center_xy_m"]) < half, axis=1)
+        assert inside.all() if over else not inside.any(), (goal["goal_id"], truth["soles_w_m"][row])
