@@ -592,6 +592,13 @@ def _print_summary(report: DeployReport, say) -> None:
             line += f"; external poses: {ext['accepted']} accepted, refused: {refused}"
             if ext["last_rejection"]:
                 line += f" (last: {ext['last_rejection']})"
+        seen = loc.get("perception")
+        if seen is not None:
+            refused = ", ".join(f"{n} {why}" for why, n in seen["rejected"].items() if n) or "none"
+            platforms = "".join(f"; platform {n} seen at ({p['center_xy_m'][0]:+.2f}, {p['center_xy_m'][1]:+.2f}) m, "
+                                f"{p['height_m']:.2f} m high" for n, p in seen["platforms_w_m"].items())
+            line += (f"; perception: {seen['frames']} object frames, {seen['platform_frames']} platform frames, "
+                     f"refused: {refused}{platforms}")
         say(line)
     say(f"loop: {report.loop['ticks']} ticks, {report.loop['deadline_misses']} deadline misses (worst "
         f"{report.loop['lateness_max_ms']:.1f} ms late, p99 {report.loop['lateness_p99_ms']:.1f} ms), "
