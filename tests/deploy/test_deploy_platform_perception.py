@@ -41,9 +41,9 @@ def test_a_step_known_only_from_perception_is_stepped_onto_and_off_over_dds(tmp_
           f"{wire['perception']['measured']} dropped; the step seen at {np.round(where['center_xy_m'], 3).tolist()} "
           f"(truth {real['center_xy_m']}, in the estimate's frame); both feet on top {up['both_feet_on_top_s']:.1f} s, "
           f"on top at the end of the step up: {up['on_top_at_end']}; on the floor at the end: {down['on_floor_at_end']}")
+    assert (up["status"], down["status"]) == ("reached", "reached"), (up.get("message"), down.get("message"))
     record = report["goals"][0]["record"]
     assert record["platform"] == "step" and record["platform_from"] == "perception"
-    assert (up["status"], down["status"]) == ("reached", "reached"), (up.get("message"), down.get("message"))
     assert up["on_top_at_end"] and up["both_feet_on_top_s"] > 1.0 and down["on_floor_at_end"]
     # where the soles stood (ground truth) when each goal ended: over the platform's top, then off it
     half = np.array(real["size_xy_m"]) / 2
