@@ -96,6 +96,17 @@ BODY_SEGMENTS = (
     ("right_elbow_link", "right_wrist_roll_link", 0.035, False),
 )
 TABLE_TOP_THICKNESS_M = 0.04
+STANDING_GIVE_M = 0.06
+"""A standing candidate's pelvis may sink this much below nominal to reach (the grasps of issue 17
+gave ~1-3 cm); more is a squat, tried as one with its own checks (a 'standing' pose that sank to
+0.54 m with the knees at 1.7 rad under a 0.53 m table fell stepping in: bench objects seed 8)."""
+MIN_KNEE_RAD = 0.3
+"""Knees bent at least this much in a hold pose (a straight knee is singular for the controller; a
+reach to a box on a 0.91 m table with one knee at 0.02 rad fell: bench objects seed 8)."""
+KNEE_EDGE_CLEARANCE_M = 0.08
+"""Knees this far (horizontally) outside a support whose top is above them: stepping in, the swing
+knee rises and comes forward (knees 0.00-0.06 m from the edge: four falls on bench objects seed 8)."""
+KNEES = (g1.JOINT_INDEX["left_knee_joint"], g1.JOINT_INDEX["right_knee_joint"])
 KNEE_HEIGHT_M = 0.35
 MIN_EDGE_CLEARANCE_M = 0.18
 """The pelvis stays this far from a support whose top is above the knees: issue 17's measured rule
@@ -309,6 +320,12 @@ class StancePlanner:
             if (squat and r.pelvis_error_m > FEASIBLE_PELVIS_M) or r.tilt_rad > MAX_TILT_RAD or \
                     r.q[2] - ground_z < MIN_PELVIS_M:
                 cand.collision = cand.collision or f"the pelvis ends at {r.q[2]:.2f} m, tilted {r.tilt_rad:.2f} rad"
+            if not squat and cand.pelvis_z_m - r.q[2] > STANDING_GIVE_M:
+                cand.collision = cand.collision or (f"standing, the pelvis sinks to {r.q[2] - ground_z:.2f} m "
+                                                    "(a squat, tried as one)")
+            knee = min(float(r.q[7 + k]) for k in KNEES)
+            if knee < MIN_KNEE_RAD:
+                cand.collision = cand.collision or f"a knee is nearly straight ({knee:.2f} rad)"
             if worst_res > FEASIBLE_RESIDUAL_M or worst_com > FEASIBLE_COM_M:
                 break  # not kept anyway: the rest is not worth its time
             if cand.collision is None:
@@ -365,6 +382,11 @@ class StancePlanner:
             if gap < MIN_EDGE_CLEARANCE_M:
                 return (f"the pelvis is {gap:.2f} m from '{support.name}' (stepping in needs "
                         f">= {MIN_EDGE_CLEARANCE_M:.2f} m)")
+            for side in ("left", "right"):
+                knee_gap = support.distance_xy(pos[f"{side}_knee_link"][:2])
+                if knee_gap < KNEE_EDGE_CLEARANCE_M:
+                    return (f"the {side} knee is {knee_gap:.2f} m from under '{support.name}' (stepping in needs "
+                            f">= {KNEE_EDGE_CLEARANCE_M:.2f} m)")
         half_box = box.size / 2
         c, s = math.cos(box.yaw_rad), math.sin(box.yaw_rad)
         for a, b, radius, meets_box in BODY_SEGMENTS:
