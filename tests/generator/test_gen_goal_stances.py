@@ -11,6 +11,7 @@ import pytest
 from g1_control.generator.goals.box import hand_points
 from g1_control.generator.goals.poses import PosePlanner
 from g1_control.generator.goals.stances import (
+    KNEES,
     MIN_PELVIS_M,
     StancePlanner,
     StanceRefused,
@@ -106,3 +107,27 @@ def test_place_heading_faces_the_nearest_edge():
     # a point near the edge facing -x in the world: the robot faces +x
     assert place_heading(table, np.array([1.6, 0.0]), np.zeros(2)) == pytest.approx(0.0, abs=1e-9)
     assert place_heading(None, np.array([1.0, 1.0]), np.zeros(2)) == pytest.approx(math.pi / 4)
+
+
+def _knee_gap(stances, q, table):
+    ik = stances.ik
+    ik.pin.framesForwardKinematics(ik.model, ik.data, q)
+    return min(table.distance_xy(ik.data.oMf[ik.model.getFrameId(f"{s}_knee_link")].translation[:2])
+               for s in ("left", "right"))
+
+
+def test_a_box_on_a_thigh_high_table_is_held_with_the_knees_bent_and_clear_of_its_edge(stances):
+    # bench objects seed 8 trial 9: a 3.2 kg box on a 0.53 m table; the search kept a 'standing' pose
+    # whose pelvis had sunk to 0.54 m with the knees at 1.7 rad under the table's edge, and the robot
+    # fell stepping in. Every kept pose: knees bent, knees clear of the edge, a standing pelvis at height
+    table = Table("table_a", (1.416, -0.421), (0.821, 0.951), 0.532, 3.020)
+    box = Box("box", (1.255, -0.242), stands_on="table_a", size_m=(0.293, 0.310, 0.249), mass_kg=3.2, yaw_rad=-1.262)
+    center = np.array([1.255, -0.242, 0.657])
+    plan = stances.plan(box, center, table, pick_headings(box, center[:2], table, np.zeros(2)), lift_m=0.1,
+                        what="pick it up")
+    standing = plan.pelvis_z_m == pytest.approx(stances.poses.nominal_pelvis_m)
+    for q in plan.chosen.poses:
+        assert min(q[7 + k] for k in KNEES) >= 0.3  # stances.MIN_KNEE_RAD
+        assert _knee_gap(stances, q, table) >= 0.08  # stances.KNEE_EDGE_CLEARANCE_M
+        assert not standing or q[2] >= stances.poses.nominal_pelvis_m - 0.06  # stances.STANDING_GIVE_M
+
