@@ -8,6 +8,7 @@ command hands back."""
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 
@@ -124,22 +125,53 @@ def test_a_reach_holds_under_the_whole_body_controller_until_a_walking_command_h
     np.testing.assert_allclose(gen.joint_reference(state.t_s).q_rad[arms], g1.DEFAULT_Q_RAD[arms], atol=1e-4)
 
 
-def test_after_setting_a_box_down_the_walking_policy_has_the_robot_when_the_goal_is_reached():
+def _pick_and_place(config: GoalConfig) -> tuple[GoalGenerator, dict]:
+    """A pick from the table and a place back on it, driven kinematically; (the generator, the phase
+    each goal was reached in)."""
     inner = Walking()
-    gen = GoalGenerator(inner, _scene(), GoalConfig())
+    gen = GoalGenerator(inner, _scene(), config)
     state = _state(xy=(0.0, 0.0))
     goals = [TaskGoal("pick", goal_id="pick", object="box"), TaskGoal("place", goal_id="place", object="box",
                                                                       target="table")]
-    phase_when_reached = {}
-    for k in range(int(60.0 / DT)):
+    phase_when_reached: dict = {}
+    deadline = time.monotonic() + 300.0  # planning beside the ticks: the plans' wall time, not the ticks', bounds it
+    k = 0
+    while time.monotonic() < deadline:
         state.t_s = k * DT
         _tick(gen, inner, state, Command(tasks=goals[:1] if "pick" not in gen.goal_status else goals))
         for gid in gen.goal_status:
             phase_when_reached.setdefault(gid, gen.phase)
         if "place" in gen.goal_status:
             break
+        if gen.ctx.planner is not None:
+            time.sleep(0.002)  # a loop's tick takes time: the planner's process gets the CPU
+        k += 1
+    return gen, phase_when_reached
+
+
+def test_after_setting_a_box_down_the_walking_policy_has_the_robot_when_the_goal_is_reached():
+    gen, phase_when_reached = _pick_and_place(GoalConfig())
     assert gen.goal_status == {"pick": REACHED, "place": REACHED}, gen.goal_messages
     # held after the pick (whole body), handed back to the walking policy once set down
     assert phase_when_reached == {"pick": PHASE_WHOLE_BODY, "place": PHASE_LOCOMOTION}
     assert gen.holding is None and gen.box_positions["box"] is not None
     assert "hand back to the walking policy" in [text for _, text in gen.log]
+
+
+def test_a_pick_and_place_planned_in_the_planner_process_are_the_ones_planned_inline():
+    # the stance search, the grasp and the release run as jobs in the real planner process (pickled
+    # there and back): the same stances and the box set down where the inline plans put it
+    inline, _ = _pick_and_place(GoalConfig())
+    there, phases = _pick_and_place(GoalConfig(plan_in_background=True))
+    try:
+        assert there.goal_status == {"pick": REACHED, "place": REACHED}, there.goal_messages
+        assert phases == {"pick": PHASE_WHOLE_BODY, "place": PHASE_LOCOMOTION}
+        planned = {key for key in there.plan_cpu_s if key.endswith("(planner process, wall)")}
+        assert {"pick stance (planner process, wall)", "pick grasp (planner process, wall)",
+                "place stance (planner process, wall)", "place release (planner process, wall)"} <= planned
+        assert not any(key.endswith(("stance", "grasp", "release")) for key in there.plan_cpu_s)  # none inline
+        for goal in ("pick", "place"):
+            assert there.goal_info[goal]["stance"] == inline.goal_info[goal]["stance"]
+        np.testing.assert_allclose(there.box_positions["box"], inline.box_positions["box"], atol=1e-9)
+    finally:
+        there.ctx.close()

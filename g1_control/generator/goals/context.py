@@ -119,6 +119,8 @@ class Held:
     """(2, 3) hand forces while held (world axes at the time of the grasp's heading)."""
     squeeze_n: float = 20.0
     """The squeeze per hand it is held with."""
+    heading_rad: float = 0.0
+    """The robot's heading when it took the box (the box turns with the robot from there)."""
 
 
 class GoalContext:

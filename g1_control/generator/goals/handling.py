@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
+from dataclasses import replace
 
 import numpy as np
 
@@ -20,11 +21,18 @@ from g1_control.generator.goals.box import (
     grasp_width,
     hand_forces,
     hand_points,
-    pick_approach,
     place_target,
 )
 from g1_control.generator.goals.context import GoalContext, GoalFailed, Held
-from g1_control.generator.goals.poses import PosePlanner, ReachRefused, Sole, flat_soles, stance_heading
+from g1_control.generator.goals.poses import PosePlanner, ReachRefused, flat_soles, stance_heading
+from g1_control.generator.goals.stances import (
+    box_com_shift,
+    grasp_hold_poses,
+    pick_headings,
+    place_heading,
+    plan_stance,
+    release_hold_poses,
+)
 from g1_control.generator.goals.stepping import (
     Footstep,
     Stance,
@@ -36,7 +44,7 @@ from g1_control.generator.goals.stepping import (
 from g1_control.generator.whole_body import keyframe_trajectory, smoothstep
 from g1_control.robot import g1
 from g1_control.rotations import wrap_angle, yaw_of
-from g1_control.scene import Box
+from g1_control.scene import FLOOR, Block, Box
 from g1_control.types import PHASE_WHOLE_BODY, TaskGoal
 
 ARMS_BACK = g1.DEFAULT_Q_RAD.copy()
@@ -49,46 +57,14 @@ for _side in ("left", "right"):
 RAISE_AHEAD_M = 0.10
 """Hands rise (and come back) this far ahead of the pelvis, above the box, on their way to it."""
 GRAVITY = 9.81
-HandPoints = tuple[np.ndarray, np.ndarray]
-"""Left and right hand-frame points (box.hand_points)."""
+CARRY_HANDS_Z_M = 0.80
+"""A box picked low is raised, standing, until the hands are at least this high to carry it."""
+JOINT_SPEED_RADPS = 1.0
+PELVIS_SPEED_MPS = 0.15
+"""Whole-body moves (a squat, rising with a box) go no faster than these."""
 
 
 # -- planner jobs (GoalContext.compute: inline, or in the planner process) ---------------------------
-def grasp_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float,
-                points: tuple[HandPoints, HandPoints, HandPoints, HandPoints], lift_shift: np.ndarray,
-                box_name: str) -> list[np.ndarray]:
-    """The via, pre-grasp, contact and lift poses (each from the one before), the CoM shifted by
-    `lift_shift` for the lift; ReachRefused when the hands cannot get within 3 cm of a point."""
-    out = []
-    q = q0
-    for name, targets, com_shift in zip(("via", "pre-grasp", "contact", "lift"), points,
-                                        (None, None, None, lift_shift)):
-        res = poses.hands_on(q, soles, targets, heading, com_shift)
-        if res.residual_m > 0.01:  # a poor warm start (the pose before): again from the stance
-            again = poses.hands_on(q0, soles, targets, heading, com_shift)
-            res = again if again.residual_m < res.residual_m else res
-        if res.residual_m > 0.03 and name != "via":
-            raise ReachRefused(f"box '{box_name}': the hands get only within {res.residual_m * 100:.1f} cm "
-                               f"of the {name} points (out of reach)")
-        q = res.q
-        out.append(q)
-    return out
-
-
-def release_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float,
-                  points: tuple[HandPoints, HandPoints, HandPoints], shift: np.ndarray):
-    """The box set down, the hands opened, the hands out, standing: (PoseResult, q, q, q)."""
-    down, opened, out = points
-    down_pose = poses.hands_on(q0, soles, down, heading, shift)
-    if down_pose.residual_m > 0.03:
-        raise ReachRefused(f"the hands get only within {down_pose.residual_m * 100:.1f} cm of where the box "
-                           "goes (out of reach)")
-    q_open = poses.hands_on(down_pose.q, soles, opened, heading).q
-    q_out = poses.hands_on(q_open, soles, out, heading).q
-    ground = min(p[2] for p, _ in soles)
-    return down_pose, q_open, q_out, poses.stand(q_out, soles, ground + poses.nominal_pelvis_m, g1.DEFAULT_Q_RAD)
-
-
 def carry_plan(poses: PosePlanner, q0: np.ndarray, steps: list[Footstep], cfg: SteppingConfig, posture: np.ndarray,
                com_offset_h_m: np.ndarray, squeeze_n: float, weight_n: float) -> SteppingPlan:
     """The carry's footsteps with the box's hand forces per sample, turned with the pelvis's heading."""
@@ -140,6 +116,22 @@ def find_box(ctx: GoalContext, name: str | None) -> Box:
     return best
 
 
+def support_of(ctx: GoalContext, box: Box, center_w: np.ndarray) -> Block | None:
+    """What the box stands on where it is now: a table or platform whose top is under its bottom,
+    else the floor (None)."""
+    bottom = float(center_w[2]) - box.size[2] / 2
+    for block in (*ctx.scene.tables, *ctx.scene.platforms):
+        if block.contains_xy(center_w[:2]) and abs(block.height_m - bottom) < 0.05:
+            return block
+    return None
+
+
+def _move_s(q_a: np.ndarray, q_b: np.ndarray, least_s: float) -> float:
+    """A joint-space move's duration: at least least_s, and slower for big moves (a squat)."""
+    return max(least_s, float(np.abs(q_b[7:] - q_a[7:]).max()) / JOINT_SPEED_RADPS,
+               abs(float(q_b[2] - q_a[2])) / PELVIS_SPEED_MPS)
+
+
 def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     cfg = ctx.config
     if ctx.held is not None:
@@ -149,7 +141,14 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     if center is None:
         raise GoalFailed(f"box '{box.name}' is held")
     _, pos_w = ctx.world_pose()
-    approach = pick_approach(ctx.scene, box, center[:2], pos_w[:2])
+    support = support_of(ctx, box, center)
+    ground = ctx.scene.ground_height(center[:2]) if support is None else 0.0
+    headings = pick_headings(box, center[:2], support, pos_w[:2])
+    # the stance, squat and lean for this box, before anything moves (refused here otherwise)
+    plan = yield from ctx.compute("stance", plan_stance, box, center, support, headings, ground, cfg.lift_m,
+                                  cfg.press_m, "pick it up")
+    ctx.note(f"pick stance: {plan.chosen.describe()} ({plan.tried} tried)")
+    approach = plan.approach
     if ctx.phase != PHASE_WHOLE_BODY:
         yield from walk_to(ctx, approach, out_m=cfg.approach_offset_m)
         yield from enter_whole_body(ctx)
@@ -157,24 +156,51 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     yield from step_to(ctx, approach.mid_xy + off, approach.heading, cfg.steps, name="approach",
                        posture=ARMS_BACK)
     yield from correct_stance(ctx, approach.mid_xy, approach.heading, cfg.steps, posture=ARMS_BACK)
-    # the grasp, from the stance the steps ended in
+    # the grasp, from the stance the steps ended in, at the planned squat and lean
     q0 = ctx.hold_q()
     soles = flat_soles(ctx.ik, q0)
     heading = stance_heading(soles)
-    c = center + np.append(ctx.offset(), 0.0)
+    floor_z = min(p[2] for p, _ in soles)
+    c = center + np.append(ctx.offset(), 0.0) + np.array([0.0, 0.0, plan.hand_dz_m])
     width = grasp_width(box, heading)
     weight = box.mass_kg * GRAVITY
     squeeze = squeeze_for(ctx, box)
-    # the hands rise close to the body first (a table's edge is ~0.22 m ahead of the pelvis:
-    # moving them straight to the box dragged them over the table top, measured)
-    via = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.08, ahead_m=-(GRASP_DISTANCE_M - RAISE_AHEAD_M))
+    mid = (soles[0][0][:2] + soles[1][0][:2]) / 2
+    ahead = float((c[:2] - mid) @ np.array([math.cos(heading), math.sin(heading)]))
+    shift = box_com_shift(box.mass_kg, ctx.poses.mass_kg, ahead)
+    low = plan.pelvis_z_m < ctx.poses.nominal_pelvis_m + plan.ground_z_m - 0.02 or plan.lean
+    pelvis_z = floor_z + plan.pelvis_z_m - plan.ground_z_m
+    nominal_z = floor_z + ctx.poses.nominal_pelvis_m
+    if low:  # nothing at hand height to catch: the hands come down over the box's sides
+        via = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.12)
+    else:  # the hands rise close to the body first (a table's edge is ~0.22 m ahead of the pelvis:
+        # moving them straight to the box dragged them over the table top, measured)
+        via = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.08, ahead_m=-(ahead - RAISE_AHEAD_M))
     pre = hand_points(c, heading, width, cfg.pre_gap_m)
     con = hand_points(c, heading, width, -cfg.press_m)
     lift = hand_points(c, heading, width, -cfg.press_m, dz_m=cfg.lift_m)
-    shift = np.array([-box.mass_kg / ctx.poses.mass_kg * GRASP_DISTANCE_M, 0.0])
-    q_via, q_pre, q_con, q_lift = yield from ctx.compute("grasp", grasp_poses, q0, soles, heading,
-                                                         (via, pre, con, lift), shift, box.name)
-    t = {"via": 1.2, "pre": 2.2, "con": 3.0, "squeeze": 3.5, "lift": 4.7, "end": 5.7}
+    carry_z = max(float(c[2]) + cfg.lift_m, floor_z + CARRY_HANDS_Z_M)
+    rise = hand_points(np.array([c[0], c[1], carry_z]), heading, width, -cfg.press_m)
+    none = np.zeros(2)
+    steps = [("via", via, none, pelvis_z, plan.lean), ("pre-grasp", pre, none, pelvis_z, plan.lean),
+             ("contact", con, none, pelvis_z, plan.lean), ("lift", lift, shift, pelvis_z, plan.lean)]
+    if low:
+        steps.append(("rise", rise, shift, nominal_z, False))
+    poses = yield from ctx.compute("grasp", grasp_hold_poses, q0, soles, heading, steps, box.name,
+                                   plan.chosen.describe())
+    q_via, q_pre, q_con, q_lift = poses[:4]
+    t = {"via": _move_s(q0, q_via, 1.2)}
+    t["pre"] = t["via"] + 1.0
+    t["con"] = t["pre"] + 0.8
+    t["squeeze"] = t["con"] + 0.5
+    t["lift"] = t["squeeze"] + 1.2
+    keys = [(0.0, q0), (t["via"], q_via), (t["pre"], q_pre), (t["con"], q_con), (t["squeeze"], q_con),
+            (t["lift"], q_lift)]
+    if low:
+        t["rise"] = t["lift"] + _move_s(q_lift, poses[4], 1.2)
+        keys.append((t["rise"], poses[4]))
+    t["end"] = keys[-1][0] + 1.0
+    keys.append((t["end"], keys[-1][1]))
     full = hand_forces(heading, squeeze, weight)
     squeeze_only = hand_forces(heading, squeeze, 0.0)
 
@@ -183,12 +209,10 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
         b = float(smoothstep((tk - t["squeeze"]) / cfg.force_ramp_s))
         return a * squeeze_only + b * (full - squeeze_only)
 
-    keys = [(0.0, q0), (t["via"], q_via), (t["pre"], q_pre), (t["con"], q_con), (t["squeeze"], q_con),
-            (t["lift"], q_lift), (t["end"], q_lift)]
     ctx.info.update(box=box.name, box_start_w_m=center.tolist(), lift_m=cfg.lift_m,
-                    held_from_s=ctx.t + t["lift"])
+                    held_from_s=ctx.t + t["lift"], stance=plan.chosen.describe())
     yield from ctx.run(keyframe_trajectory("pick", keys, hand_forces=forces))
-    ctx.held = Held(box, full, squeeze)
+    ctx.held = Held(box, full, squeeze, heading_rad=heading)
     ctx.box_positions[box.name] = None
 
 
@@ -198,7 +222,8 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     cfg = ctx.config
     if ctx.held is None:
         raise GoalFailed("holding no box")
-    box = ctx.held.box
+    held = ctx.held
+    box = held.box
     if goal.object is not None and goal.object != box.name:
         raise GoalFailed(f"holding '{box.name}', not '{goal.object}'")
     s, pos_w = ctx.world_pose()
@@ -213,35 +238,68 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
             target = min(near, key=lambda b: b.distance_xy(ahead)).name
         else:
             point = np.array([ahead[0], ahead[1], box.size[2] / 2])
-    center_w, approach = place_target(ctx.scene, box, target, point, pos_w[:2])
-    ctx.info.update(box=box.name, target_w_m=center_w.tolist())
+    support = ctx.scene.block(target) if target is not None and target != FLOOR else None
+    if target is not None and target != FLOOR and support is None:
+        raise ReachRefused(f"'{target}' is not a table or platform of the scene")
+    if point is not None:
+        top = support.height_m if support is not None else ctx.scene.ground_height(np.asarray(point[:2]))
+        center_w = np.array([point[0], point[1], top + box.size[2] / 2])
+    else:
+        center_w, _ = place_target(ctx.scene, box, target, None, pos_w[:2])
+    heading_now = yaw_of(s.imu_quat_wxyz)
+    heading = place_heading(support, center_w[:2], pos_w[:2])
+    # the box turns with the robot: as held, its faces across the new heading are the ones in the hands
+    as_held = replace(box, yaw_rad=box.yaw_rad + wrap_angle(heading - held.heading_rad))
+    ground = 0.0 if support is not None else ctx.scene.ground_height(center_w[:2])
+    plan = yield from ctx.compute("stance", plan_stance, as_held, center_w, support, [heading], ground, None,
+                                  cfg.press_m, "set it down there")
+    ctx.note(f"place stance: {plan.chosen.describe()} ({plan.tried} tried; heading now {heading_now:.2f})")
+    approach = plan.approach
+    ctx.info.update(box=box.name, target_w_m=center_w.tolist(), stance=plan.chosen.describe())
     q0 = ctx.hold_q()
     posture = q0[7:].copy()
     weight = box.mass_kg * GRAVITY
-    squeeze = ctx.held.squeeze_n
-    shift = np.array([-box.mass_kg / ctx.poses.mass_kg * GRASP_DISTANCE_M, 0.0])
+    squeeze = held.squeeze_n
     stance = Stance.of(ctx.ik, q0)
+    carry_shift = box_com_shift(box.mass_kg, ctx.poses.mass_kg, GRASP_DISTANCE_M)
     far = float(np.hypot(*(approach.mid_xy - stance.mid_xy))) > 0.05 or \
         abs(wrap_angle(approach.heading - stance.heading)) > 0.05
     if far:
         off = ctx.offset()
         # carry: the hand forces turn with the robot, so plan them per heading: held constant in
         # the robot's frame (the squeeze across it, the weight down)
-        yield from carry(ctx, approach.mid_xy + off, approach.heading, posture, weight, shift)
+        yield from carry(ctx, approach.mid_xy + off, approach.heading, posture, weight, carry_shift)
         yield from correct_stance(ctx, approach.mid_xy, approach.heading, cfg.carry, posture=posture,
-                              forces=hand_forces(approach.heading, squeeze, weight),
-                              com_shift=ctx.poses.com_offset_m + shift)
+                                  forces=hand_forces(approach.heading, squeeze, weight),
+                                  com_shift=ctx.poses.com_offset_m + carry_shift)
     q0 = ctx.hold_q()
     soles = flat_soles(ctx.ik, q0)
     heading = stance_heading(soles)
-    c = center_w + np.append(ctx.offset(), 0.0)
-    width = grasp_width(box, heading)
+    floor_z = min(p[2] for p, _ in soles)
+    c = center_w + np.append(ctx.offset(), 0.0) + np.array([0.0, 0.0, plan.hand_dz_m])
+    width = grasp_width(replace(box, yaw_rad=box.yaw_rad + wrap_angle(heading - held.heading_rad)), heading)
+    mid = (soles[0][0][:2] + soles[1][0][:2]) / 2
+    held_ahead = float((c[:2] - mid) @ np.array([math.cos(heading), math.sin(heading)]))
+    shift = box_com_shift(box.mass_kg, ctx.poses.mass_kg, held_ahead)
+    low = plan.pelvis_z_m < ctx.poses.nominal_pelvis_m + plan.ground_z_m - 0.02 or plan.lean
+    pelvis_z = floor_z + plan.pelvis_z_m - plan.ground_z_m
+    above = hand_points(c, heading, width, -cfg.press_m, dz_m=0.10)
     down = hand_points(c, heading, width, -cfg.press_m, dz_m=0.005)
     opened = hand_points(c, heading, width, cfg.pre_gap_m, dz_m=0.005)
-    out = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.08, ahead_m=-(GRASP_DISTANCE_M - RAISE_AHEAD_M))
-    q_down, q_open, q_out, q_stand = yield from ctx.compute("release", release_poses, q0, soles, heading,
-                                                            (down, opened, out), shift)
-    t = {"down": 1.5, "release": 2.2, "open": 3.0, "out": 4.0, "stand": 5.5, "end": 6.0}
+    if low:
+        out = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.12)
+    else:
+        out = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.08, ahead_m=-(held_ahead - RAISE_AHEAD_M))
+    q_above, q_down, q_open, q_out, q_stand = yield from ctx.compute(
+        "release", release_hold_poses, q0, soles, heading, (above, down, opened, out), shift, pelvis_z, plan.lean,
+        low, plan.chosen.describe())
+    t = {"above": _move_s(q0, q_above, 0.0) if low else 0.0}
+    t["down"] = t["above"] + 1.5
+    t["release"] = t["down"] + 0.7
+    t["open"] = t["release"] + 0.8
+    t["out"] = t["open"] + 1.0
+    t["stand"] = t["out"] + _move_s(q_out, q_stand, 1.5)
+    t["end"] = t["stand"] + 0.5
     full = hand_forces(heading, squeeze, weight)
     squeeze_only = hand_forces(heading, squeeze, 0.0)
 
@@ -250,8 +308,9 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
         a = 1.0 - float(smoothstep((tk - t["down"]) / (t["release"] - t["down"])))
         return a * squeeze_only + b * (full - squeeze_only)
 
-    keys = [(0.0, q0), (t["down"], q_down.q), (t["release"], q_down.q), (t["open"], q_open), (t["out"], q_out),
-            (t["stand"], q_stand), (t["end"], q_stand)]
+    keys = [(0.0, q0)] + ([(t["above"], q_above)] if low else []) + [
+        (t["down"], q_down), (t["release"], q_down), (t["open"], q_open), (t["out"], q_out),
+        (t["stand"], q_stand), (t["end"], q_stand)]
     yield from ctx.run(keyframe_trajectory("place", keys, hand_forces=forces))
     ctx.info["released_s"] = ctx.t - t["end"] + t["release"]
     ctx.held = None

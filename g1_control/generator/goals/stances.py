@@ -1,0 +1,509 @@
+"""Where to stand, how low to go and how far to lean to hold a box at a place: a small search over
+stances, each solved by the whole-body IK and scored by its reach and balance (issue 25).
+
+A box is held by both hands on two of its side faces, the robot square to the other two; a place
+is where the box is (a pick) or where it goes (a place), on a support (a table or platform top) or
+on the floor. The candidates:
+  heading   square to a face of the box whose outward normal is within 60 deg of the support's
+            edge nearest to the box (pick from a support), any face (pick from the floor), facing
+            the support's nearest edge (place on a support), or the robot's own way (place on the floor)
+  gap       from the middle of the soles to the box's near face
+  pelvis    standing (nominal height), then lower in steps down to a squat at 0.42 m
+  torso     upright, or leaning forward (pelvis pitched 0.4 rad, waist pulled forward 0.45 rad)
+Each candidate is solved from the standing pose at its stance: both hands on the grasp points
+(and, for a pick, again lifted), the CoM over the soles shifted for the box's weight; it is kept
+when the hands are within FEASIBLE_RESIDUAL_M, the CoM within FEASIBLE_COM_M of its target and no
+leg, trunk or arm point comes into the support's top or the box. The highest pelvis with a kept
+candidate wins (standing is easier on the controller than squatting), and among those the distance
+of issue 17's pick when kept, else the smallest reach residual and CoM error. When none is kept the place is refused before
+anything moves, with the reason and the closest pose.
+
+The search and the hold poses built on it run as planner jobs (GoalContext.compute: inline in
+lockstep, or in the planner's own process beside a wall-clock loop): top-level functions
+fn(poses, *args) with picklable arguments (`plan_stance`, `grasp_hold_poses`, `release_hold_poses`);
+each finds its StancePlanner for the PosePlanner it is given (`stance_planner`, built once).
+
+Hands go at the box's centre height, or higher on a low box (centre below LOW_BOX_Z_M): up to a
+quarter of its height, keeping HAND_BELOW_TOP_M below its top.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+
+from g1_control.generator.goals.box import Approach, grasp_width, hand_points
+from g1_control.generator.goals.poses import (
+    PELVIS_CAP_ABOVE_NOMINAL_M,
+    WAIST,
+    PosePlanner,
+    ReachRefused,
+    Sole,
+    flat_soles,
+)
+from g1_control.ik.whole_body import LEG_LIGHT_POSTURE_WEIGHT
+from g1_control.robot import g1
+from g1_control.robot.dynamics import HAND_FRAMES
+from g1_control.rotations import rot_z
+from g1_control.scene import Block, Box
+
+GAPS_M = (0.22, 0.16, 0.28)
+"""Middle of the soles to the box's near face."""
+PREFERRED_CENTER_M = 0.366
+"""From the soles' middle to the box's centre in the pick of issue 17 (measured in physics with a
+0.3 m box): the first gap tried and kept when it works (not closer than the smallest gap)."""
+LEAN_WAIST_RAD = 0.45
+"""Leaning: the waist's pitch pull (its limit is 0.52)."""
+LEAN_PELVIS_RAD = 0.4
+"""Leaning: the pelvis's pitch target (a soft one)."""
+CONTINUATION_STEP_M = 0.08
+SQUAT_PELVIS_M = (0.66, 0.60, 0.55)
+"""Pelvis heights tried below standing (the fall monitor calls 0.40 m a fall; a leaning squat
+planned at 0.46 m sank to 0.40 m under the whole-body controller, measured)."""
+FEASIBLE_PELVIS_M = 0.05
+MIN_PELVIS_M = 0.51
+MAX_TILT_RAD = 0.75
+"""The pelvis's tilt a pose may have (the safety layer calls 1.0 rad a fall)."""
+SQUAT_BELOW_M = 0.85
+"""Hands below this (above the ground): squatting is tried too (standing, the pelvis may sink only
+STANDING_GIVE_M: a box on a 0.64 m table reached standing with the pelvis 11 cm down, bench objects
+seed 8, is a squat and is tried as one)."""
+LEAN_BELOW_M = 0.7
+"""Hands below this: leaning (squatting) is tried too."""
+LEAN_MAX_KG = 3.0
+"""Leaning only with a box lighter than this: leaning squats picking 3.2 and 5.6 kg boxes fell at the
+lift (bench objects seeds 8 and 9; a 0.5 kg box was picked leaning)."""
+MIN_HAND_Z_M = 0.10
+LOWEST_GRASP_M = 0.40
+"""Below this (hands above the ground) the search is not run: with the pelvis at MIN_PELVIS_M or
+higher, no candidate held a box lower than ~0.45 m (measured over the issue 25 scenes and the
+tests' boxes); it only cost 5-10 s of CPU to find that out each time."""
+"""Hands no lower above the ground (below, the rubber hands strike the floor: a fall by body contact)."""
+FEASIBLE_RESIDUAL_M = 0.02
+"""Kept within this (the grasp itself refuses beyond 3 cm from the stance the steps end in)."""
+FEASIBLE_COM_M = 0.02
+EDGE_CONE_RAD = math.radians(60.0)
+LOW_BOX_Z_M = 0.6
+HAND_BELOW_TOP_M = 0.07
+WAIST_PITCH = g1.JOINT_INDEX["waist_pitch_joint"]
+BODY_SEGMENTS = (
+    # (frame from, frame to, radius m, meets the box too)
+    ("left_hip_pitch_link", "left_knee_link", 0.06, True),
+    ("right_hip_pitch_link", "right_knee_link", 0.06, True),
+    ("left_knee_link", "left_ankle_roll_link", 0.05, True),
+    ("right_knee_link", "right_ankle_roll_link", 0.05, True),
+    ("pelvis_contour_link", "torso_link", 0.13, True),  # the trunk needs ~0.18 m from a table (issue 17)
+    ("torso_link", "head_link", 0.09, True),
+    ("left_shoulder_pitch_link", "left_elbow_link", 0.04, False),
+    ("right_shoulder_pitch_link", "right_elbow_link", 0.04, False),
+    ("left_elbow_link", "left_wrist_roll_link", 0.035, False),
+    ("right_elbow_link", "right_wrist_roll_link", 0.035, False),
+)
+TABLE_TOP_THICKNESS_M = 0.04
+STANDING_GIVE_M = 0.06
+"""A standing candidate's pelvis may sink this much below nominal to reach (the grasps of issue 17
+gave ~1-3 cm); more is a squat, tried as one with its own checks (a 'standing' pose that sank to
+0.54 m with the knees at 1.7 rad under a 0.53 m table fell stepping in: bench objects seed 8)."""
+MIN_KNEE_RAD = 0.3
+"""Knees bent at least this much in a hold pose (a straight knee is singular for the controller; a
+reach to a box on a 0.91 m table with one knee at 0.02 rad fell: bench objects seed 8)."""
+KNEE_EDGE_CLEARANCE_M = 0.08
+"""Knees this far (horizontally) outside a support whose top is above them: stepping in, the swing
+knee rises and comes forward (knees 0.00-0.06 m from the edge: four falls on bench objects seed 8)."""
+KNEES = (g1.JOINT_INDEX["left_knee_joint"], g1.JOINT_INDEX["right_knee_joint"])
+KNEE_HEIGHT_M = 0.35
+MIN_EDGE_CLEARANCE_M = 0.18
+"""The pelvis stays this far from a support whose top is above the knees: issue 17's measured rule
+(box.MIN_EDGE_CLEARANCE_M); closer, the stepping-in knees met 0.53-0.63 m tables and the robot fell
+(g1 bench objects seed 8, measured)."""
+
+
+@dataclass
+class HoldPose:
+    q: np.ndarray
+    residual_m: float
+    """The farther hand from its point."""
+    com_error_m: float
+    """The CoM (xy) from its target over the soles."""
+    pelvis_error_m: float
+    tilt_rad: float
+    """The pelvis's tilt from upright."""
+
+
+def box_com_shift(mass_kg: float, robot_kg: float, ahead_m: float) -> np.ndarray:
+    """Where the robot's own CoM goes (heading frame) so that robot and box together stand over the
+    soles: back by the box's share of the mass times how far ahead of the soles it is held."""
+    return np.array([-mass_kg / robot_kg * ahead_m, 0.0])
+
+
+class StanceRefused(ReachRefused):
+    """No stance holds the box at its place (the message gives the reason and the closest pose)."""
+
+
+@dataclass
+class Candidate:
+    heading: float
+    mid_xy: np.ndarray
+    gap_m: float
+    pelvis_z_m: float
+    lean: bool
+    preferred: bool = False
+    residual_m: float = math.inf
+    com_error_m: float = math.inf
+    collision: str | None = None
+    poses: list[np.ndarray] = field(default_factory=list)
+    """The hold pose (and, for a pick, the lifted one) at this stance."""
+
+    @property
+    def feasible(self) -> bool:
+        return self.residual_m <= FEASIBLE_RESIDUAL_M and self.com_error_m <= FEASIBLE_COM_M and self.collision is None
+
+    @property
+    def score(self) -> float:
+        return self.residual_m + self.com_error_m + (0.05 if self.collision else 0.0)
+
+    def describe(self) -> str:
+        return (f"heading {math.degrees(self.heading):.0f} deg, soles' middle {self.gap_m:.2f} m from the box, pelvis "
+                f"{self.pelvis_z_m:.2f} m, {'leaning' if self.lean else 'upright'}: hands "
+                f"{self.residual_m * 100:.1f} cm off, CoM {self.com_error_m * 100:.1f} cm off"
+                + (f", {self.collision}" if self.collision else ""))
+
+
+@dataclass
+class StancePlan:
+    """The stance chosen to hold a box at a place, and how the body holds it there."""
+
+    approach: Approach
+    chosen: Candidate
+    width_m: float
+    """The box's extent across the heading (between the palms)."""
+    hand_dz_m: float
+    """Hands this far above the box's centre."""
+    tried: int
+    ground_z_m: float = 0.0
+    """The ground under the stance (the pelvis heights are world heights above it)."""
+
+    @property
+    def pelvis_z_m(self) -> float:
+        return self.chosen.pelvis_z_m
+
+    @property
+    def lean(self) -> bool:
+        return self.chosen.lean
+
+
+def hand_height(box: Box, center_z: float) -> float:
+    """Hands above the box's centre (module docstring)."""
+    if center_z >= LOW_BOX_Z_M:
+        return 0.0
+    h = float(box.size[2])
+    return max(0.0, min(0.25 * h, h / 2 - HAND_BELOW_TOP_M))
+
+
+def face_normals(box: Box) -> list[np.ndarray]:
+    """The outward normals (world xy) of the box's four side faces."""
+    return [np.array([math.cos(box.yaw_rad + k * math.pi / 2), math.sin(box.yaw_rad + k * math.pi / 2)])
+            for k in range(4)]
+
+
+def edge_normal(block: Block, xy_w: np.ndarray) -> np.ndarray:
+    """The outward normal (world xy) of the block's side nearest to a point on its top."""
+    local = block.local_xy(xy_w)
+    half = block.half
+    gaps = [half[0] - local[0], half[0] + local[0], half[1] - local[1], half[1] + local[1]]
+    n = [np.array([1.0, 0.0]), np.array([-1.0, 0.0]), np.array([0.0, 1.0]), np.array([0.0, -1.0])][int(np.argmin(gaps))]
+    c, s = math.cos(block.yaw_rad), math.sin(block.yaw_rad)
+    return np.array([c * n[0] - s * n[1], s * n[0] + c * n[1]])
+
+
+class StancePlanner:
+    """plan(...) -> StancePlan, or StanceRefused (module docstring)."""
+
+    def __init__(self, poses: PosePlanner):
+        self.poses = poses
+        self.ik = poses.ik
+        q = self.ik.nominal()
+        self._nominal = q
+        s = flat_soles(self.ik, q)
+        self._mid0 = (s[0][0][:2] + s[1][0][:2]) / 2  # soles' middle relative to the pelvis (heading 0)
+        self._soles0 = [(p[:2] - self._mid0, p[2]) for p, _ in s]
+        self._frames = {n: self.ik.model.getFrameId(n) for seg in BODY_SEGMENTS for n in seg[:2]}
+
+    # -- the stance ---------------------------------------------------------------------------------
+    def stance(self, mid_xy: np.ndarray, heading: float, ground_z: float) -> tuple[np.ndarray, list[Sole]]:
+        """The nominal standing pose with the soles' middle at mid_xy, facing heading."""
+        c, s = math.cos(heading), math.sin(heading)
+        r = np.array([[c, -s], [s, c]])
+        q = self._nominal.copy()
+        q[:2] = mid_xy - r @ self._mid0
+        q[2] += ground_z
+        q[3:7] = [0.0, 0.0, math.sin(heading / 2), math.cos(heading / 2)]
+        rot = rot_z(np.asarray(heading))
+        soles = [(np.array([*(mid_xy + r @ off), ground_z + z]), rot) for off, z in self._soles0]
+        return q, soles
+
+    # -- the search ---------------------------------------------------------------------------------
+    def plan(self, box: Box, center_w: np.ndarray, support: Block | None, headings: list[float], *,
+             ground_z: float = 0.0, lift_m: float | None = None, press_m: float = 0.01,
+             what: str = "hold it") -> StancePlan:
+        """The stance to hold `box` with its centre at center_w on `support` (None: the floor),
+        trying `headings` in order; lift_m: also lift it this much (a pick)."""
+        center_w = np.asarray(center_w, dtype=float)
+        dz = hand_height(box, float(center_w[2]))
+        mass = box.mass_kg
+        nominal = self.poses.nominal_pelvis_m + ground_z
+        grasp_z = float(center_w[2]) + dz - ground_z
+        size = f"box '{box.name}' ({'x'.join(f'{s:.2f}' for s in box.size)} m, {mass:.1f} kg, centre {center_w[2]:.2f} m up)"
+        if grasp_z < MIN_HAND_Z_M:
+            raise StanceRefused(f"{size}: no stance can {what}: the hands would hold it {grasp_z * 100:.0f} cm above "
+                                f"the ground (the hands strike the ground below {MIN_HAND_Z_M * 100:.0f} cm); "
+                                "closest: none tried")
+        if grasp_z < LOWEST_GRASP_M:  # one candidate, the deepest, for the closest pose
+            heading = headings[0]
+            depth = grasp_width(box, heading + math.pi / 2)
+            gap = max(GAPS_M[1], PREFERRED_CENTER_M - depth / 2)
+            fwd = np.array([math.cos(heading), math.sin(heading)])
+            cand = Candidate(heading, center_w[:2] - (gap + depth / 2) * fwd, gap, ground_z + SQUAT_PELVIS_M[-1], True)
+            self._evaluate(cand, box, center_w, support, grasp_width(box, heading), dz, mass, ground_z, lift_m,
+                           press_m)
+            raise StanceRefused(f"{size}: no stance can {what}: the hands would hold it {grasp_z:.2f} m above the "
+                                f"ground; squatting no lower than the pelvis at {MIN_PELVIS_M:.2f} m, the lowest "
+                                f"the search reaches is {LOWEST_GRASP_M:.2f} m; closest: {cand.describe()}")
+        # squatting lowers the hands for a box below the waist; above it, it only costs
+        levels = [nominal] + ([ground_z + z for z in SQUAT_PELVIS_M] if grasp_z < SQUAT_BELOW_M else [])
+        best: Candidate | None = None
+        tried = 0
+        for pelvis_z in levels:
+            kept: list[Candidate] = []
+            for heading in headings:
+                fwd = np.array([math.cos(heading), math.sin(heading)])
+                width = grasp_width(box, heading)
+                depth = grasp_width(box, heading + math.pi / 2)
+                for lean in (False, True):
+                    if lean and (grasp_z > LEAN_BELOW_M or pelvis_z >= nominal - 1e-6 or mass >= LEAN_MAX_KG):
+                        continue  # leaning only helps below the waist, squatting
+                    preferred = max(GAPS_M[1], PREFERRED_CENTER_M - depth / 2)
+                    gaps = (preferred, *(g for g in GAPS_M if abs(g - preferred) > 0.02))
+                    for gap in gaps if pelvis_z >= nominal - 1e-6 else [g for g in gaps if g >= 0.2]:
+                        mid = center_w[:2] - (gap + depth / 2) * fwd
+                        cand = Candidate(heading, mid, gap, pelvis_z, lean, preferred=gap == preferred)
+                        self._evaluate(cand, box, center_w, support, width, dz, mass, ground_z, lift_m, press_m)
+                        tried += 1
+                        if best is None or cand.score < best.score:
+                            best = cand
+                        if cand.feasible:
+                            kept.append(cand)
+            if kept:
+                chosen = min(kept, key=lambda k: (k.preferred is False, k.residual_m + k.com_error_m))
+                return StancePlan(Approach(chosen.mid_xy, chosen.heading), chosen, grasp_width(box, chosen.heading),
+                                  dz, tried, ground_z)
+        assert best is not None
+        why = best.collision if best.collision and best.residual_m <= FEASIBLE_RESIDUAL_M else \
+            f"the hands get only within {best.residual_m * 100:.1f} cm" if best.residual_m > FEASIBLE_RESIDUAL_M else \
+            f"the CoM is {best.com_error_m * 100:.1f} cm from over the feet"
+        raise StanceRefused(f"{size}: no stance can {what} ({tried} tried, pelvis down to {levels[-1]:.2f} m): {why}; "
+                            f"closest: {best.describe()}")
+
+    def _evaluate(self, cand: Candidate, box: Box, center_w: np.ndarray, support: Block | None, width: float,
+                  dz: float, mass: float, ground_z: float, lift_m: float | None, press_m: float) -> None:
+        q, soles = self.stance(cand.mid_xy, cand.heading, ground_z)
+        c = center_w + np.array([0.0, 0.0, dz])
+        depth = grasp_width(box, cand.heading + math.pi / 2)
+        shift = box_com_shift(mass, self.poses.mass_kg, cand.gap_m + depth / 2)
+        targets = [hand_points(c, cand.heading, width, -press_m)]
+        if lift_m is not None:
+            targets.append(hand_points(c, cand.heading, width, -press_m, dz_m=lift_m))
+        worst_res, worst_com = 0.0, 0.0
+        for t in targets:
+            r = self.hold(q, soles, t, cand.heading, shift, cand.pelvis_z_m, cand.lean)
+            q = r.q
+            cand.poses.append(q)
+            worst_res = max(worst_res, r.residual_m)
+            worst_com = max(worst_com, r.com_error_m)
+            squat = cand.pelvis_z_m < ground_z + self.poses.nominal_pelvis_m - 1e-6
+            if (squat and r.pelvis_error_m > FEASIBLE_PELVIS_M) or r.tilt_rad > MAX_TILT_RAD or \
+                    r.q[2] - ground_z < MIN_PELVIS_M:
+                cand.collision = cand.collision or f"the pelvis ends at {r.q[2]:.2f} m, tilted {r.tilt_rad:.2f} rad"
+            if not squat and cand.pelvis_z_m - r.q[2] > STANDING_GIVE_M:
+                cand.collision = cand.collision or (f"standing, the pelvis sinks to {r.q[2] - ground_z:.2f} m "
+                                                    "(a squat, tried as one)")
+            knee = min(float(r.q[7 + k]) for k in KNEES)
+            if knee < MIN_KNEE_RAD:
+                cand.collision = cand.collision or f"a knee is nearly straight ({knee:.2f} rad)"
+            if worst_res > FEASIBLE_RESIDUAL_M or worst_com > FEASIBLE_COM_M:
+                break  # not kept anyway: the rest is not worth its time
+            if cand.collision is None:
+                cand.collision = self.collision(q, box, center_w, support)
+        cand.residual_m, cand.com_error_m = worst_res, worst_com
+
+    def hold(self, q0: np.ndarray, soles: list[Sole], targets: tuple[np.ndarray, np.ndarray], heading: float,
+             com_shift_h: np.ndarray, pelvis_z: float, lean: bool) -> HoldPose:
+        """Both hands at `targets` (palms in across the heading), the pelvis at pelvis_z, the CoM over the
+        soles (shifted by com_shift_h, heading frame); lean: the pelvis may pitch and the waist leans
+        forward. Solved by continuation from q0: the pelvis and the hands move there in steps of at
+        most CONTINUATION_STEP_M, each step's IK from the last (one jump into a deep squat lands in
+        a wrong local solution, measured: hands 10-60 cm off where the steps get within 1 cm)."""
+        pp = self.poses
+        posture = g1.DEFAULT_Q_RAD.copy()
+        if lean:
+            posture[WAIST_PITCH] = LEAN_WAIST_RAD
+        weights = LEG_LIGHT_POSTURE_WEIGHT.copy()
+        weights[WAIST] = 0.5
+        com = pp.com_over(soles, com_shift_h)
+        rot = rot_z(np.asarray(heading))
+        pitch = LEAN_PELVIS_RAD if lean else 0.0
+        pelvis_rot = rot @ np.array([[math.cos(pitch), 0.0, math.sin(pitch)], [0.0, 1.0, 0.0],
+                                     [-math.sin(pitch), 0.0, math.cos(pitch)]])
+        z_cap = min(p[2] for p, _ in soles) + pp.nominal_pelvis_m + PELVIS_CAP_ABOVE_NOMINAL_M
+        # standing, the pelvis may give a little (the grasps of issue 17, measured in physics)
+        standing = pelvis_z >= z_cap - PELVIS_CAP_ABOVE_NOMINAL_M - 1e-6
+        start = [pp.hand_point(q0, i) for i in range(2)]
+        move = max(abs(pelvis_z - q0[2]), *(float(np.linalg.norm(targets[i] - start[i])) for i in range(2)))
+        steps = max(1, math.ceil(move / CONTINUATION_STEP_M))
+        q = q0
+        for k in range(1, steps + 1):
+            a = k / steps
+            hands = [(HAND_FRAMES[i], start[i] + a * (targets[i] - start[i])) for i in range(2)]
+            for _ in range(4 if k == steps else 2):
+                q = self.ik.solve(q, soles, com, q0[2] + a * (pelvis_z - q0[2]), pelvis_rot, posture, hands=hands,
+                                  hand_weight=100.0, hand_rot=[(HAND_FRAMES[0], rot), (HAND_FRAMES[1], rot)],
+                                  hand_rot_weight=1.0 if lean else 3.0,
+                                  pelvis_rot_weight=(10.0, 3.0 if lean else 1.0, 5.0), sole_weight=1000.0,
+                                  pelvis_z_weight=1.0 if standing else 30.0, posture_weight=weights, com_weight=300.0,
+                                  pelvis_z_max=z_cap, iterations=40 if k == steps else 20)
+        res = max(float(np.linalg.norm(pp.hand_point(q, i) - targets[i])) for i in range(2))
+        tilt = float(np.arccos(np.clip(self.ik.frame_pose(q, "pelvis")[1][2, 2], -1.0, 1.0)))
+        return HoldPose(q, res, float(np.linalg.norm(self.ik.com(q)[:2] - com)), abs(float(q[2]) - pelvis_z), tilt)
+
+    # -- clearance ----------------------------------------------------------------------------------
+    def collision(self, q: np.ndarray, box: Box, center_w: np.ndarray, support: Block | None) -> str | None:
+        """What part of the body, in pose q, comes into the support's top or the box (None: clear)."""
+        ik = self.ik
+        ik.pin.framesForwardKinematics(ik.model, ik.data, q)
+        pos = {n: ik.data.oMf[f].translation for n, f in self._frames.items()}
+        if support is not None and support.height_m > KNEE_HEIGHT_M:
+            gap = support.distance_xy(q[:2])
+            if gap < MIN_EDGE_CLEARANCE_M:
+                return (f"the pelvis is {gap:.2f} m from '{support.name}' (stepping in needs "
+                        f">= {MIN_EDGE_CLEARANCE_M:.2f} m)")
+            for side in ("left", "right"):
+                knee_gap = support.distance_xy(pos[f"{side}_knee_link"][:2])
+                if knee_gap < KNEE_EDGE_CLEARANCE_M:
+                    return (f"the {side} knee is {knee_gap:.2f} m from under '{support.name}' (stepping in needs "
+                            f">= {KNEE_EDGE_CLEARANCE_M:.2f} m)")
+        half_box = box.size / 2
+        c, s = math.cos(box.yaw_rad), math.sin(box.yaw_rad)
+        for a, b, radius, meets_box in BODY_SEGMENTS:
+            for u in np.linspace(0.0, 1.0, 6):
+                p = pos[a] + u * (pos[b] - pos[a])
+                if support is not None and support.distance_xy(p[:2]) < radius and \
+                        support.height_m - TABLE_TOP_THICKNESS_M - radius < p[2] < support.height_m + radius:
+                    return f"the {_part(a, b)} meets the top of '{support.name}'"
+                if meets_box:
+                    d = p[:2] - center_w[:2]
+                    local = np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1]])
+                    out = np.maximum(np.abs(local) - half_box[:2], 0.0)
+                    if np.linalg.norm(out) < radius and center_w[2] - half_box[2] - radius < p[2] < \
+                            center_w[2] + half_box[2] + radius:
+                        return f"the {_part(a, b)} meets the box"
+        return None
+
+
+# -- planner jobs (GoalContext.compute: inline, or in the planner process) ---------------------------
+@lru_cache(maxsize=4)
+def stance_planner(poses: PosePlanner) -> StancePlanner:
+    """The StancePlanner over `poses` (one per PosePlanner: the loop's own, or the planner process's)."""
+    return StancePlanner(poses)
+
+
+def plan_stance(poses: PosePlanner, box: Box, center_w: np.ndarray, support: Block | None, headings: list[float],
+                ground_z: float, lift_m: float | None, press_m: float, what: str) -> StancePlan:
+    """StancePlanner.plan as a planner job: the stance, squat and lean to hold `box` at center_w."""
+    return stance_planner(poses).plan(box, center_w, support, headings, ground_z=ground_z, lift_m=lift_m,
+                                      press_m=press_m, what=what)
+
+
+HoldStep = tuple[str, tuple[np.ndarray, np.ndarray], np.ndarray, float, bool]
+"""(name, the hands' two points, CoM shift (heading frame), pelvis height, leaning)."""
+
+
+def grasp_hold_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float, steps: list[HoldStep],
+                     box_name: str, planned: str) -> list[np.ndarray]:
+    """A pick's poses at the planned squat and lean, each from the one before (via, pre-grasp, contact,
+    lift and, from a squat, the rise); ReachRefused when the hands get no closer than 3 cm to a grasp
+    point from the stance the steps ended in (`planned`: the stance the search chose)."""
+    hold = stance_planner(poses).hold
+    out = []
+    q = q0
+    for name, targets, shift, pelvis_z, lean in steps:
+        res = hold(q, soles, targets, heading, shift, pelvis_z, lean)
+        if res.residual_m > 0.01 and q is not q0:  # a poor warm start (the pose before): again from the stance
+            again = hold(q0, soles, targets, heading, shift, pelvis_z, lean)
+            res = again if again.residual_m < res.residual_m else res
+        if res.residual_m > 0.03 and name not in ("via", "rise"):
+            raise StanceRefused(f"box '{box_name}': from the stance the steps ended in, the hands get only within "
+                                f"{res.residual_m * 100:.1f} cm of the {name} points (planned: {planned})")
+        q = res.q
+        out.append(q)
+    return out
+
+
+def release_hold_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float,
+                       points: tuple[tuple[np.ndarray, np.ndarray], ...], shift: np.ndarray, pelvis_z: float,
+                       lean: bool, low: bool, planned: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                                                                     np.ndarray]:
+    """A place's poses (above where the box goes, from a squat; set down; hands opened; hands out;
+    standing): the box set down at the planned squat and lean; StanceRefused when the hands get no
+    closer than 3 cm to where it goes."""
+    above, down, opened, out = points
+    hold = stance_planner(poses).hold
+    q_above = hold(q0, soles, above, heading, shift, pelvis_z, lean).q if low else q0
+    down_pose = hold(q_above, soles, down, heading, shift, pelvis_z, lean)
+    if down_pose.residual_m > 0.03:
+        raise StanceRefused(f"from the stance the carry ended in, the hands get only within "
+                            f"{down_pose.residual_m * 100:.1f} cm of where the box goes (planned: {planned})")
+    q_open = hold(down_pose.q, soles, opened, heading, np.zeros(2), pelvis_z, lean).q
+    q_out = hold(q_open, soles, out, heading, np.zeros(2), pelvis_z, lean).q
+    ground_z = min(p[2] for p, _ in soles)
+    q_stand = poses.stand(q_out, soles, ground_z + poses.nominal_pelvis_m, g1.DEFAULT_Q_RAD)
+    return q_above, down_pose.q, q_open, q_out, q_stand
+
+
+def _part(a: str, b: str) -> str:
+    side = "left " if a.startswith("left") else "right " if a.startswith("right") else ""
+    names = {"hip_pitch_link": "thigh", "knee_link": "shin", "pelvis_contour_link": "trunk", "torso_link": "chest",
+             "shoulder_pitch_link": "upper arm", "elbow_link": "forearm"}
+    key = a.removeprefix("left_").removeprefix("right_")
+    return side + names.get(key, key)
+
+
+def pick_headings(box: Box, box_xy: np.ndarray, support: Block | None, robot_xy: np.ndarray) -> list[float]:
+    """Headings (facing the box square on) to pick it from, best first (module docstring)."""
+    normals = face_normals(box)
+    if support is not None:
+        edge = edge_normal(support, box_xy)
+        ok = [n for n in normals if float(n @ edge) >= math.cos(EDGE_CONE_RAD) - 1e-9]
+        ok.sort(key=lambda n: -float(n @ edge))
+    else:
+        toward = np.asarray(robot_xy, dtype=float) - box_xy
+        toward = toward / max(float(np.linalg.norm(toward)), 1e-6)
+        ok = sorted(normals, key=lambda n: -float(n @ toward))[:2]
+    return [math.atan2(-n[1], -n[0]) for n in ok]
+
+
+def place_heading(support: Block | None, xy: np.ndarray, robot_xy: np.ndarray) -> float:
+    """Facing the support's edge nearest to the place, or (the floor) from where the robot is."""
+    if support is not None:
+        n = edge_normal(support, xy)
+    else:
+        n = np.asarray(robot_xy, dtype=float) - xy
+        n = n / max(float(np.linalg.norm(n)), 1e-6)
+    return math.atan2(-n[1], -n[0])
+
+
+__all__ = ["Candidate", "StancePlan", "StancePlanner", "StanceRefused", "box_com_shift", "edge_normal", "face_normals",
+           "grasp_hold_poses", "hand_height", "pick_headings", "place_heading", "plan_stance", "release_hold_poses",
+           "stance_planner"]
