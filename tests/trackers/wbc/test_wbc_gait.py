@@ -15,6 +15,8 @@ from g1_control.trackers.wbc.gait import (
     _min_jerk,
     nominal_dcm_offset,
     nominal_step,
+    step_duration_for,
+    support_times_for,
 )
 
 OMEGA = math.sqrt(9.81 / 0.66)
@@ -54,7 +56,10 @@ def test_commands_beyond_the_step_limits_are_walked_at_the_limit():
     gait = VelocityGait()
     cfg = gait.config
     T, m = cfg.step_s, cfg.speed_margin
-    limits = (m * cfg.max_forward_m / T, m * (cfg.max_width_m - cfg.step_width_m) / (2 * T),
+    # walking fast the steps come quicker (the fast double support): vx and vy reach further
+    T_fast = cfg.single_support_s + cfg.fast_double_support_s
+    assert T_fast < T
+    limits = (m * cfg.max_forward_m / T_fast, m * (cfg.max_width_m - cfg.step_width_m) / (2 * T_fast),
               m * cfg.max_relative_yaw_rad / T)
     for axis, limit in enumerate(limits):
         command = np.zeros(3)
@@ -62,12 +67,40 @@ def test_commands_beyond_the_step_limits_are_walked_at_the_limit():
         out = gait.feasible(command)
         assert abs(out[axis]) == pytest.approx(limit) and np.sign(out[axis]) == np.sign(command[axis])
         assert np.count_nonzero(out) == 1
-    assert gait.feasible(np.array([-5.0, 0.0, 0.0]))[0] == pytest.approx(-m * cfg.max_backward_m / T)
+    assert gait.feasible(np.array([-5.0, 0.0, 0.0]))[0] == pytest.approx(-m * cfg.max_backward_m / T_fast)
     np.testing.assert_allclose(gait.feasible(np.array([0.3, 0.05, 0.2])), [0.3, 0.05, 0.2])
     # combined axes share the reach: their fractions of the limits add up to one, direction kept
     out = gait.feasible(np.array([0.8, 0.2, -1.0]))
     assert sum(abs(out[k]) / limits[k] for k in range(3)) == pytest.approx(1.0)
     np.testing.assert_allclose(out / np.linalg.norm(out), np.array([0.8, 0.2, -1.0]) / np.linalg.norm([0.8, 0.2, -1.0]))
+
+
+def test_steps_come_quicker_walking_fast_and_not_walking_slowly():
+    """The cadence rises with the step reach: slow walking keeps the configured timing; fast
+    walking shortens the double support (down to the fast one), never the swing."""
+    cfg = GaitConfig()
+    for slow in ((0.0, 0.0), (0.5, 0.0), (-0.4, 0.0), (0.2, 0.1)):
+        assert support_times_for(cfg, np.array(slow)) == (cfg.single_support_s, cfg.double_support_s)
+    durations = [step_duration_for(cfg, np.array([vx, 0.0])) for vx in (0.7, 0.8, 0.9, 1.0)]
+    assert all(a > b for a, b in zip(durations, durations[1:], strict=False))
+    assert support_times_for(cfg, np.array([0.0, 0.4])) == pytest.approx((cfg.single_support_s,
+                                                                           cfg.fast_double_support_s))
+    assert step_duration_for(cfg, np.array([1.5, 0.0])) == pytest.approx(cfg.single_support_s + cfg.fast_double_support_s)
+
+
+def test_the_gait_walks_the_fast_cadence_once_the_command_is_fast():
+    """Through the state machine (no physics): the steps' duration follows the walked command."""
+    gait = VelocityGait()
+    soles, yaws = _feet()
+    command = np.array([1.0, 0.0, 0.0])
+    durations = []
+    for k in range(1500):
+        gait.schedule(0.004 * k, command, soles, yaws, np.zeros(2))
+        if gait.mode == "walk":
+            durations.append(gait.step_T)
+    assert durations[0] == pytest.approx(gait.config.step_s)  # from standing: the slow cadence
+    assert durations[-1] == pytest.approx(step_duration_for(gait.config, command[:2]))
+    assert durations[-1] < gait.config.step_s - 0.02
 
 
 def _feet():
@@ -113,6 +146,8 @@ def test_landing_moves_with_the_measured_dcm():
     ({"single_support_s": 0.0}, "single_support_s must be a finite number > 0"),
     ({"min_width_m": 0.3}, "min_width_m <= step_width_m <= max_width_m"),
     ({"freeze_landing_after": 1.5}, "freeze_landing_after must be in"),
+    ({"fast_double_support_s": 0.1}, "fast_double_support_s <= double_support_s"),
+    ({"cadence_reach_from": 1.2}, "cadence_reach_from < cadence_reach_full"),
 ])
 def test_bad_gait_config_is_refused(kwargs, text):
     with pytest.raises(WbcConfigError, match=text):
