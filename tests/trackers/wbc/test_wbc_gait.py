@@ -1,6 +1,7 @@
 """The velocity gait's pieces without physics: DCM offsets that repeat step after step, swing
 segments that arrive, commands kept within the step limits, named configuration errors."""
 
+import itertools
 import math
 
 import numpy as np
@@ -82,7 +83,7 @@ def test_steps_come_quicker_walking_fast_and_not_walking_slowly():
     for slow in ((0.0, 0.0), (0.5, 0.0), (-0.4, 0.0), (0.2, 0.1)):
         assert support_times_for(cfg, np.array(slow)) == (cfg.single_support_s, cfg.double_support_s)
     durations = [step_duration_for(cfg, np.array([vx, 0.0])) for vx in (0.7, 0.8, 0.9, 1.0)]
-    assert all(a > b for a, b in zip(durations, durations[1:], strict=False))
+    assert all(a > b for a, b in itertools.pairwise(durations))
     assert support_times_for(cfg, np.array([0.0, 0.4])) == pytest.approx((cfg.single_support_s,
                                                                            cfg.fast_double_support_s))
     assert step_duration_for(cfg, np.array([1.5, 0.0])) == pytest.approx(cfg.single_support_s + cfg.fast_double_support_s)
