@@ -17,6 +17,7 @@ from g1_control.trackers.wbc.gait import (
     nominal_dcm_offset,
     nominal_step,
     step_duration_for,
+    step_load,
     support_times_for,
 )
 
@@ -57,7 +58,8 @@ def test_commands_beyond_the_step_limits_are_walked_at_the_limit():
     gait = VelocityGait()
     cfg = gait.config
     T, m = cfg.step_s, cfg.speed_margin
-    # walking fast the steps come quicker (the fast double support): vx and vy reach further
+    # walking fast the steps come quicker (the fast double support): vx and vy reach further than
+    # the slow cadence's limits, exactly as far as the fast cadence's
     T_fast = cfg.single_support_s + cfg.fast_double_support_s
     assert T_fast < T
     limits = (m * cfg.max_forward_m / T_fast, m * (cfg.max_width_m - cfg.step_width_m) / (2 * T_fast),
@@ -68,12 +70,18 @@ def test_commands_beyond_the_step_limits_are_walked_at_the_limit():
         out = gait.feasible(command)
         assert abs(out[axis]) == pytest.approx(limit) and np.sign(out[axis]) == np.sign(command[axis])
         assert np.count_nonzero(out) == 1
+        assert step_load(cfg, out, m) == pytest.approx(1.0)
     assert gait.feasible(np.array([-5.0, 0.0, 0.0]))[0] == pytest.approx(-m * cfg.max_backward_m / T_fast)
     np.testing.assert_allclose(gait.feasible(np.array([0.3, 0.05, 0.2])), [0.3, 0.05, 0.2])
     # combined axes share the reach: their fractions of the limits add up to one, direction kept
+    # (slow: the fractions of the slow cadence's limits, as before the cadence rose with speed)
     out = gait.feasible(np.array([0.8, 0.2, -1.0]))
-    assert sum(abs(out[k]) / limits[k] for k in range(3)) == pytest.approx(1.0)
+    slow = (m * cfg.max_forward_m / T, m * (cfg.max_width_m - cfg.step_width_m) / (2 * T), limits[2])
+    assert sum(abs(out[k]) / slow[k] for k in range(3)) == pytest.approx(1.0)
     np.testing.assert_allclose(out / np.linalg.norm(out), np.array([0.8, 0.2, -1.0]) / np.linalg.norm([0.8, 0.2, -1.0]))
+    # the speed correction's limit at a given cadence (fixed step duration) and margin
+    out = gait.feasible(np.array([5.0, 0.0, 0.0]), margin=1.0, step_s=T)
+    assert out[0] == pytest.approx(cfg.max_forward_m / T)
 
 
 def test_steps_come_quicker_walking_fast_and_not_walking_slowly():
@@ -82,7 +90,7 @@ def test_steps_come_quicker_walking_fast_and_not_walking_slowly():
     cfg = GaitConfig()
     for slow in ((0.0, 0.0), (0.5, 0.0), (-0.4, 0.0), (0.2, 0.1)):
         assert support_times_for(cfg, np.array(slow)) == (cfg.single_support_s, cfg.double_support_s)
-    durations = [step_duration_for(cfg, np.array([vx, 0.0])) for vx in (0.7, 0.8, 0.9, 1.0)]
+    durations = [step_duration_for(cfg, np.array([vx, 0.0])) for vx in (0.85, 0.9, 0.95, 1.0)]
     assert all(a > b for a, b in itertools.pairwise(durations))
     assert support_times_for(cfg, np.array([0.0, 0.4])) == pytest.approx((cfg.single_support_s,
                                                                            cfg.fast_double_support_s))
