@@ -103,11 +103,17 @@ class GaitConfig:
     max_speed_correction_mps: float = 0.4
     corrected_speed_margin: float = 0.85
     """The command with the speed correction added walks at most this fraction of the speeds the
-    step limits allow: the correction makes up for steps that land shorter than planned, so it may
-    plan beyond `speed_margin` (at 1.0 m/s the robot walked 73 % of the plan, measured)."""
+    step limits allow at the walked command's cadence. At 1.0 m/s the robot walks ~73 % of the plan
+    (measured), so the correction saturates here; 1.0 (planning up to the limits) made that walk fall
+    (one run, measured)."""
     speed_margin: float = 0.85
     fast_single_support_s: float = 0.28
     fast_double_support_s: float = 0.03
+    fast_max_width_m: float = 0.52
+    """... and, walking fast sideways, the widest stance grows from `max_width_m` towards this (with the
+    sideways step's own cadence share): within 0.45 m the quicker steps walked 0.31 m/s for 0.4
+    (measured); slow walking keeps 0.45 (a wider limit at every speed made the random timelines fall
+    more often, measured)."""
     """Walking fast, the steps come quicker (cadence rising with speed): the single support shrinks
     from `single_support_s` towards this as the steps' reach (the nominal step's share of its limits at
     the slow cadence, `step_reach`) grows from `cadence_reach_from` to `cadence_reach_full`, and the
@@ -157,6 +163,9 @@ class GaitConfig:
             raise WbcConfigError(f"GaitConfig needs 0 < fast_single_support_s <= single_support_s and 0 < "
                                  f"fast_double_support_s <= double_support_s; got {self.fast_single_support_s}, "
                                  f"{self.single_support_s}, {self.fast_double_support_s}, {self.double_support_s}")
+        if not self.max_width_m <= self.fast_max_width_m:
+            raise WbcConfigError(f"GaitConfig needs max_width_m <= fast_max_width_m; got {self.max_width_m}, "
+                                 f"{self.fast_max_width_m}")
         if not 0 <= self.cadence_reach_from < self.cadence_reach_full:
             raise WbcConfigError(f"GaitConfig needs 0 <= cadence_reach_from < cadence_reach_full; got "
                                  f"{self.cadence_reach_from}, {self.cadence_reach_full}")
@@ -235,26 +244,35 @@ def support_times_for(cfg: GaitConfig, v_h: np.ndarray) -> tuple[float, float]:
             cfg.double_support_s + a * (cfg.fast_double_support_s - cfg.double_support_s))
 
 
+def max_width_for(cfg: GaitConfig, v_h: np.ndarray) -> float:
+    """The widest stance (sideways step limit) of steps walking at v_h: `max_width_m` slowly, growing
+    towards `fast_max_width_m` with the cadence of the sideways part alone (cadence_share)."""
+    sideways = np.array([0.0, float(v_h[1])])
+    return cfg.max_width_m + cadence_share(cfg, sideways) * (cfg.fast_max_width_m - cfg.max_width_m)
+
+
 def step_duration_for(cfg: GaitConfig, v_h: np.ndarray) -> float:
     """Touchdown to touchdown of steps walking steadily at v_h (flat ground): a stride is two."""
     return sum(support_times_for(cfg, v_h))
 
 
-def step_load(cfg: GaitConfig, command_h: np.ndarray, margin: float, step_s: float | None = None) -> float:
+def step_load(cfg: GaitConfig, command_h: np.ndarray, margin: float, cadence_of: np.ndarray | None = None) -> float:
     """The share of the step limits (`margin` of them) walking command_h = (vx, vy, wz) takes: the
-    forward step over its limit, the sideways step out over the room beyond the step width, the
-    turn over the relative yaw limit, summed. The steps last `step_s`, or (None) as long as the
-    command's cadence has them (step_duration_for); the turn is per step of `step_s` (the slow one)."""
-    T = step_duration_for(cfg, command_h[:2]) if step_s is None else step_s
+    forward step over its limit, the sideways step out over the room beyond the step width (up to
+    the width limit, max_width_for), the turn (per slow step) over the relative yaw limit, summed.
+    The steps have the cadence and width limit of `cadence_of` (vx, vy), None: of the command itself."""
+    pace = command_h[:2] if cadence_of is None else cadence_of[:2]
+    T = step_duration_for(cfg, pace)
     vx, vy, wz = (float(x) for x in command_h[:3])
     forward = cfg.max_forward_m if vx >= 0 else cfg.max_backward_m
-    return (abs(vx) * T / (margin * forward) + 2.0 * abs(vy) * T / (margin * (cfg.max_width_m - cfg.step_width_m))
-            + abs(wz) * (cfg.step_s if step_s is None else step_s) / (margin * cfg.max_relative_yaw_rad))
+    return (abs(vx) * T / (margin * forward)
+            + 2.0 * abs(vy) * T / (margin * (max_width_for(cfg, pace) - cfg.step_width_m))
+            + abs(wz) * cfg.step_s / (margin * cfg.max_relative_yaw_rad))
 
 
-def _axis_limits(cfg: GaitConfig, margin: float, step_s: float | None) -> tuple[float, float, float, float]:
+def _axis_limits(cfg: GaitConfig, margin: float, cadence_of: np.ndarray | None) -> tuple[float, float, float, float]:
     """The largest forward, backward, sideways speed and turn rate each alone within step_load <= 1
-    (with the cadence the speed has, when step_s is None: the load grows with the speed, bisected)."""
+    (with the cadence each speed has, when cadence_of is None: the load grows with the speed, bisected)."""
     out = []
     for axis, sign in ((0, 1.0), (0, -1.0), (1, 1.0), (2, 1.0)):
         lo, hi = 0.0, 10.0
@@ -262,7 +280,7 @@ def _axis_limits(cfg: GaitConfig, margin: float, step_s: float | None) -> tuple[
             mid = 0.5 * (lo + hi)
             v = np.zeros(3)
             v[axis] = sign * mid
-            lo, hi = (mid, hi) if step_load(cfg, v, margin, step_s) <= 1.0 else (lo, mid)
+            lo, hi = (mid, hi) if step_load(cfg, v, margin, cadence_of) <= 1.0 else (lo, mid)
         out.append(lo)
     return out[0], out[1], out[2], out[3]
 
@@ -410,29 +428,30 @@ class VelocityGait:
         self.targets.mode = self.mode
         return contacts
 
-    def feasible(self, command_h: np.ndarray, margin: float | None = None, step_s: float | None = None) -> np.ndarray:
+    def feasible(self, command_h: np.ndarray, margin: float | None = None,
+                 cadence_of: np.ndarray | None = None) -> np.ndarray:
         """`command_h` within what the step limits allow (`margin` of them, GaitConfig.speed_margin by
         default), each axis and together (the three axes' fractions of their limits, step_load, add up
-        to at most one); the steps last `step_s`, or (None) as long as the cadence of the command
-        (step_duration_for): walking fast, quicker steps reach further per second."""
+        to at most one); the steps have the cadence and width limit of `cadence_of`'s (vx, vy), or (None)
+        of the command itself: walking fast, quicker steps reach further per second."""
         cfg = self.config
         m = cfg.speed_margin if margin is None else margin
-        limits = self._limits if margin is None and step_s is None else _axis_limits(cfg, m, step_s)
+        limits = self._limits if margin is None and cadence_of is None else _axis_limits(cfg, m, cadence_of)
         out = np.array(command_h, dtype=float)
         out[0] = min(max(out[0], -limits[1]), limits[0])
         out[1] = min(max(out[1], -limits[2]), limits[2])
         out[2] = min(max(out[2], -limits[3]), limits[3])
         # combined axes share the step's reach: walking fast while turning hard stretched the swing
         # leg straight to its landing point (a knee overspeed at touchdown, measured)
-        load = step_load(cfg, out, m, step_s)
+        load = step_load(cfg, out, m, cadence_of)
         if load > 1.0:
             scaled = out / load
-            if step_load(cfg, scaled, m, step_s) > 1.0 + 1e-9:
+            if step_load(cfg, scaled, m, cadence_of) > 1.0 + 1e-9:
                 # slower, the steps come slower and reach less far per second: scale down further
                 lo, hi = 0.0, 1.0 / load
                 for _ in range(40):
                     mid = 0.5 * (lo + hi)
-                    lo, hi = (mid, hi) if step_load(cfg, mid * out, m, step_s) <= 1.0 else (lo, mid)
+                    lo, hi = (mid, hi) if step_load(cfg, mid * out, m, cadence_of) <= 1.0 else (lo, mid)
                 scaled = lo * out
             out = scaled
         return out
@@ -450,7 +469,8 @@ class VelocityGait:
         single, double = support_times_for(cfg, self.command_h[:2])
         if single == cfg.single_support_s and double == cfg.double_support_s:
             return cfg
-        return dataclasses.replace(cfg, single_support_s=single, double_support_s=double)
+        return dataclasses.replace(cfg, single_support_s=single, double_support_s=double,
+                                   max_width_m=max_width_for(cfg, self.command_h[:2]))
 
     def _terrain_limited(self, command_h: np.ndarray, soles_m: np.ndarray) -> np.ndarray:
         """`command_h` slowed to GaitConfig.terrain_speed_mps while a step is ahead of the feet."""
@@ -479,8 +499,7 @@ class VelocityGait:
             # no wind-up: the corrected command stays within the step limits
             # at the cadence the walked command has (the correction does not quicken the steps)
             corrected = np.array([*(self.command_h[:2] + c), 0.0])
-            cadence = step_duration_for(cfg, self.command_h[:2])
-            c[:] = self.feasible(corrected, cfg.corrected_speed_margin, cadence)[:2] - self.command_h[:2]
+            c[:] = self.feasible(corrected, cfg.corrected_speed_margin, self.command_h)[:2] - self.command_h[:2]
         self._td_pos[foot] = landed_xy
         self._td_t[foot] = t_s
 
@@ -657,5 +676,5 @@ class VelocityGait:
         return out
 
 
-__all__ = ["GaitConfig", "GaitTargets", "VelocityGait", "cadence_share", "nominal_dcm_offset", "nominal_step",
+__all__ = ["GaitConfig", "GaitTargets", "VelocityGait", "cadence_share", "max_width_for", "nominal_dcm_offset", "nominal_step",
            "step_duration_for", "step_load", "step_reach", "support_times_for", "yaw_rotation"]

@@ -14,6 +14,7 @@ from g1_control.trackers.wbc.gait import (
     GaitConfig,
     VelocityGait,
     _min_jerk,
+    max_width_for,
     nominal_dcm_offset,
     nominal_step,
     step_duration_for,
@@ -58,11 +59,11 @@ def test_commands_beyond_the_step_limits_are_walked_at_the_limit():
     gait = VelocityGait()
     cfg = gait.config
     T, m = cfg.step_s, cfg.speed_margin
-    # walking fast the steps come quicker (the fast double support): vx and vy reach further than
-    # the slow cadence's limits, exactly as far as the fast cadence's
+    # walking fast the steps come quicker (the fast double support) and sideways wider: vx and vy
+    # reach further than the slow cadence's limits, exactly as far as the fast cadence's
     T_fast = cfg.single_support_s + cfg.fast_double_support_s
-    assert T_fast < T
-    limits = (m * cfg.max_forward_m / T_fast, m * (cfg.max_width_m - cfg.step_width_m) / (2 * T_fast),
+    assert T_fast < T and cfg.fast_max_width_m > cfg.max_width_m
+    limits = (m * cfg.max_forward_m / T_fast, m * (cfg.fast_max_width_m - cfg.step_width_m) / (2 * T_fast),
               m * cfg.max_relative_yaw_rad / T)
     for axis, limit in enumerate(limits):
         command = np.zeros(3)
@@ -80,7 +81,7 @@ def test_commands_beyond_the_step_limits_are_walked_at_the_limit():
     assert sum(abs(out[k]) / slow[k] for k in range(3)) == pytest.approx(1.0)
     np.testing.assert_allclose(out / np.linalg.norm(out), np.array([0.8, 0.2, -1.0]) / np.linalg.norm([0.8, 0.2, -1.0]))
     # the speed correction's limit at a given cadence (fixed step duration) and margin
-    out = gait.feasible(np.array([5.0, 0.0, 0.0]), margin=1.0, step_s=T)
+    out = gait.feasible(np.array([5.0, 0.0, 0.0]), margin=1.0, cadence_of=np.zeros(2))
     assert out[0] == pytest.approx(cfg.max_forward_m / T)
 
 
@@ -95,6 +96,10 @@ def test_steps_come_quicker_walking_fast_and_not_walking_slowly():
     assert support_times_for(cfg, np.array([0.0, 0.4])) == pytest.approx((cfg.single_support_s,
                                                                            cfg.fast_double_support_s))
     assert step_duration_for(cfg, np.array([1.5, 0.0])) == pytest.approx(cfg.single_support_s + cfg.fast_double_support_s)
+    # the stance may widen for fast sideways steps only
+    assert max_width_for(cfg, np.array([0.0, 0.2])) == cfg.max_width_m
+    assert max_width_for(cfg, np.array([1.5, 0.0])) == cfg.max_width_m
+    assert max_width_for(cfg, np.array([0.0, 0.4])) == pytest.approx(cfg.fast_max_width_m)
 
 
 def test_the_gait_walks_the_fast_cadence_once_the_command_is_fast():
@@ -157,6 +162,7 @@ def test_landing_moves_with_the_measured_dcm():
     ({"freeze_landing_after": 1.5}, "freeze_landing_after must be in"),
     ({"fast_double_support_s": 0.1}, "fast_double_support_s <= double_support_s"),
     ({"cadence_reach_from": 1.2}, "cadence_reach_from < cadence_reach_full"),
+    ({"fast_max_width_m": 0.4}, "max_width_m <= fast_max_width_m"),
 ])
 def test_bad_gait_config_is_refused(kwargs, text):
     with pytest.raises(WbcConfigError, match=text):
