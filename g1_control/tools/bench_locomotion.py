@@ -11,7 +11,7 @@ segments, reversals, combined axes, stops; 30 s each); the WBC (tracker.type wbc
 the policies (tracker.type policy, their trained command range, not the shipped envelope) at their
 50 Hz. Figures, all from the simulator's ground truth:
   achieved   mean heading-frame (vx, vy, wz) over whole gait cycles after the first STEADY_SKIP_S
-             of walking (the WBC's stride is two of its steps; the policies' gait period is 1 s);
+             of walking (the WBC's stride is two of its steps at the command's cadence; the policies' gait period is 1 s);
   error      achieved minus commanded on a commanded axis, in % of the command (the worst axis);
   off-axis   the largest |achieved| of the uncommanded axes (m/s or rad/s);
   fell       the loop's fall monitor (pelvis below 0.4 m or tilted), and the lowest pelvis height;
@@ -150,6 +150,15 @@ def steady_velocity(log: dict[str, np.ndarray], t_from_s: float, t_to_s: float, 
     return log["velocity_true"][window].mean(axis=0)
 
 
+def wbc_stride_s(tracker, command: tuple[float, float, float]) -> float:
+    """The WBC's stride (two steps) walking `command` steadily: its cadence rises with speed
+    (gait.py, GaitConfig.fast_single_support_s)."""
+    from g1_control.trackers.wbc.gait import step_duration_for
+
+    gait = tracker.gait
+    return 2 * step_duration_for(gait.config, gait.feasible(np.array(command, dtype=float))[:2])
+
+
 def case_launch(controller: str, case: Case, walk_s: float, randomize: RandomizeConfig | None = None):
     """The launch of one row; `randomize`: on a randomised robot (g1_control/sim/randomize.py)."""
     from g1_control.launch.schema import LaunchFile
@@ -201,7 +210,7 @@ def run_case(controller: str, case: Case, walk_s: float, states: list | None = N
 
     tracker.act = timed_act  # type: ignore[method-assign]
     duration = sum(seg.duration_s for seg in case.timeline) if case.timeline else 1.0 + walk_s
-    stride = 2 * tracker.config.gait.step_s if controller == "wbc" else POLICY_GAIT_PERIOD_S  # type: ignore[attr-defined]
+    stride = wbc_stride_s(tracker, case.command) if controller == "wbc" else POLICY_GAIT_PERIOD_S
     shifted = tuple((t + case.push_stride_fraction * stride, f) for t, f in case.pushes)
     marks = sorted({t for t, _ in shifted if t < duration} | {duration})
     pushes = dict(shifted)
@@ -235,7 +244,7 @@ def run_case(controller: str, case: Case, walk_s: float, states: list | None = N
         row.pushes_survived = sum(1 for t, _ in shifted if t + PUSH_SETTLE_S <= t_end and t < duration)
         row.pushes = len(case.pushes)
     if not row.fell and not case.timeline:
-        period = 2 * tracker.config.gait.step_s if controller == "wbc" else POLICY_GAIT_PERIOD_S  # type: ignore[attr-defined]
+        period = stride
         achieved = steady_velocity(log, 1.0 + STEADY_SKIP_S, duration, period)
         row.achieved = [float(v) for v in achieved]
         errors = [100.0 * (achieved[k] - c) / c for k, c in enumerate(case.command) if c]

@@ -34,6 +34,21 @@ def test_steady_velocity_averages_whole_cycles_only():
         B.steady_velocity(log, 9.5, 10.0, 0.7)
 
 
+def test_the_wbc_stride_is_its_cadence_at_the_command():
+    """Walking fast the WBC's steps come quicker: the whole cycles the figures average over are
+    its strides at the command's cadence, the slow one walking slowly."""
+    from g1_control.trackers.wbc.gait import VelocityGait, step_duration_for
+
+    tracker = SimpleNamespace(gait=VelocityGait())
+    cfg = tracker.gait.config
+    assert B.wbc_stride_s(tracker, (0.5, 0.0, 0.0)) == pytest.approx(2 * cfg.step_s)
+    fast = B.wbc_stride_s(tracker, (0.0, 0.4, 0.0))
+    assert fast == pytest.approx(2 * step_duration_for(cfg, np.array([0.0, 0.4]))) and fast < 2 * cfg.step_s - 0.05
+    # beyond the gait's limits: the cadence of the speed it walks
+    assert B.wbc_stride_s(tracker, (3.0, 0.0, 0.0)) == pytest.approx(
+        2 * step_duration_for(cfg, tracker.gait.feasible(np.array([3.0, 0.0, 0.0]))[:2]))
+
+
 def test_a_fall_makes_the_bench_exit_1_and_is_in_the_json(tmp_path, monkeypatch):
     # a 600 N shove from the side for half a second topples any of the controllers
     shove = B.Case("shove", (0.0, 0.0, 0.0), timeline=(B.Segment(4.0, label="stand"),),

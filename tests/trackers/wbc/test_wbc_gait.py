@@ -1,6 +1,7 @@
 """The velocity gait's pieces without physics: DCM offsets that repeat step after step, swing
 segments that arrive, commands kept within the step limits, named configuration errors."""
 
+import itertools
 import math
 
 import numpy as np
@@ -13,8 +14,12 @@ from g1_control.trackers.wbc.gait import (
     GaitConfig,
     VelocityGait,
     _min_jerk,
+    max_width_for,
     nominal_dcm_offset,
     nominal_step,
+    step_duration_for,
+    step_load,
+    support_times_for,
 )
 
 OMEGA = math.sqrt(9.81 / 0.66)
@@ -54,7 +59,11 @@ def test_commands_beyond_the_step_limits_are_walked_at_the_limit():
     gait = VelocityGait()
     cfg = gait.config
     T, m = cfg.step_s, cfg.speed_margin
-    limits = (m * cfg.max_forward_m / T, m * (cfg.max_width_m - cfg.step_width_m) / (2 * T),
+    # walking fast the steps come quicker (the fast double support) and sideways wider: vx and vy
+    # reach further than the slow cadence's limits, exactly as far as the fast cadence's
+    T_fast = cfg.single_support_s + cfg.fast_double_support_s
+    assert T_fast < T and cfg.fast_max_width_m > cfg.max_width_m
+    limits = (m * cfg.max_forward_m / T_fast, m * (cfg.fast_max_width_m - cfg.step_width_m) / (2 * T_fast),
               m * cfg.max_relative_yaw_rad / T)
     for axis, limit in enumerate(limits):
         command = np.zeros(3)
@@ -62,12 +71,50 @@ def test_commands_beyond_the_step_limits_are_walked_at_the_limit():
         out = gait.feasible(command)
         assert abs(out[axis]) == pytest.approx(limit) and np.sign(out[axis]) == np.sign(command[axis])
         assert np.count_nonzero(out) == 1
-    assert gait.feasible(np.array([-5.0, 0.0, 0.0]))[0] == pytest.approx(-m * cfg.max_backward_m / T)
+        assert step_load(cfg, out, m) == pytest.approx(1.0)
+    assert gait.feasible(np.array([-5.0, 0.0, 0.0]))[0] == pytest.approx(-m * cfg.max_backward_m / T_fast)
     np.testing.assert_allclose(gait.feasible(np.array([0.3, 0.05, 0.2])), [0.3, 0.05, 0.2])
     # combined axes share the reach: their fractions of the limits add up to one, direction kept
+    # (slow: the fractions of the slow cadence's limits, as before the cadence rose with speed)
     out = gait.feasible(np.array([0.8, 0.2, -1.0]))
-    assert sum(abs(out[k]) / limits[k] for k in range(3)) == pytest.approx(1.0)
+    slow = (m * cfg.max_forward_m / T, m * (cfg.max_width_m - cfg.step_width_m) / (2 * T), limits[2])
+    assert sum(abs(out[k]) / slow[k] for k in range(3)) == pytest.approx(1.0)
     np.testing.assert_allclose(out / np.linalg.norm(out), np.array([0.8, 0.2, -1.0]) / np.linalg.norm([0.8, 0.2, -1.0]))
+    # the speed correction's limit at a given cadence (fixed step duration) and margin
+    out = gait.feasible(np.array([5.0, 0.0, 0.0]), margin=1.0, cadence_of=np.zeros(2))
+    assert out[0] == pytest.approx(cfg.max_forward_m / T)
+
+
+def test_steps_come_quicker_walking_fast_and_not_walking_slowly():
+    """The cadence rises with the step reach: slow walking keeps the configured timing; fast
+    walking shortens the double support (down to the fast one), never the swing."""
+    cfg = GaitConfig()
+    for slow in ((0.0, 0.0), (0.5, 0.0), (-0.4, 0.0), (0.2, 0.1)):
+        assert support_times_for(cfg, np.array(slow)) == (cfg.single_support_s, cfg.double_support_s)
+    durations = [step_duration_for(cfg, np.array([vx, 0.0])) for vx in (0.85, 0.9, 0.95, 1.0)]
+    assert all(a > b for a, b in itertools.pairwise(durations))
+    assert support_times_for(cfg, np.array([0.0, 0.4])) == pytest.approx((cfg.single_support_s,
+                                                                           cfg.fast_double_support_s))
+    assert step_duration_for(cfg, np.array([1.5, 0.0])) == pytest.approx(cfg.single_support_s + cfg.fast_double_support_s)
+    # the stance may widen for fast sideways steps only
+    assert max_width_for(cfg, np.array([0.0, 0.2])) == cfg.max_width_m
+    assert max_width_for(cfg, np.array([1.5, 0.0])) == cfg.max_width_m
+    assert max_width_for(cfg, np.array([0.0, 0.4])) == pytest.approx(cfg.fast_max_width_m)
+
+
+def test_the_gait_walks_the_fast_cadence_once_the_command_is_fast():
+    """Through the state machine (no physics): the steps' duration follows the walked command."""
+    gait = VelocityGait()
+    soles, yaws = _feet()
+    command = np.array([1.0, 0.0, 0.0])
+    durations = []
+    for k in range(1500):
+        gait.schedule(0.004 * k, command, soles, yaws, np.zeros(2))
+        if gait.mode == "walk":
+            durations.append(gait.step_T)
+    assert durations[0] == pytest.approx(gait.config.step_s)  # from standing: the slow cadence
+    assert durations[-1] == pytest.approx(step_duration_for(gait.config, command[:2]))
+    assert durations[-1] < gait.config.step_s - 0.02
 
 
 def _feet():
@@ -113,6 +160,9 @@ def test_landing_moves_with_the_measured_dcm():
     ({"single_support_s": 0.0}, "single_support_s must be a finite number > 0"),
     ({"min_width_m": 0.3}, "min_width_m <= step_width_m <= max_width_m"),
     ({"freeze_landing_after": 1.5}, "freeze_landing_after must be in"),
+    ({"fast_double_support_s": 0.1}, "fast_double_support_s <= double_support_s"),
+    ({"cadence_reach_from": 1.2}, "cadence_reach_from < cadence_reach_full"),
+    ({"fast_max_width_m": 0.4}, "max_width_m <= fast_max_width_m"),
 ])
 def test_bad_gait_config_is_refused(kwargs, text):
     with pytest.raises(WbcConfigError, match=text):

@@ -6,6 +6,7 @@ import numpy as np
 from g1_control.robot import g1
 from g1_control.rotations import yaw_of
 from g1_control.sim.mujoco_backend import MujocoBackend
+from g1_control.trackers.wbc.gait import step_duration_for
 from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
 from g1_control.types import JointReference
 
@@ -46,6 +47,21 @@ def test_walks_forward_at_the_commanded_speed_without_falling():
     assert abs(pos[b, 1] - pos[a, 1]) / (t[b] - t[a]) < 0.05  # straight means straight
     assert abs(yaw[b] - yaw[a]) < 0.1
     assert tracker.gait is not None and tracker.gait.steps >= 12
+    assert tracker.diagnostics.unsolved_ticks == 0
+
+
+def test_walks_sideways_at_0_4_within_ten_percent():
+    """Sideways 0.4 m/s (ground truth, whole strides): at the slow cadence within the slow width
+    limit the gait allows 0.28 m/s at most (GaitConfig.speed_margin); the quicker, wider steps of
+    fast walking (GaitConfig.fast_double_support_s, fast_max_width_m) leave the room for 0.4."""
+    tracker, trace = walk((0.0, 0.4, 0.0), 5.6)
+    t, pos = trace[:, 0], trace[:, 1:4]
+    assert t[-1] > 5.5, f"fell at {t[-1]:.2f} s"
+    stride = 2 * step_duration_for(tracker.config.gait, np.array([0.0, 0.4]))
+    a, b = np.searchsorted(t, 3.0), np.searchsorted(t, 3.0 + 3 * stride)
+    velocity = (pos[b, :2] - pos[a, :2]) / (t[b] - t[a])
+    assert abs(velocity[1] - 0.4) < 0.04, f"walked {velocity[1]:.3f} m/s sideways for 0.4"
+    assert abs(velocity[0]) < 0.05
     assert tracker.diagnostics.unsolved_ticks == 0
 
 
