@@ -124,12 +124,20 @@ def test_a_dcm_far_off_its_plan_makes_the_step_a_recovery_step_until_it_lands():
     soles, yaws = _feet()
     gait = VelocityGait()
     t = _into_single_support(gait, soles, yaws)
-    on_plan = gait.update(t, 0.004, soles, yaws, soles[LEFT, :2] + np.array([0.0, -0.03]), OMEGA)
-    assert on_plan.dcm_error_m < gait.config.recovery_dcm_error_m and not on_plan.recovery
-    pushed = soles[LEFT, :2] + np.array([0.0, -0.03 - 1.2 * gait.config.recovery_dcm_error_m])
-    assert gait.update(t + 0.004, 0.004, soles, yaws, pushed, OMEGA).recovery
-    # back on plan, the step stays a recovery step (latched) ...
-    assert gait.update(t + 0.008, 0.004, soles, yaws, soles[LEFT, :2] + np.array([0.0, -0.03]), OMEGA).recovery
+    cfg = gait.config
+    # late in the swing, where the landing point is frozen: the DCM's error alone marks the step
+    while t - gait._t0 < cfg.double_support_s + (cfg.freeze_landing_after + 0.05) * cfg.single_support_s:
+        t += 0.004
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+    near = soles[LEFT, :2] + np.array([0.05, -0.03])
+    on_plan = gait.update(t, 0.004, soles, yaws, near, OMEGA)
+    assert on_plan.dcm_error_m < cfg.recovery_dcm_error_m and not on_plan.recovery
+    # pushed sideways: the error grows by more than the threshold (whatever the plan is exactly)
+    pushed = near + np.array([0.0, -(cfg.recovery_dcm_error_m + on_plan.dcm_error_m + 0.02)])
+    out = gait.update(t + 0.004, 0.004, soles, yaws, pushed, OMEGA)
+    assert out.dcm_error_m > cfg.recovery_dcm_error_m and out.recovery
+    # back near the plan, the step stays a recovery step (latched) ...
+    assert gait.update(t + 0.008, 0.004, soles, yaws, near, OMEGA).recovery
     # ... until the next step
     first = gait.steps
     while gait.steps == first or gait.targets.contacts.all():
