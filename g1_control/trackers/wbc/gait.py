@@ -22,6 +22,11 @@ commanded ones again: the robot's speed follows the command within one step. Ins
 CoP tracks the nominal DCM, p = u + (1 + k)(xi - xi_nom), clipped to the sole (the rest is left to
 the step). The landing point is frozen late in the swing so the foot can get there.
 
+Recovery steps: a step whose DCM strays GaitConfig.recovery_dcm_error_m from its plan during the
+swing, or whose landing stays beyond the step limits after its timing was adjusted (a push), is
+marked (GaitTargets.recovery) until it lands; the tracker then holds the swing foot to its path
+harder (WbcConfig.recovery_swing_weight), so the QP steps rather than swinging the leg back.
+
 Swing feet: the horizontal path and the yaw are re-planned each tick as a minimum-jerk segment
 from the reference's current position, velocity and acceleration to the (moving) landing point,
 arriving a little before touchdown; the height is a smooth bump of `swing_height_m` with zero
