@@ -24,6 +24,11 @@ commanded ones again: the robot's speed follows the command within one step. Ins
 CoP tracks the nominal DCM, p = u + (1 + k)(xi - xi_nom), clipped to the sole (the rest is left to
 the step). The landing point is frozen late in the swing so the foot can get there.
 
+Recovery steps: a step whose DCM strays GaitConfig.recovery_dcm_error_m from its plan during the
+swing, or whose landing stays beyond the step limits after its timing was adjusted (a push), is
+marked (GaitTargets.recovery) until it lands; the tracker then holds the swing foot to its path
+harder (WbcConfig.recovery_swing_weight), so the QP steps rather than swinging the leg back.
+
 Swing feet: the horizontal path and the yaw are re-planned each tick as a minimum-jerk segment
 from the reference's current position, velocity and acceleration to the (moving) landing point,
 arriving a little before touchdown; the height is a smooth bump of `swing_height_m` with zero
@@ -93,6 +98,10 @@ class GaitConfig:
     a step's length cannot change much from the one before without a large DCM error."""
     timing_adjust_excess_m: float = 0.03
     """A landing point this far beyond the step limits makes the step land sooner (step timing)."""
+    recovery_dcm_error_m: float = 0.2
+    """A step during whose swing the DCM strays this far from its nominal plan (a push, say), or whose
+    landing lies more than timing_adjust_excess_m beyond the step limits even after its timing was
+    adjusted, is a recovery step (GaitTargets.recovery: the tracker holds its swing foot harder)."""
     min_swing_s: float = 0.2
     min_remaining_s: float = 0.08
     """A step made sooner still swings this long in all, and lands no sooner than this from now."""
@@ -200,6 +209,10 @@ class GaitTargets:
     swing_progress: float = 0.0
     """Fraction of this step's swing done (0 in double support)."""
     mode: str = "stand"
+    recovery: bool = False
+    """The step under way is a recovery step (GaitConfig.recovery_dcm_error_m): a push, say."""
+    dcm_error_m: float = 0.0
+    """How far the DCM is from its nominal plan this tick (walking; 0 otherwise)."""
 
 
 def nominal_dcm_offset(cfg: GaitConfig, stance: int, v_h: np.ndarray, omega: float) -> np.ndarray:
@@ -361,6 +374,8 @@ class VelocityGait:
         """This step's duration (touchdown to touchdown): shortened when balance needs a step sooner."""
         self._lifted_at = math.nan
         """The _t0 of the step whose swing has started (nan: none)."""
+        self._recovery_at = math.nan
+        """The _t0 of the step that is a recovery step (GaitConfig.recovery_dcm_error_m; nan: none)."""
         self.command_h = np.zeros(3)
         """The command being walked: the operator's, rate limited (GaitConfig.max_accel)."""
         self.speed_correction_h = np.zeros(2)
@@ -569,6 +584,8 @@ class VelocityGait:
         out.yaw_rate_radps = 0.0 if self.mode == "stand" else float(command_h[2])
         out.swing_foot = -1
         out.swing_progress = 0.0
+        out.recovery = False
+        out.dcm_error_m = 0.0
         mid = soles_m[:, :2].mean(axis=0)
         centre = mid + _rot2(self.heading) @ np.array([cfg.com_offset_x_m, 0.0])
         if self.mode in ("stand", "start", "stop"):
@@ -602,6 +619,9 @@ class VelocityGait:
         u = soles_m[s]
         b_now = _rot2(self.heading - float(command_h[2]) * t_in) @ nominal_dcm_offset(cfg, s, command_h[:2], omega)
         xi_nom = u[:2] + b_now * math.exp(omega * t_in)
+        out.dcm_error_m = float(np.hypot(*(dcm_xy - xi_nom)))
+        if self._swinging and t_in >= Tds and out.dcm_error_m > cfg.recovery_dcm_error_m:
+            self._recovery_at = self._t0
         if t_in < Tds or not self._swinging:
             # double support: the CoP anywhere between the feet, to take out the DCM's error
             # before the other foot lifts (its offset then grows by e^{w T_ss} until touchdown)
@@ -633,6 +653,8 @@ class VelocityGait:
                     self.step_T = t_in + t_try
                     if excess <= cfg.timing_adjust_excess_m:
                         break
+            if excess > cfg.timing_adjust_excess_m and self._swinging:
+                self._recovery_at = self._t0  # latched: the rest of the step is a recovery step
             side = _SIDE[f]
             rel[0] = min(max(rel[0], -cfg.max_backward_m), cfg.max_forward_m)
             rel[1] = side * min(max(side * rel[1], cfg.min_width_m), cfg.max_width_m)
@@ -647,6 +669,7 @@ class VelocityGait:
         out.landing_m[:] = self._landing
         if not self._swinging:
             return out
+        out.recovery = bool(self._recovery_at == self._t0)
         # the swing foot: horizontal and yaw by re-planned minimum jerk once the foot is off the
         # ground, height up early, across, down late (a foot moving forward low trips on its toe)
         out.swing_foot = f

@@ -108,6 +108,12 @@ class WbcConfig:
     bent stance knee, which is near its torque limit."""
     terrain_swing_weight: float = 1000.0
     """On steps, the swing foot's task weight (the flat gait's is `swing_foot`'s)."""
+    recovery_swing_weight: float = 300.0
+    """In a recovery step (the gait's GaitTargets.recovery: a push), the swing foot's task weight (the
+    flat gait's is `swing_foot`'s): at 100 against the CoM task's 1000 the QP swung the leg backwards
+    and up (using it as angular momentum for the falling trunk) instead of stepping, and the foot
+    landed 0.7 m behind its landing point (pushed forward at 150 N, measured). 1000 in every step
+    made plain walking fall; 1000 in recovery steps made the random timelines worse (measured)."""
     walking_leg_posture_weight: float = 0.05
     """Walking by its own gait, the legs' posture task is only a regulariser (relative to `posture`)."""
     walking_crouch_lean_per_m: float = 2.5
@@ -495,8 +501,11 @@ class WholeBodyTracker(Tracker):
         f = gt.swing_foot
         if f >= 0 and not stance[f]:
             ft = dyn.frame(dyn.sole_ids[f])
-            swing = cfg.swing_foot if not terrain else TaskGains(cfg.swing_foot.kp, cfg.swing_foot.kd,
-                                                                 cfg.terrain_swing_weight)
+            swing = cfg.swing_foot
+            if terrain or gt.recovery:
+                weight = max(cfg.terrain_swing_weight if terrain else 0.0,
+                             cfg.recovery_swing_weight if gt.recovery else 0.0)
+                swing = TaskGains(cfg.swing_foot.kp, cfg.swing_foot.kd, weight)
             tasks.append(position_task("swing_foot", ft.jac_w[:3], ft.drift_w[:3], ft.pos_w_m + shift, ft.vel_w[:3],
                                        gt.swing_pos_m, gt.swing_vel_mps, gt.swing_acc_mps2, swing))
             tasks.append(orientation_task("swing_foot_rot", ft.jac_w[3:], ft.drift_w[3:], ft.rot_w, ft.vel_w[3:],

@@ -156,6 +156,45 @@ def test_landing_moves_with_the_measured_dcm():
     assert landings[1] > landings[0] + 0.2
 
 
+def _into_single_support(gait, soles, yaws):
+    t = 0.0
+    gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+    while gait.mode != "walk" or gait.targets.contacts.all():
+        t += 0.004
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+    return t
+
+
+def test_a_dcm_far_off_its_plan_makes_the_step_a_recovery_step_until_it_lands():
+    """A push (the DCM GaitConfig.recovery_dcm_error_m off its plan) makes the step under way a
+    recovery step (the tracker then holds its swing foot harder), for the rest of that step only."""
+    soles, yaws = _feet()
+    gait = VelocityGait()
+    t = _into_single_support(gait, soles, yaws)
+    cfg = gait.config
+    # late in the swing, where the landing point is frozen: the DCM's error alone marks the step
+    while t - gait._t0 < cfg.double_support_s + (cfg.freeze_landing_after + 0.05) * cfg.single_support_s:
+        t += 0.004
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+    near = soles[LEFT, :2] + np.array([0.05, -0.03])
+    on_plan = gait.update(t, 0.004, soles, yaws, near, OMEGA)
+    assert on_plan.dcm_error_m < cfg.recovery_dcm_error_m and not on_plan.recovery
+    # pushed sideways: the error grows by more than the threshold (whatever the plan is exactly)
+    pushed = near + np.array([0.0, -(cfg.recovery_dcm_error_m + on_plan.dcm_error_m + 0.02)])
+    out = gait.update(t + 0.004, 0.004, soles, yaws, pushed, OMEGA)
+    assert out.dcm_error_m > cfg.recovery_dcm_error_m and out.recovery
+    # back near the plan, the step stays a recovery step (latched) ...
+    assert gait.update(t + 0.008, 0.004, soles, yaws, near, OMEGA).recovery
+    # ... until the next step
+    first = gait.steps
+    while gait.steps == first or gait.targets.contacts.all():
+        t += 0.004
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+    stance = soles[gait.stance, :2]
+    later = gait.update(t, 0.004, soles, yaws, stance + np.array([0.0, 0.03 * (1 if gait.stance == RIGHT else -1)]), OMEGA)
+    assert later.swing_foot >= 0 and not later.recovery
+
+
 @pytest.mark.parametrize("kwargs, text", [
     ({"single_support_s": 0.0}, "single_support_s must be a finite number > 0"),
     ({"min_width_m": 0.3}, "min_width_m <= step_width_m <= max_width_m"),
