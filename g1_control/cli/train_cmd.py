@@ -45,6 +45,9 @@ def register(subparsers) -> None:
     gen.add_argument("--threads", type=int, default=1, help="torch threads per process (default 1: fastest here)")
     gen.add_argument("--seed", type=int, default=0)
     gen.add_argument("--eval-every", type=int, default=250, help="steps between held-out evaluations (default 250)")
+    gen.add_argument("--skate-weight", type=float, default=0.1,
+                     help="weight of the foot-skating term: the predicted feet's horizontal speed (m/s) where the "
+                          "true foot stands; 0 turns it off (default 0.1)")
     gen.add_argument("--model", metavar="JSON", default="{}",
                      help='backbone size overrides, e.g. \'{"d_model": 96, "layers": 4}\' (default: BackboneConfig)')
     gen.set_defaults(func=_generator)
@@ -77,6 +80,8 @@ def _generator(args) -> int:
         model = json.loads(args.model)
     except json.JSONDecodeError as exc:
         raise G1ControlError(f"--model must be a JSON object of BackboneConfig fields: {exc}") from None
+    if args.skate_weight < 0:
+        raise G1ControlError(f"--skate-weight must be >= 0 (0 turns the foot-skating term off), got {args.skate_weight}")
     if args.skeletons:
         skeletons = tuple(s for s in args.skeletons.split(",") if s)
     elif args.library:
@@ -97,7 +102,7 @@ def _generator(args) -> int:
     config = TrainConfig(steps=args.steps, batch=args.batch, lr=args.lr, time_limit_s=args.time_limit * 60,
                          wall_limit_s=args.wall_limit * 60,
                          threads=args.threads, seed=args.seed, eval_every=args.eval_every, model=model,
-                         skeletons=skeletons)
+                         skeletons=skeletons, skate_weight=args.skate_weight)
     from g1_control.training import TRAINING_RECORDS_DIR
 
     out = args.output or SHIPPED_DIR

@@ -90,15 +90,17 @@ def fk_numpy(root_pos: np.ndarray, root_rot: np.ndarray, joints: np.ndarray) -> 
     return np.stack(pos, axis=-2), np.stack(rot, axis=-3)
 
 
-def fk_torch(root_pos, root_rot, joints):
-    """Torch version of fk_numpy (differentiable)."""
+def fk_torch(root_pos, root_rot, joints, num_joints: int | None = None):
+    """Torch version of fk_numpy (differentiable). num_joints: only the bodies of the first
+    num_joints joints (and the pelvis); the tree is in topological order, so a prefix of it is a
+    whole subtree (the first 12 joints are the two legs, down to the ankle roll links)."""
     import torch
 
     tree = kinematic_tree()
     off_p = torch.as_tensor(tree.offset_pos, dtype=root_pos.dtype)
     off_r = torch.as_tensor(tree.offset_rot, dtype=root_pos.dtype)
     pos, rot = [root_pos], [root_rot]
-    for k in range(g1.NUM_JOINTS):
+    for k in range(g1.NUM_JOINTS if num_joints is None else num_joints):
         p, r = pos[tree.parent[k]], rot[tree.parent[k]]
         pos.append(p + (r @ off_p[k].unsqueeze(-1)).squeeze(-1))
         q = joints[..., k]
