@@ -73,6 +73,8 @@ class GaitConfig:
     """Landing sole ahead of the stance sole, at most (heading frame of the step)."""
     max_backward_m: float = 0.32
     max_relative_yaw_rad: float = 0.7
+    plan_turn: bool = True
+    """The nominal DCM offsets follow the turn (nominal_dcm_offset's wz); off: planned as if straight."""
     swing_height_m: float = 0.07
     swing_rise: float = 0.4
     swing_fall: float = 0.4
@@ -215,13 +217,27 @@ class GaitTargets:
     """How far the DCM is from its nominal plan this tick (walking; 0 otherwise)."""
 
 
-def nominal_dcm_offset(cfg: GaitConfig, stance: int, v_h: np.ndarray, omega: float) -> np.ndarray:
+def nominal_dcm_offset(cfg: GaitConfig, stance: int, v_h: np.ndarray, omega: float, wz: float = 0.0) -> np.ndarray:
     """DCM offset b (heading frame) at the touchdown of foot `stance`, walking periodically at the
-    heading-frame velocity v_h = (vx, vy) (module docstring)."""
+    heading-frame velocity v_h = (vx, vy) (module docstring) and turning at wz (rad/s): the heading
+    turns by wz T each step, so the next step's offset is in a frame turned by that much and the
+    steps follow the arc (the centre's chord turned by half the step's turn, the feet beside the
+    turned centre line); without the turn the DCM drifted out of the curve (measured, issue 23)."""
     T = cfg.step_s
     E = math.exp(omega * T)
     d1, d2 = nominal_step(cfg, 1 - stance, v_h), nominal_step(cfg, stance, v_h)
-    return (d1 * E + d2) / (E * E - 1.0)
+    turn = wz * T
+    if turn == 0.0:
+        return (d1 * E + d2) / (E * E - 1.0)
+    R, half = _rot2(turn), _rot2(0.5 * turn)
+    chord = np.array([v_h[0] * T, v_h[1] * T])
+    eye = np.eye(2)
+    # a step landing foot f: its straight displacement plus the arc's terms (R(turn/2) - I) chord
+    # and (R(turn) - I) o_f, o_f the landing foot's offset from the centre line (half the width)
+    d1 = d1 + (half - eye) @ chord + (R - eye) @ np.array([0.0, 0.5 * _SIDE[1 - stance] * cfg.step_width_m])
+    d2 = d2 + (half - eye) @ chord + (R - eye) @ np.array([0.0, 0.5 * _SIDE[stance] * cfg.step_width_m])
+    # periodic: d1 = E b_s - R b_o, d2 = E b_o - R b_s  ->  (E^2 I - R^2) b_s = E d1 + R d2
+    return np.asarray(np.linalg.solve(E * E * eye - R @ R, E * d1 + R @ d2))
 
 
 def nominal_step(cfg: GaitConfig, foot: int, v_h: np.ndarray) -> np.ndarray:
@@ -473,6 +489,10 @@ class VelocityGait:
             out = scaled
         return out
 
+    def _turn(self, command_h: np.ndarray) -> float:
+        """The turn rate the nominal DCM offsets plan for (0 with GaitConfig.plan_turn off)."""
+        return float(command_h[2]) if self.config.plan_turn else 0.0
+
     def _timing_for(self, soles_m: np.ndarray) -> GaitConfig:
         """The step timing for the coming step: longer single support near a step; shorter walking
         fast (GaitConfig.fast_single_support_s)."""
@@ -529,7 +549,7 @@ class VelocityGait:
         cfg = self.active
         heading_td = self.heading + float(command_h[2]) * t_r
         xi_td = p + (dcm_xy - p) * math.exp(omega * t_r)
-        b_next = _rot2(heading_td) @ nominal_dcm_offset(cfg, f, command_h[:2], omega)
+        b_next = _rot2(heading_td) @ nominal_dcm_offset(cfg, f, command_h[:2], omega, self._turn(command_h))
         rel = _rot2(heading_td).T @ (xi_td - b_next - u[:2])
         side_out = _SIDE[f] * rel[1]
         excess = max(rel[0] - cfg.max_forward_m, -cfg.max_backward_m - rel[0], side_out - cfg.max_width_m, 0.0)
@@ -594,7 +614,7 @@ class VelocityGait:
                 dur = 1.0
             elif self.mode == "start":
                 s = self.stance
-                b = nominal_dcm_offset(cfg, s, command_h[:2], omega)
+                b = nominal_dcm_offset(cfg, s, command_h[:2], omega, self._turn(command_h))
                 goal = soles_m[s, :2] + _rot2(self.heading) @ b * math.exp(omega * cfg.double_support_s)
                 dur = cfg.start_s
                 a = (t_s - self._t0) / dur
@@ -617,7 +637,8 @@ class VelocityGait:
         t_in = t_s - self._t0
         t_r = max(self.step_T - t_in, 0.0)
         u = soles_m[s]
-        b_now = _rot2(self.heading - float(command_h[2]) * t_in) @ nominal_dcm_offset(cfg, s, command_h[:2], omega)
+        b_now = _rot2(self.heading - float(command_h[2]) * t_in) @ nominal_dcm_offset(cfg, s, command_h[:2], omega,
+                                                                                      self._turn(command_h))
         xi_nom = u[:2] + b_now * math.exp(omega * t_in)
         out.dcm_error_m = float(np.hypot(*(dcm_xy - xi_nom)))
         if self._swinging and t_in >= Tds and out.dcm_error_m > cfg.recovery_dcm_error_m:

@@ -38,6 +38,32 @@ def test_nominal_offsets_repeat_under_the_pendulum(v):
         np.testing.assert_allclose(b * E - d, nominal_dcm_offset(cfg, 1 - stance, v, OMEGA), atol=1e-12)
 
 
+@pytest.mark.parametrize("v, wz", [((0.6, 0.0), 0.5), ((0.0, 0.0), 1.2), ((0.3, 0.1), -0.8)])
+def test_nominal_offsets_repeat_while_turning(v, wz):
+    """Turning, each step's frame is turned by wz T from the last: from the nominal offset with the
+    CoP on the stance foot the DCM reaches, at touchdown, the next foot's offset in the turned frame,
+    the step following the arc (the centre's chord turned by half the turn, the landing foot beside
+    the turned centre line). Planned as if straight the DCM ran out of the curve (issue 23)."""
+    cfg = GaitConfig()
+    T = cfg.step_s
+    E = math.exp(OMEGA * T)
+    v = np.array(v)
+
+    def rot(a):
+        return np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+
+    for stance in (LEFT, RIGHT):
+        f = 1 - stance
+        b = nominal_dcm_offset(cfg, stance, v, OMEGA, wz)
+        side = 1.0 if f == LEFT else -1.0
+        half_w = np.array([0.0, 0.5 * side * cfg.step_width_m])
+        d = (nominal_step(cfg, f, v) + (rot(0.5 * wz * T) - np.eye(2)) @ (v * T)
+             + (rot(wz * T) - np.eye(2)) @ half_w)
+        np.testing.assert_allclose(b * E - d, rot(wz * T) @ nominal_dcm_offset(cfg, f, v, OMEGA, wz), atol=1e-12)
+    # no turn: the straight offsets
+    np.testing.assert_allclose(nominal_dcm_offset(cfg, LEFT, v, OMEGA, 0.0), nominal_dcm_offset(cfg, LEFT, v, OMEGA))
+
+
 def test_steps_average_the_commanded_velocity():
     cfg = GaitConfig()
     v = np.array([0.4, 0.15])

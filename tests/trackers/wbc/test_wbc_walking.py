@@ -14,10 +14,10 @@ FALL_HEIGHT_M = 0.6
 """Pelvis height (ground truth) the robot never goes below while walking (it walks at ~0.72 m)."""
 
 
-def walk(command, seconds, start_s=0.5, pelvis_height_m=None, fall_height_m=FALL_HEIGHT_M):
+def walk(command, seconds, start_s=0.5, pelvis_height_m=None, fall_height_m=FALL_HEIGHT_M, config=None):
     backend = MujocoBackend()
     state = backend.reset()
-    tracker = WholeBodyTracker(WbcConfig(footsteps="velocity"))
+    tracker = WholeBodyTracker(config or WbcConfig(footsteps="velocity"))
     tracker.reset(state)
     ref = JointReference(q_rad=g1.DEFAULT_Q_RAD.copy(), pelvis_height_m=pelvis_height_m)
     trace = []
@@ -81,3 +81,16 @@ def test_walks_at_the_commanded_pelvis_height():
     assert abs(pos[a:, 2].mean() - 0.60) < 0.025, f"pelvis at {pos[a:, 2].mean():.3f} m for 0.60"
     speed = (pos[-1, 0] - pos[a, 0]) / (t[-1] - t[a])
     assert abs(speed - 0.4) < 0.04, f"walked {speed:.3f} m/s for 0.4"
+
+
+def test_walking_while_turning_needs_no_sideways_correction():
+    """0.6 m/s forward turning 0.5 rad/s: with the nominal DCM offsets planned along the turn
+    (GaitConfig.plan_turn) the strides the feet walk (measured) match the command sideways, so the
+    gait's sideways speed correction stays small; planned as if straight it saturated near 0.1 m/s
+    and the widened steps ended in an ankle/knee over-speed fall (issue 23, bench wbc/combined)."""
+    tracker, trace = walk((0.6, 0.0, 0.5), 5.2)
+    assert trace[-1, 0] > 5.1, f"fell at {trace[-1, 0]:.2f} s"
+    assert tracker.gait is not None
+    correction = tracker.gait.speed_correction_h
+    assert abs(correction[1]) < 0.05, f"sideways correction {correction[1]:+.3f} m/s"
+    assert tracker.diagnostics.unsolved_ticks == 0
