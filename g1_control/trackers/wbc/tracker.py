@@ -113,7 +113,10 @@ class WbcConfig:
     flat gait's is `swing_foot`'s): at 100 against the CoM task's 1000 the QP swung the leg backwards
     and up (using it as angular momentum for the falling trunk) instead of stepping, and the foot
     landed 0.7 m behind its landing point (pushed forward at 150 N, measured). 1000 in every step
-    made plain walking fall; 1000 in recovery steps made the random timelines worse (measured)."""
+    made plain walking fall; 1000 in recovery steps made the random timelines worse (measured).
+    Scaling the pelvis's and torso's orientation weights in recovery steps (to let the trunk lean)
+    did not help: x0.1, x0.3, x0.5 and x2 each survived 1/20 of the push grid (front_4; 2/20 unscaled,
+    measured), so the trunk's orientation task is not what kicks the leg."""
     walking_leg_posture_weight: float = 0.05
     """Walking by its own gait, the legs' posture task is only a regulariser (relative to `posture`)."""
     walking_crouch_lean_per_m: float = 2.5
