@@ -60,7 +60,8 @@ GROUPS: dict[str, dict[str, list[str]]] = {
                   "tests/launch/test_malformed_corpus.py", "tests/launch/test_launch_schema_bounds.py",
                   "tests/deploy/test_deploy_launch_schema.py", "tests/launch/test_launch_goals.py",
                   "tests/launch/test_launch_schema_paths.py", "tests/launch/test_launch_ik_section.py",
-                  "tests/launch/test_launch_estimation.py", "tests/launch/test_launch_start_pose.py"],
+                  "tests/launch/test_launch_estimation.py", "tests/launch/test_launch_start_pose.py",
+                  "tests/launch/test_launch_schema_words.py"],
     },
     "loop": {
         # The robot path's runtime trips (issue 26): the loop's CRC, peer and fall checks, the fall
