@@ -182,12 +182,14 @@ def test_a_body_on_the_ground_is_a_fall_naming_it():
 
 def test_an_invalid_state_trips_naming_it():
     loop, robot, _ = _loop()
-    loop.run(0.1)
+    loop.run(0.11)  # the next state read (100 Hz) falls between two tracker ticks (50 Hz)
     robot.q_rad[3] = np.nan
-    loop.run(0.02)
+    loop.run(0.01)
     trip = loop.safety.trip_event
     assert trip.kind == SafetyEventKind.ESTOP and trip.detail.startswith("invalid robot state: ")
     assert "q_rad" in trip.detail
+    sent = robot.last_command
+    assert np.all(sent.kp == 0) and np.all(sent.kd > 0), "damping goes out at once, not at the next tracker tick"
 
 
 def test_the_tracker_acts_on_the_state_the_estimator_read_once_per_tick():
