@@ -139,3 +139,14 @@ def test_first_fault_is_the_first_unplanned_trip():
     assert first_fault([stop, note, crc, dict(crc, kind="later")]) is crc
     assert first_fault([stop, note]) is None
     assert first_fault([{"kind": "old", "trips": True}]) == {"kind": "old", "trips": True}  # planned absent: a fault
+
+
+def test_the_monitors_default_tilt_limit_is_one_radian():
+    from g1_control.safety.fall import FallMonitor
+
+    def tilted(angle: float) -> np.ndarray:
+        return np.array([np.cos(angle / 2), np.sin(angle / 2), 0.0, 0.0])
+
+    assert FallMonitor().update(0.0, tilted(0.95), 0.7, None) is None
+    fall = FallMonitor().update(0.0, tilted(1.05), 0.7, None)
+    assert fall is not None and fall.detail == "pelvis tilted 1.05 rad (limit 1.00)"

@@ -1,0 +1,232 @@
+"""The loop's trip path on a stand-in robot whose link reports are set by the test (issue 26: the
+mutation run's loop group): bad CRCs, a foreign peer, missed deadlines (on a wall-clock robot, not
+on a simulator we step), falls judged from ground truth or from the estimator, an invalid state,
+and the records each event leaves (events and the run folder's event records)."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from g1_control.estimation.localiser import Localiser
+from g1_control.estimation.pose import LegOdometry
+from g1_control.generator.velocity import VelocityReferenceGenerator
+from g1_control.ik.stage import IKStage
+from g1_control.interfaces import Backend, InputDevice, Tracker
+from g1_control.loop.control_loop import ControlLoop
+from g1_control.robot import g1
+from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter
+from g1_control.types import Command, MotorCommand, RobotState
+
+
+class StandInRobot(Backend):
+    """A robot standing still on its default pose, whose link reports (bad CRCs, peers, contacts)
+    and pelvis height the test sets. Lockstep: it advances in step(); wall clock: every read is a
+    new sample stamped with time.monotonic(), as a robot link stamps them on arrival."""
+
+    def __init__(self, lockstep: bool = True, pelvis_z_m: float | None = 0.78):
+        self.lockstep = lockstep
+        self.t_s, self.tick = 0.0, 0
+        self.pelvis_z_m = pelvis_z_m
+        self.q_rad = g1.DEFAULT_Q_RAD.copy()
+        self.crc, self.peer, self.contacts = 0, None, ()
+        self.states: list[RobotState] = []
+
+    def reset(self) -> RobotState:
+        return self.read_state()
+
+    def read_state(self) -> RobotState:
+        if not self.lockstep:
+            self.t_s, self.tick = time.monotonic(), self.tick + 1
+        state = RobotState(t_s=self.t_s, q_rad=self.q_rad.copy(), tick=self.tick,
+                           base_pos_w_m=None if self.pelvis_z_m is None else np.array([0.0, 0.0, self.pelvis_z_m]))
+        self.states.append(state)
+        return state
+
+    def write_command(self, command: MotorCommand) -> None:
+        self.last_command = command
+
+    def step(self, dt_s: float) -> None:
+        self.t_s, self.tick = self.t_s + dt_s, self.tick + 1
+
+    def ground_contacts(self):
+        return self.contacts
+
+    @property
+    def bad_crc(self) -> int:
+        return self.crc
+
+    @property
+    def peer_fault(self) -> str | None:
+        return self.peer
+
+    def close(self) -> None:
+        pass
+
+
+class Hold(Tracker):
+    """Holds the default pose; records the states it acts on."""
+
+    def __init__(self):
+        self.states: list[RobotState] = []
+
+    def act(self, reference, state) -> MotorCommand:
+        self.states.append(state)
+        return MotorCommand(q_rad=g1.DEFAULT_Q_RAD.copy(), kp=g1.KP_DEFAULT.copy(), kd=g1.KD_DEFAULT.copy())
+
+
+class Still(InputDevice):
+    def __init__(self, commands=()):
+        self.commands = list(commands)
+
+    def poll(self, now_s: float) -> Command:
+        return self.commands.pop(0) if self.commands else Command()
+
+
+def _loop(robot=None, device=None, **kw) -> tuple[ControlLoop, StandInRobot, list[dict]]:
+    robot = robot or StandInRobot()
+    loop = ControlLoop(robot, device or Still(), VelocityReferenceGenerator(), IKStage(), Hold(), **kw)
+    records: list[dict] = []
+    loop.on_record = records.append
+    loop.reset()
+    return loop, robot, records
+
+
+def test_a_burst_of_bad_crcs_trips_at_the_loops_time():
+    loop, robot, _records = _loop()
+    loop.run(0.1)
+    robot.crc = 5
+    loop.run(0.02)
+    trip = loop.safety.trip_event
+    assert trip.kind == SafetyEventKind.CRC_BURST and trip.detail.endswith("(5 in total)")
+    assert 0.1 <= trip.t_s <= 0.12
+    assert np.all(loop.motor_command.kp == 0)
+
+
+def test_a_foreign_peer_trips_at_once_naming_it_and_is_recorded():
+    loop, robot, records = _loop()
+    loop.run(0.1)
+    robot.peer = "a second publisher of rt/lowstate"
+    loop.run(0.02)
+    trip = loop.safety.trip_event
+    assert trip.kind == SafetyEventKind.FOREIGN_PEER and trip.detail == "a second publisher of rt/lowstate"
+    assert 0.1 <= trip.t_s <= 0.12
+    assert records == [{"type": "safety", "t_s": trip.t_s, "loop_t_s": loop.events[0].t_s, "kind": "foreign_peer",
+                        "detail": "a second publisher of rt/lowstate", "trips": True, "planned": False}]
+    assert (loop.events[0].kind, loop.events[0].detail, loop.events[0].trips) == ("foreign_peer", trip.detail, True)
+
+
+def _wallclock_loop(lockstep: bool, late_s: float, monkeypatch, wallclock=True):
+    loop, _robot, _records = _loop(StandInRobot(lockstep=lockstep), wallclock=wallclock)
+    monkeypatch.setattr(loop.scheduler, "take_lateness", lambda: late_s)
+    return loop
+
+
+def test_late_ticks_on_a_robot_trip_after_the_overrun_burst_naming_the_lateness(monkeypatch):
+    loop = _wallclock_loop(False, 0.9, monkeypatch)
+    loop.run(0.1)  # 5 tracker ticks, each reported 900 ms late
+    trip = loop.safety.trip_event
+    assert trip is not None and trip.kind == SafetyEventKind.DEADLINE_OVERRUNS
+    assert trip.detail == "5 deadline overruns within 1.0 s (900 ms late)"
+    assert abs(trip.t_s - time.monotonic()) < 5.0, "judged on the robot's (monotonic) clock"
+
+
+def test_ticks_exactly_on_time_are_not_overruns(monkeypatch):
+    loop = _wallclock_loop(False, 0.0, monkeypatch)
+    loop.run(0.2)
+    assert not loop.faulted, loop.events
+
+
+@pytest.mark.parametrize("lockstep, wallclock", [(True, True), (False, False)])
+def test_no_deadline_is_judged_on_a_simulator_we_step_or_without_the_wall_clock(lockstep, wallclock, monkeypatch):
+    loop = _wallclock_loop(lockstep, 0.9, monkeypatch, wallclock=wallclock)
+    loop.run(0.2)
+    assert not loop.faulted, loop.events
+
+
+def test_a_low_pelvis_in_the_ground_truth_is_a_fall_even_if_the_legs_look_standing():
+    loop, robot, records = _loop(StandInRobot(pelvis_z_m=0.78))
+    loop.run(0.1)
+    assert not loop.fell
+    robot.pelvis_z_m = 0.3  # the simulator's pelvis sank; the joint angles still say "standing"
+    loop.run(0.02)
+    assert loop.fell and loop.fall.kind == "pelvis_low" and loop.fall.detail == "pelvis at 0.30 m (limit 0.40)"
+    trip = loop.safety.trip_event
+    assert (trip.kind, trip.detail) == (SafetyEventKind.FALL, loop.fall.detail)
+    assert trip.t_s == loop.fall.t_s and 0.1 <= trip.t_s <= 0.12
+    fall_event = next(e for e in loop.events if e.kind == "fall")
+    assert fall_event.detail == loop.fall.detail
+    assert {"type": "loop", "t_s": fall_event.t_s, "kind": "fall", "detail": loop.fall.detail} in records
+    assert np.all(loop.motor_command.kp == 0)
+
+
+def test_a_robot_without_ground_truth_is_judged_by_the_estimators_height():
+    loop, _robot, _ = _loop(StandInRobot(pelvis_z_m=None))
+    loop.run(0.2)
+    assert loop.estimator.estimate.pelvis_height_m > 0.6 and not loop.fell and not loop.faulted
+    loop.falls.config = type(loop.falls.config)(min_pelvis_height_m=loop.estimator.estimate.pelvis_height_m + 0.01)
+    loop.run(0.02)
+    assert loop.fell and loop.fall.kind == "pelvis_low"
+
+
+def test_a_body_on_the_ground_is_a_fall_naming_it():
+    loop, robot, _ = _loop()
+    loop.run(0.1)
+    robot.contacts = ("left_knee_link",)
+    loop.run(0.02)
+    assert loop.fell and loop.fall.detail == "left_knee_link on the ground"
+    assert loop.safety.trip_event.detail == "left_knee_link on the ground"
+
+
+def test_an_invalid_state_trips_naming_it():
+    loop, robot, _ = _loop()
+    loop.run(0.11)  # the next state read (100 Hz) falls between two tracker ticks (50 Hz)
+    robot.q_rad[3] = np.nan
+    loop.run(0.01)
+    trip = loop.safety.trip_event
+    assert trip.kind == SafetyEventKind.ESTOP and trip.detail.startswith("invalid robot state: ")
+    assert "q_rad" in trip.detail
+    sent = robot.last_command
+    assert np.all(sent.kp == 0) and np.all(sent.kd > 0), "damping goes out at once, not at the next tracker tick"
+
+
+def test_the_tracker_acts_on_the_state_the_estimator_read_once_per_tick():
+    loop, robot, _ = _loop()
+    loop.run(0.2)  # 10 tracker ticks; the estimator runs at 100 Hz
+    tracked = loop.tracker.states
+    assert len(tracked) == 10 and all(any(s is r for r in robot.states) for s in tracked)
+    assert len(robot.states) == 1 + 20, "one read per estimator tick (plus reset's), shared with the tracker"
+
+
+def test_invalid_commands_leave_loop_records():
+    loop, _, records = _loop(device=Still([Command(vx_mps=float("nan"))]))
+    loop.run(0.02)
+    assert records == [{"type": "loop", "t_s": 0.0, "kind": "invalid_command", "detail": loop.events[0].detail}]
+    assert "vx_mps is nan" in records[0]["detail"]
+
+
+def test_a_planned_ending_is_recorded_as_planned():
+    loop, _, records = _loop()
+    loop.run(0.1)
+    loop.safety.estop("operator stop", loop.time_s, planned=True)
+    assert loop.events[-1].planned is True and loop.events[-1].trips is True
+    assert records[-1]["planned"] is True and records[-1]["kind"] == "estop"
+
+
+def test_the_feedback_carries_the_state_and_the_localisers_pose():
+    loop, robot, _ = _loop(localiser=Localiser(LegOdometry()))
+    loop.run(0.1)
+    fb = loop.feedback
+    # Filled before the last poll (t 0.09 s), which comes before that tick's state read.
+    assert fb.t_s == pytest.approx(0.09) and fb.state is robot.states[-2]
+    assert fb.pose is not None and fb.pose.t_s == fb.state.t_s, "the localiser's pose of that state"
+
+
+def test_the_default_safety_filter_carries_the_loops_tilt_limit():
+    loop = ControlLoop(StandInRobot(), Still(), VelocityReferenceGenerator(), IKStage(), Hold(), max_tilt_rad=0.7)
+    assert loop.safety.config.max_tilt_rad == 0.7 and loop.falls.max_tilt_rad == 0.7
+    given = SafetyFilter(SafetyConfig(max_tilt_rad=0.9))
+    loop = ControlLoop(StandInRobot(), Still(), VelocityReferenceGenerator(), IKStage(), Hold(), safety=given)
+    assert loop.falls.max_tilt_rad == 0.9
