@@ -23,10 +23,13 @@ ROWS_PER_FOOT = 11
 DEFAULT_FRICTION = 0.45
 """The foot-floor friction coefficient the controller assumes when nobody says what the floor is.
 
-Conservative on purpose: the pyramid's rows bound each horizontal axis by mu fz, so a force along
-a diagonal may reach sqrt(2) mu fz, and nothing measures the floor. Rubber soles reach mu 0.5-1.2 on
-ordinary floors (the range `g1 bench robust` draws, g1_control/sim/randomize.py); planned at 0.7,
-the WBC fell on 5 of its 10 seeded randomised robots, at 0.45 on none (g1 bench robust --only wbc).
+Conservative on purpose: rubber soles reach mu 0.5-1.2 on ordinary floors (the range `g1 bench
+robust` draws, g1_control/sim/randomize.py), nothing measures the floor, and the pyramid's rows
+bound each horizontal axis by mu fz, so a diagonal force may reach sqrt(2) mu fz (walking at
+0.6 m/s the QP planned |f_t| / f_z up to 0.99 = sqrt(2) 0.7 at 0.7, measured). Walking 0.6 m/s on
+the robust bench's draws 0-19, the WBC fell on 8 of 20 planned at 0.7 and on 5 at 0.45; most of
+those falls are the command latency's, not the floor's (draws 0, 1 and 9 with their latency set to
+0 walked; draws 0 and 1 with their friction set to 1.0 still fell), so the gain is partly chance.
 A floor known to grip better or worse is set per launch file (tracker.foot_friction)."""
 
 
