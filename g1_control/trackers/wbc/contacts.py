@@ -27,7 +27,9 @@ may reach sqrt(2) mu fz (walking 0.6 m/s at 0.7 the QP planned |f_t| / f_z up to
 A lower default (0.45) was measured and not shipped: on `g1 bench robust`'s draws 0-19 it fell on 5
 of 20 (0.7: 8), but most of those falls are the command latency's (draws 0, 1, 9 with latency 0
 walked; draws 0, 1 with floor friction 1.0 still fell), and on the nominal robot it fell at
-forward 1.0 m/s (0.7: 0.844 m/s) and in tests/trackers/wbc/test_wbc_sim.py's 0.3 m/s walk.
+forward 1.0 m/s (0.7: 0.844 m/s), walked sideways 0.4 m/s at 0.270 (0.7: 0.401), survived 1 of 20
+pushes (0.7: 2) and fell in tests/trackers/wbc/test_wbc_sim.py's 0.3 m/s walk; it did walk 9 of 10
+random timelines (0.7: 6). `g1 bench locomotion --only wbc/...`, one run each, same machine.
 A floor known to grip better or worse is set per launch file (tracker.foot_friction)."""
 
 
