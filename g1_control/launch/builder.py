@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
 from g1_control.errors import LaunchFileError
 from g1_control.estimation.estimator import StateEstimator
@@ -35,6 +35,7 @@ if TYPE_CHECKING:
     from g1_control.estimation.localiser import Localiser
     from g1_control.ik.stage import IKStage
     from g1_control.sim.mujoco_backend import MujocoBackend
+    from g1_control.trackers.wbc.tracker import WbcConfig
 
 CHAIN_STAGES = ("generator", "retargeter", "tracker", "rates", "safety")
 """The parts of `loop.chain` that must be the same in a deploy's dry run and on the robot."""
@@ -55,6 +56,17 @@ def timeline_of(launch: LaunchFile) -> list[Segment]:
     return []
 
 
+def wbc_config(launch: LaunchFile, footsteps: Literal["plan", "velocity"] = "plan") -> WbcConfig:
+    """The whole-body controller's WbcConfig for this launch file: the tracker rate, the footsteps'
+    source and the foot-floor friction it plans within (tracker.foot_friction)."""
+    from g1_control.trackers.wbc.contacts import FootGeometry
+    from g1_control.trackers.wbc.qp import QpConfig
+    from g1_control.trackers.wbc.tracker import WbcConfig
+
+    qp = QpConfig(foot=FootGeometry(friction=launch.tracker.foot_friction))
+    return WbcConfig(rate_hz=launch.rates.tracker_hz, footsteps=footsteps, qp=qp)
+
+
 def make_tracker(launch: LaunchFile) -> Tracker:
     cfg = launch.tracker
     check_tracker_fits(launch)  # a policy that does not fit the robot variant is refused by name
@@ -66,11 +78,10 @@ def make_tracker(launch: LaunchFile) -> Tracker:
                                        envelope_limits=cfg.envelope_limits)
     if cfg.type == "wbc":
         from g1_control.trackers.wbc.terrain import Terrain
-        from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
+        from g1_control.trackers.wbc.tracker import WholeBodyTracker
 
         # a scripted reference plans the feet; any other generator gives a root twist to walk
-        config = (WbcConfig(rate_hz=launch.rates.tracker_hz, footsteps="plan") if launch.generator.type == "scripted"
-                  else WbcConfig(rate_hz=launch.rates.tracker_hz, footsteps="velocity"))
+        config = wbc_config(launch, footsteps="plan" if launch.generator.type == "scripted" else "velocity")
         # its own gait steps onto the scene's platforms and stairs (a map, like the goals' scene)
         return WholeBodyTracker(config, variant=robot_variant(launch), hands=launch.backend.hands,
                                 terrain=Terrain.of_scene(launch.scene))
@@ -82,11 +93,11 @@ def make_tracker(launch: LaunchFile) -> Tracker:
         from g1_control.trackers.layer import TrackingLayer
         from g1_control.trackers.locomotion import LocomotionPolicyTracker, VelocityCorrectionConfig
         from g1_control.trackers.policy_spec import load_spec
-        from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
+        from g1_control.trackers.wbc.tracker import WholeBodyTracker
 
         policy = LocomotionPolicyTracker(load_spec(cfg.policy), VelocityCorrectionConfig(enabled=cfg.velocity_correction),
                                          envelope_limits=cfg.envelope_limits)
-        wbc = WholeBodyTracker(WbcConfig(rate_hz=launch.rates.tracker_hz), variant=robot_variant(launch),
+        wbc = WholeBodyTracker(wbc_config(launch), variant=robot_variant(launch),
                                hands=launch.backend.hands)
         return TrackingLayer(policy, wbc, launch.rates.tracker_hz)
     raise LaunchFileError(f"tracker.type: unknown tracker '{cfg.type}'")

@@ -22,6 +22,7 @@ from g1_control.safety.fall import FallConfig
 from g1_control.scene import FLOOR, SceneConfig
 from g1_control.sim.randomize import RandomizeConfig
 from g1_control.teleop.scripted import RandomTimelineConfig, Segment
+from g1_control.trackers.wbc.contacts import DEFAULT_FRICTION as DEFAULT_FOOT_FRICTION
 
 ROBOT_BACKENDS = ("unitree_dds", "can", "serial")
 """Backends that drive a robot (real, or `g1 sim-robot`) through a robot link; `g1 deploy` runs them."""
@@ -39,6 +40,10 @@ MIN_WBC_TRACKER_HZ = 100.0
 """The whole-body controller's slowest rate in use: every task of issue 17 (standing at any height,
 reaching, holding and carrying a box, stepping onto a platform) was tracked at 100 Hz as at
 250 Hz in the execution bench's debugging runs (`g1 bench execution --only reach,height,box,step`)."""
+
+MIN_FOOT_FRICTION, MAX_FOOT_FRICTION = 0.05, 1.5
+"""tracker.foot_friction's range: ice to the grippiest rubber on a dry floor. Beyond it the friction
+pyramid plans forces no floor holds (or a value below ice, where the gait cannot walk at all)."""
 
 
 @dataclass
@@ -217,6 +222,16 @@ class TrackerConfig:
     envelope_limits: bool = True
     """Operator command limits from the policy's measured envelope (`g1 bench envelope`, shipped next
     to its spec); false: from the range it was trained on (what the envelope bench measures)."""
+    foot_friction: float = DEFAULT_FOOT_FRICTION
+    """wbc and layer: the foot-floor friction coefficient the whole-body controller plans its contact
+    forces within (g1_control/trackers/wbc/contacts.py; the default is conservative for a floor
+    nobody measured). Not the simulator's friction: a floor known to grip better may raise it."""
+
+    def validate(self, where: str) -> None:
+        if not MIN_FOOT_FRICTION <= self.foot_friction <= MAX_FOOT_FRICTION:
+            raise LaunchFileError(f"{where}.foot_friction: {self.foot_friction:g} is outside [{MIN_FOOT_FRICTION:g}, "
+                                  f"{MAX_FOOT_FRICTION:g}] (the foot-floor friction coefficient the whole-body "
+                                  "controller assumes)")
 
 
 @dataclass

@@ -54,6 +54,8 @@ def launch_cases() -> dict[str, str | bytes]:
         "scripted_without_timeline.yaml": b.replace(
             "  timeline:\n    - {duration_s: 2.0, vx_mps: 0.3, label: walk}\n", ""),
         "wbc_too_slow.yaml": b + "tracker: {type: wbc}\ngenerator: {type: scripted}\n",
+        "wbc_foot_friction_zero.yaml": b + "rates: {tracker_hz: 250}\ntracker: {type: wbc, foot_friction: 0}\n",
+        "wbc_foot_friction_nan.yaml": b + "rates: {tracker_hz: 250}\ntracker: {type: wbc, foot_friction: .nan}\n",
         "unknown_reference.yaml": b + "rates: {tracker_hz: 250}\ntracker: {type: wbc}\n"
                                       "generator: {type: scripted, reference: moonwalk}\n",
         "negative_stale_state.yaml": b + "safety: {stale_state_s: -1}\n",

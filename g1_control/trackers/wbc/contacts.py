@@ -4,7 +4,7 @@ The wrench (fx, fy, fz, tx, ty, tz) acts at the sole frame's origin, in the sole
 (z normal to the ground). For forces spread over the sole plane, tx = py * fz and
 ty = -px * fz, so the centre of pressure (px, py) = (-ty / fz, tx / fz). Every constraint below is
 linear in the wrench because each bound is scaled by fz:
-  friction pyramid   |fx| <= mu fz,  |fy| <= mu fz     (inner pyramid of the Coulomb cone)
+  friction pyramid   |fx| <= mu fz,  |fy| <= mu fz     (mu: the friction the controller assumes)
   centre of pressure x_min fz <= -ty <= x_max fz,  y_min fz <= tx <= y_max fz
   yaw torque         |tz| <= mu r fz                  (r: a conservative torsion radius)
   normal force       fz_min <= fz <= fz_max
@@ -20,6 +20,18 @@ from g1_control.errors import WbcConfigError
 
 ROWS_PER_FOOT = 11
 
+DEFAULT_FRICTION = 0.7
+"""The foot-floor friction coefficient the controller assumes unless the launch file says
+(tracker.foot_friction). The pyramid's rows bound each horizontal axis by mu fz, so a diagonal force
+may reach sqrt(2) mu fz (walking 0.6 m/s at 0.7 the QP planned |f_t| / f_z up to 0.99, measured).
+A lower default (0.45) was measured and not shipped: on `g1 bench robust`'s draws 0-19 it fell on 5
+of 20 (0.7: 8), but most of those falls are the command latency's (draws 0, 1, 9 with latency 0
+walked; draws 0, 1 with floor friction 1.0 still fell), and on the nominal robot it fell at
+forward 1.0 m/s (0.7: 0.844 m/s), walked sideways 0.4 m/s at 0.270 (0.7: 0.401), survived 1 of 20
+pushes (0.7: 2) and fell in tests/trackers/wbc/test_wbc_sim.py's 0.3 m/s walk; it did walk 9 of 10
+random timelines (0.7: 6). `g1 bench locomotion --only wbc/...`, one run each, same machine.
+A floor known to grip better or worse is set per launch file (tracker.foot_friction)."""
+
 
 @dataclass(frozen=True)
 class FootGeometry:
@@ -33,9 +45,11 @@ class FootGeometry:
     ankle-roll link; the sole frame is at x 0.035, so the rectangle is x +-0.085, y +-0.025."""
     cop_margin: float = 0.8
     """Fraction of the rectangle the centre of pressure may use (the edge is a tipping point)."""
-    friction: float = 0.7
-    """Below MuJoCo's 1.0 floor friction: the pyramid is an inner approximation with margin."""
+    friction: float = DEFAULT_FRICTION
+    """The sliding friction coefficient assumed between sole and floor (DEFAULT_FRICTION: why)."""
     torsion_radius_m: float = 0.02
+    """The yaw torque a foot may use is mu r fz (Coulomb friction integrated over the contact patch,
+    so it scales with mu like the forces do); r is well inside the sole's half-diagonal (0.09 m)."""
     fz_min_n: float = 5.0
     """A stance foot presses with at least this much, so it is not on the verge of lifting."""
     fz_max_n: float = 800.0
@@ -46,8 +60,8 @@ class FootGeometry:
                                  f"{self.x_max_m}] y [{self.y_min_m}, {self.y_max_m}]")
         if not 0 < self.cop_margin <= 1:
             raise WbcConfigError(f"FootGeometry.cop_margin must be in (0, 1]; got {self.cop_margin}")
-        if self.friction <= 0:
-            raise WbcConfigError(f"FootGeometry.friction must be > 0; got {self.friction}")
+        if not (np.isfinite(self.friction) and self.friction > 0):
+            raise WbcConfigError(f"FootGeometry.friction must be a finite number > 0; got {self.friction}")
         if not 0 <= self.fz_min_n < self.fz_max_n:
             raise WbcConfigError(f"FootGeometry needs 0 <= fz_min_n < fz_max_n; got {self.fz_min_n}, {self.fz_max_n}")
 

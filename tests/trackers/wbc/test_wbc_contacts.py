@@ -52,7 +52,8 @@ def test_normal_force_ramp_is_monotone_and_capped():
 @pytest.mark.parametrize("kwargs, text", [
     ({"x_min_m": 0.01}, "must contain the sole origin"),
     ({"cop_margin": 0.0}, "cop_margin must be in"),
-    ({"friction": -1.0}, "friction must be > 0"),
+    ({"friction": -1.0}, "friction must be a finite number > 0; got -1.0"),
+    ({"friction": float("nan")}, "friction must be a finite number > 0; got nan"),
     ({"fz_min_n": 900.0}, "fz_min_n < fz_max_n"),
 ])
 def test_bad_geometry_is_refused(kwargs, text):
