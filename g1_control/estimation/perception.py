@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Generic, Protocol, TypeVar
 
 import numpy as np
 
@@ -98,30 +98,40 @@ class PlatformSource(Protocol):
     def close(self) -> None: ...
 
 
-class DdsObjectSource:
-    """ObjectPoses_ from a DDS topic (hardware/ros2/topics.py), stamps moved onto the loop's clock by age."""
+_Frame = TypeVar("_Frame")
+
+
+class _DdsFrames(Generic[_Frame]):
+    """Frames from a DDS perception reader (hardware/ros2/topics.py), stamps moved onto the loop's clock by age."""
 
     def __init__(self, reader) -> None:
         self.reader = reader
 
-    def take(self, now_s: float) -> list[tuple[float, Objects]]:
-        return [(now_s - r.age_s, r.objects) for r in self.reader.take()]
+    def take(self, now_s: float) -> list[tuple[float, _Frame]]:
+        return [(now_s - r.age_s, self._payload(r)) for r in self.reader.take()]
+
+    @staticmethod
+    def _payload(reading) -> _Frame:
+        raise NotImplementedError
 
     def close(self) -> None:
         self.reader.close()
 
 
-class DdsPlatformSource:
-    """PlatformPoses_ from a DDS topic (hardware/ros2/topics.py), stamps moved onto the loop's clock by age."""
+class DdsObjectSource(_DdsFrames[Objects]):
+    """ObjectPoses_ from a DDS topic."""
 
-    def __init__(self, reader) -> None:
-        self.reader = reader
+    @staticmethod
+    def _payload(reading) -> Objects:
+        return reading.objects
 
-    def take(self, now_s: float) -> list[tuple[float, Platforms]]:
-        return [(now_s - r.age_s, r.platforms) for r in self.reader.take()]
 
-    def close(self) -> None:
-        self.reader.close()
+class DdsPlatformSource(_DdsFrames[Platforms]):
+    """PlatformPoses_ from a DDS topic."""
+
+    @staticmethod
+    def _payload(reading) -> Platforms:
+        return reading.platforms
 
 
 @dataclass

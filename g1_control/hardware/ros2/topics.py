@@ -196,26 +196,32 @@ def _wxyz(q) -> tuple[float, float, float, float]:
     return (q.w, q.x, q.y, q.z)
 
 
-class ObjectPosesReader:
-    """Takes ObjectPoses samples from rt/<topic> (perception: objects in the robot's heading frame)."""
+class _PerceptionReader:
+    """Takes one perception message type from rt/<topic>; subclasses turn a sample into a reading."""
+
+    _message = ""  # the message class's name in hardware/ros2/messages.py
+    _field = ""  # a field only that message has (samples of another type on the topic are skipped)
 
     def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
         from g1_control.hardware.ros2 import messages as m
 
         self._participant: Any
-        self._participant, self._reader = _perception_reader(interface, domain, topic, partition, m.ObjectPoses_)
+        self._participant, self._reader = _perception_reader(interface, domain, topic, partition,
+                                                             getattr(m, self._message))
         self._seconds = m.seconds
 
-    def take(self) -> list[ObjectsReading]:
+    def take(self) -> list:
         now = time.time()
         out = []
         for msg in self._reader.take(HISTORY_DEPTH):
-            if not hasattr(msg, "poses"):
+            if not hasattr(msg, self._field):
                 continue
             stamp = self._seconds(msg.header.stamp)
-            objects = {name: (_xyz(p.position), _wxyz(p.orientation)) for name, p in zip(msg.names, msg.poses)}
-            out.append(ObjectsReading(stamp, now - stamp, objects))
+            out.append(self._reading(stamp, now - stamp, msg))
         return out
+
+    def _reading(self, stamp_s: float, age_s: float, msg):
+        raise NotImplementedError
 
     def close(self) -> None:
         if self._participant is not None:
@@ -223,54 +229,50 @@ class ObjectPosesReader:
             self._participant = None
 
 
-class PlatformPosesReader:
+class ObjectPosesReader(_PerceptionReader):
+    """Takes ObjectPoses samples from rt/<topic> (perception: objects in the robot's heading frame)."""
+
+    _message, _field = "ObjectPoses_", "poses"
+
+    def take(self) -> list[ObjectsReading]:
+        return super().take()
+
+    def _reading(self, stamp_s: float, age_s: float, msg) -> ObjectsReading:
+        return ObjectsReading(stamp_s, age_s, {name: (_xyz(p.position), _wxyz(p.orientation))
+                                               for name, p in zip(msg.names, msg.poses)})
+
+
+class PlatformPosesReader(_PerceptionReader):
     """Takes PlatformPoses samples from rt/<topic> (perception: platforms in the robot's heading frame;
     `topic` is the perception topic with PLATFORMS_SUFFIX)."""
 
-    def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
-        from g1_control.hardware.ros2 import messages as m
-
-        self._participant: Any
-        self._participant, self._reader = _perception_reader(interface, domain, topic, partition, m.PlatformPoses_)
-        self._seconds = m.seconds
+    _message, _field = "PlatformPoses_", "sizes"
 
     def take(self) -> list[PlatformsReading]:
-        now = time.time()
-        out = []
-        for msg in self._reader.take(HISTORY_DEPTH):
-            if not hasattr(msg, "sizes"):
-                continue
-            stamp = self._seconds(msg.header.stamp)
-            platforms = {name: (_xyz(p.position), _wxyz(p.orientation), _xyz(size))
-                         for name, p, size in zip(msg.names, msg.poses, msg.sizes)}
-            out.append(PlatformsReading(stamp, now - stamp, platforms))
-        return out
+        return super().take()
 
-    def close(self) -> None:
-        if self._participant is not None:
-            del self._reader
-            self._participant = None
+    def _reading(self, stamp_s: float, age_s: float, msg) -> PlatformsReading:
+        return PlatformsReading(stamp_s, age_s, {name: (_xyz(p.position), _wxyz(p.orientation), _xyz(size))
+                                                 for name, p, size in zip(msg.names, msg.poses, msg.sizes)})
 
 
-class ObjectPosesWriter:
-    """Writes ObjectPoses samples to rt/<topic> (g1 sim-robot --scene's perception)."""
+class _PerceptionWriter:
+    """Writes one perception message type to rt/<topic>, stamped, in the heading frame."""
+
+    _message = ""  # the message class's name in hardware/ros2/messages.py
 
     def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
         from g1_control.hardware.ros2 import messages as m
 
         self._m = m
         self._participant: Any
-        self._participant, self._writer = _perception_writer(interface, domain, topic, partition, m.ObjectPoses_)
+        self._participant, self._writer = _perception_writer(interface, domain, topic, partition,
+                                                             getattr(m, self._message))
         self.sent = 0
 
-    def write(self, stamp_s: float, objects: dict) -> None:
-        """objects: name -> (position xyz, quat wxyz) in the robot's heading frame."""
+    def _send(self, stamp_s: float, *fields) -> None:
         m = self._m
-        names, poses = [], []
-        for name, (pos, quat) in objects.items():
-            names.append(name)
-            poses.append(_pose(m, pos, quat))
-        self._writer.write(m.ObjectPoses_(m.Header_(m.stamp(stamp_s), "heading"), names, poses))
+        self._writer.write(getattr(m, self._message)(m.Header_(m.stamp(stamp_s), "heading"), *fields))
         self.sent += 1
 
     def close(self) -> None:
@@ -279,32 +281,26 @@ class ObjectPosesWriter:
             self._participant = None
 
 
-class PlatformPosesWriter:
+class ObjectPosesWriter(_PerceptionWriter):
+    """Writes ObjectPoses samples to rt/<topic> (g1 sim-robot --scene's perception)."""
+
+    _message = "ObjectPoses_"
+
+    def write(self, stamp_s: float, objects: dict) -> None:
+        """objects: name -> (position xyz, quat wxyz) in the robot's heading frame."""
+        self._send(stamp_s, list(objects), [_pose(self._m, pos, quat) for pos, quat in objects.values()])
+
+
+class PlatformPosesWriter(_PerceptionWriter):
     """Writes PlatformPoses samples to rt/<topic> (g1 sim-robot --scene's perception of the scene's platforms)."""
 
-    def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
-        from g1_control.hardware.ros2 import messages as m
-
-        self._m = m
-        self._participant: Any
-        self._participant, self._writer = _perception_writer(interface, domain, topic, partition, m.PlatformPoses_)
-        self.sent = 0
+    _message = "PlatformPoses_"
 
     def write(self, stamp_s: float, platforms: dict) -> None:
         """platforms: name -> (top centre xyz, quat wxyz, size: footprint x, y and height) in the heading frame."""
         m = self._m
-        names, poses, sizes = [], [], []
-        for name, (pos, quat, size) in platforms.items():
-            names.append(name)
-            poses.append(_pose(m, pos, quat))
-            sizes.append(m.Vector3_(*(float(v) for v in size)))
-        self._writer.write(m.PlatformPoses_(m.Header_(m.stamp(stamp_s), "heading"), names, poses, sizes))
-        self.sent += 1
-
-    def close(self) -> None:
-        if self._participant is not None:
-            del self._writer
-            self._participant = None
+        self._send(stamp_s, list(platforms), [_pose(m, pos, quat) for pos, quat, _ in platforms.values()],
+                   [m.Vector3_(*(float(v) for v in size)) for _, _, size in platforms.values()])
 
 
 def _pose(m, pos, quat):
