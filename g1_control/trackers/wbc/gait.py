@@ -365,6 +365,7 @@ class VelocityGait:
         self._terrain_cfg: GaitConfig | None = None
         self._limits = _axis_limits(self.config, self.config.speed_margin, None)
         """feasible()'s per-axis limits (forward, backward, sideways, turning) at the cadence of each speed."""
+        self._limits_memo: dict[tuple, tuple[float, float, float, float]] = {}
         self.targets = GaitTargets()
         self.reset()
 
@@ -469,7 +470,7 @@ class VelocityGait:
         of the command itself: walking fast, quicker steps reach further per second."""
         cfg = self.config
         m = cfg.speed_margin if margin is None else margin
-        limits = self._limits if margin is None and cadence_of is None else _axis_limits(cfg, m, cadence_of)
+        limits = self._limits if margin is None and cadence_of is None else self._limits_for(m, cadence_of)
         out = np.array(command_h, dtype=float)
         out[0] = min(max(out[0], -limits[1]), limits[0])
         out[1] = min(max(out[1], -limits[2]), limits[2])
@@ -488,6 +489,17 @@ class VelocityGait:
                 scaled = lo * out
             out = scaled
         return out
+
+    def _limits_for(self, margin: float, cadence_of: np.ndarray | None) -> tuple[float, float, float, float]:
+        """_axis_limits, remembered per (margin, cadence_of): bisecting them costs ~2 ms of CPU, and the
+        speed correction asks at every touchdown, inside the controller's tick, mostly for the same command."""
+        key = (margin, None if cadence_of is None else tuple(float(v) for v in cadence_of))
+        limits = self._limits_memo.get(key)
+        if limits is None:
+            if len(self._limits_memo) >= 64:
+                self._limits_memo.clear()
+            limits = self._limits_memo[key] = _axis_limits(self.config, margin, cadence_of)
+        return limits
 
     def _turn(self, command_h: np.ndarray) -> float:
         """The turn rate the nominal DCM offsets plan for (0 with GaitConfig.plan_turn off)."""
