@@ -489,6 +489,7 @@ def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTr
                    "tick_p99_us": loop.scheduler.report()["tick"]["p99_us"],
                    "lateness_p99_ms": late["p99_us"] / 1000, "lateness_max_ms": loop.scheduler.max_lateness_s * 1000,
                    "misses_over_period": loop.scheduler.misses_over_period,
+                   "skipped_ticks": loop.scheduler.skipped_ticks,
                    "clamped_commands": safety.clamps.commands}
     if loop.generator.plan_windows:
         report.loop["while_planning"] = lateness_while(log_arrays, t_loop0, loop.generator.plan_windows,
@@ -601,7 +602,8 @@ def _print_summary(report: DeployReport, say) -> None:
                      f"refused: {refused}{platforms}")
         say(line)
     say(f"loop: {report.loop['ticks']} ticks, {report.loop['deadline_misses']} deadline misses (worst "
-        f"{report.loop['lateness_max_ms']:.1f} ms late, p99 {report.loop['lateness_p99_ms']:.1f} ms), "
+        f"{report.loop['lateness_max_ms']:.1f} ms late, p99 {report.loop['lateness_p99_ms']:.1f} ms; "
+        f"{report.loop['skipped_ticks']} ticks skipped after stalls), "
         f"{report.loop['clamped_commands']} commands clamped by the safety layer")
     planning = report.loop.get("while_planning")
     if planning:

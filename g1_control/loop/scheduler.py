@@ -4,7 +4,9 @@ One base tick runs at the fastest rate (the low-level command stream). Every sta
 ticks that are a multiple of its period, in the order the stages were given, so one tick is
 "input, estimator, generator, tracker, safety, low-level" when all are due. The same code runs
 in lockstep (as fast as possible; the backend advances simulated time) and in wall-clock mode
-(each tick waits for its deadline). A tick that ends after its deadline is a deadline miss.
+(each tick waits for its deadline). A tick that ends after its deadline is a deadline miss; one that
+ends more than a whole period late skips the periods it lost (tick_index moves on by them, so the
+control time stays the wall clock's) instead of running the missed ticks back to back.
 
 In lockstep, ticks on which only the one every-tick stage is due (the low-level stream between
 tracker ticks) run as one call of that stage's `batch(n)` when it has one: n ticks of the stage
@@ -92,6 +94,8 @@ class Scheduler:
         self.max_lateness_s = 0.0
         self.misses_over_period = 0
         """Ticks that finished more than a whole tick period late (the next tick's deadline passed too)."""
+        self.skipped_ticks = 0
+        """Wall-clock ticks not run: the whole periods a late tick overran (tick_index moves past them)."""
         self._late_since_take = 0.0
         self._late_since_log = 0.0
         self._t0: float | None = None
@@ -140,6 +144,13 @@ class Scheduler:
                 self.max_lateness_s = max(self.max_lateness_s, late)
                 if late > self.dt_s:
                     self.misses_over_period += 1
+                    # The whole periods lost are skipped, not run back to back to catch up: after a stall
+                    # of a few ticks every catch-up tick would finish late too (a controller using most of
+                    # its period catches up slowly), each counted as one more overrun, and they would
+                    # act on almost the same state. Control time stays the wall clock's.
+                    lost = int(late // self.dt_s)
+                    self.tick_index += lost
+                    self.skipped_ticks += lost
                 self._late_since_take = max(self._late_since_take, late)
                 self._late_since_log = max(self._late_since_log, late)
             else:
@@ -185,7 +196,9 @@ class Scheduler:
 
     def run(self, n_ticks: int, stop: Callable[[], bool] | None = None,
             progress: Callable[[int], None] | None = None) -> int:
-        """Run up to `n_ticks` ticks; returns how many ran (fewer when `stop()` turns true)."""
+        """Run up to `n_ticks` ticks of control time; returns how many passed (fewer when `stop()` turns
+        true). Ticks a late wall-clock tick skipped count as passed."""
+        start = self.tick_index
         i = 0
         while i < n_ticks:
             if stop is not None and stop():
@@ -194,12 +207,12 @@ class Scheduler:
             if n > 1:
                 self._run_batch(n)
             else:
-                n = 1
                 self.tick()
+            done = min(self.tick_index - start, n_ticks)
             if progress is not None:
-                for j in range(i, i + n):
+                for j in range(i, done):
                     progress(j)
-            i += n
+            i = done
         return n_ticks
 
     def report(self) -> dict[str, dict[str, float]]:

@@ -44,9 +44,32 @@ def test_wallclock_counts_deadline_misses_and_sleeps_otherwise():
     sched.run(10)
     assert sched.deadline_misses == 0
     assert clock.t == pytest.approx(10 * 0.002)  # slept to each deadline
-    work["dt"] = 0.005  # 2.5 ticks of work per tick
-    sched.run(4)
-    assert sched.deadline_misses == 4 and sched.overruns == 4
+    work["dt"] = 0.0051  # 2.5 ticks of work per tick: every tick that runs misses, the periods lost are skipped
+    sched.run(8)
+    assert sched.deadline_misses == sched.overruns == 4
+    assert sched.skipped_ticks == 6 and sched.tick_index == 20  # 4 ran + 6 skipped >= 8 ticks of control time
+    assert sched.time_s == pytest.approx(clock.t, abs=0.002)  # control time stayed the wall clock's
+
+
+def test_a_stall_is_one_miss_and_the_ticks_after_it_are_on_time():
+    """One tick stalls for 5 periods (a preempted thread); the ticks after it run on the wall clock's
+    schedule again at once, not back to back to catch up (each of those would finish late too)."""
+    clock = FakeClock()
+    stalls = {4: 0.0105}
+    ran: list[int] = []
+
+    def stage():
+        ran.append(sched.tick_index)
+        clock.t += stalls.get(sched.tick_index, 0.0012)  # 60 % of the 2 ms period, 10.5 ms once
+
+    sched = Scheduler(500, [Stage("work", 500, stage)], wallclock=True, clock=clock, sleep=clock.sleep)
+    assert sched.run(20) == 20
+    assert sched.deadline_misses == 1 and sched.misses_over_period == 1
+    assert sched.max_lateness_s == pytest.approx(0.0105 - 0.002)
+    assert sched.skipped_ticks == 4 and ran == [*range(5), *range(9, 20)]  # ticks 5-8 lost to the stall
+    assert clock.t == pytest.approx(20 * 0.002)  # ends on the 20th deadline, as without the stall
+    late = sched.lateness.samples[:sched.lateness.count]
+    assert (late > 0).sum() == 1
 
 
 def test_lockstep_never_sleeps_but_counts_overruns():
