@@ -45,7 +45,8 @@ GROUPS: dict[str, dict[str, list[str]]] = {
     "preflight": {
         "mutate": ["g1_control/deploy/preflight.py"],
         "tests": ["tests/deploy/test_deploy_preflight_checks.py", "tests/deploy/test_deploy_preflight_paths.py",
-                  "tests/deploy/test_deploy_preflight_bounds.py"],
+                  "tests/deploy/test_deploy_preflight_bounds.py", "tests/deploy/test_deploy_preflight_simulators.py",
+                  "tests/deploy/test_deploy_preflight_services.py"],
     },
     "decoders": {
         "mutate": ["g1_control/hardware/unitree/messages.py", "g1_control/hardware/unitree/conversions.py",

@@ -162,7 +162,7 @@ def test_a_device_that_cannot_open_is_refused_for_good(launch):
     assert r.status == FAIL and r.overridable is False and r.reason.startswith("no gamepad at /dev/input/event9")
 
 
-@pytest.mark.parametrize("kind", ["scripted", "random", "gamepad_script", "program"])
+@pytest.mark.parametrize("kind", ["scripted", "random", "gamepad_script", "program", "ros2"])
 def test_inputs_without_an_operator_pass_only_against_the_emulator(launch, kind):
     pf = Preflight()
     assert pf.check_input(None, _teleop(launch, kind))
