@@ -32,6 +32,17 @@ FINGER_ARMATURE_KGM2 = 1e-4
 a spring-damper: what the hand's own controller does with its last command. Nothing commands the
 fingers yet (no HandCmd_ path); the hand is there for its mass, its shape and its contacts."""
 
+JOINT_STOP_TIMECONST_STEPS = 2
+"""A joint's stop (its limit constraint) pulls a joint back from beyond its range with a time
+constant of this many physics steps: the stiffest MuJoCo integrates stably (its default, 0.02 s,
+is 4 steps of 5 ms and 10 of 2 ms)."""
+JOINT_STOP_SOLIMP = (0.99, 0.999, 0.001, 0.5, 2.0)
+"""The stop's impedance: it takes 99 % of the load at the range's edge (MuJoCo's default takes 90 %,
+rising to 95 % 1 mrad in). The G1's stops are metal: with MuJoCo's default soft limits a limp G1
+hanging in its gantry sagged 0.0075 rad past its waist pitch stop under the torso's weight, and a
+joint arriving at 3-10 rad/s went 0.02-0.05 rad past its range, more than the deploy's preflight
+allows (DeployConfig.joint_limit_tolerance_rad) and nothing the robot's encoders would read."""
+
 
 @functools.cache
 def description_dir() -> Path:
@@ -157,6 +168,8 @@ def mujoco_spec(floor: bool = True, timestep_s: float = 0.005, variant: g1.Varia
         joint.armature = float(g1.ARMATURE_KGM2[i])
         joint.range = [float(g1.Q_MIN_RAD[i]), float(g1.Q_MAX_RAD[i])]
         joint.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+        joint.solref_limit = [JOINT_STOP_TIMECONST_STEPS * timestep_s, 1.0]  # critically damped
+        joint.solimp_limit = list(JOINT_STOP_SOLIMP)
         motor = spec.add_actuator(name=name.removesuffix("_joint"), target=name)
         motor.trntype = mujoco.mjtTrn.mjTRN_JOINT
         limit = float(g1.EFFORT_LIMIT_NM[i])

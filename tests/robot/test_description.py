@@ -40,3 +40,25 @@ def test_forward_kinematics_agree():
             worst = max(worst, np.abs(pd.oMf[fid].translation - data.body(body).xpos).max())
             np.testing.assert_allclose(pd.oMf[fid].rotation, data.body(body).xmat.reshape(3, 3), atol=1e-6)
     assert worst < 1e-6
+
+
+
+def test_joint_stops_are_hard_a_joint_pressed_by_its_motor_at_full_torque_stays_at_its_stop():
+    """The G1's stops are metal: a joint pressed into one at its motor's effort limit rests at it, not
+    0.126 rad past it (a wrist roll under 25 N m with MuJoCo's default soft limits)."""
+    for timestep_s in (0.002, 0.005):  # the robot's physics step, and unitree_mujoco's
+        model = description.mujoco_model(timestep_s)
+        data = mujoco.MjData(model)
+        for side, stop in ((1.0, g1.Q_MAX_RAD), (-1.0, g1.Q_MIN_RAD)):
+            mujoco.mj_resetData(model, data)
+            data.qpos[2] = 2.0  # the pelvis held in the air: no foot reaches the floor
+            data.qpos[7:] = stop  # every joint at its stop, at rest
+            base = data.qpos[:7].copy()
+            data.qfrc_applied[6:] = side * g1.EFFORT_LIMIT_NM
+            for _ in range(round(1.0 / timestep_s)):
+                data.qpos[:7], data.qvel[:6] = base, 0.0
+                mujoco.mj_step(model, data)
+            past = side * (data.qpos[7:] - stop)
+            worst = int(np.argmax(past))
+            assert past[worst] < 0.002, (f"{timestep_s} s steps: {g1.JOINT_NAMES[worst]} rests {past[worst]:.4f} rad "
+                                         f"past its stop under {g1.EFFORT_LIMIT_NM[worst]:.0f} N m")

@@ -48,6 +48,35 @@ def test_the_pd_torque_is_computed_when_the_command_arrives_and_held():
     assert np.ptp(seen) > 0.5
 
 
+def test_a_limp_g1_hanging_in_the_elastic_band_stays_inside_its_joint_stops_and_comes_to_rest():
+    """`g1 sim-robot --mode unitree_mujoco --lower-gantry-on-policy` before the host's first command:
+    no motor torque, the robot hanging in the gantry. The preflight then finds every joint within
+    its range (+ its tolerance), whenever it samples: on main the limp arms swung for good at up to
+    10 rad/s and went 0.05 rad past their shoulder yaw stops (CI: right_shoulder_yaw_joint +2.640 rad)."""
+    from g1_control.launch.schema import DeployConfig
+    from g1_control.sim.emulator import Gantry
+
+    held = HeldTorqueMujoco(MujocoConfig(lockstep=True, physics_dt_s=PHYSICS_DT_S))
+    robot = Gantry(held, physics_dt_s=held.config.physics_dt_s, lower_on_policy=True)  # as g1 sim-robot builds it
+    robot.reset()
+    robot.write_command(MotorCommand.damping(g1.KD_DEFAULT))  # the emulator's start: a held torque of 0
+    tolerance = DeployConfig().joint_limit_tolerance_rad
+    worst, last_second_speed = np.zeros(g1.NUM_JOINTS), 0.0
+    steps = round(30.0 / PHYSICS_DT_S)
+    for step in range(steps):
+        robot.step(PHYSICS_DT_S)
+        state = robot.read_state()
+        worst = np.maximum(worst, np.maximum(g1.Q_MIN_RAD - state.q_rad, state.q_rad - g1.Q_MAX_RAD))
+        if step >= steps - round(1.0 / PHYSICS_DT_S):
+            last_second_speed = max(last_second_speed, float(np.max(np.abs(state.dq_radps))))
+    past = {g1.JOINT_NAMES[j]: round(float(worst[j]), 4) for j in np.nonzero(worst > tolerance)[0]}
+    assert not past, f"joints went past their range by more than the preflight's {tolerance} rad: {past}"
+    assert last_second_speed < 0.05, f"still swinging after 29 s: {last_second_speed:.2f} rad/s"
+    resting = np.maximum(g1.Q_MIN_RAD - state.q_rad, state.q_rad - g1.Q_MAX_RAD)
+    assert np.max(resting) < 0.001, f"{g1.JOINT_NAMES[int(np.argmax(resting))]} rests {np.max(resting):.4f} rad past its stop"
+    assert state.base_pos_w_m is not None and state.base_pos_w_m[2] > 0.6  # still hanging
+
+
 @pytest.mark.timing
 def test_the_emulator_in_unitree_mujoco_mode_speaks_as_that_simulator():
     from g1_control.hardware.links.dds import DdsLink
