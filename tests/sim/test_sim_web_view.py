@@ -80,7 +80,10 @@ class Browser:
                     raise RuntimeError(f"{method}: {answer['error'].get('message')}")
                 return answer["result"]
 
-    def look(self, url: str, done, deadline_s: float = 150.0) -> np.ndarray:
+    def look(self, url: str, done, settled: bool = False, deadline_s: float = 150.0) -> tuple[np.ndarray, bool]:
+        """The last screenshot of `url` and whether `done` held on it (and, with `settled`, whether it
+        was the same picture as the one before: the scene fades in over seconds under load, and a
+        picture that stopped changing has finished)."""
         import base64
 
         import imageio.v2 as imageio
@@ -89,19 +92,21 @@ class Browser:
                    deviceScaleFactor=1, mobile=False)
         self._call("Page.navigate", self._session, url=url)
         end = time.monotonic() + deadline_s
-        picture, error = None, None
+        picture, before, error = None, None, None
         while True:
             try:
                 png = self._call("Page.captureScreenshot", self._session, format="png")["data"]
-                picture = imageio.imread(base64.b64decode(png))[..., :3]
+                before, picture = picture, imageio.imread(base64.b64decode(png))[..., :3]
             except (RuntimeError, TimeoutError) as e:  # the page is swapping renderers, or the host is slow
                 error = e
-            if (picture is not None and done(picture)) or time.monotonic() > end:
+            held = picture is not None and bool(done(picture)) and (
+                not settled or (before is not None and np.array_equal(before, picture)))
+            if held or time.monotonic() > end:
                 break
             time.sleep(1.0)
         if picture is None:
             pytest.fail(f"headless Chromium gave no screenshot of {url} within {deadline_s:.0f} s ({error})")
-        return picture
+        return picture, held
 
     def close(self) -> None:
         if self._socket is not None:
@@ -120,8 +125,8 @@ def robot_pixels(image: np.ndarray) -> int:
 
 
 MARKER_RGB = (60, 180, 70)
-"""A green box the robot test puts where the camera looks once the robot is out of sight: a
-picture with it in full colour has drawn its scene (it fades in with the robot), so a missing robot
+"""A green box the robot test puts where the camera looks once the robot is out of sight: a settled
+picture with it has drawn its scene (which fades in, the marker with the robot), so a missing robot
 there means out of sight, not not yet drawn."""
 
 
@@ -138,22 +143,25 @@ def test_browser_shows_the_robot():
             q = np.zeros(model.nq)
             q[2], q[3], q[7:] = 0.79, 1.0, g1.DEFAULT_Q_RAD
             view.show(q, "t 1.0 s\nsafety ok")
-            image = browser.look(view.url, lambda p: robot_pixels(p) > 3000)
+            image, _ = browser.look(view.url, lambda p: _drawn(p) and robot_pixels(p) > 3000)
             # The same page with the robot far out of sight: the count must drop to (nearly) nothing.
             view.show(q, "gone")
             view.server.scene.add_box("/marker", color=MARKER_RGB, dimensions=(2.0, 2.0, 2.0),
                                       position=(0.0, 0.0, -200.0))
             view.server.initial_camera.look_at = (0.0, 0.0, -200.0)  # look at the marker far below: no robot
             view.server.initial_camera.position = (0.0, 0.0, -190.0)
-            empty = browser.look(view.url, lambda p: box_pixels(p) > 500 and robot_pixels(p) < 100)
+            empty, settled = browser.look(view.url, lambda p: box_pixels(p) > 500 and robot_pixels(p) < 100,
+                                          settled=True)
         finally:
             browser.close()
     finally:
         view.close()
+    assert _drawn(image), "the page never drew its 3D scene within the deadline (the canvas stayed blank)"
     assert robot_pixels(image) > 3000, f"robot not in the screenshot ({robot_pixels(image)} robot-coloured pixels)"
     assert box_pixels(empty) > 500, (f"the page looking away from the robot never drew its scene within the deadline "
                                      f"(the marker where it looks: {box_pixels(empty)} green pixels)")
     assert robot_pixels(empty) < 100, f"robot still in the screenshot looking away ({robot_pixels(empty)} pixels)"
+    assert settled, "the page looking away from the robot never stopped changing (still fading in?) within the deadline"
 
 
 def _scene_model():
@@ -220,12 +228,13 @@ def test_browser_shows_the_box():
             adr = model.jnt_qposadr[model.joint("box_free").id]
             q[adr:adr + 7] = [0.6, 0.3, 0.9, 1.0, 0.0, 0.0, 0.0]
             view.show(q, "box beside the robot")
-            image = browser.look(view.url, lambda p: _drawn(p) and box_pixels(p) > 500)
+            image, _ = browser.look(view.url, lambda p: _drawn(p) and box_pixels(p) > 500)
             q[adr:adr + 3] = [60.0, 60.0, 0.15]  # recorded far away: gone from the picture
             view.show(q, "box gone")
-            # Drawn here means the robot beside it in full colour: the scene fades in, and while it is
-            # pale (seen for 10 s under load) the box would not count either.
-            gone = browser.look(view.url, lambda p: robot_pixels(p) > 3000 and box_pixels(p) < 50)
+            # Drawn here means the robot beside it in colour, in a settled picture: the scene fades in,
+            # and while it is pale (seen for 10-25 s under load) the box would not count either.
+            gone, settled = browser.look(view.url, lambda p: robot_pixels(p) > 3000 and box_pixels(p) < 50,
+                                         settled=True)
         finally:
             browser.close()
     finally:
@@ -235,3 +244,4 @@ def test_browser_shows_the_box():
     assert robot_pixels(gone) > 3000, ("the page with the box gone never drew its scene within the deadline "
                                        f"(the robot beside it: {robot_pixels(gone)} pixels)")
     assert box_pixels(gone) < 50, f"box still in the screenshot after it moved away ({box_pixels(gone)} green pixels)"
+    assert settled, "the page with the box gone never stopped changing (still fading in?) within the deadline"
