@@ -33,7 +33,8 @@ class Browser:
     screenshots, one about every second, until `done(picture)` holds or `deadline_s` of wall time
     passes, and returns the last one. Nothing rides on a virtual-time budget: on a loaded 2-core host a
     `--screenshot --virtual-time-budget` run took 10 to 53 s and now and then handed back a page whose
-    software WebGL had not drawn yet; here a slow host only makes the wait longer."""
+    software WebGL had not drawn yet; here a slow host only makes the wait longer (a page took up to
+    ~110 s to draw and settle beside 2 busy processes and other jobs on 2 cores, a load of 9)."""
 
     def __init__(self, size=(800, 600)):
         import os
@@ -80,7 +81,7 @@ class Browser:
                     raise RuntimeError(f"{method}: {answer['error'].get('message')}")
                 return answer["result"]
 
-    def look(self, url: str, done, settled: bool = False, deadline_s: float = 150.0) -> tuple[np.ndarray, bool]:
+    def look(self, url: str, done, settled: bool = False, deadline_s: float = 240.0) -> tuple[np.ndarray, bool]:
         """The last screenshot of `url` and whether `done` held on it (and, with `settled`, whether it
         was the same picture as the one before: the scene fades in over seconds under load, and a
         picture that stopped changing has finished)."""
