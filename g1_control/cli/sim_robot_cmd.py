@@ -193,8 +193,8 @@ def _run(args) -> int:
             physics = mujoco = HeldTorqueMujoco(MujocoConfig(lockstep=True, physics_dt_s=PHYSICS_DT_S, variant=variant,
                                                              randomize=randomize), scene=scene)
         else:
-            physics = mujoco = MujocoBackend(MujocoConfig(lockstep=True, variant=variant, randomize=randomize),
-                                             scene=scene)
+            physics = mujoco = MujocoBackend(MujocoConfig(lockstep=True, variant=variant, randomize=randomize,
+                                                          hard_joint_stops=True), scene=scene)
         if mujoco.draw is not None:
             print(f"g1 sim-robot: {mujoco.describe()}", file=sys.stderr, flush=True)
         if args.gantry or args.lower_gantry_on_policy:

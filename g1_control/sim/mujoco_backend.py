@@ -41,10 +41,11 @@ from g1_control.sim.randomize import RandomizeConfig, RobotDraw, draw
 from g1_control.types import MotorCommand, RobotState
 
 
-def motor_law_scene(physics_dt_s: float, variant: g1.Variant = g1.G1_29DOF, hands: str = "none") -> mujoco.MjSpec:
+def motor_law_scene(physics_dt_s: float, variant: g1.Variant = g1.G1_29DOF, hands: str = "none",
+                    hard_stops: bool = False) -> mujoco.MjSpec:
     """The G1 scene (robot/description.py) of `variant` (with `hands`) with the drivers' motor law
     in its actuators (see above): one actuator per joint the variant has."""
-    spec = description.mujoco_spec(timestep_s=physics_dt_s, variant=variant, hands=hands)
+    spec = description.mujoco_spec(timestep_s=physics_dt_s, variant=variant, hands=hands, hard_stops=hard_stops)
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER
     for i in variant.active_joints:
         name = g1.JOINT_NAMES[i]
@@ -73,6 +74,9 @@ class MujocoConfig:
     """Which G1 is built (g1.VARIANTS by name; a launch file's backend.expected_variant): a variant
     without some joints has no such joints and motors in the model, and its state reports them as 0
     (q, dq, tau), as the robot's LowState_ does for the slots it has no motor behind."""
+    hard_joint_stops: bool = False
+    """The joints' stops hard (robot/description.py JOINT_STOP_*), as the emulated robot has them
+    (`g1 sim-robot`); False: MuJoCo's default soft limits (a joint striking one goes 0.02-0.05 rad past)."""
     randomize: RandomizeConfig | None = None
     """A seeded domain randomisation of the robot (g1_control/sim/randomize.py): link masses, CoM
     offsets, motor strength, command latency, foot friction. None: the nominal robot."""
@@ -148,7 +152,7 @@ class MujocoBackend(Backend):
         self.closed = False
 
     def _compile(self) -> mujoco.MjModel:
-        spec = motor_law_scene(self.config.physics_dt_s, self.variant, self.config.hands)
+        spec = motor_law_scene(self.config.physics_dt_s, self.variant, self.config.hands, self.config.hard_joint_stops)
         if not self.scene.empty:
             from g1_control.sim.scene import build_scene
 

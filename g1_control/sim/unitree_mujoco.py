@@ -19,6 +19,8 @@ good at up to 10 rad/s, and at 5 ms steps every strike of a stop went 0.02-0.05 
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from g1_control.hardware.unitree.simulators import SIMULATORS
@@ -39,10 +41,11 @@ class HeldTorqueMujoco(MujocoBackend):
     """MuJoCo with unitree_mujoco's motor law: the PD torque of a command is computed once, when the
     command arrives (write_command), from the joints' state then, and held as a plain torque until
     the next command; a disabled motor gives none. Its joints have that simulator's passive damping
-    and friction (JOINT_DAMPING_NMS_PER_RAD, JOINT_FRICTION_NM)."""
+    and friction (JOINT_DAMPING_NMS_PER_RAD, JOINT_FRICTION_NM), and hard stops (the emulated robot's)."""
 
     def __init__(self, config: MujocoConfig | None = None, **kwargs):
-        super().__init__(config or MujocoConfig(physics_dt_s=PHYSICS_DT_S), **kwargs)
+        config = config or MujocoConfig(physics_dt_s=PHYSICS_DT_S)
+        super().__init__(dataclasses.replace(config, hard_joint_stops=True), **kwargs)
         wrist = np.array(["_wrist_" in g1.JOINT_NAMES[i] for i in self._active])
         self.model.dof_damping[self._v] = JOINT_DAMPING_NMS_PER_RAD
         self.model.dof_frictionloss[self._v] = np.where(wrist, WRIST_FRICTION_NM, JOINT_FRICTION_NM)

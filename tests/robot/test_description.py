@@ -43,11 +43,11 @@ def test_forward_kinematics_agree():
 
 
 
-def test_joint_stops_are_hard_a_joint_pressed_by_its_motor_at_full_torque_stays_at_its_stop():
+def test_hard_joint_stops_hold_a_joint_pressed_by_its_motor_at_full_torque_at_its_stop():
     """The G1's stops are metal: a joint pressed into one at its motor's effort limit rests at it, not
     0.126 rad past it (a wrist roll under 25 N m with MuJoCo's default soft limits)."""
     for timestep_s in (0.002, 0.005):  # the robot's physics step, and unitree_mujoco's
-        model = description.mujoco_model(timestep_s)
+        model = description.mujoco_spec(timestep_s=timestep_s, hard_stops=True).compile()
         data = mujoco.MjData(model)
         for side, stop in ((1.0, g1.Q_MAX_RAD), (-1.0, g1.Q_MIN_RAD)):
             mujoco.mj_resetData(model, data)

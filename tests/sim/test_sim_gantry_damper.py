@@ -11,7 +11,7 @@ from g1_control.types import MotorCommand
 
 
 def test_a_damped_robot_hanging_in_the_gantry_stays_slow():
-    mujoco = MujocoBackend(MujocoConfig(lockstep=True))
+    mujoco = MujocoBackend(MujocoConfig(lockstep=True, hard_joint_stops=True))  # as g1 sim-robot builds it
     gantry = Gantry(mujoco, physics_dt_s=mujoco.config.physics_dt_s, lower_on_policy=True)
     gantry.reset()
     damping = MotorCommand.damping(g1.KD_DEFAULT)
