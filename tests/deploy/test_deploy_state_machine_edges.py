@@ -10,6 +10,7 @@ import logging
 
 import numpy as np
 import pytest
+from test_deploy_state_machine import Clock  # a settable clock at 100 s
 
 from g1_control.deploy.state_machine import DeployState, DeployTracker, OperatorButtons, Transition, smooth_step
 from g1_control.interfaces import InputDevice, Tracker
@@ -20,14 +21,6 @@ from g1_control.teleop.scripted import ScriptedInput, Segment
 from g1_control.types import Command, JointReference, MotorCommand, RobotState
 
 DT = 0.25  # exact in binary: in_state lands exactly on every limit below
-
-
-class Clock:
-    def __init__(self):
-        self.t = 100.0
-
-    def __call__(self) -> float:
-        return self.t
 
 
 class RecordingPolicy(Tracker):
@@ -91,6 +84,14 @@ def _ticks_until(tracker, clock, target, limit=40):
     raise AssertionError(f"never reached {target}: {tracker.sequence}")
 
 
+def _start_then_run(tracker, clock, device, ops):
+    """One tick limp, the operator's start, ticks until the hold, then run pressed (not yet ticked)."""
+    _act(tracker, clock)
+    _press(device, ops, "start")
+    _ticks_until(tracker, clock, DeployState.HOLD)
+    _press(device, ops, "run")
+
+
 def test_auto_start_run_and_control_time_each_at_the_first_tick_their_time_allows():
     tracker, clock, safety, _, _, _ = _machine(auto=True, control_s=1.5)
     # The first tick starts the clock of zero_torque; auto_start_s 0.5 = 2 ticks later.
@@ -109,10 +110,7 @@ def test_auto_start_run_and_control_time_each_at_the_first_tick_their_time_allow
 
 def test_a_run_pressed_early_is_taken_at_exactly_min_hold():
     tracker, clock, _, _policy, device, ops = _machine()
-    _act(tracker, clock)
-    _press(device, ops, "start")
-    _ticks_until(tracker, clock, DeployState.HOLD)
-    _press(device, ops, "run")
+    _start_then_run(tracker, clock, device, ops)
     assert _ticks_until(tracker, clock, DeployState.CONTROL) == 2, "min_hold_s 0.5: 2 ticks"
     assert tracker.transitions[-1].reason == "operator run"
     assert tracker.transitions[0].reason == "operator start"
@@ -205,10 +203,7 @@ def test_a_default_pose_given_as_integers_still_ramps_smoothly():
 
 def test_control_hands_the_policy_the_reference_and_state_and_resets_it_with_the_state():
     tracker, clock, _, policy, device, ops = _machine()
-    _act(tracker, clock)
-    _press(device, ops, "start")
-    _ticks_until(tracker, clock, DeployState.HOLD)
-    _press(device, ops, "run")
+    _start_then_run(tracker, clock, device, ops)
     _act(tracker, clock)
     state, reference = _state(g1.DEFAULT_Q_RAD), JointReference()
     clock.t += DT
