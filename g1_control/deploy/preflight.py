@@ -227,7 +227,9 @@ class Preflight:
             self.record("state_stream", FAIL, f"{detail}; need >= {min_rate:.0f} Hz on {where}: check the "
                         "cable/switch and that nothing else loads this host")
         elif frozen:
-            self.record("state_stream", FAIL, f"{detail}; {frozen}{_simulator_hint(backend, launch)}")
+            # Not overridable: the loop's tick-order check would damp on the first tick anyway.
+            self.record("state_stream", FAIL, f"{detail}; {frozen}{_simulator_hint(backend, launch)}",
+                        overridable=False)
         elif bad or malformed or bad_frames:
             self.record("state_stream", FAIL, f"{detail}; corrupted samples on {where}: check the cable, the switch "
                         "and that only one robot publishes on this domain")

@@ -144,13 +144,24 @@ def test_no_state_and_no_dropped_sample_hints_from_the_last_state_if_there_is_on
 def test_the_simulators_stream_without_its_profile_fails_frozen_and_without_a_variant_with_the_hint(launch):
     pf = _check(launch, _Link(_sim_state(), tick_step=0))
     r = pf.results["state_stream"]
-    assert (r.status, r.overridable) == (FAIL, True)
+    assert (r.status, r.overridable) == (FAIL, False)
     assert r.reason == ("500 Hz over 1.0 s, 0 bad CRC, 0 malformed; tick frozen: 500 samples arrived in 1.0 s, every "
                         "one with tick 0: the robot's state publisher is stuck (the control loop would trip on 'tick "
                         "frozen' at once)" + TICK_MODE)
     r = pf.results["variant"]
     assert (r.status, r.overridable, r.reason) == (FAIL, False, NO_VARIANT + TICK_MODE)
     assert pf.results["imu_upright"].status == PASS  # the other checks still run: every fault is shown at once
+
+
+def test_a_frozen_tick_cannot_be_overridden(launch):
+    """The loop's tick-order check would damp on the first tick: an override would only start a damp."""
+    pf = Preflight(overrides=frozenset({"state_stream"}))
+    pf.check_robot(_Link(standing_state(), tick_step=0), launch, None)
+    r = pf.results["state_stream"]
+    assert (r.status, r.overridable) == (FAIL, False)
+    assert r.reason.endswith("tick frozen' at once) (--override state_stream refused: this failure cannot be "
+                             "overridden)")
+    assert not pf.passed
 
 
 def test_off_loopback_the_same_stream_fails_without_the_hint(launch):
