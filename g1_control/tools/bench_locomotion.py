@@ -16,7 +16,9 @@ the policies (tracker.type policy, their trained command range, not the shipped 
   off-axis   the largest |achieved| of the uncommanded axes (m/s or rad/s);
   fell       the loop's fall monitor (pelvis below 0.4 m or tilted), and the lowest pelvis height;
   act CPU    p50/p99 of the tracker's act() in thread CPU time (not wall time: the machines are
-             shared), beside pinocchio RNEA + CRBA on the WBC's visited states in the same run.
+             shared), beside pinocchio RNEA + CRBA on the WBC's visited states in the same run;
+  log_sha256 (JSON only) a digest of the row's per-tick ground truth and motor targets: lockstep rows
+             repeat bit for bit, in any order and any process, so two runs of one code agree on it.
 Exits 1 when any row fell.
 
     g1 bench locomotion                          # every row (~15 min)
@@ -26,6 +28,7 @@ Exits 1 when any row fell.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import time
@@ -48,6 +51,8 @@ CONTROLLERS: dict[str, tuple[str, str, float]] = {
 }
 """name -> (tracker.type, tracker.policy, tracker rate Hz)."""
 POLICY_GAIT_PERIOD_S = 1.0
+LOG_DIGEST_FIELDS = ("t_s", "base_pos_m", "base_quat_wxyz", "velocity_true", "q_rad", "q_target_rad", "tau_nm")
+"""The per-tick log fields Row.log_sha256 covers: the simulator's ground truth and what was commanded."""
 
 
 @dataclass(frozen=True)
@@ -134,6 +139,8 @@ class Row:
     """The safety layer's first trip (damping), if any: a joint over-speed, say."""
     backend: str = ""
     """The simulated robot (loop.chain's backend: nominal, or the randomisation drawn)."""
+    log_sha256: str = ""
+    """log_digest of the run: equal for two runs exactly when their logs agree bit for bit."""
 
     @property
     def name(self) -> str:
@@ -148,6 +155,16 @@ def steady_velocity(log: dict[str, np.ndarray], t_from_s: float, t_to_s: float, 
     t = log["t_s"]
     window = (t >= t_from_s - 1e-9) & (t < t_from_s + cycles * period_s - 1e-9)
     return log["velocity_true"][window].mean(axis=0)
+
+
+def log_digest(log: dict[str, np.ndarray]) -> str:
+    """sha256 over the bytes of a run log's LOG_DIGEST_FIELDS (their names and shapes included)."""
+    digest = hashlib.sha256()
+    for name in LOG_DIGEST_FIELDS:
+        values = np.ascontiguousarray(log[name], dtype=np.float64)
+        digest.update(f"{name}{values.shape}".encode())
+        digest.update(values.tobytes())
+    return digest.hexdigest()
 
 
 def wbc_stride_s(tracker, command: tuple[float, float, float]) -> float:
@@ -230,7 +247,7 @@ def run_case(controller: str, case: Case, walk_s: float, states: list | None = N
         loop.backend.close()
     log = loop.log.arrays()
     row = Row(controller, case.name, list(case.command), sim_s=float(loop.time_s), wall_s=wall,
-              backend=loop.chain["backend"])
+              backend=loop.chain["backend"], log_sha256=log_digest(log))
     row.fell = loop.fell
     row.fall = str(loop.fall) if loop.fall else ""
     trip = next((e for e in loop.events if e.trips and e.kind != "fall"), None)

@@ -2,12 +2,16 @@
 a walking policy, the JSON it writes, and its exit code on a fall."""
 
 import json
+import os
+import subprocess
+import sys
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from g1_control.tools import bench_locomotion as B
+from tests.paths import REPO
 
 
 def test_rows_measure_what_the_robot_achieved():
@@ -76,3 +80,59 @@ def test_the_push_grid_is_one_run_per_direction_and_point_of_the_stride():
         assert sum(seg.duration_s for seg in case.timeline) >= t + 1.0 + B.PUSH_S + B.PUSH_SETTLE_S
     fractions = sorted({c.push_stride_fraction for c in cases})
     assert fractions == pytest.approx([k / B.PUSH_PHASES for k in range(B.PUSH_PHASES)])
+
+
+# Two short lockstep rows of the WBC walking by its own gait: a walk with a turn (the gait's turned DCM
+# offsets and its per-command speed limits) and a walk with a push on the pelvis from behind.
+_TURN = B.Case("turn", (0.4, 0.0, 0.6), timeline=(B.Segment(0.5, label="stand"),
+                                                  B.Segment(2.5, vx_mps=0.4, wz_radps=0.6, label="walk")))
+_PUSH = B.Case("push", (0.5, 0.0, 0.0), timeline=(B.Segment(0.5, label="stand"),
+                                                  B.Segment(2.5, vx_mps=0.5, label="walk")),
+               pushes=((1.6, (60.0, 0.0, 0.0)),))
+
+
+def test_a_rows_result_does_not_depend_on_the_rows_run_before_it_in_the_process():
+    """Issue 26 item 4: a row's outcome is a function of its case alone. Run in two orders in one
+    process, each row gives the same bytes in its whole per-tick log (a controller's state carried
+    from one loop to the next, a solver warm-started from another tracker's solution or a memo whose
+    values depend on history would change the bits: the WBC walks near its limits, where such
+    rounding-level differences grow)."""
+    first = [B.run_case("wbc", case, 0.0) for case in (_TURN, _PUSH)]
+    second = [B.run_case("wbc", case, 0.0) for case in (_PUSH, _TURN)][::-1]
+    for a, b in zip(first, second):
+        assert a.sim_s == pytest.approx(3.0) and not a.fell, a
+        assert a.log_sha256 == b.log_sha256, f"{a.case}: the row's log differs when run after another row"
+    assert first[0].log_sha256 != first[1].log_sha256  # the digest tells different runs apart
+    assert first[1].pushes_survived == 1
+
+
+def test_the_rows_give_the_same_bytes_in_two_processes(tmp_path):
+    """The same two rows in two fresh processes, in opposite orders, with the heap shifted by different
+    amounts and different string hash seeds (set and dict orders of str keys): the same digests."""
+    code = ("import json, sys; pad = bytearray(1024 + 16 * int(sys.argv[1])); "
+            "from g1_control.tools import bench_locomotion as B; "
+            "from tests.tools.test_bench_locomotion import _PUSH, _TURN; "
+            "cases = [_TURN, _PUSH] if sys.argv[1] == '0' else [_PUSH, _TURN]; "
+            "print(json.dumps({c.name: B.run_case('wbc', c, 0.0).log_sha256 for c in cases}))")
+    digests = []
+    for shift in (0, 1):
+        env = {**os.environ, "PYTHONHASHSEED": str(shift),
+               "PYTHONPATH": str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+        proc = subprocess.run([sys.executable, "-c", code, str(shift)], cwd=REPO, env=env, capture_output=True,
+                              text=True, timeout=300, check=False)
+        assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-3000:]
+        digests.append(json.loads(proc.stdout.strip().splitlines()[-1]))
+    assert set(digests[0]) == {"turn", "push"}
+    assert digests[0] == digests[1]
+    # and the same as in this process
+    assert digests[0]["turn"] == B.run_case("wbc", _TURN, 0.0).log_sha256
+
+
+def test_log_digest_covers_every_tick_of_the_ground_truth():
+    log = {name: np.zeros((5, 3)) for name in B.LOG_DIGEST_FIELDS}
+    base = B.log_digest(log)
+    log["base_pos_m"][4, 2] = np.nextafter(0.0, 1.0)  # the last tick, the smallest change there is
+    assert B.log_digest(log) != base
+    log["base_pos_m"][4, 2] = 0.0
+    assert B.log_digest(log) == base
+    assert B.log_digest({**log, "q_rad": np.zeros((4, 3))}) != base  # one tick fewer
