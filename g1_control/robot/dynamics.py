@@ -125,6 +125,8 @@ class WbcModel:
         """Both soles' 6 x nv Jacobians in their LOCAL frames, stacked (left, right)."""
         self.contact_drift_local = np.zeros(12)
         self.contact_vel_local = np.zeros(12)
+        self._lower = np.tril_indices(self.nv, -1)
+        """The mass matrix's strict lower triangle (pinocchio fills the upper one)."""
         self.hand_forces_w_n = np.zeros((2, 3))
         """Known forces on the (left, right) hand frames, world axes: what a held object does to
         the hands (its weight share, the squeeze's reaction). update() folds them into `bias`
@@ -148,7 +150,7 @@ class WbcModel:
         pin, m, d = self._pin, self.model, self.data
         pin.computeAllTerms(m, d, q, v)  # M (upper triangle), nle, joint Jacobians, CoM, Jcom
         self.mass_matrix[:] = d.M
-        lower = np.tril_indices(self.nv, -1)
+        lower = self._lower
         self.mass_matrix[lower] = self.mass_matrix.T[lower]
         self.bias[:] = d.nle
         self.com_m[:] = d.com[0]
