@@ -528,7 +528,7 @@ class VelocityGait:
         if self.terrain.flat or speed <= cfg.terrain_speed_mps:
             return command_h
         direction = self.heading + math.atan2(command_h[1], command_h[0])
-        mid = soles_m[:, :2].mean(axis=0)
+        mid = (soles_m[0, :2] + soles_m[1, :2]) / 2
         if not self.terrain.level_change_ahead(mid, direction, cfg.terrain_look_ahead_m):
             return command_h
         out = command_h.copy()
@@ -618,7 +618,7 @@ class VelocityGait:
         out.swing_progress = 0.0
         out.recovery = False
         out.dcm_error_m = 0.0
-        mid = soles_m[:, :2].mean(axis=0)
+        mid = (soles_m[0, :2] + soles_m[1, :2]) / 2
         centre = mid + _rot2(self.heading) @ np.array([cfg.com_offset_x_m, 0.0])
         if self.mode in ("stand", "start", "stop"):
             if self.mode == "stand":

@@ -84,6 +84,8 @@ class InverseDynamicsQP:
         self._vel_rows = slice(nv - 6 + 2 * ROWS_PER_FOOT, 2 * (nv - 6) + 2 * ROWS_PER_FOOT)
         self._vel_diag = (np.arange(self._vel_rows.start, self._vel_rows.stop), np.arange(6, nv))
         self._foot_rows = wrench_constraint_rows(self.config.foot)
+        self._diag = np.diag_indices(self.n)
+        self._eye6 = np.eye(6)
         self.H = np.zeros((self.n, self.n))
         self.g = np.zeros(self.n)
         self.A = np.zeros((self.n_eq, self.n))
@@ -131,7 +133,7 @@ class InverseDynamicsQP:
             wj = task.jac * task.weight[:, None]
             Hq += task.jac.T @ wj
             g[:nv] -= wj.T @ task.target
-        H[np.diag_indices(n)] += self._reg
+        H[self._diag] += self._reg
 
         # floating-base dynamics
         A[:] = 0.0
@@ -168,7 +170,7 @@ class InverseDynamicsQP:
                 fz_min, fz_max = normal_force_bounds(self.config.foot, load_fraction[i])
                 l[rows.stop - 1], u[rows.stop - 1] = fz_min, fz_max
             else:
-                A[eq, cols] = np.eye(6)
+                A[eq, cols] = self._eye6
                 b[eq] = 0.0
                 l[rows], u[rows] = -_FREE, _FREE
 

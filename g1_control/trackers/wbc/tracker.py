@@ -144,6 +144,14 @@ class WbcConfig:
                 raise WbcConfigError(f"WbcConfig.{name} must be a finite number >= 0; got {value}")
 
 
+def _stance_height(sole_pos: np.ndarray, stance: np.ndarray) -> float:
+    """The stance soles' mean height (np.mean's value, without its ~10 us of overhead per call)."""
+    z_left, z_right = float(sole_pos[0, 2]), float(sole_pos[1, 2])
+    if stance[0] and stance[1]:
+        return (z_left + z_right) / 2
+    return z_left if stance[0] else z_right
+
+
 @dataclass
 class WbcDiagnostics:
     """What the last tick computed (for logs, tests and the benchmark)."""
@@ -380,7 +388,7 @@ class WholeBodyTracker(Tracker):
         com_vel = dyn.com_vel_mps
         sole_pos = self._sole_pos
         sole_rot = np.array([dyn.data.oMf[f].rotation for f in dyn.sole_ids])
-        ground_z = float(np.mean(sole_pos[stance, 2]))
+        ground_z = _stance_height(sole_pos, stance)
         omega = cp.lipm_frequency(max(com[2] - ground_z, 0.2))
         cop_ref = com_ref[:2] - self._com_acc_ref[:2] / omega**2
         cop = cp.desired_cop(com[:2], com_vel[:2], com_ref[:2], com_vel_ref[:2], cop_ref, omega,
@@ -543,7 +551,7 @@ class WholeBodyTracker(Tracker):
         (WbcConfig.ground_follow_s). On flat ground it is the stance soles' height."""
         cfg = self.config
         assert self.gait is not None
-        target = float(np.mean(self._sole_pos[stance, 2]))
+        target = _stance_height(self._sole_pos, stance)
         gt = self.gait.targets
         if gt.swing_foot >= 0 and not stance[gt.swing_foot]:
             drop = min(float(gt.landing_m[2]) - target, 0.0)
