@@ -139,6 +139,14 @@ class InverseDynamicsQP:
         self._set_constraints(model, stance, load_fraction, contact_damping_per_s, joint_velocity_radps, dt_s)
         return self._solve(model, stance)
 
+    def resolve(self, model: WbcModel, stance: np.ndarray, load_fraction: np.ndarray,
+                contact_damping_per_s: float | None = None, joint_velocity_radps: np.ndarray | None = None,
+                dt_s: float = 0.0) -> IdSolution:
+        """solve() again with the last solve()'s tasks (its cost is kept, not rebuilt) and these
+        contact and speed settings: a retry after a failed solve, at the same state."""
+        self._set_constraints(model, stance, load_fraction, contact_damping_per_s, joint_velocity_radps, dt_s)
+        return self._solve(model, stance)
+
     def _set_cost(self, tasks: list[AccelerationTask]) -> None:
         H, g, nv = self.H, self.g, self.nv
         H[:] = 0.0

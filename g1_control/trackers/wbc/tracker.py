@@ -577,11 +577,11 @@ class WholeBodyTracker(Tracker):
             # bounds; failing that, keep the last command.
             diag.solve_failures += 1
             try:
-                sol = self.qp.solve(self.dyn, tasks, stance, np.ones(2), contact_damping_per_s=0.0,
-                                    joint_velocity_radps=dq_radps, dt_s=dt)
+                sol = self.qp.resolve(self.dyn, stance, np.ones(2), contact_damping_per_s=0.0,
+                                      joint_velocity_radps=dq_radps, dt_s=dt)
             except WbcSolveError:
                 try:
-                    sol = self.qp.solve(self.dyn, tasks, stance, np.ones(2), contact_damping_per_s=0.0)
+                    sol = self.qp.resolve(self.dyn, stance, np.ones(2), contact_damping_per_s=0.0)
                 except WbcSolveError:
                     diag.unsolved_ticks += 1
                     return None

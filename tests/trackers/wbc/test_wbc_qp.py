@@ -125,3 +125,17 @@ def test_constraints_written_incrementally_equal_a_fresh_problem_whatever_the_co
         fresh.solve(model, *args, joint_velocity_radps=speeds, dt_s=dt)
         for a, b in zip(_problem(kept), _problem(fresh)):
             np.testing.assert_array_equal(a, b)
+
+
+def test_resolve_keeps_the_last_cost_and_takes_new_contact_settings(model):
+    tasks = [posture(model), com_task(model, [0.0, -0.5, 0.0])]
+    stance = np.array([True, True])
+    retried = InverseDynamicsQP(model.nv)
+    retried.solve(model, tasks, stance, np.array([0.2, 1.0]))
+    again = retried.resolve(model, stance, np.ones(2), contact_damping_per_s=0.0)
+    direct = InverseDynamicsQP(model.nv)
+    once = direct.solve(model, tasks, stance, np.ones(2), contact_damping_per_s=0.0)
+    for a, b in zip(_problem(retried), _problem(direct)):
+        np.testing.assert_array_equal(a, b)
+    check_dynamics(model, again)
+    check_dynamics(model, once)
