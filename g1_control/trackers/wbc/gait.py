@@ -412,11 +412,11 @@ class VelocityGait:
         cfg = self.config
         dt = 0.0 if self._last_t is None else t_s - self._last_t
         self._last_t = t_s
-        moving = bool(np.any(np.abs(command_h) > cfg.moving_speed))
+        moving = any(abs(c) > cfg.moving_speed for c in command_h.tolist())
         walked = self.command_h
         if self.mode == "walk":
             step = np.asarray(cfg.max_accel) * dt
-            walked += np.clip(self._terrain_limited(self.feasible(command_h), soles_m) - walked, -step, step)
+            walked += np.minimum(np.maximum(self._terrain_limited(self.feasible(command_h), soles_m) - walked, -step), step)
         else:
             walked[:] = 0.0
         command_h = walked

@@ -317,7 +317,7 @@ class WholeBodyTracker(Tracker):
             elif not scheduled[i] and self._prev_stance[i]:
                 self._swing_since[i] = t_s
         self._prev_stance[:] = scheduled
-        load = np.clip((t_s - self._stance_since) / max(cfg.contact_ramp_s, 1e-6), 0.0, 1.0)
+        load = np.minimum(np.maximum((t_s - self._stance_since) / max(cfg.contact_ramp_s, 1e-6), 0.0), 1.0)
         unloading = ~scheduled & (t_s - self._swing_since < cfg.liftoff_unload_s)
         load[unloading] = 1.0 - (t_s - self._swing_since[unloading]) / max(cfg.liftoff_unload_s, 1e-6)
         return scheduled, scheduled | unloading, load
