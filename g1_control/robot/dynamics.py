@@ -159,7 +159,7 @@ class WbcModel:
         # Drift terms: accelerations with zero joint acceleration.
         pin.forwardKinematics(m, d, q, v, self._a0)
         pin.updateFramePlacements(m, d)
-        pin.centerOfMass(m, d, q, v, self._a0)
+        pin.centerOfMass(m, d, pin.KinematicLevel.ACCELERATION)  # on the kinematics just computed (not a third pass)
         self.com_drift[:] = d.acom[0]
         for i, fid in enumerate(self.sole_ids):
             rows = slice(6 * i, 6 * i + 6)
@@ -205,7 +205,7 @@ class WbcModel:
         self.com_jac[:, vi] = d.Jcom
         pin.forwardKinematics(m, d, qr, vr, self._a0r)
         pin.updateFramePlacements(m, d)
-        pin.centerOfMass(m, d, qr, vr, self._a0r)
+        pin.centerOfMass(m, d, pin.KinematicLevel.ACCELERATION)  # on the kinematics just computed
         self.com_drift[:] = d.acom[0]
         for i, fid in enumerate(self.sole_ids):
             rows = slice(6 * i, 6 * i + 6)

@@ -372,7 +372,7 @@ class WholeBodyTracker(Tracker):
         vr[6:] = reference.dq_radps
         pin.forwardKinematics(dyn.model, rd, qr, vr)
         pin.updateFramePlacements(dyn.model, rd)
-        pin.centerOfMass(dyn.model, rd, qr, vr, False)
+        pin.centerOfMass(dyn.model, rd, pin.KinematicLevel.VELOCITY, False)  # on the kinematics just computed
         com_ref, com_vel_ref = rd.com[0].copy(), rd.vcom[0].copy()
         if self._com_vel_ref_prev is not None:
             raw = (com_vel_ref - self._com_vel_ref_prev) / dt
