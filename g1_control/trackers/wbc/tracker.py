@@ -502,11 +502,11 @@ class WholeBodyTracker(Tracker):
             c, sn = np.cos(lean), np.sin(lean)
             heading_rot = heading_rot @ np.array([[c, 0.0, sn], [0.0, 1.0, 0.0], [-sn, 0.0, c]])
         yaw_rate = np.array([0.0, 0.0, gt.yaw_rate_radps])
-        pelvis_ref = rd.oMf[dyn.pelvis_id].rotation
+        # the reference's poses relative to its own heading, turned to the gait's heading
+        turn = heading_rot @ yaw_rotation(-float(yaw_of_matrix(rd.oMf[dyn.pelvis_id].rotation)))
         for fid, gains in ((dyn.pelvis_id, cfg.pelvis_orientation), (dyn.torso_id, cfg.torso_orientation)):
             ft = dyn.frame(fid)
-            # the reference's pose relative to its own heading, turned to the gait's heading
-            ref_rot = heading_rot @ yaw_rotation(-float(yaw_of_matrix(pelvis_ref))) @ rd.oMf[fid].rotation
+            ref_rot = turn @ rd.oMf[fid].rotation
             tasks.append(orientation_task("orientation", ft.jac_w[3:], ft.drift_w[3:], ft.rot_w, ft.vel_w[3:],
                                           ref_rot, yaw_rate, gains))
         f = gt.swing_foot
