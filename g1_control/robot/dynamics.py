@@ -125,6 +125,8 @@ class WbcModel:
         """Both soles' 6 x nv Jacobians in their LOCAL frames, stacked (left, right)."""
         self.contact_drift_local = np.zeros(12)
         self.contact_vel_local = np.zeros(12)
+        self._lower = np.tril_indices(self.nv, -1)
+        """The mass matrix's strict lower triangle (pinocchio fills the upper one)."""
         self.hand_forces_w_n = np.zeros((2, 3))
         """Known forces on the (left, right) hand frames, world axes: what a held object does to
         the hands (its weight share, the squeeze's reaction). update() folds them into `bias`
@@ -148,7 +150,7 @@ class WbcModel:
         pin, m, d = self._pin, self.model, self.data
         pin.computeAllTerms(m, d, q, v)  # M (upper triangle), nle, joint Jacobians, CoM, Jcom
         self.mass_matrix[:] = d.M
-        lower = np.tril_indices(self.nv, -1)
+        lower = self._lower
         self.mass_matrix[lower] = self.mass_matrix.T[lower]
         self.bias[:] = d.nle
         self.com_m[:] = d.com[0]
@@ -157,7 +159,7 @@ class WbcModel:
         # Drift terms: accelerations with zero joint acceleration.
         pin.forwardKinematics(m, d, q, v, self._a0)
         pin.updateFramePlacements(m, d)
-        pin.centerOfMass(m, d, q, v, self._a0)
+        pin.centerOfMass(m, d, pin.KinematicLevel.ACCELERATION)  # on the kinematics just computed (not a third pass)
         self.com_drift[:] = d.acom[0]
         for i, fid in enumerate(self.sole_ids):
             rows = slice(6 * i, 6 * i + 6)
@@ -203,7 +205,7 @@ class WbcModel:
         self.com_jac[:, vi] = d.Jcom
         pin.forwardKinematics(m, d, qr, vr, self._a0r)
         pin.updateFramePlacements(m, d)
-        pin.centerOfMass(m, d, qr, vr, self._a0r)
+        pin.centerOfMass(m, d, pin.KinematicLevel.ACCELERATION)  # on the kinematics just computed
         self.com_drift[:] = d.acom[0]
         for i, fid in enumerate(self.sole_ids):
             rows = slice(6 * i, 6 * i + 6)

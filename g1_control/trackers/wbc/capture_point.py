@@ -40,7 +40,7 @@ def desired_cop(com_xy: np.ndarray, com_vel_xy: np.ndarray, com_ref_xy: np.ndarr
 
 def convex_hull(points: np.ndarray) -> np.ndarray:
     """Counter-clockwise convex hull of 2D points (Andrew's monotone chain)."""
-    pts = sorted(map(tuple, np.asarray(points, dtype=float)))
+    pts = sorted(map(tuple, np.asarray(points, dtype=float).tolist()))  # Python floats: numpy scalars cost ~10x
     if len(pts) <= 2:
         return np.array(pts)
 
@@ -64,9 +64,10 @@ def project_into_polygon(point: np.ndarray, hull: np.ndarray) -> np.ndarray:
     """`point` if inside the CCW convex polygon `hull`, else the closest point on its boundary."""
     n = len(hull)
     inside = True
+    corners, (px, py) = np.asarray(hull, dtype=float).tolist(), np.asarray(point, dtype=float).tolist()  # Python floats: numpy scalars cost ~10x
     for i in range(n):
-        a, b = hull[i], hull[(i + 1) % n]
-        if (b[0] - a[0]) * (point[1] - a[1]) - (b[1] - a[1]) * (point[0] - a[0]) < 0:
+        (ax, ay), (bx, by) = corners[i], corners[(i + 1) % n]
+        if (bx - ax) * (py - ay) - (by - ay) * (px - ax) < 0:
             inside = False
             break
     if inside:
@@ -76,7 +77,7 @@ def project_into_polygon(point: np.ndarray, hull: np.ndarray) -> np.ndarray:
     for i in range(n):
         a, b = hull[i], hull[(i + 1) % n]
         ab = b - a
-        t = np.clip(np.dot(point - a, ab) / max(np.dot(ab, ab), 1e-12), 0.0, 1.0)
+        t = min(max(float(np.dot(point - a, ab) / max(np.dot(ab, ab), 1e-12)), 0.0), 1.0)
         c = a + t * ab
         d = float(np.sum((point - c) ** 2))
         if d < best_d:

@@ -104,7 +104,7 @@ def normal_force_bounds(foot: FootGeometry, load_fraction: float) -> tuple[float
 
     Ramping the upper bound after touchdown moves the weight onto the new foot over a few
     ticks instead of in one, so torques do not jump when the contact set changes."""
-    frac = float(np.clip(load_fraction, 0.0, 1.0))
+    frac = min(max(float(load_fraction), 0.0), 1.0)
     fz_max = max(foot.fz_min_n + 1.0, frac * foot.fz_max_n)
     return foot.fz_min_n * min(1.0, frac * 4.0), fz_max
 

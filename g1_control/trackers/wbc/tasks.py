@@ -7,6 +7,7 @@ so a task contributes J^T W J to the Hessian and -J^T W (a_des - drift) to the g
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,6 +43,9 @@ class AccelerationTask:
     target: np.ndarray
     weight: np.ndarray
     """Per-row weight (the square root enters the residual, so this is W^T W)."""
+    joint_space: bool = False
+    """jac is the identity on the last len(target) velocity coordinates (posture_task): the QP adds
+    the weights to its Hessian's diagonal instead of multiplying the Jacobian out."""
 
 
 
@@ -66,9 +70,16 @@ def orientation_task(name: str, jac_ang: np.ndarray, drift_ang: np.ndarray, rot:
 def posture_task(nv: int, q: np.ndarray, dq: np.ndarray, q_ref: np.ndarray, dq_ref: np.ndarray,
                  gains: TaskGains, joint_weights: np.ndarray | None = None) -> AccelerationTask:
     """Joint-space task on the actuated joints (the last len(q) velocity coordinates)."""
+    a_des = gains.kp * (q_ref - q) + gains.kd * (dq_ref - dq)
     n = len(q)
+    weight = np.full(n, gains.weight) if joint_weights is None else gains.weight * joint_weights
+    return AccelerationTask("posture", _joint_space_jacobian(n, nv), a_des, weight, joint_space=True)
+
+
+@functools.cache
+def _joint_space_jacobian(n: int, nv: int) -> np.ndarray:
+    """(n, nv): the identity on the last n velocity coordinates (read-only: one array serves every tick)."""
     jac = np.zeros((n, nv))
     jac[:, nv - n:] = np.eye(n)
-    a_des = gains.kp * (q_ref - q) + gains.kd * (dq_ref - dq)
-    weight = np.full(n, gains.weight) if joint_weights is None else gains.weight * joint_weights
-    return AccelerationTask("posture", jac, a_des, weight)
+    jac.flags.writeable = False
+    return jac

@@ -232,3 +232,19 @@ def test_a_dcm_far_off_its_plan_makes_the_step_a_recovery_step_until_it_lands():
 def test_bad_gait_config_is_refused(kwargs, text):
     with pytest.raises(WbcConfigError, match=text):
         GaitConfig(**kwargs)
+
+
+def test_axis_limits_at_a_cadence_are_the_bisection_of_step_load_bit_for_bit():
+    """The written-out bisection (_axis_limits_at_cadence) gives exactly what bisecting step_load
+    itself gives, for commands slow and fast, forward, backward and sideways, at several margins."""
+    from g1_control.trackers.wbc.gait import _AXES, _axis_limit_bisected, _axis_limits
+
+    cfg = GaitConfig()
+    rng = np.random.default_rng(3)
+    cadences = [np.zeros(3), np.array([1.0, 0.0, 0.0]), np.array([-0.4, 0.3, 0.5])]
+    cadences += [rng.uniform([-1.0, -0.6, -1.5], [1.2, 0.6, 1.5]) for _ in range(20)]
+    for cadence in cadences:
+        for margin in (0.8, 0.9, 1.0):
+            fast = _axis_limits(cfg, margin, cadence)
+            generic = tuple(_axis_limit_bisected(cfg, margin, cadence, axis, sign) for axis, sign in _AXES)
+            assert fast == generic, (cadence, margin)

@@ -93,3 +93,49 @@ def test_infeasible_problem_raises_a_named_error(model):
     qp = InverseDynamicsQP(model.nv, QpConfig(effort_limit_nm=(0.0,) * 29, max_iter=100))
     with pytest.raises(WbcSolveError, match="QP not solved"):
         qp.solve(model, [posture(model)], np.array([True, False]), np.zeros(2))
+
+
+def _problem(qp):
+    return tuple(m.copy() for m in (qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u))
+
+
+def test_a_joint_space_task_enters_the_hessian_as_its_jacobian_product_would(model):
+    task = posture(model, g1.DEFAULT_Q_RAD + 0.1)
+    task.weight = np.linspace(0.5, 3.0, 29)
+    general = AccelerationTask("posture", task.jac, task.target, task.weight)  # multiplied out
+    qp_diag, qp_full = InverseDynamicsQP(model.nv), InverseDynamicsQP(model.nv)
+    stance = np.array([True, True])
+    qp_diag.solve(model, [com_task(model, [0.1, 0, 0]), task], stance, np.ones(2))
+    qp_full.solve(model, [com_task(model, [0.1, 0, 0]), general], stance, np.ones(2))
+    for a, b in zip(_problem(qp_diag), _problem(qp_full)):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_constraints_written_incrementally_equal_a_fresh_problem_whatever_the_contact_history(model):
+    """The QP rewrites only the rows that change between ticks: after any sequence of contact states
+    and speed bounds its matrices are those a new QP writes for the last one."""
+    kept = InverseDynamicsQP(model.nv)
+    dq = np.full(29, 0.5)
+    steps = [((True, True), dq, 0.004), ((False, True), dq, 0.004), ((False, True), None, 0.0),
+             ((True, False), dq, 0.005), ((True, True), dq, 0.004), ((True, False), None, 0.0)]
+    for contacts, speeds, dt in steps:
+        args = ([posture(model)], np.array(contacts), np.array([0.5, 1.0]))
+        kept.solve(model, *args, joint_velocity_radps=speeds, dt_s=dt)
+        fresh = InverseDynamicsQP(model.nv)
+        fresh.solve(model, *args, joint_velocity_radps=speeds, dt_s=dt)
+        for a, b in zip(_problem(kept), _problem(fresh)):
+            np.testing.assert_array_equal(a, b)
+
+
+def test_resolve_keeps_the_last_cost_and_takes_new_contact_settings(model):
+    tasks = [posture(model), com_task(model, [0.0, -0.5, 0.0])]
+    stance = np.array([True, True])
+    retried = InverseDynamicsQP(model.nv)
+    retried.solve(model, tasks, stance, np.array([0.2, 1.0]))
+    again = retried.resolve(model, stance, np.ones(2), contact_damping_per_s=0.0)
+    direct = InverseDynamicsQP(model.nv)
+    once = direct.solve(model, tasks, stance, np.ones(2), contact_damping_per_s=0.0)
+    for a, b in zip(_problem(retried), _problem(direct)):
+        np.testing.assert_array_equal(a, b)
+    check_dynamics(model, again)
+    check_dynamics(model, once)
