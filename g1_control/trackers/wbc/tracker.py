@@ -21,7 +21,8 @@ gait's heading and at the reference's pelvis height when it asks one, the gait's
 reference's upper-body posture). With footsteps "velocity" a whole-body plan (JointReference.phase
 PHASE_WHOLE_BODY: a goal's pick, place, steps) is still followed by its own contact schedule, so one
 controller both walks and handles objects. Walking with a held load (hand forces in the
-reference), the load's weight joins the pendulum's CoM at the hands and the hands are held where
+reference), the load's weight joins the pendulum's CoM at the hands, its inertia the dynamics (point masses
+at the hands, WbcConfig.held_load_inertia), and the hands are held where
 the posture puts them. A foot that touches down takes load gradually (contact_ramp_s), so torques
 do not jump.
 """
