@@ -132,6 +132,11 @@ class WbcModel:
         the hands (its weight share, the squeeze's reaction). update() folds them into `bias`
         (bias - J^T f), so the QP's dynamics, torque limits and foot forces account for them and
         its torques push back."""
+        self.hand_masses_kg = np.zeros(2)
+        """Point masses moving rigidly with the (left, right) hand frames: a held object's inertia.
+        update() adds m J^T J to `mass_matrix` and m J^T (J-dot v) to `bias` (the hand's linear
+        Jacobian and drift, world axes), so the hands' force is also -m a_hand: accelerating the
+        body accelerates the load (its weight is in hand_forces_w_n, not here)."""
         if self._reduced:
             nr = self.dynamics_model.nv
             self._mr = np.zeros((nr, nr))
@@ -169,6 +174,12 @@ class WbcModel:
         if self.hand_forces_w_n.any():
             for fid, force in zip(self.hand_ids, self.hand_forces_w_n):
                 self.bias -= pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED)[:3].T @ force
+        if self.hand_masses_kg.any():
+            for fid, mass in zip(self.hand_ids, self.hand_masses_kg):
+                jac = pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED)[:3]
+                drift = pin.getFrameClassicalAcceleration(m, d, fid, pin.LOCAL_WORLD_ALIGNED).linear
+                self.mass_matrix += mass * (jac.T @ jac)
+                self.bias += mass * (jac.T @ drift)
 
     def frame(self, frame_id: int) -> FrameTerms:
         """Kinematics of one frame at the state of the last update()."""
@@ -215,3 +226,9 @@ class WbcModel:
         if self.hand_forces_w_n.any():
             for fid, force in zip(self.hand_ids, self.hand_forces_w_n):
                 self.bias[vi] -= pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED)[:3].T @ force
+        if self.hand_masses_kg.any():
+            for fid, mass in zip(self.hand_ids, self.hand_masses_kg):
+                jac = pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED)[:3]
+                drift = pin.getFrameClassicalAcceleration(m, d, fid, pin.LOCAL_WORLD_ALIGNED).linear
+                self.mass_matrix[np.ix_(vi, vi)] += mass * (jac.T @ jac)
+                self.bias[vi] += mass * (jac.T @ drift)

@@ -2,14 +2,17 @@
 from a table (the goal skills), then walks ~1 m from velocity commands while holding it. Judged from
 MuJoCo's ground truth: the box stays between the hands, off the floor, and moves with the robot."""
 
+from pathlib import Path
+
 import numpy as np
 
 from g1_control.launch.builder import build_loop
-from g1_control.launch.schema import parse_launch
+from g1_control.launch.schema import load_launch, parse_launch
 from g1_control.report.outcomes import GoalWatcher
 from g1_control.trackers.wbc.tracker import WholeBodyTracker
 
 PICK_S, WALK_S, STOP_S = 22.0, 5.0, 2.0
+REPO = Path(__file__).resolve().parents[2]
 
 
 def carry_launch() -> dict:
@@ -49,4 +52,29 @@ def test_walks_a_metre_with_a_held_box_and_keeps_it_in_the_hands():
     assert box[walk, 2].min() > 0.6, f"box down to {box[walk, 2].min():.2f} m"
     carried = float(np.hypot(*(box[walk][-1, :2] - box[walk][0, :2])))
     assert carried > 0.8, f"box carried {carried:.2f} m"
+    assert loop.generator.holding == "box"
+
+
+def test_the_carry_launch_walks_forward_with_its_3kg_box():
+    """launch/sim_wbc_carry.yaml to 5 s into its forward walk (0.3 m/s, after the pick, the back-off and
+    the turn): without the box's inertia in the controller's dynamics (WbcConfig.held_load_inertia) the
+    DCM ran ahead and the robot fell 2.7 s into it (issue 23). Ground truth: no fall, the box between
+    the hands, the pelvis ~1.5 m along."""
+    launch = load_launch(REPO / "launch" / "sim_wbc_carry.yaml")
+    walk_from = sum(seg.duration_s for seg in launch.input.timeline[:4])
+    assert launch.input.timeline[4].vx_mps == 0.3
+    loop = build_loop(launch)
+    loop.reset()
+    watcher = GoalWatcher(loop)
+    rate = loop.rates.lowlevel_hz
+    loop.scheduler.run(round(walk_from * rate), stop=lambda: loop.fell, progress=watcher.tick)
+    start = loop.backend.data.qpos[:2].copy()
+    loop.scheduler.run(round(5.0 * rate), stop=lambda: loop.fell, progress=watcher.tick)
+    assert not loop.fell
+    walked = float(np.linalg.norm(loop.backend.data.qpos[:2] - start))
+    assert walked > 1.2, f"walked {walked:.2f} m in 5 s at 0.3 m/s"
+    a = watcher.arrays()
+    walk = a["t_s"] >= walk_from
+    gap = np.linalg.norm(a["box_box"][walk, :3] - a["hands_w_m"][walk].mean(axis=1), axis=1)
+    assert gap.max() < 0.05, f"box {gap.max() * 100:.1f} cm from between the hands while walking"
     assert loop.generator.holding == "box"

@@ -88,3 +88,34 @@ def test_the_dex3_model_is_mujocos_with_the_fingers_held():
     np.testing.assert_allclose(model.mass_matrix, mass[np.ix_(kept, kept)], atol=1e-9)
     np.testing.assert_allclose(model.bias, d.qfrc_bias[kept], atol=1e-9)
     assert model.mass_kg == pytest.approx(34.394, abs=1e-3) and WbcModel().mass_kg == pytest.approx(33.341, abs=1e-3)
+
+
+@pytest.mark.parametrize("variant", [g1.G1_23DOF, g1.G1_29DOF])
+def test_hand_masses_add_the_loads_inertia_at_the_hands(variant):
+    """With point masses at the hands (a held box's inertia), M ddq + bias grows by m J^T a_hand for any
+    ddq (a_hand the hand's classical acceleration): the hands' forces include -m a_hand. A 23-DoF
+    variant's locked joints (its wrists) are at 0 here, so the full model's hand kinematics are its own."""
+    import pinocchio as pin
+
+    plain, loaded = WbcModel(variant), WbcModel(variant)
+    loaded.hand_masses_kg[:] = (1.5, 2.0)
+    q, dq = _state(variant, seed=5)
+    qf = np.concatenate([[0.1, -0.2, 0.75, 0.0, 0.0, 0.0, 1.0], q])
+    v = np.concatenate([[0.2, -0.1, 0.05, 0.3, -0.2, 0.4], dq])
+    plain.update(qf, v)
+    loaded.update(qf, v)
+    rng = np.random.default_rng(1)
+    ddq = rng.uniform(-2.0, 2.0, plain.nv) * np.concatenate([np.ones(6), variant.active_mask])
+    # the hands' accelerations for this ddq, from the full 29-DoF model's own kinematics
+    full = WbcModel(g1.G1_29DOF)
+    data = full.model.createData()
+    pin.forwardKinematics(full.model, data, qf, v, ddq)
+    pin.updateFramePlacements(full.model, data)
+    expected = plain.mass_matrix @ ddq + plain.bias
+    for fid, mass in zip(full.hand_ids, loaded.hand_masses_kg):
+        jac = pin.computeFrameJacobian(full.model, data, qf, fid, pin.LOCAL_WORLD_ALIGNED)[:3]
+        acc = pin.getFrameClassicalAcceleration(full.model, data, fid, pin.LOCAL_WORLD_ALIGNED).linear
+        expected += mass * jac.T @ acc
+    kept = np.concatenate([np.arange(6), 6 + np.array(variant.active_joints)])  # locked rows stay decoupled
+    np.testing.assert_allclose((loaded.mass_matrix @ ddq + loaded.bias)[kept], expected[kept], atol=1e-8)
+    assert np.abs(loaded.mass_matrix - plain.mass_matrix).max() > 0.1  # the load is felt

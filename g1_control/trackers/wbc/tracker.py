@@ -21,7 +21,8 @@ gait's heading and at the reference's pelvis height when it asks one, the gait's
 reference's upper-body posture). With footsteps "velocity" a whole-body plan (JointReference.phase
 PHASE_WHOLE_BODY: a goal's pick, place, steps) is still followed by its own contact schedule, so one
 controller both walks and handles objects. Walking with a held load (hand forces in the
-reference), the load's weight joins the pendulum's CoM at the hands and the hands are held where
+reference), the load's weight joins the pendulum's CoM at the hands, its inertia the dynamics (point masses
+at the hands, WbcConfig.held_load_inertia), and the hands are held where
 the posture puts them. A foot that touches down takes load gradually (contact_ramp_s), so torques
 do not jump.
 """
@@ -132,6 +133,13 @@ class WbcConfig:
     """Walking by its own gait with a held load (hand forces), the waist's and arms' posture weight
     (relative to `posture`): the arms keep the box's pose (at 1 they served the balance, sagged and
     tilted, and a 3 kg box rolled out of the hands after 8 s, measured)."""
+
+    held_load_inertia: bool = True
+    """A held load's inertia in the dynamics: each hand's share of its weight (the hand forces'
+    downward part) as a point mass moving with the hand (WbcModel.hand_masses_kg), so the hands'
+    forces include -m a_hand. Without it the QP's dynamics carried the load's weight only: accelerating
+    the body it left the box's inertia out of the feet's forces (walking with 3 kg, the DCM ran
+    ahead and the robot fell, measured)."""
 
     def __post_init__(self) -> None:
         if self.footsteps not in ("plan", "velocity"):
@@ -341,6 +349,9 @@ class WholeBodyTracker(Tracker):
         v[3:6] = state.imu_gyro_radps
         v[6:] = state.dq_radps
         dyn.hand_forces_w_n[:] = reference.hand_forces_w_n
+        if self.config.held_load_inertia:
+            # the load's weight share at each hand as a mass moving with it
+            dyn.hand_masses_kg[:] = np.maximum(0.0, -reference.hand_forces_w_n[:, 2] / cp.GRAVITY_MPS2)
         dyn.update(q, v)
         sole_pos_before = np.array([dyn.data.oMf[f].translation for f in dyn.sole_ids])
         offsets = sole_pos_before - q[:3]
