@@ -104,9 +104,16 @@ class GaitConfig:
     """A step during whose swing the DCM strays this far from its nominal plan (a push, say), or whose
     landing lies more than timing_adjust_excess_m beyond the step limits even after its timing was
     adjusted, is a recovery step (GaitTargets.recovery: the tracker holds its swing foot harder)."""
-    min_swing_s: float = 0.2
+    min_swing_s: float = 0.15
     min_remaining_s: float = 0.08
-    """A step made sooner still swings this long in all, and lands no sooner than this from now."""
+    """A step made sooner still swings this long in all, and lands no sooner than this from now.
+    Pushed (150 N for 0.2 s walking 0.5 m/s), the DCM runs away from the stance foot while the
+    recovery step swings; landing sooner leaves it less far to catch. `g1 bench locomotion --only
+    wbc/push`: 0.2 survived 2/20 (front_3, front_4), 0.17 3/20, 0.15 and 0.12 4/20 (front_1, front_3,
+    front_4, right_4); at 10 stride phases (40 pushes) 0.2: 2/40, 0.15: 5/40; random timelines 0.2:
+    6/10, 0.15: 7/10 (measured, one machine). Most pushes still end in a joint over-speed trip: the
+    QP loads a stance foot that is tipping on its edge or off the ground (its ankle roll or the knee
+    at its stop), and the torques meant for a contact spin the free foot or leg (issue 23's notes)."""
     speed_feedback_gain: float = 0.3
     """Per stride, this fraction of the error between the command and the stride's speed (from the
     feet's measured touchdowns) is added to the speed the steps are planned for: the pendulum model

@@ -118,6 +118,15 @@ class WbcConfig:
     Scaling the pelvis's and torso's orientation weights in recovery steps (to let the trunk lean)
     did not help: x0.1, x0.3, x0.5 and x2 each survived 1/20 of the push grid (front_4; 2/20 unscaled,
     measured), so the trunk's orientation task is not what kicks the leg."""
+    swing_max_accel_mps2: float = 60.0
+    """Walking by its own gait, the swing foot's reference acceleration (the feedforward of its task) is
+    scaled down to at most this magnitude. The gait re-plans the swing as a minimum-jerk segment to a
+    landing point that moves with the DCM: pushed, the landing jumps and the remaining time shrinks
+    (step timing), and the segment asked up to ~1400 m/s^2 for a tick (measured); the QP met it with
+    swing-leg joint accelerations, then the stance foot tipped and joints over-sped. `g1 bench
+    locomotion --only wbc/push` (with GaitConfig.min_swing_s 0.15): uncapped 4/20, 45: 6/20, 60: 7/20,
+    80: 5/20, 120: 1/20 (with min_swing_s 0.2: 30: 2/20, 60: 3/20); at 10 stride phases uncapped 5/40,
+    60: 15/40 (measured, one machine)."""
     walking_leg_posture_weight: float = 0.05
     """Walking by its own gait, the legs' posture task is only a regulariser (relative to `posture`)."""
     walking_crouch_lean_per_m: float = 2.5
@@ -146,7 +155,8 @@ class WbcConfig:
             raise WbcConfigError(f"WbcConfig.footsteps must be 'plan' or 'velocity'; got {self.footsteps!r}")
         if self.rate_hz <= 0:
             raise WbcConfigError(f"WbcConfig.rate_hz must be > 0; got {self.rate_hz}")
-        for name in ("kp_scale", "kd_scale", "contact_ramp_s", "liftoff_unload_s", "capture_point_gain", "com_xy_weight"):
+        for name in ("kp_scale", "kd_scale", "contact_ramp_s", "liftoff_unload_s", "capture_point_gain", "com_xy_weight",
+                     "swing_max_accel_mps2"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise WbcConfigError(f"WbcConfig.{name} must be a finite number >= 0; got {value}")
@@ -528,8 +538,12 @@ class WholeBodyTracker(Tracker):
                 weight = max(cfg.terrain_swing_weight if terrain else 0.0,
                              cfg.recovery_swing_weight if gt.recovery else 0.0)
                 swing = TaskGains(cfg.swing_foot.kp, cfg.swing_foot.kd, weight)
+            acc = gt.swing_acc_mps2
+            norm = float(np.sqrt(acc @ acc))
+            if norm > cfg.swing_max_accel_mps2:
+                acc = acc * (cfg.swing_max_accel_mps2 / norm)
             tasks.append(position_task("swing_foot", ft.jac_w[:3], ft.drift_w[:3], ft.pos_w_m + shift, ft.vel_w[:3],
-                                       gt.swing_pos_m, gt.swing_vel_mps, gt.swing_acc_mps2, swing))
+                                       gt.swing_pos_m, gt.swing_vel_mps, acc, swing))
             tasks.append(orientation_task("swing_foot_rot", ft.jac_w[3:], ft.drift_w[3:], ft.rot_w, ft.vel_w[3:],
                                           yaw_rotation(gt.swing_yaw_rad), np.array([0.0, 0.0, gt.swing_yaw_rate_radps]),
                                           swing))
