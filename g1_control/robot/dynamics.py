@@ -126,6 +126,8 @@ class WbcModel:
         self.contact_drift_local = np.zeros(12)
         self.contact_vel_local = np.zeros(12)
         self._lower = np.tril_indices(self.nv, -1)
+        self._all = np.arange(self.nv)
+        """Every velocity coordinate (the full model's columns for _add_held_load)."""
         """The mass matrix's strict lower triangle (pinocchio fills the upper one)."""
         self.hand_forces_w_n = np.zeros((2, 3))
         """Known forces on the (left, right) hand frames, world axes: what a held object does to
@@ -171,15 +173,7 @@ class WbcModel:
             self.contact_jac_local[rows] = pin.getFrameJacobian(m, d, fid, pin.LOCAL)
             self.contact_drift_local[rows] = pin.getFrameAcceleration(m, d, fid, pin.LOCAL).vector
             self.contact_vel_local[rows] = pin.getFrameVelocity(m, d, fid, pin.LOCAL).vector
-        if self.hand_forces_w_n.any():
-            for fid, force in zip(self.hand_ids, self.hand_forces_w_n):
-                self.bias -= pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED)[:3].T @ force
-        if self.hand_masses_kg.any():
-            for fid, mass in zip(self.hand_ids, self.hand_masses_kg):
-                jac = pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED)[:3]
-                drift = pin.getFrameClassicalAcceleration(m, d, fid, pin.LOCAL_WORLD_ALIGNED).linear
-                self.mass_matrix += mass * (jac.T @ jac)
-                self.bias += mass * (jac.T @ drift)
+        self._add_held_load(m, d, self._all)
 
     def frame(self, frame_id: int) -> FrameTerms:
         """Kinematics of one frame at the state of the last update()."""
@@ -223,12 +217,23 @@ class WbcModel:
             self.contact_jac_local[rows, vi] = pin.getFrameJacobian(m, d, fid, pin.LOCAL)
             self.contact_drift_local[rows] = pin.getFrameAcceleration(m, d, fid, pin.LOCAL).vector
             self.contact_vel_local[rows] = pin.getFrameVelocity(m, d, fid, pin.LOCAL).vector
-        if self.hand_forces_w_n.any():
-            for fid, force in zip(self.hand_ids, self.hand_forces_w_n):
-                self.bias[vi] -= pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED)[:3].T @ force
-        if self.hand_masses_kg.any():
-            for fid, mass in zip(self.hand_ids, self.hand_masses_kg):
-                jac = pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED)[:3]
+        self._add_held_load(m, d, vi)
+
+    def _add_held_load(self, m, d, cols: np.ndarray) -> None:
+        """The hands' known forces (hand_forces_w_n: bias - J^T f) and point masses (hand_masses_kg:
+        m J^T J into the mass matrix, m J^T (J-dot v) into bias) on the 29-DoF coordinates `cols`
+        that `m` (the model just computed) has."""
+        forces, masses = self.hand_forces_w_n.any(), self.hand_masses_kg.any()
+        if not (forces or masses):
+            return
+        pin = self._pin
+        jacs = [pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED)[:3] for fid in self.hand_ids]
+        if forces:
+            for jac, force in zip(jacs, self.hand_forces_w_n):
+                self.bias[cols] -= jac.T @ force
+        if masses:
+            block = np.ix_(cols, cols)
+            for fid, jac, mass in zip(self.hand_ids, jacs, self.hand_masses_kg):
                 drift = pin.getFrameClassicalAcceleration(m, d, fid, pin.LOCAL_WORLD_ALIGNED).linear
-                self.mass_matrix[np.ix_(vi, vi)] += mass * (jac.T @ jac)
-                self.bias[vi] += mass * (jac.T @ drift)
+                self.mass_matrix[block] += mass * (jac.T @ jac)
+                self.bias[cols] += mass * (jac.T @ drift)

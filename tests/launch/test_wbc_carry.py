@@ -2,17 +2,15 @@
 from a table (the goal skills), then walks ~1 m from velocity commands while holding it. Judged from
 MuJoCo's ground truth: the box stays between the hands, off the floor, and moves with the robot."""
 
-from pathlib import Path
-
 import numpy as np
 
 from g1_control.launch.builder import build_loop
 from g1_control.launch.schema import load_launch, parse_launch
 from g1_control.report.outcomes import GoalWatcher
 from g1_control.trackers.wbc.tracker import WholeBodyTracker
+from tests.paths import LAUNCH_DIR
 
 PICK_S, WALK_S, STOP_S = 22.0, 5.0, 2.0
-REPO = Path(__file__).resolve().parents[2]
 
 
 def carry_launch() -> dict:
@@ -60,7 +58,7 @@ def test_the_carry_launch_walks_forward_with_its_3kg_box():
     the turn): without the box's inertia in the controller's dynamics (WbcConfig.held_load_inertia) the
     DCM ran ahead and the robot fell 2.7 s into it (issue 23). Ground truth: no fall, the box between
     the hands, the pelvis ~1.5 m along."""
-    launch = load_launch(REPO / "launch" / "sim_wbc_carry.yaml")
+    launch = load_launch(LAUNCH_DIR / "sim_wbc_carry.yaml")
     walk_from = sum(seg.duration_s for seg in launch.input.timeline[:4])
     assert launch.input.timeline[4].vx_mps == 0.3
     loop = build_loop(launch)

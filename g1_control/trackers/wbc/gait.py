@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -321,15 +322,23 @@ _AXES = ((0, 1.0), (0, -1.0), (1, 1.0), (2, 1.0))
 """(axis, sign) of _axis_limits' four limits: forward, backward, sideways, turn."""
 
 
-def _axis_limit_bisected(cfg: GaitConfig, margin: float, cadence_of: np.ndarray | None, axis: int,
-                         sign: float) -> float:
+def _largest_within(load: Callable[[float], float]) -> float:
+    """The largest speed in [0, 10) whose load is <= 1 (60 bisection steps; load grows with speed)."""
     lo, hi = 0.0, 10.0
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        v = np.zeros(3)
-        v[axis] = sign * mid
-        lo, hi = (mid, hi) if step_load(cfg, v, margin, cadence_of) <= 1.0 else (lo, mid)
+        lo, hi = (mid, hi) if load(mid) <= 1.0 else (lo, mid)
     return lo
+
+
+def _axis_limit_bisected(cfg: GaitConfig, margin: float, cadence_of: np.ndarray | None, axis: int,
+                         sign: float) -> float:
+    def load(speed: float) -> float:
+        v = np.zeros(3)
+        v[axis] = sign * speed
+        return step_load(cfg, v, margin, cadence_of)
+
+    return _largest_within(load)
 
 
 def _axis_limits_at_cadence(cfg: GaitConfig, margin: float,
@@ -350,13 +359,7 @@ def _axis_limits_at_cadence(cfg: GaitConfig, margin: float,
                      for axis, sign in _AXES)
     loads = (lambda s: s * T / denominators[0], lambda s: s * T / denominators[1],
              lambda s: 2.0 * s * T / denominators[2], lambda s: s * cfg.step_s / denominators[3])
-    out = []
-    for load in loads:
-        lo, hi = 0.0, 10.0
-        for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            lo, hi = (mid, hi) if load(mid) <= 1.0 else (lo, mid)
-        out.append(lo)
+    out = [_largest_within(load) for load in loads]
     return out[0], out[1], out[2], out[3]
 
 
