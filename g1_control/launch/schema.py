@@ -37,6 +37,9 @@ SKELETON_GENERATORS = ("backbone", "learned_motion_matching", "motion_matching")
 backend.hands): checked when the launch file is read, chosen when the loop is built."""
 
 MIN_WBC_TRACKER_HZ = 100.0
+WBC_TRACKER_HZ = 250.0
+"""rates.tracker_hz when a launch file with tracker.type wbc or layer does not state it (the policies' 50 Hz
+default is too slow for the whole-body controller)."""
 """The whole-body controller's slowest rate in use: every task of issue 17 (standing at any height,
 reaching, holding and carrying a box, stepping onto a platform) was tracked at 100 Hz as at
 250 Hz in the execution bench's debugging runs (`g1 bench execution --only reach,height,box,step`)."""
@@ -203,7 +206,7 @@ class TrackerConfig:
 
     policy: a velocity-command walking policy (`policy`: a built-in spec name or a spec YAML) with
     upper-body override and closed-loop velocity correction; wbc: the model-based whole-body
-    controller (needs rates.tracker_hz >= 100): with generator.type scripted its feet follow the
+    controller (needs rates.tracker_hz >= 100; 250 when the file states none): with generator.type scripted its feet follow the
     reference's contact schedule, with any other generator it walks by its own gait from the
     reference's root twist (g1_control/trackers/wbc/gait.py), at the pelvis height a command asks, and
     in a scene it executes goals too (LaunchFile.executes_goals: it follows their whole-body plans and
@@ -211,7 +214,7 @@ class TrackerConfig:
     a comparison baseline for the WBC; layer: the tracking layer that executes goals - the walking
     policy while the plan walks, the WBC for whole-body phases (manipulation, stepping onto
     platforms, standing heights the policy cannot hold), with a blended hand-over
-    (g1_control/trackers/layer.py); rates.tracker_hz is the WBC's (>= 100 Hz), the policy runs at
+    (g1_control/trackers/layer.py); rates.tracker_hz is the WBC's (>= 100 Hz, 250 unstated), the policy runs at
     its own 50 Hz inside it.
     """
 
@@ -670,11 +673,22 @@ class LaunchFile:
         return 60.0
 
 
+def _wbc_rate_default(data):
+    """`data` with rates.tracker_hz at WBC_TRACKER_HZ when the tracker is the whole-body controller and the
+    file does not state a rate (`g1 launch sim_generator --set tracker.type=wbc` runs at the WBC's rate)."""
+    if not isinstance(data, dict) or not isinstance(data.get("tracker"), dict):
+        return data
+    rates = data.get("rates", {})
+    if data["tracker"].get("type") not in ("wbc", "layer") or not isinstance(rates, dict) or "tracker_hz" in rates:
+        return data
+    return {**data, "rates": {**rates, "tracker_hz": WBC_TRACKER_HZ}}
+
+
 def parse_launch(data, source: str = "<launch>") -> LaunchFile:
     from g1_control.launch.start_pose import to_start_frame
 
     try:
-        return from_dict(LaunchFile, to_start_frame(data), "")
+        return from_dict(LaunchFile, to_start_frame(_wbc_rate_default(data)), "")
     except LaunchFileError as exc:
         raise LaunchFileError(f"{source}: {exc}") from None
     except SafetyConfigError as exc:  # SafetyConfig's own messages, or fall.* (FallConfig, which names its key)

@@ -47,3 +47,26 @@ def test_wbc_with_a_velocity_generator_walks_by_its_own_gait():
     data["generator"] = {"type": "velocity"}
     assert make_tracker(parse_launch(data)).config.footsteps == "velocity"
     assert make_tracker(parse_launch(launch_dict())).config.footsteps == "plan"
+
+
+def test_the_wbc_runs_at_its_own_rate_when_the_file_states_none():
+    """`g1 launch sim_generator.yaml --set tracker.type=wbc`: the file states no rates, and the policies'
+    50 Hz default would be refused; unstated, the WBC's 250 Hz. A stated rate is kept (and judged)."""
+    data = launch_dict()
+    del data["rates"]
+    assert parse_launch(data).rates.tracker_hz == 250
+    data["rates"] = {"input_hz": 100}
+    assert parse_launch(data).rates.tracker_hz == 250 and parse_launch(data).rates.input_hz == 100
+    data["tracker"] = {"type": "layer"}
+    data["generator"] = {"type": "velocity"}
+    assert parse_launch(data).rates.tracker_hz == 250
+    data["tracker"] = {"type": "policy"}
+    assert parse_launch(data).rates.tracker_hz == 50
+    assert parse_launch(launch_dict(tracker_hz=100)).rates.tracker_hz == 100
+    with pytest.raises(LaunchFileError, match="tracker_hz: 50 Hz is too slow"):
+        parse_launch(launch_dict(tracker_hz=50))
+
+
+def test_the_shipped_generator_file_runs_the_wbc_from_the_command_line():
+    launch = load_launch(LAUNCH_DIR / "sim_generator.yaml", ["tracker.type=wbc"])
+    assert launch.tracker.type == "wbc" and launch.rates.tracker_hz == 250
