@@ -147,6 +147,9 @@ def _run_loop(launch: LaunchFile, sim: MujocoBackend, loop: ControlLoop, segment
         result.extra["goals"] = watcher.outcomes()
     if launch.pushes:
         result.extra["pushes"] = push_outcomes(launch.pushes, log, result.fall)
+    by_style = style_figures(log, result.fall)
+    if by_style:
+        result.extra["by_style"] = by_style
     if program is not None:
         from g1_control.program.device import record_dict
 
@@ -160,6 +163,24 @@ def _run_loop(launch: LaunchFile, sim: MujocoBackend, loop: ControlLoop, segment
     if interrupted is not None:
         raise interrupted
     return result
+
+
+def style_figures(log: dict[str, np.ndarray], fall: dict | None) -> dict[str, dict]:
+    """Per operator style, up to a fall: the upper body vs the plan (RMS) and the footsteps vs the plan's
+    (report/footsteps.py), for runs with a reference and ground truth."""
+    from g1_control.report.footsteps import footsteps_by_style
+    from g1_control.report.results import upper_body_rms_by_style
+
+    if not len(log["t_s"]):
+        return {}
+    window = np.ones(len(log["t_s"]), dtype=bool) if fall is None else log["t_s"] < fall["t_s"]
+    cut = {k: (v[window] if k != "style_names" else v) for k, v in log.items()}
+    out: dict[str, dict] = {}
+    for name, ub in upper_body_rms_by_style(cut).items():
+        out.setdefault(name, {})["upper_body_rms_rad"] = ub["rms_rad"]
+    for name, steps in footsteps_by_style(cut).items():
+        out.setdefault(name, {})["footsteps"] = steps
+    return out
 
 
 def _push(sim: MujocoBackend, push) -> None:

@@ -71,6 +71,8 @@ class RunLog:
     q_rad: np.ndarray = field(init=False)
     q_target_rad: np.ndarray = field(init=False)     # what the motors were sent (after the safety filter)
     q_ref_rad: np.ndarray = field(init=False)        # the tracker's reference posture (the plan after the IK)
+    ref_root_pos_m: np.ndarray = field(init=False)   # the tracker's reference root position (world)
+    ref_root_quat_wxyz: np.ndarray = field(init=False)  # the tracker's reference root orientation
     tau_nm: np.ndarray = field(init=False)
     late_s: np.ndarray = field(init=False)           # worst lateness of the wall-clock ticks since the last row
     style_id: np.ndarray = field(init=False)         # index into style_names of the operator's style
@@ -81,7 +83,7 @@ class RunLog:
         self.t_s = np.zeros(c)
         for name, width in (("command", 3), ("policy_command", 3), ("velocity_est", 3), ("velocity_true", 3),
                             ("base_pos_m", 3), ("base_quat_wxyz", 4), ("q_rad", j), ("q_target_rad", j),
-                            ("q_ref_rad", j), ("tau_nm", j)):
+                            ("q_ref_rad", j), ("ref_root_pos_m", 3), ("ref_root_quat_wxyz", 4), ("tau_nm", j)):
             setattr(self, name, np.full((c, width), np.nan))
         self.style_id = np.full(c, -1, dtype=np.int16)
         self.yaw_rad = np.full(c, np.nan)
@@ -89,7 +91,8 @@ class RunLog:
         self.late_s = np.zeros(c)
 
     NAMES = ("t_s", "command", "policy_command", "velocity_est", "velocity_true", "base_pos_m", "base_quat_wxyz",
-             "yaw_rad", "tilt_rad", "q_rad", "q_target_rad", "q_ref_rad", "tau_nm", "late_s", "style_id")
+             "yaw_rad", "tilt_rad", "q_rad", "q_target_rad", "q_ref_rad", "ref_root_pos_m", "ref_root_quat_wxyz",
+             "tau_nm", "late_s", "style_id")
     """The per-tick arrays (style_names, the names behind style_id, is not per tick)."""
 
     def arrays(self) -> dict[str, np.ndarray]:
@@ -363,6 +366,8 @@ class ControlLoop:
         log.q_target_rad[i] = self.motor_command.q_rad
         if self._joint_ref is not None:
             log.q_ref_rad[i] = self._joint_ref.q_rad
+            log.ref_root_pos_m[i] = self._joint_ref.root_pos_w_m
+            log.ref_root_quat_wxyz[i] = self._joint_ref.root_quat_wxyz
         log.style_id[i] = log.style_index(self.command.style)
         log.tau_nm[i] = s.tau_nm
         log.n = i + 1

@@ -215,12 +215,32 @@ def format_summary(result: RunResult) -> str:
         from g1_control.report.outcomes import outcome_line
 
         lines += ["", "goals (ground truth):"] + ["  " + outcome_line(o) for o in result.extra["goals"]]
+    if result.extra.get("by_style"):
+        lines += ["", style_table(result.extra["by_style"])]
     if result.extra.get("pushes"):
         lines += ["", "pushes (ground truth):"] + ["  " + push_line(p) for p in result.extra["pushes"]]
     if result.extra.get("program"):
         lines += ["", program_summary(result.extra["program"])]
     if result.run_dir:
         lines.append(f"run folder: {result.run_dir}" + (f" (video: {Path(result.video).name})" if result.video else ""))
+    return "\n".join(lines)
+
+
+def style_table(by_style: dict[str, dict]) -> str:
+    """Per style: the upper body vs the plan, and the footsteps (measured) vs the plan's (report/footsteps.py)."""
+    lines = ["per style, vs the plan (after the IK): upper body RMS; footsteps: steps measured/planned/paired, "
+             "RMS of the paired steps' difference (x, y), mean step length and width measured (plan)",
+             f"{'style':<12} {'ub rms':>7}   {'steps':>11}   {'rms x':>6} {'rms y':>6}   {'length':>13} {'width':>13}"]
+    for name, d in by_style.items():
+        ub = d.get("upper_body_rms_rad")
+        row = f"{name[:12]:<12} {'-' if ub is None else f'{ub:.3f}':>7}"
+        f = d.get("footsteps")
+        if f:
+            counts = f"{f['steps']}/{f['plan_steps']}/{f['paired']}"
+            rx, ry = (f"{f[k]:.3f}" if k in f else "-" for k in ("rms_x_m", "rms_y_m"))
+            (mx, my), (px, py) = f["mean_step_m"], f["plan_mean_step_m"]
+            row += f"   {counts:>11}   {rx:>6} {ry:>6}   {mx:+.2f} ({px:+.2f}) {my:+.2f} ({py:+.2f})"
+        lines.append(row)
     return "\n".join(lines)
 
 

@@ -58,6 +58,8 @@ LOG_FIELDS: dict[str, tuple[str, str]] = {
     "q_rad": ("rad", "measured joint positions, G1 joint order (joint_names)"),
     "q_target_rad": ("rad", "joint position targets sent (after the safety filter), joint order"),
     "q_ref_rad": ("rad", "the tracker's reference posture (the plan after the IK), joint order"),
+    "ref_root_pos_m": ("m", "the tracker's reference root (pelvis) position in the plan's world frame"),
+    "ref_root_quat_wxyz": ("1", "the tracker's reference root orientation (w, x, y, z)"),
     "tau_nm": ("N m", "measured (estimated) joint torques, joint order"),
     "style_id": ("1", "index into style_names of the operator's style (-1 before the first tick)"),
 }
