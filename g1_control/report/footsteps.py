@@ -1,7 +1,7 @@
 """Footsteps from a run's log: where the feet landed against where the plan put them, per style.
 
 A touchdown is a foot coming down after a swing: its ankle rises more than `LIFT_M` above the height
-that foot stands at, then comes back within `LAND_M` of it (flat ground). A step is where the landing
+that foot stands at (its lowest within `STAND_WINDOW_S`), then comes back within `LAND_M` of it. A step is where the landing
 foot rests (`SETTLE_S` after its touchdown) relative to where the other foot stood at the touchdown, in
 the pelvis's heading frame (x forward, y left): a step's length and width, whatever the robot's or the
 plan's drift in the world. The same
@@ -29,8 +29,8 @@ SETTLE_S = 0.05
 """A landed foot's position is read this long after its touchdown (it may still slide as it lands)."""
 MATCH_S = 0.25
 """A measured step and a planned step of the same foot pair up when they land at most this far apart."""
-STAND_PERCENTILE = 5.0
-"""The height a foot stands at: this percentile of its ankle's height over the run (flat ground)."""
+STAND_WINDOW_S = 1.0
+"""The height a foot stands at: the lowest its ankle comes within this long either side (flat ground)."""
 
 
 @dataclass(frozen=True)
@@ -65,21 +65,31 @@ def ankle_positions(base_pos_m: np.ndarray, base_quat_wxyz: np.ndarray, q_rad: n
     return out
 
 
-def touchdowns(z: np.ndarray, lift_m: float = LIFT_M, land_m: float = LAND_M) -> np.ndarray:
+def standing_height(z: np.ndarray, window: int) -> np.ndarray:
+    """Per row, the height the foot stands at around it: the lowest of its ankle's heights within
+    `window` rows either side (a plan's ground level may wander by centimetres over a run)."""
+    filled = np.where(np.isfinite(z), z, np.inf)
+    n = len(z)
+    out = np.empty(n)
+    for k in range(n):
+        out[k] = filled[max(0, k - window): k + window + 1].min()
+    return out
+
+
+def touchdowns(z: np.ndarray, window: int, lift_m: float = LIFT_M, land_m: float = LAND_M) -> np.ndarray:
     """Row indices where a foot whose ankle heights are `z` lands: the first row back within land_m
     of its standing height after having been more than lift_m above it."""
-    finite = np.isfinite(z)
-    if finite.sum() < 2:
+    if np.isfinite(z).sum() < 2:
         return np.zeros(0, dtype=int)
-    ground = float(np.percentile(z[finite], STAND_PERCENTILE))
+    ground = standing_height(z, window)
     out, swinging = [], False
     for k, h in enumerate(z):
         if not np.isfinite(h):
             swinging = False
             continue
-        if not swinging and h > ground + lift_m:
+        if not swinging and h > ground[k] + lift_m:
             swinging = True
-        elif swinging and h < ground + land_m:
+        elif swinging and h < ground[k] + land_m:
             swinging = False
             out.append(k)
     return np.array(out, dtype=int)
@@ -87,7 +97,9 @@ def touchdowns(z: np.ndarray, lift_m: float = LIFT_M, land_m: float = LAND_M) ->
 
 def steps(t_s: np.ndarray, ankles: np.ndarray, yaw_rad: np.ndarray, style_id: np.ndarray) -> Steps:
     """Every touchdown of either foot as a step (module docstring)."""
-    rows = [touchdowns(ankles[:, side, 2]) for side in (0, 1)]
+    dt = float(np.median(np.diff(t_s))) if len(t_s) > 1 else 1.0
+    window = max(1, round(STAND_WINDOW_S / dt))
+    rows = [touchdowns(ankles[:, side, 2], window) for side in (0, 1)]
     k = np.concatenate(rows)
     foot = np.concatenate([np.full(len(r), side) for side, r in enumerate(rows)])
     order = np.argsort(k, kind="stable")

@@ -52,9 +52,9 @@ def test_a_touchdown_is_the_first_tick_back_on_the_ground_after_a_swing():
     z[5:10] = [0.01, 0.03, 0.05, 0.03, 0.005]  # lands at 9
     z[20:24] = [0.01, 0.02, 0.01, 0.0]          # a shuffle under LIFT_M: no step
     z[30:34] = [0.04, 0.06, 0.02, 0.0]          # lands at 33
-    assert touchdowns(z).tolist() == [9, 33]
+    assert touchdowns(z, 100).tolist() == [9, 33]
     z[6:9] = LIFT_M - 1e-3  # the first swing never rises LIFT_M
-    assert touchdowns(z).tolist() == [33]
+    assert touchdowns(z, 100).tolist() == [33]
 
 
 def test_steps_are_the_landing_foot_against_the_other_in_the_heading_frame():
