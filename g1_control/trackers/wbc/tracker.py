@@ -129,6 +129,14 @@ class WbcConfig:
     60: 15/40 (measured, one machine)."""
     walking_leg_posture_weight: float = 0.05
     """Walking by its own gait, the legs' posture task is only a regulariser (relative to `posture`)."""
+    walking_reference_velocity: bool = False
+    """Walking by its own gait, the posture task's velocity target is the reference's joint velocities
+    (on) or zero (off: a PD on the reference posture with damping). A reference that comes through the
+    IK stage carries the IK's step from the measured joints divided by the tick (ik/retargeter.py), a
+    correction rather than the plan's motion: at 250 Hz a 0.02 rad error reads as 5 rad/s, and the
+    plan's legs, out of phase with the gait's, as tens of rad/s. With it on, `g1 launch
+    sim_generator.yaml --set tracker.type=wbc` (the backbone's plan) fell in its first walking segment
+    (joint over-speed at 0.6 m/s and at 0.25 m/s sideways); off, 8 styles' segments walked (measured)."""
     walking_crouch_lean_per_m: float = 2.5
     """Walking by its own gait below its nominal pelvis height, the pelvis and trunk pitch forward by
     this much (rad) per metre lower: an upright pelvis that low keeps the hips over the ankles, and the
@@ -218,6 +226,7 @@ class WholeBodyTracker(Tracker):
         self._posture_weights = np.ones(self.dyn.nv - 6)
         self._posture_weights[list(g1.LEG_JOINTS)] = self.config.walking_leg_posture_weight
         self._held_posture_weights = self._posture_weights.copy()
+        self._zero_dq = np.zeros(self.dyn.nv - 6)
         self._held_posture_weights[list(g1.UPPER_BODY_JOINTS)] = self.config.walking_held_upper_weight
         self.reset()
 
@@ -550,7 +559,8 @@ class WholeBodyTracker(Tracker):
         if load_kg > 0.0:
             tasks += self._held_hand_tasks(shift)
         weights = self._held_posture_weights if load_kg > 0.0 else self._posture_weights
-        tasks.append(posture_task(dyn.nv, state.q_rad, state.dq_radps, reference.q_rad, reference.dq_radps,
+        dq_ref = reference.dq_radps if cfg.walking_reference_velocity else self._zero_dq
+        tasks.append(posture_task(dyn.nv, state.q_rad, state.dq_radps, reference.q_rad, dq_ref,
                                   cfg.posture, weights))
         return tasks
 

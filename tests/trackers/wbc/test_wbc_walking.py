@@ -94,3 +94,31 @@ def test_walking_while_turning_needs_no_sideways_correction():
     correction = tracker.gait.speed_correction_h
     assert abs(correction[1]) < 0.05, f"sideways correction {correction[1]:+.3f} m/s"
     assert tracker.diagnostics.unsolved_ticks == 0
+
+
+def test_a_reference_through_the_ik_does_not_throw_the_walk():
+    """A reference that comes through the IK stage carries, as its joint velocities, the IK's step from
+    the measured joints over one tick (ik/retargeter.py): a correction, tens of rad/s where the plan's
+    legs are out of phase with the gait's. Walking by its own gait the controller damps the posture to
+    zero velocity instead (WbcConfig.walking_reference_velocity); with that velocity it fell walking the
+    backbone generator's plan."""
+    backend = MujocoBackend()
+    state = backend.reset()
+    tracker = WholeBodyTracker(WbcConfig(footsteps="velocity"))
+    tracker.reset(state)
+    ref = JointReference(q_rad=g1.DEFAULT_Q_RAD.copy())
+    lowest = np.inf
+    for _ in range(round(5.0 / 0.004)):
+        state = backend.read_state()
+        ref.root_linvel_h_mps[0] = 0.6 if state.t_s >= 0.5 else 0.0
+        # the plan's legs in a walk of their own, slower than the gait's; the IK's velocity
+        phase = 2 * np.pi * 0.8 * state.t_s
+        ref.q_rad[list(g1.LEG_JOINTS)] = g1.DEFAULT_Q_RAD[list(g1.LEG_JOINTS)] + 0.3 * np.sin(phase + np.arange(12))
+        ref.dq_radps[:] = (ref.q_rad - state.q_rad) / 0.004
+        backend.write_command(tracker.act(ref, state))
+        backend.step(0.004)
+        lowest = min(lowest, float(state.base_pos_w_m[2]))
+        if lowest < FALL_HEIGHT_M:
+            break
+    assert lowest > FALL_HEIGHT_M, f"fell at {state.t_s:.2f} s"
+    assert state.t_s > 4.9 and state.base_pos_w_m[0] > 1.5
