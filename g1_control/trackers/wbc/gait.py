@@ -112,9 +112,17 @@ class GaitConfig:
     recovery step swings; landing sooner leaves it less far to catch. `g1 bench locomotion --only
     wbc/push`: 0.2 survived 2/20 (front_3, front_4), 0.17 3/20, 0.15 and 0.12 4/20 (front_1, front_3,
     front_4, right_4); at 10 stride phases (40 pushes) 0.2: 2/40, 0.15: 5/40; random timelines 0.2:
-    6/10, 0.15: 7/10 (measured, one machine). Most pushes still end in a joint over-speed trip: the
-    QP loads a stance foot that is tipping on its edge or off the ground (its ankle roll or the knee
-    at its stop), and the torques meant for a contact spin the free foot or leg (issue 23's notes)."""
+    6/10, 0.15: 7/10 (measured, one machine). Most pushes still end in a joint over-speed trip, but the
+    trip is a symptom: with the safety layer's over-speed and joint-range trips switched off (diagnosis
+    only) the same 7 of 20 survive and the other 13 fall (pelvis below 0.4 m or tilted) 0.6-2 s after
+    the push. The first recovery step is torque-bound (pushed from behind: the swing hip pitch at its
+    88 N m, the stance ankle at its limit, both knees straightening, the foot 6 cm up at the clock's
+    touchdown) and lands with the DCM ~0.4 m off its plan, more than 0.42 m steps every 0.22 s can
+    catch (0.42 / (e^{w 0.22} - 1) ~ 0.3 m). Tried, not kept (stop 34): touchdown detection from the
+    soles' measured heights (an early landing ends the step, a late one keeps lowering the foot for up
+    to 0.12 s) survived 5/20 (waiting for the late foot lengthens the single support while the DCM runs
+    away); a minimum swing growing with the distance to go 1/20; a 0.02 s double support after a
+    recovery step 9/20 but 8/20 at 120 N against 10/20 (measured)."""
     speed_feedback_gain: float = 0.3
     """Per stride, this fraction of the error between the command and the stride's speed (from the
     feet's measured touchdowns) is added to the speed the steps are planned for: the pendulum model
