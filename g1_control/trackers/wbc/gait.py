@@ -428,6 +428,10 @@ class VelocityGait:
         self._landing = np.zeros(3)
         self._landing_yaw = 0.0
         self._path_top = 0.0
+        self._snap_shift = np.zeros(2)
+        """How far (xy) the terrain moved this step's landing from where the DCM would put it."""
+        self._snap_shift_at = math.nan
+        """The _t0 of the step _snap_shift belongs to (nan: none)."""
         self.active = self.config
         """The configuration of the step under way: near a step, the one with longer single support."""
         """The highest point under the swing's path, relative to the stance sole (terrain)."""
@@ -624,6 +628,8 @@ class VelocityGait:
         forward = np.array([math.cos(heading_td), math.sin(heading_td)])
         if float((xy - u[:2]) @ forward) < self.config.min_advance_m < float((self._landing[:2] - u[:2]) @ forward):
             xy, ground_l = terrain.snap(self._landing[:2], self._landing_yaw, heading_td, forward_only=True)
+        self._snap_shift = xy - self._landing[:2]
+        self._snap_shift_at = self._t0
         self._landing[:2] = xy
         self._landing[2] = u[2] + ground_l - ground_s
         start = self._swing_from[:2] if self._swinging else self._landing[:2]
@@ -699,6 +705,10 @@ class VelocityGait:
         b_now = _rot2(self.heading - float(command_h[2]) * t_in) @ nominal_dcm_offset(cfg, s, command_h[:2], omega,
                                                                                       self._turn(command_h))
         xi_nom = u[:2] + b_now * math.exp(omega * t_in)
+        if self._snap_shift_at == self._t0:
+            # the landing the terrain moved (onto a tread) moves the DCM's plan with it: the DCM at
+            # touchdown is to lie that much further, so its plan now is that much e^{-w t_r} further
+            xi_nom = xi_nom + self._snap_shift * math.exp(-omega * t_r)
         out.dcm_error_m = float(np.hypot(*(dcm_xy - xi_nom)))
         if self._swinging and t_in >= Tds and out.dcm_error_m > cfg.recovery_dcm_error_m:
             self._recovery_at = self._t0

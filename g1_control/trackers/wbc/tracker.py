@@ -366,7 +366,9 @@ class WholeBodyTracker(Tracker):
         sole_pos_before = np.array([dyn.data.oMf[f].translation for f in dyn.sole_ids])
         offsets = sole_pos_before - q[:3]
         base_prev = q[:3].copy()
-        base = self.odometry.update(dt, est.base_linvel_w_mps, offsets, stance)
+        terrain = self.gait.terrain if self.gait is not None and not self.gait.terrain.flat else None
+        base = self.odometry.update(dt, est.base_linvel_w_mps, offsets, stance,
+                                    None if terrain is None else terrain.height)
         shift = base - base_prev
         q[:3] = base
         self._sole_pos = sole_pos_before + shift
