@@ -432,6 +432,8 @@ class VelocityGait:
         """How far (xy) the terrain moved this step's landing from where the DCM would put it."""
         self._snap_shift_at = math.nan
         """The _t0 of the step _snap_shift belongs to (nan: none)."""
+        self._snap_dir = 0
+        """That step's landing moved forward (1) or back (-1) onto a level, once it was (0: not yet)."""
         self.active = self.config
         """The configuration of the step under way: near a step, the one with longer single support."""
         """The highest point under the swing's path, relative to the stance sole (terrain)."""
@@ -624,11 +626,26 @@ class VelocityGait:
         under the swing's path."""
         terrain = self.terrain
         ground_s = terrain.height(u[:2])  # where it stands (with the margin, a toe near a riser reads the tread above)
-        xy, ground_l = terrain.snap(self._landing[:2], self._landing_yaw, heading_td)
+        want = self._landing[:2]
         forward = np.array([math.cos(heading_td), math.sin(heading_td)])
-        if float((xy - u[:2]) @ forward) < self.config.min_advance_m < float((self._landing[:2] - u[:2]) @ forward):
-            xy, ground_l = terrain.snap(self._landing[:2], self._landing_yaw, heading_td, forward_only=True)
-        self._snap_shift = xy - self._landing[:2]
+        if self._snap_shift_at == self._t0 and self._snap_dir != 0:
+            # the step keeps the side of the edge it chose (re-choosing as the DCM moved, the landing
+            # jumped from before a riser onto its tread late in the swing, measured)
+            xy, ground_l = terrain.snap(want, self._landing_yaw, heading_td, forward_only=self._snap_dir > 0,
+                                        backward_only=self._snap_dir < 0)
+        else:
+            xy, ground_l = terrain.snap(want, self._landing_yaw, heading_td)
+            advance = float((xy - u[:2]) @ forward)
+            if advance < self.config.min_advance_m and advance < float((want - u[:2]) @ forward):
+                # moved back to little ahead of the stance foot: onto the tread instead (walking
+                # slowly at a riser, the feet otherwise shuffle in front of it)
+                ahead, ground_a = terrain.snap(want, self._landing_yaw, heading_td, forward_only=True)
+                if terrain.is_level(ahead, self._landing_yaw):
+                    xy, ground_l = ahead, ground_a
+        shift = float((xy - want) @ forward)
+        if self._snap_shift_at != self._t0 or self._snap_dir == 0:
+            self._snap_dir = 1 if shift > 1e-9 else -1 if shift < -1e-9 else 0
+        self._snap_shift = xy - want
         self._snap_shift_at = self._t0
         self._landing[:2] = xy
         self._landing[2] = u[2] + ground_l - ground_s
@@ -731,7 +748,8 @@ class VelocityGait:
         tau = (t_in - Tds) / cfg.single_support_s
         if tau < cfg.freeze_landing_after or not self._swinging:
             heading_td, rel, excess = self._landing_for(t_r, p, u, f, dcm_xy, omega, command_h)
-            if excess > cfg.timing_adjust_excess_m and self._swinging:
+            snapped = self._snap_shift_at == self._t0 and self._snap_dir != 0
+            if excess > cfg.timing_adjust_excess_m and self._swinging and not snapped:
                 # step timing: the step cannot reach far enough in time; land sooner, when the
                 # DCM has not yet run as far (the earliest that leaves the swing its minimum)
                 t_sw = t_in - Tds
