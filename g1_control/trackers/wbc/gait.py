@@ -433,6 +433,9 @@ class VelocityGait:
         self._snap_shift_at = math.nan
         """The _t0 of the step _snap_shift belongs to (nan: none)."""
         self._snap_dir = 0
+        self._foothold = np.zeros(2)
+        self._foothold_ground = 0.0
+        """The foothold (xy, height of its level) _on_terrain chose last."""
         """That step's landing moved forward (1) or back (-1) onto a level, once it was (0: not yet)."""
         self.active = self.config
         """The configuration of the step under way: near a step, the one with longer single support."""
@@ -631,15 +634,23 @@ class VelocityGait:
         if self._snap_shift_at == self._t0 and self._snap_dir != 0:
             # the step keeps the side of the edge it chose (re-choosing as the DCM moved, the landing
             # jumped from before a riser onto its tread late in the swing, measured)
+            # (on the level it chose, else where it chose it: a landing straddling the riser, measured)
+            reach = max(self.active.max_forward_m - float((want - u[:2]) @ forward), 0.0) if self._snap_dir > 0 else None
             xy, ground_l = terrain.snap(want, self._landing_yaw, heading_td, forward_only=self._snap_dir > 0,
-                                        backward_only=self._snap_dir < 0)
+                                        backward_only=self._snap_dir < 0, max_shift_m=reach)
+            if (abs(ground_l - self._foothold_ground) > terrain.config.level_tolerance_m
+                    or not terrain.is_level(xy, self._landing_yaw)):
+                xy, ground_l = self._foothold.copy(), self._foothold_ground
         else:
             xy, ground_l = terrain.snap(want, self._landing_yaw, heading_td)
             advance = float((xy - u[:2]) @ forward)
             if advance < self.config.min_advance_m and advance < float((want - u[:2]) @ forward):
                 # moved back to little ahead of the stance foot: onto the tread instead (walking
                 # slowly at a riser, the feet otherwise shuffle in front of it)
-                ahead, ground_a = terrain.snap(want, self._landing_yaw, heading_td, forward_only=True)
+                # (as far as the step limit allows: a riser's tread lies a sole and a riser gap ahead)
+                reach = max(self.active.max_forward_m - float((want - u[:2]) @ forward), 0.0)
+                ahead, ground_a = terrain.snap(want, self._landing_yaw, heading_td, forward_only=True,
+                                               max_shift_m=reach)
                 if terrain.is_level(ahead, self._landing_yaw):
                     xy, ground_l = ahead, ground_a
         shift = float((xy - want) @ forward)
@@ -647,6 +658,7 @@ class VelocityGait:
             self._snap_dir = 1 if shift > 1e-9 else -1 if shift < -1e-9 else 0
         self._snap_shift = xy - want
         self._snap_shift_at = self._t0
+        self._foothold, self._foothold_ground = xy.copy(), ground_l
         self._landing[:2] = xy
         self._landing[2] = u[2] + ground_l - ground_s
         start = self._swing_from[:2] if self._swinging else self._landing[:2]
