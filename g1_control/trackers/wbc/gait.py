@@ -34,6 +34,12 @@ from the reference's current position, velocity and acceleration to the (moving)
 arriving a little before touchdown; the height is a smooth bump of `swing_height_m` with zero
 velocity and acceleration at both ends.
 
+Steps and platforms (terrain.py, the scene's map): a landing is snapped onto one tread and keeps
+the level it chose for its step; the DCM's plan moves with the snapped landing; a step onto another
+level is not made sooner and swings long enough to cross (terrain_swing_speed_mps); the double
+support before it lasts until the DCM is over the stance sole (terrain_max_wait_s); near a step the
+CoP may go further sideways (terrain_cop_limit_y_m).
+
 Starting from standing, a weight shift first brings the DCM onto the first stance foot's nominal
 place; stopping, once the command is zero and the feet stand side by side, the DCM returns to
 the middle between the feet. Nothing here reads simulator ground truth; positions are the
@@ -446,12 +452,12 @@ class VelocityGait:
         self._snap_shift_at = math.nan
         """The _t0 of the step _snap_shift belongs to (nan: none)."""
         self._snap_dir = 0
+        """That step's landing moved forward (1) or back (-1) onto a level, once it was (0: not yet)."""
         self._foothold = np.zeros(2)
         self._foothold_ground = 0.0
+        """The foothold (xy, height of its level) _on_terrain chose last."""
         self._level_change = False
         """That foothold is on another level than the stance foot or the swing foot."""
-        """The foothold (xy, height of its level) _on_terrain chose last."""
-        """That step's landing moved forward (1) or back (-1) onto a level, once it was (0: not yet)."""
         self.active = self.config
         """The configuration of the step under way: near a step, the one with longer single support."""
         """The highest point under the swing's path, relative to the stance sole (terrain)."""
@@ -655,9 +661,9 @@ class VelocityGait:
         want = self._landing[:2]
         forward = np.array([math.cos(heading_td), math.sin(heading_td)])
         if self._snap_shift_at == self._t0 and self._snap_dir != 0:
-            # the step keeps the side of the edge it chose (re-choosing as the DCM moved, the landing
-            # jumped from before a riser onto its tread late in the swing, measured)
-            # (on the level it chose, else where it chose it: a landing straddling the riser, measured)
+            # the step keeps the side of the edge and the level it chose, else the foothold it chose
+            # (re-choosing as the DCM moved, the landing jumped from before a riser onto its tread late
+            # in the swing; snapped within max_shift_m alone, it once straddled the riser, measured)
             reach = max(self.active.max_forward_m - float((want - u[:2]) @ forward), 0.0) if self._snap_dir > 0 else None
             xy, ground_l = terrain.snap(want, self._landing_yaw, heading_td, forward_only=self._snap_dir > 0,
                                         backward_only=self._snap_dir < 0, max_shift_m=reach)
@@ -668,9 +674,9 @@ class VelocityGait:
             xy, ground_l = terrain.snap(want, self._landing_yaw, heading_td)
             advance = float((xy - u[:2]) @ forward)
             if advance < self.config.min_advance_m and advance < float((want - u[:2]) @ forward):
-                # moved back to little ahead of the stance foot: onto the tread instead (walking
-                # slowly at a riser, the feet otherwise shuffle in front of it)
-                # (as far as the step limit allows: a riser's tread lies a sole and a riser gap ahead)
+                # moved back to little ahead of the stance foot: onto the tread instead, as far as the
+                # step limit allows (a riser's tread lies a sole and a riser gap ahead; within
+                # max_shift_m alone the feet shuffled at the riser while the DCM ran ahead, measured)
                 reach = max(self.active.max_forward_m - float((want - u[:2]) @ forward), 0.0)
                 ahead, ground_a = terrain.snap(want, self._landing_yaw, heading_td, forward_only=True,
                                                max_shift_m=reach)
