@@ -34,6 +34,12 @@ from the reference's current position, velocity and acceleration to the (moving)
 arriving a little before touchdown; the height is a smooth bump of `swing_height_m` with zero
 velocity and acceleration at both ends.
 
+Steps and platforms (terrain.py, the scene's map): a landing is snapped onto one tread and keeps
+the level it chose for its step; the DCM's plan moves with the snapped landing; a step onto another
+level is not made sooner and swings long enough to cross (terrain_swing_speed_mps); the double
+support before it lasts until the DCM is over the stance sole (terrain_max_wait_s); near a step the
+CoP may go further sideways (terrain_cop_limit_y_m).
+
 Starting from standing, a weight shift first brings the DCM onto the first stance foot's nominal
 place; stopping, once the command is zero and the feet stand side by side, the DCM returns to
 the middle between the feet. Nothing here reads simulator ground truth; positions are the
@@ -162,6 +168,19 @@ class GaitConfig:
     terrain_hold: float = 0.4
     """... and the foot rises this fraction of the single support before it moves across (its toe
     would catch the riser), and comes down only once across."""
+    terrain_max_wait_s: float = 0.4
+    """Near a step, the double support lasts at most this much longer while the DCM is short of the
+    stance sole's centre (VelocityGait._dcm_short_of_stance)."""
+    terrain_cop_limit_y_m: float = 0.03
+    """Near a step, the CoP may leave the stance sole's centre this far sideways (cop_limit_y_m on flat
+    ground): the longer single supports there let a sideways DCM error grow past what 1.5 cm caught
+    (`g1 bench stairs --only step` seeds 0-4: 1 of 5 up and down without a fall, 0 with 1.5 cm)."""
+    terrain_swing_speed_mps: float = 1.5
+    terrain_max_single_support_s: float = 0.8
+    """A step onto another level swings longer when its foot has far to go: its horizontal crossing
+    averages at most terrain_swing_speed_mps, its single support at most terrain_max_single_support_s."""
+    terrain_rise: float = 0.4
+    """Over a step, the fraction of the single support the swing foot takes to rise to its apex."""
     terrain_single_support_s: float = 0.42
     """Near a step (as for terrain_speed_mps), every step's single support lasts this long: the swing
     foot goes up, across, then down. The DCM plan is the periodic one of these longer steps (one
@@ -436,6 +455,17 @@ class VelocityGait:
         self._landing = np.zeros(3)
         self._landing_yaw = 0.0
         self._path_top = 0.0
+        self._snap_shift = np.zeros(2)
+        """How far (xy) the terrain moved this step's landing from where the DCM would put it."""
+        self._snap_shift_at = math.nan
+        """The _t0 of the step _snap_shift belongs to (nan: none)."""
+        self._snap_dir = 0
+        """That step's landing moved forward (1) or back (-1) onto a level, once it was (0: not yet)."""
+        self._foothold = np.zeros(2)
+        self._foothold_ground = 0.0
+        """The foothold (xy, height of its level) _on_terrain chose last."""
+        self._level_change = False
+        """That foothold is on another level than the stance foot or the swing foot."""
         self.active = self.config
         """The configuration of the step under way: near a step, the one with longer single support."""
         """The highest point under the swing's path, relative to the stance sole (terrain)."""
@@ -507,7 +537,14 @@ class VelocityGait:
                     self.mode, self._t0 = "stop", t_s
                     self._dcm_from = np.array(dcm_xy, dtype=float)
             elif self._in_swing(t_s) and not self._swinging:
-                self._lift(soles_m, sole_yaws)
+                if self._dcm_short_of_stance(command_h, soles_m, dcm_xy) and (
+                        self.active.double_support_s < cfg.double_support_s + cfg.terrain_max_wait_s):
+                    # the double support lasts until the DCM is over the stance foot (below)
+                    self.active = dataclasses.replace(self.active,
+                                                      double_support_s=self.active.double_support_s + dt)
+                    self.step_T += dt
+                else:
+                    self._lift(soles_m, sole_yaws)
         if self.mode == "stop" and t_s - self._t0 >= cfg.stop_s:
             self.mode = "stand"
         contacts = self.targets.contacts
@@ -568,7 +605,8 @@ class VelocityGait:
             direction = self.heading + math.atan2(self.command_h[1], self.command_h[0])
             if self.terrain.level_change_ahead(soles_m[:, :2].mean(axis=0), direction, cfg.terrain_look_ahead_m):
                 if self._terrain_cfg is None:
-                    self._terrain_cfg = dataclasses.replace(cfg, single_support_s=cfg.terrain_single_support_s)
+                    self._terrain_cfg = dataclasses.replace(cfg, single_support_s=cfg.terrain_single_support_s,
+                                                            cop_limit_y_m=cfg.terrain_cop_limit_y_m)
                 return self._terrain_cfg
         single, double = support_times_for(cfg, self.command_h[:2])
         if single == cfg.single_support_s and double == cfg.double_support_s:
@@ -622,20 +660,59 @@ class VelocityGait:
         excess = max(rel[0] - cfg.max_forward_m, -cfg.max_backward_m - rel[0], side_out - cfg.max_width_m, 0.0)
         return heading_td, rel, float(excess)
 
-    def _on_terrain(self, u: np.ndarray, stance_yaw: float, heading_td: float) -> None:
+    def _on_terrain(self, u: np.ndarray, swing_sole: np.ndarray, heading_td: float) -> None:
         """The landing point snapped onto one tread (terrain.py), its height from the terrain relative
         to the stance sole's (odometry's height drifts; the map's steps do not), and the highest point
         under the swing's path."""
         terrain = self.terrain
         ground_s = terrain.height(u[:2])  # where it stands (with the margin, a toe near a riser reads the tread above)
-        xy, ground_l = terrain.snap(self._landing[:2], self._landing_yaw, heading_td)
+        want = self._landing[:2]
         forward = np.array([math.cos(heading_td), math.sin(heading_td)])
-        if float((xy - u[:2]) @ forward) < self.config.min_advance_m < float((self._landing[:2] - u[:2]) @ forward):
-            xy, ground_l = terrain.snap(self._landing[:2], self._landing_yaw, heading_td, forward_only=True)
+        if self._snap_shift_at == self._t0 and self._snap_dir != 0:
+            # the step keeps the side of the edge and the level it chose, else the foothold it chose
+            # (re-choosing as the DCM moved, the landing jumped from before a riser onto its tread late
+            # in the swing; snapped within max_shift_m alone, it once straddled the riser, measured)
+            reach = max(self.active.max_forward_m - float((want - u[:2]) @ forward), 0.0) if self._snap_dir > 0 else None
+            xy, ground_l = terrain.snap(want, self._landing_yaw, heading_td, forward_only=self._snap_dir > 0,
+                                        backward_only=self._snap_dir < 0, max_shift_m=reach)
+            if (abs(ground_l - self._foothold_ground) > terrain.config.level_tolerance_m
+                    or not terrain.is_level(xy, self._landing_yaw)):
+                xy, ground_l = self._foothold.copy(), self._foothold_ground
+        else:
+            xy, ground_l = terrain.snap(want, self._landing_yaw, heading_td)
+            advance = float((xy - u[:2]) @ forward)
+            if advance < self.config.min_advance_m and advance < float((want - u[:2]) @ forward):
+                # moved back to little ahead of the stance foot: onto the tread instead, as far as the
+                # step limit allows (a riser's tread lies a sole and a riser gap ahead; within
+                # max_shift_m alone the feet shuffled at the riser while the DCM ran ahead, measured)
+                reach = max(self.active.max_forward_m - float((want - u[:2]) @ forward), 0.0)
+                ahead, ground_a = terrain.snap(want, self._landing_yaw, heading_td, forward_only=True,
+                                               max_shift_m=reach)
+                if terrain.is_level(ahead, self._landing_yaw):
+                    xy, ground_l = ahead, ground_a
+        shift = float((xy - want) @ forward)
+        if self._snap_shift_at != self._t0 or self._snap_dir == 0:
+            self._snap_dir = 1 if shift > 1e-9 else -1 if shift < -1e-9 else 0
+        self._snap_shift = xy - want
+        self._snap_shift_at = self._t0
+        self._foothold, self._foothold_ground = xy.copy(), ground_l
+        ground_f = terrain.height(swing_sole[:2])
+        self._level_change = max(abs(ground_l - ground_s), abs(ground_l - ground_f)) > self.config.step_change_m
         self._landing[:2] = xy
         self._landing[2] = u[2] + ground_l - ground_s
         start = self._swing_from[:2] if self._swinging else self._landing[:2]
         self._path_top = terrain.max_height_along(start, xy, self._landing_yaw) - ground_s
+
+    def _dcm_short_of_stance(self, command_h: np.ndarray, soles_m: np.ndarray, dcm_xy: np.ndarray) -> bool:
+        """Near a step, whether the DCM lies behind the stance sole's centre along the motion: lifting
+        the other foot then, the DCM runs back off the sole's heel (after a long step up onto a tread
+        the trailing foot lifted with the DCM 0.13 m short of the front sole and the robot fell back,
+        measured)."""
+        if self.terrain.flat or float(np.hypot(command_h[0], command_h[1])) <= self.config.moving_speed:
+            return False
+        direction = self.heading + math.atan2(command_h[1], command_h[0])
+        along = np.array([math.cos(direction), math.sin(direction)])
+        return float((dcm_xy - soles_m[self.stance, :2]) @ along) < 0.0
 
     def _in_swing(self, t_s: float) -> bool:
         return t_s - self._t0 >= self.active.double_support_s
@@ -651,6 +728,17 @@ class VelocityGait:
         self._ref[:] = 0.0
         self._ref[0] = (soles_m[swing, 0], soles_m[swing, 1], sole_yaws[swing])
         self._lifted_at = self._t0
+        cfg = self.config
+        if self._snap_shift_at == self._t0 and self._level_change:
+            # a step onto another level swings long enough to cross at terrain_swing_speed_mps on
+            # average (the trailing foot's 0.6 m at 0.42 s threw the body, measured)
+            across = float(np.hypot(*(self._landing[:2] - soles_m[swing, :2])))
+            window = 1.0 - cfg.terrain_hold - 0.6 * cfg.swing_fall
+            single = min(max(self.active.single_support_s, across / (cfg.terrain_swing_speed_mps * window)),
+                         cfg.terrain_max_single_support_s)
+            if single > self.active.single_support_s:
+                self.step_T += single - self.active.single_support_s
+                self.active = dataclasses.replace(self.active, single_support_s=single)
 
     def _side_by_side(self, soles_m: np.ndarray, sole_yaws: np.ndarray) -> bool:
         cfg = self.config
@@ -707,6 +795,10 @@ class VelocityGait:
         b_now = _rot2(self.heading - float(command_h[2]) * t_in) @ nominal_dcm_offset(cfg, s, command_h[:2], omega,
                                                                                       self._turn(command_h))
         xi_nom = u[:2] + b_now * math.exp(omega * t_in)
+        if self._snap_shift_at == self._t0:
+            # the landing the terrain moved (onto a tread) moves the DCM's plan with it: the DCM at
+            # touchdown is to lie that much further, so its plan now is that much e^{-w t_r} further
+            xi_nom = xi_nom + self._snap_shift * math.exp(-omega * t_r)
         out.dcm_error_m = float(np.hypot(*(dcm_xy - xi_nom)))
         if self._swinging and t_in >= Tds and out.dcm_error_m > cfg.recovery_dcm_error_m:
             self._recovery_at = self._t0
@@ -729,7 +821,10 @@ class VelocityGait:
         tau = (t_in - Tds) / cfg.single_support_s
         if tau < cfg.freeze_landing_after or not self._swinging:
             heading_td, rel, excess = self._landing_for(t_r, p, u, f, dcm_xy, omega, command_h)
-            if excess > cfg.timing_adjust_excess_m and self._swinging:
+            # a step onto another level keeps its timing: sooner, its swing had no time to go up,
+            # across and down (it crossed 0.43 m in 0.05 s and caught the edge, measured)
+            level_change = self._snap_shift_at == self._t0 and self._level_change
+            if excess > cfg.timing_adjust_excess_m and self._swinging and not level_change:
                 # step timing: the step cannot reach far enough in time; land sooner, when the
                 # DCM has not yet run as far (the earliest that leaves the swing its minimum)
                 t_sw = t_in - Tds
@@ -753,7 +848,7 @@ class VelocityGait:
             lim = cfg.max_relative_yaw_rad
             self._landing_yaw = yaw_s + min(max(dyaw, -lim), lim)
             if not self.terrain.flat:
-                self._on_terrain(u, yaw_s, heading_td)
+                self._on_terrain(u, soles_m[f], heading_td)
         out.landing_m[:] = self._landing
         if not self._swinging:
             return out
@@ -780,7 +875,7 @@ class VelocityGait:
         apex = max(z0, z1) + cfg.swing_height_m
         if stepping:
             apex = max(apex, u[2] + self._path_top + cfg.terrain_clearance_m)
-        rise = min(cfg.swing_rise, hold) if stepping else cfg.swing_rise
+        rise = cfg.terrain_rise if stepping else cfg.swing_rise
         up = _smooth(t_sw / (rise * Tss), rise * Tss)
         fall = min(cfg.swing_fall * Tss, 0.5 * Tsw)
         down = _smooth((t_sw - (Tsw - fall)) / fall, fall)

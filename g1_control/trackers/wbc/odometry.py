@@ -4,10 +4,17 @@ orientation). Between anchors the estimator's velocity (IMU + leg kinematics) ca
 position, and a first-order correction pulls it to the anchored value, so a change in the set of
 stance feet never makes the position jump.
 
+On steps (a height map of the scene, trackers/wbc/terrain.py), a foot's anchor takes its height
+from the map at touchdown: the schedule's touchdown comes while the foot may still be above the
+tread, and an anchor set there left the base (and the CoM's height reference) several centimetres
+too high on the step, the stance knee straight (0.15 m step: 5 cm, measured).
+
 Nothing here reads simulator ground truth: it is the same computation on the robot.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 
@@ -30,8 +37,9 @@ class BaseOdometry:
         self._anchored[:] = True
 
     def update(self, dt_s: float, base_linvel_w_mps: np.ndarray, sole_offsets_w_m: np.ndarray,
-               stance: np.ndarray) -> np.ndarray:
-        """Advance by dt_s; sole_offsets_w_m: (2, 3) sole positions minus base position, world axes."""
+               stance: np.ndarray, ground_height: Callable[[np.ndarray], float] | None = None) -> np.ndarray:
+        """Advance by dt_s; sole_offsets_w_m: (2, 3) sole positions minus base position, world axes.
+        ground_height: the map's height (m) at an xy (None: the anchor keeps the estimate's height)."""
         p = self.base_pos_w_m
         p += base_linvel_w_mps * dt_s
         kin, n = np.zeros(3), 0
@@ -42,6 +50,8 @@ class BaseOdometry:
             if not self._anchored[i]:
                 # Touchdown: anchor the foot where the current estimate puts it (continuity).
                 self.anchors_w_m[i] = p + sole_offsets_w_m[i]
+                if ground_height is not None:
+                    self.anchors_w_m[i, 2] = ground_height(self.anchors_w_m[i, :2])
                 self._anchored[i] = True
             kin += self.anchors_w_m[i] - sole_offsets_w_m[i]
             n += 1

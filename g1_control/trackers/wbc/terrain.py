@@ -115,18 +115,20 @@ class Terrain:
         return bool(self._sole_heights(xy_m, yaw_rad, self._toe_points).max() <= h.max() + tol)
 
     def snap(self, xy_m: np.ndarray, yaw_rad: float, heading_rad: float,
-             forward_only: bool = False) -> tuple[np.ndarray, float]:
+             forward_only: bool = False, backward_only: bool = False,
+             max_shift_m: float | None = None) -> tuple[np.ndarray, float]:
         """(foothold xy, its height): xy_m moved along heading_rad to the nearest place where the
         sole lies on one level (module docstring); unchanged when it does or none is in reach.
-        forward_only: only along heading_rad, not against it."""
+        forward_only / backward_only: only along heading_rad / only against it; max_shift_m: the
+        reach (TerrainConfig.max_shift_m by default)."""
         xy = np.asarray(xy_m, dtype=float)[:2]
         if self.flat or self.is_level(xy, yaw_rad):
             return xy.copy(), self.sole_height(xy, yaw_rad)
         c = self.config
         direction = np.array([math.cos(heading_rad), math.sin(heading_rad)])
-        n = int(c.max_shift_m / c.shift_step_m)
+        n = int((c.max_shift_m if max_shift_m is None else max_shift_m) / c.shift_step_m)
         for k in range(1, n + 1):
-            for sign in ((1.0,) if forward_only else (1.0, -1.0)):
+            for sign in ((1.0,) if forward_only else (-1.0,) if backward_only else (1.0, -1.0)):
                 p = xy + sign * k * c.shift_step_m * direction
                 if self.is_level(p, yaw_rad):
                     return p, self.sole_height(p, yaw_rad)

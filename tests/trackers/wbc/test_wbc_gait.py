@@ -248,3 +248,64 @@ def test_axis_limits_at_a_cadence_are_the_bisection_of_step_load_bit_for_bit():
             fast = _axis_limits(cfg, margin, cadence)
             generic = tuple(_axis_limit_bisected(cfg, margin, cadence, axis, sign) for axis, sign in _AXES)
             assert fast == generic, (cadence, margin)
+
+
+def _step_ahead(x_edge: float = 1.0):
+    from g1_control.scene import Platform, SceneConfig
+    from g1_control.trackers.wbc.terrain import Terrain
+
+    return Terrain.of_scene(SceneConfig(platforms=[Platform("step", (x_edge + 0.6, 0.0), (1.2, 1.4), 0.15)]))
+
+
+def _double_support_after_first_touchdown(terrain, dcm_ahead_of_right_m):
+    """How long (s) the left foot stays down after the first step's touchdown (the right foot's), the
+    DCM held dcm_ahead_of_right_m ahead of the right sole."""
+    gait = VelocityGait(GaitConfig(), terrain)
+    soles, yaws = _feet()
+    soles[:, 0] += 0.6
+    cmd = np.array([0.3, 0.0, 0.0])
+    t = _into_single_support(gait, soles, yaws)
+    dcm = soles[RIGHT, :2] + np.array([dcm_ahead_of_right_m, 0.05])
+    while gait.stance == LEFT:
+        t += 0.004
+        gait.schedule(t, cmd, soles, yaws, dcm)
+    touchdown = t
+    while gait.targets.contacts[LEFT] and t < touchdown + 2.0:
+        t += 0.004
+        gait.schedule(t, cmd, soles, yaws, dcm)
+    return t - touchdown
+
+
+def test_near_a_step_the_other_foot_lifts_only_once_the_dcm_is_over_the_stance_sole():
+    cfg = GaitConfig()
+    near = _step_ahead()
+    # the DCM behind the stance sole: the double support waits for it, at most terrain_max_wait_s
+    waited = _double_support_after_first_touchdown(near, -0.05)
+    assert waited == pytest.approx(cfg.double_support_s + cfg.terrain_max_wait_s, abs=0.01)
+    # over it, or on flat ground, the double support is the configured one
+    assert _double_support_after_first_touchdown(near, 0.02) == pytest.approx(cfg.double_support_s, abs=0.005)
+    assert _double_support_after_first_touchdown(None, -0.05) == pytest.approx(cfg.double_support_s, abs=0.005)
+
+
+def test_at_a_riser_the_step_goes_onto_the_tread_and_keeps_that_level():
+    """The stance foot just short of a riser: the landing the DCM asks lies across the edge; moved
+    back it would gain nothing, so it goes onto the tread (further than TerrainConfig.max_shift_m
+    reaches), whole sole on it; the DCM then falling back does not bring the landing back down."""
+    terrain = _step_ahead(1.0)
+    tc = terrain.config
+    gait = VelocityGait(GaitConfig(), terrain)
+    soles, yaws = _feet()
+    soles[:, 0] = 1.0 - tc.sole_half_length_m - tc.riser_gap_m - 0.01
+    t = _into_single_support(gait, soles, yaws)
+    dcm = soles[LEFT, :2] + np.array([0.05, -0.03])  # asks a short step, across the edge
+    out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+    landing = out.landing_m.copy()
+    assert landing[2] == pytest.approx(0.15)
+    assert landing[0] - tc.sole_half_length_m - tc.edge_margin_m >= 1.0 - 1e-9
+    assert landing[0] - soles[LEFT, 0] > tc.max_shift_m + 0.05
+    assert terrain.is_level(landing[:2], 0.0)
+    for _ in range(5):
+        t += 0.004
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+        out = gait.update(t, 0.004, soles, yaws, dcm - np.array([0.04, 0.0]), OMEGA)
+        assert out.landing_m[2] == pytest.approx(0.15) and terrain.is_level(out.landing_m[:2], 0.0)

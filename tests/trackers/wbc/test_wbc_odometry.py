@@ -37,3 +37,28 @@ def test_touchdown_anchors_where_the_foot_lands_without_a_jump():
 def test_bad_time_constant_is_refused():
     with pytest.raises(WbcConfigError, match="correction_tau_s must be > 0"):
         BaseOdometry(0.0)
+
+
+def test_touchdown_on_a_mapped_tread_anchors_the_foot_at_the_maps_height():
+    # the schedule's touchdown comes with the foot 4 cm above a 0.15 m tread: the anchor takes the
+    # tread's height from the map, and the base settles 4 cm lower than the foot's estimate says
+    odo = BaseOdometry(correction_tau_s=0.05)
+    base = np.array([0.0, 0.0, 0.75])
+    odo.reset(base, FEET - base)
+    offsets = FEET - base
+    offsets[0] += (0.3, 0.0, 0.19)
+
+    def tread(xy):
+        return 0.15 if xy[0] > 0.2 else 0.0
+
+    odo.update(0.002, np.zeros(3), offsets, np.array([False, True]), tread)
+    for _ in range(200):
+        est = odo.update(0.002, np.zeros(3), offsets, np.array([True, False]), tread)
+    assert odo.anchors_w_m[0, 2] == pytest.approx(0.15)
+    assert est[2] == pytest.approx(0.75 - 0.04, abs=1e-4)
+    # without a map the anchor keeps the estimate's height
+    plain = BaseOdometry(correction_tau_s=0.05)
+    plain.reset(base, FEET - base)
+    plain.update(0.002, np.zeros(3), offsets, np.array([False, True]))
+    plain.update(0.002, np.zeros(3), offsets, np.array([True, False]))
+    assert plain.anchors_w_m[0, 2] == pytest.approx(0.19)
