@@ -179,13 +179,16 @@ class Run:
         return [(round(t["t_s"] - T0, 6), t["from"], t["to"], t["reason"]) for t in self.report.transitions]
 
 
-def _run(tmp_path, clock: Clock, changes: dict | None = None, device: InputDevice | None = None, yes: bool = True,
+def _run(tmp_path, clock: Clock, changes: dict | None = None, device=None, yes: bool = True,
          duration_s: float | None = 5.0, prepare=None, finish: bool = True) -> Run:
-    """The control phase of a deploy as session._control runs it (build_loop, check_chain, open_run_folder,
-    run, finish) on the stand-in clock and link; `prepare(control, link)` runs before run()."""
+    """The control phase of a deploy as session._control runs it (build_loop, open_run_folder, run, finish)
+    on the stand-in clock and link. `device`: the operator's (None: the launch file's input; a function
+    of the launch file: made from it); `prepare(control, link)` runs before run()."""
     changes = dict(changes or {})
     launch = load_launch(write_launch(tmp_path, {**changes, "deploy": {**TIMING, **changes.get("deploy", {})}}))
     link = StandInLink(clock, launch.safety.damping_kd)
+    if callable(device):
+        device = device(launch)
     if device is None:
         device, why = _open_input(launch, link, None)
         assert why is None, why
@@ -394,3 +397,22 @@ def test_an_unexpected_exception_still_ends_in_damping_and_propagates(tmp_path, 
         _run(tmp_path, clock, device=Remote(at=(T0 + 1.0, RuntimeError("driver crashed"))), finish=False)
     assert signal.getsignal(signal.SIGTERM) == before
     assert clock.t == pytest.approx(T0 + 1.5), "damping streamed exit_damping_s before the link closes"
+
+
+
+@pytest.mark.parametrize("instruction, finished", [("wait 1 second", True), ("wait 10 seconds", False)])
+def test_a_behaviour_programs_steps_and_whether_it_finished_go_into_the_report(tmp_path, clock, instruction,
+                                                                             finished):
+    from g1_control.program import parse_instruction
+    from g1_control.program.device import ProgramInput, record_dict
+
+    def program(launch):  # as deploy() wraps the operator's device
+        return ProgramInput(parse_instruction(instruction), launch.program_world(), pose="estimator",
+                            start_delay_s=0.5, operator=Remote())
+
+    run = _run(tmp_path, clock, device=program, duration_s=3.0)
+    device = run.control.device
+    assert isinstance(device, ProgramInput)
+    assert run.report.control["program"] == {"steps": [record_dict(r) for r in device.records], "finished": finished}
+    assert len(run.report.control["program"]["steps"]) == int(finished)
+    assert run.summary()["control"]["program"]["finished"] is finished
