@@ -28,7 +28,7 @@ from deploy_test_helpers import ROOT, write_launch
 
 from g1_control.deploy import session
 from g1_control.deploy.session import DeployOptions, DeployReport, _open_input, _RobotControl
-from g1_control.errors import RobotNotConnectedError
+from g1_control.errors import InvalidCommandError, RobotNotConnectedError
 from g1_control.hardware.link_backend import LinkStats
 from g1_control.interfaces import Backend, InputDevice
 from g1_control.launch.schema import load_launch
@@ -86,6 +86,8 @@ class StandInLink(Backend):
         """From this time on, the waist yaw motor reports 110 degC."""
         self.lost_at: float | None = None
         """From this time on, no state arrives (read_state raises, as LinkBackend does)."""
+        self.refuses_at: float | None = None
+        """From this time on, write_command raises (the link refuses the command, as LinkBackend does)."""
 
     def reset(self) -> RobotState:
         return self.read_state()
@@ -103,6 +105,8 @@ class StandInLink(Backend):
         return state
 
     def write_command(self, command: MotorCommand) -> None:
+        if self.refuses_at is not None and self.clock.t >= self.refuses_at:
+            raise InvalidCommandError("MotorCommand.q_rad has shape (23,); expected (29,)")
         self.streaming = dataclasses.replace(command, q_rad=command.q_rad.copy(), kp=command.kp.copy(),
                                              kd=command.kd.copy())
         self.sent.append((self.clock.t, self.streaming))
@@ -250,7 +254,8 @@ def test_the_report_measures_control_over_its_steady_window_after_the_gaits_firs
     assert c["velocity_est_mean"] != pytest.approx(_window_mean(log, "velocity_est", T0 + 5.52, T0 + 8.5), abs=1e-6)
     assert c["velocity_est_mean"][2] == pytest.approx(0.05 * 7.0, abs=0.02)
     assert list(c["upper_body_vs_plan"]) == ["default"]
-    assert c["upper_body_vs_plan"]["default"]["seconds"] == pytest.approx(5.0, abs=0.03)
+    # the upper body over the whole of control, [start, end): 250 ticks of 20 ms
+    assert c["upper_body_vs_plan"]["default"]["seconds"] == pytest.approx(5.0, abs=1e-9)
 
 
 @pytest.mark.parametrize("control_s", [3.0, 4.5])
@@ -365,6 +370,9 @@ def test_a_trip_in_control_is_a_fault_that_ends_in_damping(tmp_path, clock):
     assert run.transitions()[-1] == (4.02, "control", "damping", f"over_temperature: {trip[0]['detail']}")
     assert run.summary()["status"] == "fault" and run.link.streams_damping()
     assert clock.t == pytest.approx(T0 + 4.52) and run.link.damped_at == [clock.t]
+    # half a second of control: measured whole
+    assert run.report.control["duration_s"] == pytest.approx(0.52)
+    assert run.report.control["steady_window_s"] == pytest.approx(0.52)
 
 
 def test_an_error_in_control_damps_ends_the_run_as_an_error_and_is_raised_after_the_report(tmp_path, clock):
@@ -416,3 +424,18 @@ def test_a_behaviour_programs_steps_and_whether_it_finished_go_into_the_report(t
     assert run.report.control["program"] == {"steps": [record_dict(r) for r in device.records], "finished": finished}
     assert len(run.report.control["program"]["steps"]) == int(finished)
     assert run.summary()["control"]["program"]["finished"] is finished
+
+
+def test_a_control_phase_without_a_logged_tick_reports_no_means(tmp_path, clock):
+    """The link refuses the first command of control (the tick control starts, before it is logged): the
+    run ends in damping at that instant, and the report has no mean of an empty window."""
+    def refuse(control, link):
+        link.refuses_at = T0 + 3.5
+
+    run = _run(tmp_path, clock, prepare=refuse)
+    assert isinstance(run.error, InvalidCommandError) and run.raised is run.error
+    assert run.transitions()[-2:] == [(3.5, "hold", "control", "run (--yes)"),
+                                      (3.5, "control", "damping", f"estop: error: {run.error}")]
+    c = run.report.control
+    assert (c["duration_s"], c["steady_window_s"]) == (0.0, 0.0)
+    assert c["velocity_est_mean"] is None and c["command_mean"] is None and c["upper_body_vs_plan"] == {}
