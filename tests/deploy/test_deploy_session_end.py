@@ -439,3 +439,16 @@ def test_a_control_phase_without_a_logged_tick_reports_no_means(tmp_path, clock)
     c = run.report.control
     assert (c["duration_s"], c["steady_window_s"]) == (0.0, 0.0)
     assert c["velocity_est_mean"] is None and c["command_mean"] is None and c["upper_body_vs_plan"] == {}
+
+
+def test_goals_whose_turn_never_came_are_reported_and_written_to_the_run_folder(tmp_path, clock):
+    """launch/sim2sim_goals.yaml (the layer tracker; its goals planned in the planner's own process)
+    stopped after 1 s of control, before the timeline's first goal (at 2 s)."""
+    run = _run(tmp_path, clock, yaml.safe_load((ROOT / "launch" / "sim2sim_goals.yaml").read_text()), duration_s=1.0)
+    assert [(g["goal_id"], g["status"], g["message"]) for g in run.report.goals] == [
+        (f"seg{i}.0", "not started", "control ended before the goal's turn came") for i in (1, 2, 3)]
+    lines = (Path(run.report.run_dir or "") / "events.jsonl").read_text().splitlines()
+    written = [json.loads(line) for line in lines]
+    assert [{k: v for k, v in e.items() if k != "t_run_s"} for e in written if e["type"] == "goal"] == [
+        {"type": "goal", **g} for g in run.report.goals]
+    assert run.summary()["goals"] == run.report.goals
