@@ -258,10 +258,12 @@ def test_the_report_measures_control_over_its_steady_window_after_the_gaits_firs
     assert c["upper_body_vs_plan"]["default"]["seconds"] == pytest.approx(5.0, abs=1e-9)
 
 
-@pytest.mark.parametrize("control_s", [3.0, 4.5])
+@pytest.mark.parametrize("control_s", [3.0, 4.0, 4.5])
 def test_a_short_control_phase_is_measured_whole_and_a_longer_one_from_2_s_in(tmp_path, clock, control_s):
+    """Up to 4 s of control (4 s included: on this clock control lasts exactly 4.0 s) is measured whole."""
     run = _run(tmp_path, clock, duration_s=control_s)
     c, log = run.report.control, run.log()
+    assert c["duration_s"] == control_s  # exactly: the ticks of 20 ms fall on whole and half seconds here
     start, end = T0 + 3.5, T0 + 3.5 + control_s
     steady_from = start + (2.0 if control_s > 4.0 else 0.0)
     assert c["duration_s"] == pytest.approx(control_s) and c["steady_window_s"] == pytest.approx(end - steady_from)
