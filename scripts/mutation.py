@@ -81,12 +81,13 @@ GROUPS: dict[str, dict[str, list[str]]] = {
                    "g1_control.safety.fall.*", "g1_control.deploy.state_machine.*",
                    *(f"g1_control.deploy.session.*{f}__mutmut_*" for f in (
                        "_end_in_damping", "_on_signal", "finish", "_fill_report", "_state_machine"))],
-        # Lockstep tests only: the deploys over DDS run on the wall clock, and under mutmut (nice 19,
-        # beside other work) their loop misses deadlines and trips, which fails mutmut's clean run.
-        # Their mutants: group loop-dds, on a quiet machine.
+        # No wall clock: the deploys over DDS run on it, and under mutmut (nice 19, beside other work)
+        # their loop misses deadlines and trips, which fails mutmut's clean run (group loop-dds, for a
+        # quiet machine). The session's end of run runs on a stand-in clock (test_deploy_session_end.py).
         "tests": ["tests/loop/test_control_loop.py", "tests/safety/test_safety_fall.py",
                   "tests/launch/test_launch_trips.py", "tests/deploy/test_deploy_state_machine.py",
-                  "tests/deploy/test_deploy_state_machine_edges.py", "tests/loop/test_control_loop_trips.py"],
+                  "tests/deploy/test_deploy_state_machine_edges.py", "tests/loop/test_control_loop_trips.py",
+                  "tests/deploy/test_deploy_session_end.py"],
     },
     "velocity": {
         # locomotion.py is mutated whole; only VelocityCorrector's mutants are counted (the tracker's
