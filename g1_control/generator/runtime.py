@@ -130,7 +130,7 @@ class RuntimeConfig:
     """... but not before this frame (0-based)."""
     hold_every_frames: int = 2
     """A goal without a time is held: given again every this many frames after its first frame."""
-    velocity_feedback_gain: float = 0.5
+    velocity_feedback_gain: float = 0.3
     """Plan-velocity feedback: at each plan, this fraction of the error between the command's (vx, vy,
     wz) and the plan's own over the last `velocity_feedback_frames` (its executed frames, heading frame)
     is added to what the primitives are asked for (an integrator, at most velocity_feedback_max per
@@ -139,6 +139,10 @@ class RuntimeConfig:
     and 0.03-0.13 rad/s in yaw walking 0.5-0.6 m/s forward (measured, five styles); a tracker that walks
     the plan (the whole-body controller) walks those errors. 0 disables."""
     velocity_feedback_frames: int = 30
+    velocity_feedback_settle_s: float = 2.0
+    """The integrator starts this long after the command changed (the window must hold only this
+    command's settled plan: from 0.5 m/s forward to 0.3 back, it read the turnaround as error and
+    the whole-body controller walked back at 0.37, measured)."""
     velocity_feedback_max: tuple[float, float, float] = (0.3, 0.3, 0.4)
 
 
@@ -217,7 +221,7 @@ class InbetweeningGenerator(Generator):
         self._feedback = np.zeros(3)
         self._root_track = self.history[:, 0:5].copy()
         self._feedback_key: tuple | None = None
-        self._feedback_from = 0
+        self._feedback_from = 0.0
 
     # ------------------------------------------------------------------ planning
     def _root_state(self) -> RootState:
@@ -253,7 +257,7 @@ class InbetweeningGenerator(Generator):
         if key != self._feedback_key:
             self._feedback_key = key
             self._feedback[:] = 0.0
-            self._feedback_from = self.stats.replans
+            self._feedback_from = self._t
         # walking straight only: with a turn commanded, the feedback slowed the plan's forward speed
         # (0.3 m/s at 0.5 rad/s: 0.24-0.28 planned without it, 0.21-0.23 with it, measured)
         straight = max(abs(command.vx_mps), abs(command.vy_mps)) > cfg.velocity_deadband_mps and \
@@ -262,8 +266,8 @@ class InbetweeningGenerator(Generator):
             self._feedback[:] = 0.0
             return v_cmd, wz
         plan = self._plan_velocity()
-        # the plan's last frames must be this command's: at least one plan made for it already executed
-        if plan is not None and self.stats.replans - self._feedback_from >= 2:
+        # the plan's last second must be this command's, the primitives' spring settled
+        if plan is not None and self._t - self._feedback_from >= cfg.velocity_feedback_settle_s:
             err = np.array([command.vx_mps, command.vy_mps, command.wz_radps]) - plan
             lim = np.asarray(cfg.velocity_feedback_max)
             self._feedback[:] = np.clip(self._feedback + cfg.velocity_feedback_gain * err, -lim, lim)
