@@ -53,7 +53,7 @@ def launch_cases() -> dict[str, str | bytes]:
         "physics_dt_too_large.yaml": b + "backend: {physics_dt_s: 0.1}\n",
         "scripted_without_timeline.yaml": b.replace(
             "  timeline:\n    - {duration_s: 2.0, vx_mps: 0.3, label: walk}\n", ""),
-        "wbc_too_slow.yaml": b + "tracker: {type: wbc}\ngenerator: {type: scripted}\n",
+        "wbc_too_slow.yaml": b + "tracker: {type: wbc}\ngenerator: {type: scripted}\nrates: {tracker_hz: 50}\n",
         "wbc_foot_friction_zero.yaml": b + "rates: {tracker_hz: 250}\ntracker: {type: wbc, foot_friction: 0}\n",
         "wbc_foot_friction_nan.yaml": b + "rates: {tracker_hz: 250}\ntracker: {type: wbc, foot_friction: .nan}\n",
         "unknown_reference.yaml": b + "rates: {tracker_hz: 250}\ntracker: {type: wbc}\n"
