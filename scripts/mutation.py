@@ -40,7 +40,7 @@ GROUPS: dict[str, dict[str, list[str]]] = {
         # to run per mutant on 2 cores; it runs in every CI run.
         "tests": ["tests/safety/test_safety_filter.py", "tests/safety/test_safety_guards.py",
                   "tests/safety/test_guarded_backend.py", "tests/safety/test_safety_edges.py",
-                  "tests/safety/test_guarded_backend_edges.py"],
+                  "tests/safety/test_guarded_backend_edges.py", "tests/safety/test_safety_ik_failure.py"],
     },
     "preflight": {
         "mutate": ["g1_control/deploy/preflight.py"],
@@ -77,7 +77,7 @@ GROUPS: dict[str, dict[str, list[str]]] = {
         "select": ["g1_control.loop.control_loop.x_first_fault*", "g1_control.loop.control_loop.xǁLoopEventǁ*",
                    *(f"g1_control.loop.control_loop.xǁControlLoopǁ{f}__mutmut_*" for f in (
                        "_safety", "_on_safety_event", "_check_fall", "_read_state", "_fault", "_event", "faulted",
-                       "fall", "fell", "_feed_back")),
+                       "fall", "fell", "_feed_back", "_retarget")),
                    "g1_control.safety.fall.*", "g1_control.deploy.state_machine.*",
                    *(f"g1_control.deploy.session.*{f}__mutmut_*" for f in (
                        "_end_in_damping", "_on_signal", "finish", "_fill_report", "_state_machine"))],
@@ -87,7 +87,7 @@ GROUPS: dict[str, dict[str, list[str]]] = {
         "tests": ["tests/loop/test_control_loop.py", "tests/safety/test_safety_fall.py",
                   "tests/launch/test_launch_trips.py", "tests/deploy/test_deploy_state_machine.py",
                   "tests/deploy/test_deploy_state_machine_edges.py", "tests/loop/test_control_loop_trips.py",
-                  "tests/deploy/test_deploy_session_end.py"],
+                  "tests/deploy/test_deploy_session_end.py", "tests/loop/test_control_loop_ik_failure.py"],
     },
     "velocity": {
         # locomotion.py is mutated whole; only VelocityCorrector's mutants are counted (the tracker's
