@@ -102,6 +102,7 @@ def test_one_failed_tick_holds_the_last_good_reference_and_the_run_goes_on(ik_co
     assert event.detail == ("the IK found no solution: the last good reference is held (up to 3 tracker ticks): "
                             f"NoSolutionFound: {INFEASIBLE}")
     assert event.t_s == pytest.approx(0.1)
+    assert str(event) == f"ik_hold: {event.detail}"  # not a trip: no "(damping)"
     assert [r["kind"] for r in records] == ["ik_hold"] and records[0]["trips"] is False
     assert first_fault(records) is None
 
