@@ -1,6 +1,6 @@
 """DDS links left open close themselves at interpreter exit, before the interpreter's teardown deletes
 the Cyclone domains and entities (g1_control/hardware/links/dds.py: _close_links_at_exit): a process
-whose links still stream from daemon threads (a writer on each side, a reader on each side) exits 0,
+whose links still stream from daemon threads (a writer on each side, a reader asking discovery too on each side) exits 0,
 its links were closed by the exit hook, and the threads' last writes are dropped without an error
 (CI's timing pass segfaulted once at exit after all its tests passed, stop 34)."""
 
@@ -40,9 +40,10 @@ SCRIPT = textwrap.dedent("""
                 seen["errors"] += 1
             time.sleep(0.001)
 
-    def receive(link):
+    def receive(link):  # as a link backend's reader thread: samples, and discovery now and then
         while True:
             received[0] += len(link.receive(0.01))
+            link.peer_writers()
 
     for target, args in ((send, (robot, LowState().to_dds())), (send, (host, LowCmd().to_dds())),
                          (receive, (host,)), (receive, (robot,))):

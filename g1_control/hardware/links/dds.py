@@ -207,6 +207,8 @@ class DdsLink(Link):
         from cyclonedds.qos import Policy
 
         with self._peer_lock:
+            if self._closed:  # a reader thread's last look after the link closed (at exit: _close_links_at_exit)
+                return dict.fromkeys(self._topics, 0)
             if self._publications is None:
                 self._publications = BuiltinDataReader(self._participant, BuiltinTopicDcpsPublication)
             return self._update_writers(InstanceState, Policy)
@@ -243,4 +245,6 @@ class DdsLink(Link):
             self._closed = True
             _open_links.discard(self)
             self._waitset.detach(self._condition)
-            del self._writer, self._reader, self._condition, self._waitset, self._participant, self._publications
+            del self._writer, self._reader, self._condition, self._waitset
+            with self._peer_lock:  # not while peer_writers() reads discovery
+                del self._participant, self._publications
