@@ -69,6 +69,12 @@ class SafetyConfigError(G1ControlError, ValueError):
     """A safety configuration with a missing, negative or non-finite threshold."""
 
 
+class RetargetError(G1ControlError, RuntimeError):
+    """The retargeter (IK stage) found no joint reference for this tick, even with its constraints
+    relaxed. The control loop holds the last good reference for safety.ik_hold_ticks tracker ticks,
+    then damps (g1_control/loop/control_loop.py)."""
+
+
 class WbcConfigError(G1ControlError, ValueError):
     """A whole-body controller configuration or input that cannot be used (bad gains, shapes, geometry)."""
 

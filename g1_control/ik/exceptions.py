@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from g1_control.errors import G1ControlError
+from g1_control.errors import G1ControlError, RetargetError
 
 
 class IKError(G1ControlError):
@@ -32,5 +32,6 @@ class InvalidReferenceError(IKError, ValueError):
     """A KinematicReference the retargeter cannot act on (NaN, wrong shape, unknown frame)."""
 
 
-class NoSolutionFound(IKError, RuntimeError):
-    """The QP solver found no solution (infeasible constraints or iteration limit)."""
+class NoSolutionFound(IKError, RetargetError):
+    """The QP solver found no solution (infeasible constraints or iteration limit). Out of the
+    retargeter (every relaxation failed too) it is the loop's RetargetError: a typed safety event."""

@@ -538,8 +538,14 @@ class IKRetargeter(Retargeter):
         tasks = self._set_targets(ref)
         self.smoothness_task.set_previous_step(self._last_step / cfg.iterations, check=False)
         self.last_solve_soft_contacts = False
-        for _ in range(cfg.iterations):
-            self._take_step(tasks)
+        try:
+            for _ in range(cfg.iterations):
+                self._take_step(tasks)
+        except NoSolutionFound:
+            # No step even relaxed: the next tick starts from this one's start (the base where the last
+            # good solve left it), not from a partly taken step. The caller decides (the loop holds).
+            conf.update(q_start, check=False)
+            raise
         self._project()
         self._last_step = pin.difference(conf.model, q_start, conf.q)
         self._initialised = True

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from g1_control.errors import InvalidCommandError, InvalidStateError
+from g1_control.errors import InvalidCommandError, InvalidStateError, RetargetError
 from g1_control.estimation.estimator import StateEstimator
 from g1_control.estimation.localiser import Localiser
 from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, Tracker
@@ -116,8 +116,8 @@ class ControlLoop:
     """One tick: input -> estimator -> generator -> retargeter -> tracker -> safety -> low-level.
 
     Every motor command passes the SafetyFilter (clamps to limits; damping for good on a fall,
-    stale or non-finite state, NaN output, e-stop, lost operator input, ...), in simulation as on
-    the robot. Time for the safety checks is the loop's own clock: simulated time in lockstep,
+    stale or non-finite state, NaN output, e-stop, lost operator input, an IK without a solution for
+    longer than safety.ik_hold_ticks ticks, ...), in simulation as on the robot. Time for the safety checks is the loop's own clock: simulated time in lockstep,
     the monotonic clock otherwise (the robot's states are stamped with it on arrival).
 
     Falls are judged every tracker tick by a FallMonitor (g1_control/safety/fall.py) from the
@@ -283,7 +283,16 @@ class ControlLoop:
 
     def _retarget(self) -> None:
         assert self._kin_ref is not None  # the generator stage ran first
-        self._joint_ref = self.retargeter.solve(self._kin_ref, self.state.q_rad)
+        try:
+            joint_ref = self.retargeter.solve(self._kin_ref, self.state.q_rad)
+        except RetargetError as exc:
+            # No reference this tick (the IK's QP failed even relaxed): the tracker keeps the last good
+            # one for up to safety.ik_hold_ticks ticks in a row; longer, or with none to keep, damps.
+            self.safety.report_ik_failure(f"{type(exc).__name__}: {exc}", self.now_s(),
+                                          can_hold=self._joint_ref is not None)
+            return
+        self._joint_ref = joint_ref
+        self.safety.report_ik_solved()
 
     def _track(self) -> None:
         if self.faulted:

@@ -53,6 +53,10 @@ class SafetyConfig:
     joint's mechanical stop is much closer)."""
     max_quat_norm_error: float = 0.1
     """Damp when the IMU quaternion's norm differs from 1 by more than this."""
+    ik_hold_ticks: int = 3
+    """While the IK finds no solution (even relaxed), the tracker keeps the last good reference for up
+    to this many tracker ticks in a row (3: 60 ms at 50 Hz); the next failure in a row damps. 0: damp
+    on the first failure. A whole number."""
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -68,6 +72,9 @@ class SafetyConfig:
         for name in ("crc_burst_count", "overrun_burst_count"):
             if int(getattr(self, name)) != getattr(self, name) or getattr(self, name) < 1:
                 raise SafetyConfigError(f"SafetyConfig.{name} is {getattr(self, name)}; it must be a whole number >= 1")
+        if int(self.ik_hold_ticks) != self.ik_hold_ticks:
+            raise SafetyConfigError(f"SafetyConfig.ik_hold_ticks is {self.ik_hold_ticks}; it must be a whole number "
+                                    ">= 0 (tracker ticks)")
         if self.max_tilt_rad >= math.pi:
             raise SafetyConfigError(f"SafetyConfig.max_tilt_rad is {self.max_tilt_rad}; it must be below pi "
                                     f"({math.pi:.4f} rad): no tilt exceeds pi, so the tilt trip could never fire")

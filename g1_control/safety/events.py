@@ -26,6 +26,12 @@ class SafetyEventKind(str, Enum):
     """The robot reports another mode_machine (DoF variant) than the one accepted at the start."""
     FOREIGN_PEER = "foreign_peer"
     """A second publisher of the robot's state, or another writer of its commands, on the link."""
+    IK_HOLD = "ik_hold"
+    """Not a trip: the IK found no solution this tick; the tracker keeps the last good reference
+    (for up to SafetyConfig.ik_hold_ticks tracker ticks in a row)."""
+    IK_FAILURE = "ik_failure"
+    """The IK found no solution for longer than SafetyConfig.ik_hold_ticks ticks in a row, or before
+    any good reference existed."""
     ESTOP = "estop"
 
 

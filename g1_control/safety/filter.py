@@ -6,7 +6,8 @@ finite everywhere, joints within their limits (give or take state_limit_margin_r
 quaternion, the mode_machine accepted at the start (`expect_mode_machine`; else the first one
 seen), a tick that advances. It trips on the first of: an invalid state, stale state, a burst of
 bad CRCs, a second publisher on the link, tilt (fall), joint over-speed, NaN/inf in a command,
-repeated deadline overruns, lost operator input, an over-temperature motor, or an e-stop; from
+repeated deadline overruns, lost operator input, an over-temperature motor, an IK that finds no
+solution for longer than ik_hold_ticks tracker ticks in a row, or an e-stop; from
 then on it returns the damping command (kp 0, kd > 0) for good. A new filter is the only way back: resuming control is an operator
 decision the deploy state machine makes, never this layer.
 
@@ -115,6 +116,10 @@ class SafetyFilter:
         self._last_input_s: float | None = None
         self._last_input: Command = Command()
         self._input_stale = False
+        self._ik_failures = 0
+        """IK failures in a row (tracker ticks without a new reference)."""
+        self.ik_held_ticks = 0
+        """Tracker ticks that ran on a held reference because the IK found no solution (all of the run)."""
 
     @property
     def tripped(self) -> bool:
@@ -224,6 +229,32 @@ class SafetyFilter:
                        f"{self.config.overrun_burst_count} deadline overruns within {self.config.overrun_window_s:.1f} s"
                        + (f" ({detail})" if detail else ""))
         return not self.tripped
+
+    def report_ik_solved(self) -> None:
+        """The IK found this tick's reference: a run of failures is over."""
+        self._ik_failures = 0
+
+    def report_ik_failure(self, reason: str, now_s: float, can_hold: bool) -> bool:
+        """The IK found no solution this tick (reason: its error). While fewer than ik_hold_ticks
+        failures came in a row and a good reference exists (can_hold), the tracker keeps the last good
+        reference: True (the first failure of a run is logged, not a trip). Otherwise trip: False."""
+        if self.tripped:
+            return False
+        self._ik_failures += 1
+        hold = int(self.config.ik_hold_ticks)
+        if not can_hold:
+            return self._trip(now_s, SafetyEventKind.IK_FAILURE,
+                              f"the IK found no solution before any good reference to hold: {reason}")
+        if self._ik_failures > hold:
+            return self._trip(now_s, SafetyEventKind.IK_FAILURE,
+                              f"the IK found no solution on {self._ik_failures} tracker ticks in a row "
+                              f"(safety.ik_hold_ticks {hold}): {reason}")
+        self.ik_held_ticks += 1
+        if self._ik_failures == 1:
+            self._log(SafetyEvent(now_s, SafetyEventKind.IK_HOLD,
+                                  f"the IK found no solution: the last good reference is held (up to {hold} "
+                                  f"tracker ticks): {reason}", trips=False))
+        return True
 
     def estop(self, reason: str, now_s: float, planned: bool = False) -> None:
         """Trip at once (e-stop button, SIGINT/SIGTERM, a fault found elsewhere). planned: an ending the

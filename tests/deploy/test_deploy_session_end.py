@@ -454,3 +454,33 @@ def test_goals_whose_turn_never_came_are_reported_and_written_to_the_run_folder(
     assert [{k: v for k, v in e.items() if k != "t_run_s"} for e in written if e["type"] == "goal"] == [
         {"type": "goal", **g} for g in run.report.goals]
     assert run.summary()["goals"] == run.report.goals
+
+
+def test_an_ik_that_stops_finding_solutions_holds_then_trips_and_the_deploy_damps(tmp_path, clock, monkeypatch):
+    """Issue 26, fail-soft IK: a generator whose references the IK solves (interpolation); from T0 + 4.0
+    the IK's QP finds no step (every solve, the relaxed retries too). Two ticks hold the last good
+    reference (safety.ik_hold_ticks 2), the third trips: a typed ik_failure fault, damping on the link,
+    the state machine in damping, not an error that ends the run."""
+    from g1_control.ik.exceptions import NoSolutionFound
+    from g1_control.ik.solver import QPSolver
+
+    qp_solve = QPSolver.solve
+
+    def failing_from_4_s(solver, *args, **kwargs):
+        if clock.t >= T0 + 4.0:
+            raise NoSolutionFound("daqp found no IK step (exit flag -1: infeasible constraints)")
+        return qp_solve(solver, *args, **kwargs)
+
+    monkeypatch.setattr(QPSolver, "solve", failing_from_4_s)
+    run = _run(tmp_path, clock, {"generator": {"type": "interpolation"}, "safety": {"ik_hold_ticks": 2}})
+    assert run.error is None and run.raised is None
+    events = [(e["kind"], e["trips"], round(e["t_s"] - T0, 6)) for e in run.report.safety_events]
+    assert events == [("ik_hold", False, 4.0), ("ik_failure", True, 4.04)], events
+    detail = ("the IK found no solution on 3 tracker ticks in a row (safety.ik_hold_ticks 2): "
+              "NoSolutionFound: daqp found no IK step (exit flag -1: infeasible constraints)")
+    assert run.report.safety_events[-1]["detail"] == detail
+    assert run.report.end_reason == detail and run.report.fault
+    assert run.link.sent_between(T0 + 4.0, T0 + 4.04)[-1].kp.max() > 0  # held: still under control
+    assert run.link.sent_between(T0 + 4.04, T0 + 4.06)[0].kp.max() == 0  # tripped: damping from that tick
+    assert run.transitions()[-1] == (4.06, "control", "damping", f"ik_failure: {detail}")
+    assert run.summary()["status"] == "fault" and run.link.streams_damping()

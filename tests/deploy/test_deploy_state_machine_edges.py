@@ -249,3 +249,16 @@ def test_a_scripted_timeline_plays_on_the_control_clock_once_given_one():
     assert ops.poll(1.5).vx_mps == 0.6, "no control clock yet: the loop's time"
     ops.timeline_clock = lambda: 0.5
     assert ops.poll(1.5).vx_mps == 0.3, "the control clock: 0.5 s into the timeline"
+
+
+def test_the_operators_button_chords_are_the_devices_own():
+    """What the loop's input says stops or starts the robot is what the device binds (a prompt or the
+    preflight asking the wrapped device gets the device's chords, per action)."""
+
+    class Bound(Buttons):
+        def button_chords(self, action: str) -> list[str]:
+            return {"estop": ["L1+R1"], "stop": ["B"]}.get(action, [])
+
+    ops = OperatorButtons(Bound())
+    assert ops.button_chords("estop") == ["L1+R1"] and ops.button_chords("stop") == ["B"]
+    assert ops.button_chords("start") == []

@@ -2,7 +2,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from g1_control.ik.exceptions import InvalidFrameError, InvalidReferenceError, TaskDefinitionError
+from g1_control.ik.exceptions import InvalidFrameError, InvalidReferenceError, NoSolutionFound, TaskDefinitionError
 from g1_control.ik.retargeter import IKConfig, IKRetargeter
 from g1_control.interfaces import Retargeter
 from g1_control.robot import g1
@@ -221,3 +221,29 @@ def test_touchdown_lays_the_foot_along_a_ramp_and_holds_no_foot_out_of_reach():
     assert high._touchdown_anchor("left_ankle_roll_link") is None
     out = high.solve(_reference(high), q)
     assert out.contacts.tolist() == [False, False]
+
+
+def test_a_tick_without_a_solution_leaves_the_configuration_where_the_tick_started():
+    """The loop holds the last good reference when the IK fails (loop/control_loop.py): the next tick
+    must start from this tick's start, not from the steps taken before the failing one."""
+    ik = IKRetargeter(IKConfig(iterations=3, frame_costs={"left_rubber_hand": (50.0, 0.0)}))
+    q = np.asarray(g1.DEFAULT_Q_RAD).copy()
+    ik.solve(_reference(ik), q)
+    q_start = ik.configuration.q.copy()
+    q_start[7:] = q
+    solve, calls = ik.solver.solve, [0]
+
+    def first_step_only(*args, **kwargs):  # the first QP of the tick solves, every later one is infeasible
+        calls[0] += 1
+        if calls[0] > 1:
+            raise NoSolutionFound("daqp found no IK step (exit flag -1: infeasible constraints)")
+        return solve(*args, **kwargs)
+
+    ik.solver.solve = first_step_only
+    with pytest.raises(NoSolutionFound):
+        ik.solve(_reference(ik, hand_offset=(0.1, 0.0, 0.1)), q)
+    assert calls[0] > 2  # a step was taken, then the relaxed retries failed as well
+    np.testing.assert_array_equal(ik.configuration.q, q_start)
+    ik.solver.solve = solve
+    out = ik.solve(_reference(ik), q)  # and the next tick solves from there
+    assert np.all(np.isfinite(out.q_rad))

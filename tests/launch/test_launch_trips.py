@@ -1,7 +1,9 @@
 """Trips are typed events end to end: a real lockstep run whose safety layer trips (an over-speed
 limit no standing robot can keep) records the trip with its `trips` flag and a detail free of any
 marker, its run folder's summary says "fault" naming the trip's kind, and the deploy's preflight
-refuses a dry run with those events naming it; a run without a trip completes."""
+refuses a dry run with those events naming it; a run without a trip completes. An IK that stops
+finding solutions ends `g1 launch` as such a fault too (before issue 26's fail-soft IK it ended the
+run with `g1 launch: error: daqp found no IK step ...` and no summary)."""
 
 from __future__ import annotations
 
@@ -60,3 +62,52 @@ def test_a_run_without_a_trip_completes(tmp_path):
     result = runner.run(_standing(1.0), out_root=tmp_path, video=False, progress=False)
     assert not any(e["trips"] for e in result.events), result.events
     assert json.loads((result.run_dir / "summary.json").read_text())["status"] == "completed"
+
+
+class _IKFault:
+    """The IK stage's QP finds no step (every solve, the relaxed retries too, NoSolutionFound as from
+    daqp's infeasible exit) from the IK stage's `after`-th tick on; the ticks before solve as usual."""
+
+    def __init__(self, monkeypatch, after: int):
+        from g1_control.ik.exceptions import NoSolutionFound
+        from g1_control.ik.solver import QPSolver
+        from g1_control.ik.stage import IKStage
+
+        self.ticks, self.on = 0, False
+        stage_solve, qp_solve = IKStage.solve, QPSolver.solve
+
+        def stage(stage_self, reference, q_prev):
+            self.ticks += 1
+            self.on = self.ticks > after
+            return stage_solve(stage_self, reference, q_prev)
+
+        def qp(solver_self, *args, **kwargs):
+            if self.on:
+                raise NoSolutionFound("daqp found no IK step (exit flag -1: infeasible constraints)")
+            return qp_solve(solver_self, *args, **kwargs)
+
+        monkeypatch.setattr(IKStage, "solve", stage)
+        monkeypatch.setattr(QPSolver, "solve", qp)
+
+
+def test_g1_launch_ends_an_ik_without_solutions_as_a_fault_with_no_traceback(tmp_path, monkeypatch, capsys):
+    """`g1 launch` with a generator whose references the IK solves (interpolation): the IK fails for good
+    after 25 ticks (0.5 s). The run ends as a fault naming the IK's error, not as an exception."""
+    from g1_control.cli.main import main
+
+    fault = _IKFault(monkeypatch, after=25)
+    code = main(["launch", str(LAUNCH_DIR / "sim_walk.yaml"), "--set", "generator.type=interpolation",
+                 "--set", "safety.ik_hold_ticks=2", "--set", "output.plot=false", "--duration", "1.0",
+                 "--out", str(tmp_path), "--no-video", "--quiet", "--viewer", "off"])
+    out, err = capsys.readouterr()
+    assert fault.ticks == 50 and "Traceback" not in out + err and "error" not in err, err
+    [run_dir] = [p for p in tmp_path.iterdir() if p.is_dir()]
+    summary = json.loads((run_dir / "summary.json").read_text())
+    detail = ("the IK found no solution on 3 tracker ticks in a row (safety.ik_hold_ticks 2): "
+              "NoSolutionFound: daqp found no IK step (exit flag -1: infeasible constraints)")
+    assert summary["status"] == "fault" and summary["end_reason"] == f"ik_failure: {detail}", summary["end_reason"]
+    assert "s: ik_failure (damping): " + detail in out
+    lines = [json.loads(line) for line in (run_dir / "events.jsonl").read_text().splitlines()]
+    kinds = [(r["kind"], r["trips"], round(r["t_s"], 3)) for r in lines if r.get("type") == "safety"]
+    assert kinds[:2] == [("ik_hold", False, 0.5), ("ik_failure", True, 0.54)], kinds
+    assert code == 1  # the damped robot then falls (g1 launch exits 1 on a fall)

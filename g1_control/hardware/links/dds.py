@@ -12,7 +12,9 @@ participant indices (ports 7400 + 250 * domain + 10 + 2 * index).
 
 from __future__ import annotations
 
+import atexit
 import threading
+import weakref
 from typing import Any
 from xml.sax.saxutils import quoteattr
 
@@ -86,6 +88,29 @@ thread writes on the same domain segfaulted the process (seen in the test suite 
 emulator's state write while a host link closed). Uncontended it costs well under a microsecond."""
 
 
+_open_links: weakref.WeakSet[DdsLink] = weakref.WeakSet()
+"""The links of this process not closed yet (closed at exit by _close_links_at_exit)."""
+_exiting = False
+"""Set at interpreter exit: a send on a link closed by the exit hook is dropped instead of raising."""
+
+
+def _close_links_at_exit() -> None:
+    """Close every link still open before the interpreter tears its modules down. Teardown deletes the
+    Cyclone domains and whatever entities are still referenced in no particular order, while daemon
+    threads (a link backend's 500 Hz writer, an emulator's state stream) may still write on them:
+    deleting entities while another thread writes on the same domain has crashed this process before
+    (see _ENTITY_LOCK). Closed here under that lock, the links' threads no longer reach Cyclone.
+    (CI's timing pass segfaulted once at exit after all its tests passed, stop 34.)"""
+    global _exiting
+    with _ENTITY_LOCK:
+        _exiting = True
+    for link in list(_open_links):
+        link.close()
+
+
+atexit.register(_close_links_at_exit)
+
+
 class DdsLink(Link):
     """One side of the G1 low-level DDS stream."""
 
@@ -133,6 +158,7 @@ class DdsLink(Link):
         """Discovered writers on our two topics and partition: instance handle -> (topic, guid)."""
         self._closed = False
         self._io_lock = _ENTITY_LOCK
+        _open_links.add(self)
 
     @property
     def participant(self):
@@ -146,6 +172,8 @@ class DdsLink(Link):
     def send(self, payload: bytes) -> None:
         with self._io_lock:
             if self._closed:
+                if _exiting:  # a daemon thread's last writes while the interpreter exits
+                    return
                 raise TransportError(f"DDS write on {self.describe()}: the link is closed")
             ret = self._write(self._writer._ref, payload)
         if ret < 0:
@@ -179,6 +207,8 @@ class DdsLink(Link):
         from cyclonedds.qos import Policy
 
         with self._peer_lock:
+            if self._closed:  # a reader thread's last look after the link closed (at exit: _close_links_at_exit)
+                return dict.fromkeys(self._topics, 0)
             if self._publications is None:
                 self._publications = BuiltinDataReader(self._participant, BuiltinTopicDcpsPublication)
             return self._update_writers(InstanceState, Policy)
@@ -213,5 +243,8 @@ class DdsLink(Link):
             if self._closed:
                 return
             self._closed = True
+            _open_links.discard(self)
             self._waitset.detach(self._condition)
-            del self._writer, self._reader, self._condition, self._waitset, self._participant, self._publications
+            del self._writer, self._reader, self._condition, self._waitset
+            with self._peer_lock:  # not while peer_writers() reads discovery
+                del self._participant, self._publications
