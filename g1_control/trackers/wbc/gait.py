@@ -861,7 +861,8 @@ class VelocityGait:
         t_sw = t_in - Tds
         ref = self._ref
         z0, z1 = self._swing_from[2], self._landing[2]
-        stepping = self._path_top > max(z0, z1) - u[2] + cfg.step_change_m or abs(z1 - z0) > cfg.step_change_m
+        stepping = not self.terrain.flat and (self._path_top > max(z0, z1) - u[2] + cfg.step_change_m
+                                              or abs(z1 - z0) > cfg.step_change_m)
         hold = cfg.terrain_hold if stepping else cfg.swing_hold_s
         out.swing_progress = min(max(t_sw / max(Tsw, 1e-6), 0.0), 1.0)
         if t_sw >= hold * Tss:

@@ -309,3 +309,27 @@ def test_at_a_riser_the_step_goes_onto_the_tread_and_keeps_that_level():
         gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
         out = gait.update(t, 0.004, soles, yaws, dcm - np.array([0.04, 0.0]), OMEGA)
         assert out.landing_m[2] == pytest.approx(0.15) and terrain.is_level(out.landing_m[:2], 0.0)
+
+
+@pytest.mark.parametrize("drift_m", [0.0, 0.05, -0.05])
+def test_on_flat_ground_a_height_drift_of_the_feet_is_not_a_step(drift_m):
+    """Without platforms in the scene, soles measured at different heights (leg odometry drifting
+    with a slipping or tipping foot) do not make the swing a step up or down: the foot moves across
+    after the flat gait's short hold, not the terrain's long one (on `g1 bench robust`'s draw 0 the
+    held foot then had to cross at up to 12 m/s, measured)."""
+    soles, yaws = _feet()
+    soles[RIGHT, 2] += drift_m
+    gait = VelocityGait()
+    assert gait.terrain.flat
+    t = _into_single_support(gait, soles, yaws)
+    cfg = gait.config
+    moved = []
+    while t - gait._t0 < cfg.double_support_s + 0.3 * cfg.single_support_s:
+        t += 0.004
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+        dcm = soles[gait.stance, :2] + np.array([0.05, 0.03 * (1 if gait.stance == RIGHT else -1)])
+        out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+        moved.append(float(np.hypot(*out.swing_vel_mps[:2])))
+    assert out.swing_foot >= 0
+    # by 0.3 of the single support (the terrain's hold is 0.4) the foot is well under way across
+    assert max(moved) > 0.3
