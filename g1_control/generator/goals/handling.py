@@ -26,7 +26,9 @@ from g1_control.generator.goals.box import (
 from g1_control.generator.goals.context import GoalContext, GoalFailed, Held
 from g1_control.generator.goals.poses import PosePlanner, ReachRefused, flat_soles, stance_heading
 from g1_control.generator.goals.stances import (
+    CLEAR_MARGIN_M,
     box_com_shift,
+    detour_poses,
     grasp_hold_poses,
     pick_headings,
     place_heading,
@@ -126,6 +128,28 @@ def support_of(ctx: GoalContext, box: Box, center_w: np.ndarray) -> Block | None
     return None
 
 
+DETOUR_STEP_S = 0.2
+"""A detour's (stances.detour_poses) poses are at least this far apart in time (and no faster than
+JOINT_SPEED_RADPS)."""
+
+
+def _timed(q0: np.ndarray, qs: list[np.ndarray], last_s: float) -> list[tuple[float, np.ndarray]]:
+    """Keyframes (time from q0's, pose) through qs: each at least DETOUR_STEP_S after the one before
+    (the last at least last_s), no joint faster than JOINT_SPEED_RADPS."""
+    out: list[tuple[float, np.ndarray]] = []
+    t, q_prev = 0.0, q0
+    for k, q in enumerate(qs):
+        t += _move_s(q_prev, q, last_s if k == len(qs) - 1 else DETOUR_STEP_S)
+        out.append((t, q))
+        q_prev = q
+    return out
+
+
+def _shifted(block: Block, off_xy: np.ndarray) -> Block:
+    """`block` where the robot's world frame (its odometry's drift, ctx.offset) has it."""
+    return replace(block, center_xy_m=(float(block.center_xy_m[0] + off_xy[0]), float(block.center_xy_m[1] + off_xy[1])))
+
+
 def _move_s(q_a: np.ndarray, q_b: np.ndarray, least_s: float) -> float:
     """A joint-space move's duration: at least least_s, and slower for big moves (a squat)."""
     return max(least_s, float(np.abs(q_b[7:] - q_a[7:]).max()) / JOINT_SPEED_RADPS,
@@ -189,13 +213,18 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     poses = yield from ctx.compute("grasp", grasp_hold_poses, q0, soles, heading, steps, box.name,
                                    plan.chosen.describe())
     q_via, q_pre, q_con, q_lift = poses[:4]
-    t = {"via": _move_s(q0, q_via, 1.2)}
+    around: list[np.ndarray] = []
+    if support is not None:  # the hands rise beside the support's top, not through it
+        around = yield from ctx.compute("around", detour_poses, q0, q_via, soles, heading, none, pelvis_z,
+                                        plan.lean, _shifted(support, ctx.offset()),
+                                        support.height_m + 2 * CLEAR_MARGIN_M)
+    path = _timed(q0, [*around, q_via], 1.2)
+    t = {"via": path[-1][0]}
     t["pre"] = t["via"] + 1.0
     t["con"] = t["pre"] + 0.8
     t["squeeze"] = t["con"] + 0.5
     t["lift"] = t["squeeze"] + 1.2
-    keys = [(0.0, q0), (t["via"], q_via), (t["pre"], q_pre), (t["con"], q_con), (t["squeeze"], q_con),
-            (t["lift"], q_lift)]
+    keys = [(0.0, q0), *path, (t["pre"], q_pre), (t["con"], q_con), (t["squeeze"], q_con), (t["lift"], q_lift)]
     if low:
         t["rise"] = t["lift"] + _move_s(q_lift, poses[4], 1.2)
         keys.append((t["rise"], poses[4]))
@@ -293,12 +322,29 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     q_above, q_down, q_open, q_out, q_stand = yield from ctx.compute(
         "release", release_hold_poses, q0, soles, heading, (above, down, opened, out), shift, pelvis_z, plan.lean,
         low, plan.chosen.describe())
+    over: list[np.ndarray] = []
+    back: list[np.ndarray] = []
+    if support is not None:  # the box goes over the support's edge, the hands come back beside it
+        block = _shifted(support, ctx.offset())
+        depth = grasp_width(replace(box, yaw_rad=box.yaw_rad + wrap_angle(heading - held.heading_rad)),
+                            heading + math.pi / 2)
+        under = plan.hand_dz_m + box.size[2] / 2
+        probes = ((depth / 2, under), (-depth / 2, under), (0.0, under))
+        over = yield from ctx.compute("over", detour_poses, q0, q_down, soles, heading, shift, pelvis_z, plan.lean,
+                                      block, support.height_m + under + 2 * CLEAR_MARGIN_M, probes)
+        back = yield from ctx.compute("back", detour_poses, q_out, q_stand, soles, heading, np.zeros(2), pelvis_z,
+                                      plan.lean, block, support.height_m + 2 * CLEAR_MARGIN_M)
     t = {"above": _move_s(q0, q_above, 0.0) if low else 0.0}
-    t["down"] = t["above"] + 1.5
+    if over:
+        t["down"] = _timed(q0, [*over, q_down], 1.5)[-1][0]
+        t["above"] = t["down"] - 1.5
+    else:
+        t["down"] = t["above"] + 1.5
     t["release"] = t["down"] + 0.7
     t["open"] = t["release"] + 0.8
     t["out"] = t["open"] + 1.0
-    t["stand"] = t["out"] + _move_s(q_out, q_stand, 1.5)
+    retreat = [(t["out"] + dt, q) for dt, q in _timed(q_out, [*back, q_stand], 1.5)]
+    t["stand"] = retreat[-1][0]
     t["end"] = t["stand"] + 0.5
     full = hand_forces(heading, squeeze, weight)
     squeeze_only = hand_forces(heading, squeeze, 0.0)
@@ -308,9 +354,12 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
         a = 1.0 - float(smoothstep((tk - t["down"]) / (t["release"] - t["down"])))
         return a * squeeze_only + b * (full - squeeze_only)
 
-    keys = [(0.0, q0)] + ([(t["above"], q_above)] if low else []) + [
-        (t["down"], q_down), (t["release"], q_down), (t["open"], q_open), (t["out"], q_out),
-        (t["stand"], q_stand), (t["end"], q_stand)]
+    if over:
+        down_keys = _timed(q0, [*over, q_down], 1.5)
+    else:
+        down_keys = ([(t["above"], q_above)] if low else []) + [(t["down"], q_down)]
+    keys = [(0.0, q0), *down_keys, (t["release"], q_down), (t["open"], q_open), (t["out"], q_out), *retreat,
+            (t["end"], q_stand)]
     yield from ctx.run(keyframe_trajectory("place", keys, hand_forces=forces))
     ctx.info["released_s"] = ctx.t - t["end"] + t["release"]
     ctx.held = None
