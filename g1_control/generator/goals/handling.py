@@ -33,6 +33,7 @@ from g1_control.generator.goals.stances import (
     pick_headings,
     place_heading,
     plan_stance,
+    raised_pose,
     release_hold_poses,
 )
 from g1_control.generator.goals.stepping import (
@@ -241,7 +242,7 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     ctx.info.update(box=box.name, box_start_w_m=center.tolist(), lift_m=cfg.lift_m,
                     held_from_s=ctx.t + t["lift"], stance=plan.chosen.describe())
     yield from ctx.run(keyframe_trajectory("pick", keys, hand_forces=forces))
-    ctx.held = Held(box, full, squeeze, heading_rad=heading)
+    ctx.held = Held(box, full, squeeze, heading_rad=heading, hand_dz_m=plan.hand_dz_m)
     ctx.box_positions[box.name] = None
 
 
@@ -293,6 +294,9 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     carry_shift = box_com_shift(box.mass_kg, ctx.poses.mass_kg, GRASP_DISTANCE_M)
     far = float(np.hypot(*(approach.mid_xy - stance.mid_xy))) > 0.05 or \
         abs(wrap_angle(approach.heading - stance.heading)) > 0.05
+    if far and support is not None:  # the box carried clear above the support's top, not into its side
+        yield from raise_over(ctx, support, posture, carry_shift)
+        posture = ctx.hold_q()[7:].copy()
     if far:
         off = ctx.offset()
         # carry: the hand forces turn with the robot, so plan them per heading: held constant in
@@ -364,6 +368,36 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     ctx.info["released_s"] = ctx.t - t["end"] + t["release"]
     ctx.held = None
     ctx.box_positions[box.name] = center_w
+
+
+BOX_OVER_TOP_M = 0.08
+"""A box carried to a support goes with its bottom at least this far above the support's top."""
+
+
+def raise_over(ctx: GoalContext, support: Block, posture: np.ndarray, carry_shift: np.ndarray) -> Iterator[None]:
+    """Before carrying the held box to `support`: raise it (standing still) until its bottom is
+    BOX_OVER_TOP_M above the top, else refuse (the box stays held). Carried at the pick's height, the
+    box came into a 0.90 m table's side on the last steps of the carry and the robot fell (bench
+    objects seed 7, trial 0)."""
+    held = ctx.held
+    assert held is not None
+    q0 = ctx.hold_q()
+    soles = flat_soles(ctx.ik, q0)
+    hands_z = min(float(ctx.poses.hand_point(q0, i)[2]) for i in range(2)) - min(p[2] for p, _ in soles)
+    need = support.height_m + BOX_OVER_TOP_M + held.hand_dz_m + held.box.size[2] / 2
+    if hands_z >= need:
+        return
+    heading = stance_heading(soles)
+    up = yield from ctx.compute("raise", raised_pose, q0, soles, heading, need - hands_z, carry_shift, float(q0[2]))
+    if up.residual_m > 0.03 or up.com_error_m > 0.03:
+        raise GoalFailed(f"box '{held.box.name}' cannot be held above '{support.name}' ({support.height_m:.2f} m): "
+                         f"the hands get only within {up.residual_m * 100:.1f} cm of {need:.2f} m up "
+                         f"(CoM {up.com_error_m * 100:.1f} cm off)")
+    q_up = up.q
+    forces = held_forces(ctx, heading)
+    move = _move_s(q0, q_up, 1.5)
+    yield from ctx.run(keyframe_trajectory("raise", [(0.0, q0), (move, q_up), (move + 0.5, q_up)],
+                                           hand_forces=lambda _t: forces))
 
 
 def carry(ctx: GoalContext, mid_xy: np.ndarray, heading: float, posture: np.ndarray, weight: float,

@@ -567,6 +567,13 @@ def detour_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: li
     return best[1]
 
 
+def raised_pose(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float, dz_m: float,
+                shift: np.ndarray, pelvis_z: float) -> HoldPose:
+    """The hold pose with both hands dz_m above where they are in q0 (a held box raised), upright."""
+    targets = tuple(poses.hand_point(q0, i) + np.array([0.0, 0.0, dz_m]) for i in range(2))
+    return stance_planner(poses).hold(q0, soles, (targets[0], targets[1]), heading, shift, pelvis_z, UPRIGHT)
+
+
 def _along(poses: PosePlanner, q: np.ndarray, corners: list[list[np.ndarray]], soles: list[Sole], heading: float,
            shift: np.ndarray, pelvis_z: float, lean: int) -> list[np.ndarray]:
     """Poses with the hands every DETOUR_SPACING_M along the polyline `corners` (pairs of hand
@@ -620,4 +627,4 @@ def place_heading(support: Block | None, xy: np.ndarray, robot_xy: np.ndarray) -
 
 __all__ = ["LEAN", "STAND_LEAN", "UPRIGHT", "Candidate", "StancePlan", "StancePlanner", "StanceRefused", "box_com_shift", "detour_poses", "edge_normal",
            "face_normals", "grasp_hold_poses", "hand_height", "path_meets", "pick_headings", "place_heading", "plan_stance",
-           "release_hold_poses", "stance_planner"]
+           "raised_pose", "release_hold_poses", "stance_planner"]
