@@ -383,7 +383,7 @@ def raise_over(ctx: GoalContext, support: Block, posture: np.ndarray, carry_shif
     assert held is not None
     q0 = ctx.hold_q()
     soles = flat_soles(ctx.ik, q0)
-    hands_z = min(float(ctx.poses.hand_point(q0, i)[2]) for i in range(2)) - min(p[2] for p, _ in soles)
+    hands_z = min(float(ctx.poses.hand_point(q0, i)[2]) for i in range(2))
     need = support.height_m + BOX_OVER_TOP_M + held.hand_dz_m + held.box.size[2] / 2
     if hands_z >= need:
         return

@@ -500,33 +500,39 @@ HAND_TIP_M = 0.08
 DETOUR_SPACING_M = 0.05
 """A detour's hand points are solved this far apart (the keyframes blend in joint space between)."""
 PATH_SAMPLES = 24
+BOX_SINK_M = 0.01
+"""A held box's bottom counts as in a support's top this far below it."""
 ELBOWS = ("left_elbow_link", "right_elbow_link")
 
 
 def _probes(poses: PosePlanner, q: np.ndarray, heading: float, box_probes: tuple[tuple[float, float], ...]
-            ) -> list[np.ndarray]:
-    """The points that must stay clear of a support in pose q: each hand point, its tip, the elbows and, with
-    a box held, the box's points (forward, down) from the middle between the hands."""
+            ) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """The points that must stay clear of a support in pose q: (each hand point, its tip and the
+    elbows; with a box held, the box's points (forward, down) from the middle between the hands)."""
     fwd = np.array([math.cos(heading), math.sin(heading), 0.0])
     frames = [poses.ik.frame_pose(q, HAND_FRAMES[i]) for i in range(2)]
     hands = [p for p, _ in frames]
-    out = [*hands, *(p + HAND_TIP_M * r[:, 0] for p, r in frames), *(poses.ik.frame_pose(q, f)[0] for f in ELBOWS)]
+    body = [*hands, *(p + HAND_TIP_M * r[:, 0] for p, r in frames), *(poses.ik.frame_pose(q, f)[0] for f in ELBOWS)]
     mid = (hands[0] + hands[1]) / 2
-    out += [mid + f * fwd - np.array([0.0, 0.0, d]) for f, d in box_probes]
-    return out
+    return body, [mid + f * fwd - np.array([0.0, 0.0, d]) for f, d in box_probes]
 
 
 def path_meets(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, heading: float, block: Block,
                box_probes: tuple[tuple[float, float], ...] = ()) -> bool:
     """Whether the straight configuration-space move from q_a to q_b (the way keyframes blend) takes
-    a hand, its tip or the held box's points (`box_probes`, see _probes) into `block`'s top: within
-    CLEAR_MARGIN_M of its outline, between its underside and CLEAR_MARGIN_M above it."""
+    a hand, its tip or an elbow into `block`'s top (within CLEAR_MARGIN_M of its outline, between its
+    underside and CLEAR_MARGIN_M above it), or the held box's points (`box_probes`, see _probes)
+    below its top (a box set down on it ends resting there)."""
     top, under = block.height_m + CLEAR_MARGIN_M, block.height_m - TABLE_TOP_THICKNESS_M - CLEAR_MARGIN_M
     for s in np.linspace(0.0, 1.0, PATH_SAMPLES):
         q = q_a + s * (q_b - q_a)
         q[3:7] /= np.linalg.norm(q[3:7])
-        for p in _probes(poses, q, heading, box_probes):
+        body, box = _probes(poses, q, heading, box_probes)
+        for p in body:
             if under < p[2] < top and block.distance_xy(p[:2]) < CLEAR_MARGIN_M:
+                return True
+        for p in box:
+            if under < p[2] < block.height_m - BOX_SINK_M and block.distance_xy(p[:2]) < CLEAR_MARGIN_M:
                 return True
     return False
 
