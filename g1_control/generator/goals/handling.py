@@ -336,8 +336,9 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
         probes = ((depth / 2, under), (-depth / 2, under), (0.0, under))
         over = yield from ctx.compute("over", detour_poses, q0, q_down, soles, heading, shift, pelvis_z, plan.lean,
                                       block, support.height_m + under + 2 * CLEAR_MARGIN_M, probes)
+        # (the hands' tips not counted: coming back, launch/sim_box.yaml's pass ~7 mm over the top)
         back = yield from ctx.compute("back", detour_poses, q_out, q_stand, soles, heading, np.zeros(2), pelvis_z,
-                                      plan.lean, block, support.height_m + 2 * CLEAR_MARGIN_M)
+                                      plan.lean, block, support.height_m + 2 * CLEAR_MARGIN_M, (), False)
     t = {"above": _move_s(q0, q_above, 0.0) if low else 0.0}
     if over:
         t["down"] = _timed(q0, [*over, q_down], 1.5)[-1][0]

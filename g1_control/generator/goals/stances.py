@@ -493,8 +493,10 @@ def release_hold_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], he
     return q_above, down_pose.q, q_open, q_out, q_stand
 
 
-CLEAR_MARGIN_M = 0.05
-"""A hand (or a held box) moving past a support keeps this far from its outline below its top + this."""
+CLEAR_MARGIN_M = 0.02
+"""A hand (or a held box) moving past a support keeps this far from its outline, and a hand 1 cm
+above its top (CLEAR_ABOVE_M) or below its underside less this."""
+CLEAR_ABOVE_M = 0.01
 HAND_TIP_M = 0.08
 """The rubber hand reaches this far beyond the hand point (the palm's middle) along the hand frame's x."""
 DETOUR_SPACING_M = 0.05
@@ -505,29 +507,31 @@ BOX_SINK_M = 0.01
 ELBOWS = ("left_elbow_link", "right_elbow_link")
 
 
-def _probes(poses: PosePlanner, q: np.ndarray, heading: float, box_probes: tuple[tuple[float, float], ...]
-            ) -> tuple[list[np.ndarray], list[np.ndarray]]:
+def _probes(poses: PosePlanner, q: np.ndarray, heading: float, box_probes: tuple[tuple[float, float], ...],
+            tips: bool = True) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """The points that must stay clear of a support in pose q: (each hand point, its tip and the
     elbows; with a box held, the box's points (forward, down) from the middle between the hands)."""
     fwd = np.array([math.cos(heading), math.sin(heading), 0.0])
     frames = [poses.ik.frame_pose(q, HAND_FRAMES[i]) for i in range(2)]
     hands = [p for p, _ in frames]
-    body = [*hands, *(p + HAND_TIP_M * r[:, 0] for p, r in frames), *(poses.ik.frame_pose(q, f)[0] for f in ELBOWS)]
+    body = [*hands, *(poses.ik.frame_pose(q, f)[0] for f in ELBOWS)]
+    if tips:
+        body += [p + HAND_TIP_M * r[:, 0] for p, r in frames]
     mid = (hands[0] + hands[1]) / 2
     return body, [mid + f * fwd - np.array([0.0, 0.0, d]) for f, d in box_probes]
 
 
 def path_meets(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, heading: float, block: Block,
-               box_probes: tuple[tuple[float, float], ...] = ()) -> bool:
+               box_probes: tuple[tuple[float, float], ...] = (), tips: bool = True) -> bool:
     """Whether the straight configuration-space move from q_a to q_b (the way keyframes blend) takes
     a hand, its tip or an elbow into `block`'s top (within CLEAR_MARGIN_M of its outline, between its
-    underside and CLEAR_MARGIN_M above it), or the held box's points (`box_probes`, see _probes)
-    below its top (a box set down on it ends resting there)."""
-    top, under = block.height_m + CLEAR_MARGIN_M, block.height_m - TABLE_TOP_THICKNESS_M - CLEAR_MARGIN_M
+    underside less CLEAR_MARGIN_M and CLEAR_ABOVE_M above it), or the held box's points (`box_probes`, see _probes)
+    below its top (a box set down on it ends resting there). tips: the hands' tips too."""
+    top, under = block.height_m + CLEAR_ABOVE_M, block.height_m - TABLE_TOP_THICKNESS_M - CLEAR_MARGIN_M
     for s in np.linspace(0.0, 1.0, PATH_SAMPLES):
         q = q_a + s * (q_b - q_a)
         q[3:7] /= np.linalg.norm(q[3:7])
-        body, box = _probes(poses, q, heading, box_probes)
+        body, box = _probes(poses, q, heading, box_probes, tips)
         for p in body:
             if under < p[2] < top and block.distance_xy(p[:2]) < CLEAR_MARGIN_M:
                 return True
@@ -539,7 +543,7 @@ def path_meets(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, heading: fl
 
 def detour_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: list[Sole], heading: float,
                  shift: np.ndarray, pelvis_z: float, lean: int, block: Block, clear_z_m: float,
-                 box_probes: tuple[tuple[float, float], ...] = ()) -> list[np.ndarray]:
+                 box_probes: tuple[tuple[float, float], ...] = (), tips: bool = True) -> list[np.ndarray]:
     """Poses to put between q_a and q_b so that the hands (and a held box) go around `block` instead
     of through it; [] where the straight move keeps clear (path_meets). The hands move at the higher of their
     two heights and clear_z_m: straight up, across, straight down, solved every DETOUR_SPACING_M from
@@ -549,7 +553,7 @@ def detour_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: li
     trial 3). Two ways are tried, each solved back from q_b (keeping its IK branch) and on from
     q_a, the first whose every blend keeps clear kept, else the one with the fewest that do not: across below, then straight up or down; straight up
     (or down) to the higher height, across, straight down."""
-    if not path_meets(poses, q_a, q_b, heading, block, box_probes):
+    if not path_meets(poses, q_a, q_b, heading, block, box_probes, tips):
         return []
     a = [poses.hand_point(q_a, i) for i in range(2)]
     b = [poses.hand_point(q_b, i) for i in range(2)]
@@ -564,7 +568,7 @@ def detour_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: li
             else:
                 chain = _along(poses, q_a, corners, soles, heading, shift, pelvis_z, lean)[:-1]
             path = [q_a, *chain, q_b]
-            bad = sum(path_meets(poses, u, v, heading, block, box_probes) for u, v in pairwise(path))
+            bad = sum(path_meets(poses, u, v, heading, block, box_probes, tips) for u, v in pairwise(path))
             if best is None or bad < best[0]:
                 best = (bad, chain)
             if bad == 0:
