@@ -206,7 +206,7 @@ def test_the_hands_go_around_a_high_tables_top_on_their_way_to_the_box(stances):
     assert path_meets(stances.poses, q0, q_via, h, SEED12_TABLE)  # the straight blend goes through the top
     around = detour_poses(stances.poses, q0, q_via, soles, h, np.zeros(2), q0[2], plan.lean, SEED12_TABLE,
                           SEED12_TABLE.height_m + 0.1)
-    assert len(around) >= 3
+    assert around  # at least one pose between
     path = [q0, *around, q_via]
     assert not any(path_meets(stances.poses, a, b, h, SEED12_TABLE) for a, b in pairwise(path))
     # a box already clear of the table needs no way around

@@ -218,7 +218,7 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     if support is not None:  # the hands rise beside the support's top, not through it
         around = yield from ctx.compute("around", detour_poses, q0, q_via, soles, heading, none, pelvis_z,
                                         plan.lean, _shifted(support, ctx.offset()),
-                                        support.height_m + 2 * CLEAR_MARGIN_M)
+                                        support.height_m + 2 * CLEAR_MARGIN_M, (), True, True)
     path = _timed(q0, [*around, q_via], 1.2)
     t = {"via": path[-1][0]}
     t["pre"] = t["via"] + 1.0
@@ -335,10 +335,9 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
         under = plan.hand_dz_m + box.size[2] / 2
         probes = ((depth / 2, under), (-depth / 2, under), (0.0, under))
         over = yield from ctx.compute("over", detour_poses, q0, q_down, soles, heading, shift, pelvis_z, plan.lean,
-                                      block, support.height_m + under + 2 * CLEAR_MARGIN_M, probes)
-        # (the hands' tips not counted: coming back, launch/sim_box.yaml's pass ~7 mm over the top)
+                                      block, support.height_m + under + 2 * CLEAR_MARGIN_M, probes, True, True)
         back = yield from ctx.compute("back", detour_poses, q_out, q_stand, soles, heading, np.zeros(2), pelvis_z,
-                                      plan.lean, block, support.height_m + 2 * CLEAR_MARGIN_M, (), False)
+                                      plan.lean, block, support.height_m + 2 * CLEAR_MARGIN_M)
     t = {"above": _move_s(q0, q_above, 0.0) if low else 0.0}
     if over:
         t["down"] = _timed(q0, [*over, q_down], 1.5)[-1][0]
