@@ -1,21 +1,29 @@
 """The stance search for holding a box (generator/goals/stances.py), without physics: a box on a
 table turned 20 deg is held square to its faces, a box on a low table gets a squat the IK reaches
-without meeting the table or the box, boxes no pose can lift (on the floor, out of reach) are
-refused with a reason and the closest pose, before anything moves."""
+without meeting the table or the box, a light box behind a table's edge is reached standing off
+the edge and leaning (a heavy one refused), boxes no pose can lift (on the floor, out of reach) are
+refused with a reason and the closest pose, before anything moves; the hands' way from hanging at
+the sides to a box on a high table goes around the table's top, not through it."""
 
 import math
+from itertools import pairwise
 
 import numpy as np
 import pytest
 
 from g1_control.generator.goals.box import hand_points
-from g1_control.generator.goals.poses import PosePlanner
+from g1_control.generator.goals.handling import ARMS_BACK
+from g1_control.generator.goals.poses import PosePlanner, flat_soles
 from g1_control.generator.goals.stances import (
     KNEES,
     MIN_PELVIS_M,
+    STAND_LEAN,
     StancePlanner,
     StanceRefused,
+    detour_poses,
+    grasp_hold_poses,
     hand_height,
+    path_meets,
     pick_headings,
     place_heading,
 )
@@ -135,3 +143,92 @@ def test_a_box_on_a_thigh_high_table_is_held_with_the_knees_bent_and_clear_of_it
                 yaw_rad=-1.262)
     with pytest.raises(StanceRefused, match=r"3\.2 kg.*no stance can pick it up"):
         stances.plan(heavy, center, table, headings, lift_m=0.1, what="pick it up")
+
+
+# bench objects seed 7 trial 0: a 1.5 kg box on a 0.72 m table, its near face ~0.1 m behind the edge:
+# every upright stance close enough to reach it put the pelvis within 0.18 m of the table (refused)
+SEED7_TABLE = Table("table_a", (1.5474, 0.3731), (0.6, 0.5), 0.7168, -1.3477)
+SEED7_SIZE = (0.2821, 0.2112, 0.3844)
+SEED7_CENTER = np.array([1.5175, 0.3398, 0.7168 + 0.3844 / 2])
+
+
+def _seed7_box(mass_kg):
+    return Box("box", (1.5175, 0.3398), stands_on="table_a", size_m=SEED7_SIZE, mass_kg=mass_kg, yaw_rad=-0.7513)
+
+
+def test_a_light_box_behind_a_table_edge_is_reached_standing_off_it_and_leaning(stances):
+    box = _seed7_box(1.5)
+    headings = pick_headings(box, SEED7_CENTER[:2], SEED7_TABLE, np.zeros(2))
+    plan = stances.plan(box, SEED7_CENTER, SEED7_TABLE, headings, lift_m=0.1, what="pick it up")
+    assert plan.lean == STAND_LEAN and "standing leaning" in plan.chosen.describe()
+    assert plan.pelvis_z_m == pytest.approx(stances.poses.nominal_pelvis_m)
+    c = SEED7_CENTER + np.array([0.0, 0.0, hand_height(box, SEED7_CENTER[2])])
+    contact, lifted = plan.chosen.poses
+    assert _hands_error(stances, contact, hand_points(c, plan.chosen.heading, plan.width_m, -0.01)) <= 0.02
+    assert _hands_error(stances, lifted, hand_points(c, plan.chosen.heading, plan.width_m, -0.01, dz_m=0.1)) <= 0.02
+    for q in plan.chosen.poses:
+        assert SEED7_TABLE.distance_xy(q[:2]) >= 0.18  # stances.MIN_EDGE_CLEARANCE_M
+        assert _knee_gap(stances, q, SEED7_TABLE) >= 0.08
+        assert min(q[7 + k] for k in KNEES) >= 0.3
+        assert stances.collision(q, box, SEED7_CENTER, SEED7_TABLE) is None
+
+
+def test_a_heavy_box_behind_a_table_edge_is_still_refused_with_the_pelvis_clearance(stances):
+    box = _seed7_box(4.0)  # no leaning with 3 kg or more (stances.LEAN_MAX_KG)
+    headings = pick_headings(box, SEED7_CENTER[:2], SEED7_TABLE, np.zeros(2))
+    with pytest.raises(StanceRefused, match=r"no stance can pick it up \(\d+ tried, pelvis down to 0.76 m\): the "
+                                            r"pelvis is 0\.\d+ m from 'table_a'"):
+        stances.plan(box, SEED7_CENTER, SEED7_TABLE, headings, lift_m=0.1, what="pick it up")
+
+
+# bench objects seed 12 trial 3: a 0.5 kg box on a 0.95 m table, ~4 cm behind its edge. The straight
+# joint-space blend from the arms hanging (swung back) to above the box swung the left hand into the
+# table's top from below; the arm stayed caught and the robot fell when it stepped back with the box
+SEED12_TABLE = Table("table_a", (1.2121, -0.4504), (0.7448, 0.5), 0.9491, -1.6248)
+SEED12_BOX = Box("box", (1.1361, -0.5871), stands_on="table_a", size_m=(0.2543, 0.2215, 0.1982), mass_kg=0.51,
+                 yaw_rad=-1.4409)
+SEED12_CENTER = np.array([1.1361, -0.5871, 0.9491 + 0.1982 / 2])
+
+
+def test_the_hands_go_around_a_high_tables_top_on_their_way_to_the_box(stances):
+    headings = pick_headings(SEED12_BOX, SEED12_CENTER[:2], SEED12_TABLE, np.zeros(2))
+    plan = stances.plan(SEED12_BOX, SEED12_CENTER, SEED12_TABLE, headings, lift_m=0.1, what="pick it up")
+    q0, soles = stances.stance(plan.approach.mid_xy, plan.approach.heading, 0.0)
+    q0[7:] = ARMS_BACK  # as the pick starts: stepped in with the arms swung back
+    q0 = stances.poses.stand(q0, soles, stances.poses.nominal_pelvis_m, ARMS_BACK)
+    soles = flat_soles(stances.ik, q0)
+    h = plan.approach.heading
+    c = SEED12_CENTER + np.array([0.0, 0.0, plan.hand_dz_m])
+    fwd = np.array([math.cos(h), math.sin(h)])
+    ahead = float((c[:2] - (soles[0][0][:2] + soles[1][0][:2]) / 2) @ fwd)
+    via = hand_points(c, h, plan.width_m, 0.06, dz_m=0.08, ahead_m=-(ahead - 0.10))  # handling.pick's via
+    (q_via,) = grasp_hold_poses(stances.poses, q0, soles, h, [("via", via, np.zeros(2), q0[2], plan.lean)], "box", "")
+    assert path_meets(stances.poses, q0, q_via, h, SEED12_TABLE)  # the straight blend goes through the top
+    around = detour_poses(stances.poses, q0, q_via, soles, h, np.zeros(2), q0[2], plan.lean, SEED12_TABLE,
+                          SEED12_TABLE.height_m + 0.1)
+    assert around  # at least one pose between
+    path = [q0, *around, q_via]
+    assert not any(path_meets(stances.poses, a, b, h, SEED12_TABLE) for a, b in pairwise(path))
+    # a box already clear of the table needs no way around
+    assert detour_poses(stances.poses, q_via, q_via, soles, h, np.zeros(2), q0[2], plan.lean, SEED12_TABLE,
+                        SEED12_TABLE.height_m + 0.1) == []
+
+
+def test_with_no_clean_way_around_a_tables_top_the_hands_are_refused_before_they_move(stances):
+    # the hands hang under a 0.95 m table's top (it reaches over them) and must get above it: every
+    # way passes through the top; strict (a pick, a place) refuses instead of keeping the least bad
+    # (bench objects seed 12 trial 1: that caught a hand under the top and the robot fell)
+    q0, soles = stances.stance(np.zeros(2), 0.0, 0.0)
+    q0[7:] = ARMS_BACK
+    q0 = stances.poses.stand(q0, soles, stances.poses.nominal_pelvis_m, ARMS_BACK)
+    soles = flat_soles(stances.ik, q0)
+    hands = [stances.poses.hand_point(q0, i) for i in range(2)]
+    over = Table("over", (float(hands[0][0]) + 0.25, 0.0), (0.6, 1.0), 0.95, 0.0)  # its near edge behind the hands
+    assert all(over.contains_xy(h[:2]) and h[2] < over.height_m - 0.1 for h in hands)
+    up = tuple(h + np.array([0.0, 0.0, 0.45]) for h in hands)
+    (q_up,) = grasp_hold_poses(stances.poses, q0, soles, 0.0, [("via", up, np.zeros(2), q0[2], 0)], "box", "")
+    assert path_meets(stances.poses, q0, q_up, 0.0, over)
+    with pytest.raises(StanceRefused, match=r"the hands find no way around the top of 'over' \(0\.95 m\)"):
+        detour_poses(stances.poses, q0, q_up, soles, 0.0, np.zeros(2), q0[2], 0, over, 1.05, strict=True)
+    # not strict (the hands coming back from a box already set down): the least bad way, no refusal
+    assert detour_poses(stances.poses, q0, q_up, soles, 0.0, np.zeros(2), q0[2], 0, over, 1.05)

@@ -121,6 +121,8 @@ class Held:
     """The squeeze per hand it is held with."""
     heading_rad: float = 0.0
     """The robot's heading when it took the box (the box turns with the robot from there)."""
+    hand_dz_m: float = 0.0
+    """The hands above the box's centre (stances.hand_height at the pick)."""
 
 
 class GoalContext:

@@ -26,11 +26,14 @@ from g1_control.generator.goals.box import (
 from g1_control.generator.goals.context import GoalContext, GoalFailed, Held
 from g1_control.generator.goals.poses import PosePlanner, ReachRefused, flat_soles, stance_heading
 from g1_control.generator.goals.stances import (
+    CLEAR_MARGIN_M,
     box_com_shift,
+    detour_poses,
     grasp_hold_poses,
     pick_headings,
     place_heading,
     plan_stance,
+    raised_pose,
     release_hold_poses,
 )
 from g1_control.generator.goals.stepping import (
@@ -126,6 +129,46 @@ def support_of(ctx: GoalContext, box: Box, center_w: np.ndarray) -> Block | None
     return None
 
 
+LIFT_CHECK_M = 0.05
+"""After a pick's lift the measured hands (forward kinematics of the joints, relative to the pelvis)
+are within this of the plan's, or the box did not come up: a 4.7 kg box on a 0.50 m table left the
+hands 10 cm below the plan, the robot carried on with the box's weight and squeeze fed forward on
+empty hands and fell on the way (bench objects seed 12, trial 7)."""
+
+
+def hands_off_plan_m(ctx: GoalContext) -> float:
+    """How far (vertically, relative to the pelvis) the measured hands are from the plan's now."""
+    s, _ = ctx.world_pose()
+    q_plan = ctx.hold_q()
+    q_meas = q_plan.copy()
+    q_meas[7:] = s.q_rad
+    w, x, y, z = s.imu_quat_wxyz
+    q_meas[3:7] = [x, y, z, w]
+    return max(abs(float(ctx.poses.hand_point(q_meas, i)[2] - ctx.poses.hand_point(q_plan, i)[2])) for i in range(2))
+
+
+DETOUR_STEP_S = 0.2
+"""A detour's (stances.detour_poses) poses are at least this far apart in time (and no faster than
+JOINT_SPEED_RADPS)."""
+
+
+def _timed(q0: np.ndarray, qs: list[np.ndarray], last_s: float) -> list[tuple[float, np.ndarray]]:
+    """Keyframes (time from q0's, pose) through qs: each at least DETOUR_STEP_S after the one before
+    (the last at least last_s), no joint faster than JOINT_SPEED_RADPS."""
+    out: list[tuple[float, np.ndarray]] = []
+    t, q_prev = 0.0, q0
+    for k, q in enumerate(qs):
+        t += _move_s(q_prev, q, last_s if k == len(qs) - 1 else DETOUR_STEP_S)
+        out.append((t, q))
+        q_prev = q
+    return out
+
+
+def _shifted(block: Block, off_xy: np.ndarray) -> Block:
+    """`block` where the robot's world frame (its odometry's drift, ctx.offset) has it."""
+    return replace(block, center_xy_m=(float(block.center_xy_m[0] + off_xy[0]), float(block.center_xy_m[1] + off_xy[1])))
+
+
 def _move_s(q_a: np.ndarray, q_b: np.ndarray, least_s: float) -> float:
     """A joint-space move's duration: at least least_s, and slower for big moves (a squat)."""
     return max(least_s, float(np.abs(q_b[7:] - q_a[7:]).max()) / JOINT_SPEED_RADPS,
@@ -189,13 +232,18 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     poses = yield from ctx.compute("grasp", grasp_hold_poses, q0, soles, heading, steps, box.name,
                                    plan.chosen.describe())
     q_via, q_pre, q_con, q_lift = poses[:4]
-    t = {"via": _move_s(q0, q_via, 1.2)}
+    around: list[np.ndarray] = []
+    if support is not None:  # the hands rise beside the support's top, not through it
+        around = yield from ctx.compute("around", detour_poses, q0, q_via, soles, heading, none, pelvis_z,
+                                        plan.lean, _shifted(support, ctx.offset()),
+                                        support.height_m + 2 * CLEAR_MARGIN_M, (), True, True)
+    path = _timed(q0, [*around, q_via], 1.2)
+    t = {"via": path[-1][0]}
     t["pre"] = t["via"] + 1.0
     t["con"] = t["pre"] + 0.8
     t["squeeze"] = t["con"] + 0.5
     t["lift"] = t["squeeze"] + 1.2
-    keys = [(0.0, q0), (t["via"], q_via), (t["pre"], q_pre), (t["con"], q_con), (t["squeeze"], q_con),
-            (t["lift"], q_lift)]
+    keys = [(0.0, q0), *path, (t["pre"], q_pre), (t["con"], q_con), (t["squeeze"], q_con), (t["lift"], q_lift)]
     if low:
         t["rise"] = t["lift"] + _move_s(q_lift, poses[4], 1.2)
         keys.append((t["rise"], poses[4]))
@@ -212,7 +260,20 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     ctx.info.update(box=box.name, box_start_w_m=center.tolist(), lift_m=cfg.lift_m,
                     held_from_s=ctx.t + t["lift"], stance=plan.chosen.describe())
     yield from ctx.run(keyframe_trajectory("pick", keys, hand_forces=forces))
-    ctx.held = Held(box, full, squeeze, heading_rad=heading)
+    lag = hands_off_plan_m(ctx)
+    if lag > LIFT_CHECK_M:  # the box did not come up: set it back down, open the hands, stand as before
+        back = [(0.0, ctx.hold_q()), (1.2, q_con), (2.0, q_pre), (2.8, q_via)]
+        back.append((2.8 + _move_s(q_via, q0, 1.2), q0))
+
+        def letting_go(tk: float) -> np.ndarray:
+            b = 1.0 - float(smoothstep(tk / 1.2))
+            a = 1.0 - float(smoothstep((tk - 1.2) / 0.8))
+            return a * squeeze_only + b * (full - squeeze_only)
+
+        yield from ctx.run(keyframe_trajectory("let go", back, hand_forces=letting_go))
+        raise GoalFailed(f"box '{box.name}' ({box.mass_kg:.1f} kg) did not come up with the hands: after the lift "
+                         f"they were {lag * 100:.0f} cm off the plan; set back down, the hands opened")
+    ctx.held = Held(box, full, squeeze, heading_rad=heading, hand_dz_m=plan.hand_dz_m)
     ctx.box_positions[box.name] = None
 
 
@@ -264,6 +325,9 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     carry_shift = box_com_shift(box.mass_kg, ctx.poses.mass_kg, GRASP_DISTANCE_M)
     far = float(np.hypot(*(approach.mid_xy - stance.mid_xy))) > 0.05 or \
         abs(wrap_angle(approach.heading - stance.heading)) > 0.05
+    if far and support is not None:  # the box carried clear above the support's top, not into its side
+        yield from raise_over(ctx, support, posture, carry_shift)
+        posture = ctx.hold_q()[7:].copy()
     if far:
         off = ctx.offset()
         # carry: the hand forces turn with the robot, so plan them per heading: held constant in
@@ -293,12 +357,29 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     q_above, q_down, q_open, q_out, q_stand = yield from ctx.compute(
         "release", release_hold_poses, q0, soles, heading, (above, down, opened, out), shift, pelvis_z, plan.lean,
         low, plan.chosen.describe())
+    over: list[np.ndarray] = []
+    back: list[np.ndarray] = []
+    if support is not None:  # the box goes over the support's edge, the hands come back beside it
+        block = _shifted(support, ctx.offset())
+        depth = grasp_width(replace(box, yaw_rad=box.yaw_rad + wrap_angle(heading - held.heading_rad)),
+                            heading + math.pi / 2)
+        under = plan.hand_dz_m + box.size[2] / 2
+        probes = ((depth / 2, under), (-depth / 2, under), (0.0, under))
+        over = yield from ctx.compute("over", detour_poses, q0, q_down, soles, heading, shift, pelvis_z, plan.lean,
+                                      block, support.height_m + under + 2 * CLEAR_MARGIN_M, probes, True, True)
+        back = yield from ctx.compute("back", detour_poses, q_out, q_stand, soles, heading, np.zeros(2), pelvis_z,
+                                      plan.lean, block, support.height_m + 2 * CLEAR_MARGIN_M)
     t = {"above": _move_s(q0, q_above, 0.0) if low else 0.0}
-    t["down"] = t["above"] + 1.5
+    if over:
+        t["down"] = _timed(q0, [*over, q_down], 1.5)[-1][0]
+        t["above"] = t["down"] - 1.5
+    else:
+        t["down"] = t["above"] + 1.5
     t["release"] = t["down"] + 0.7
     t["open"] = t["release"] + 0.8
     t["out"] = t["open"] + 1.0
-    t["stand"] = t["out"] + _move_s(q_out, q_stand, 1.5)
+    retreat = [(t["out"] + dt, q) for dt, q in _timed(q_out, [*back, q_stand], 1.5)]
+    t["stand"] = retreat[-1][0]
     t["end"] = t["stand"] + 0.5
     full = hand_forces(heading, squeeze, weight)
     squeeze_only = hand_forces(heading, squeeze, 0.0)
@@ -308,13 +389,46 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
         a = 1.0 - float(smoothstep((tk - t["down"]) / (t["release"] - t["down"])))
         return a * squeeze_only + b * (full - squeeze_only)
 
-    keys = [(0.0, q0)] + ([(t["above"], q_above)] if low else []) + [
-        (t["down"], q_down), (t["release"], q_down), (t["open"], q_open), (t["out"], q_out),
-        (t["stand"], q_stand), (t["end"], q_stand)]
+    if over:
+        down_keys = _timed(q0, [*over, q_down], 1.5)
+    else:
+        down_keys = ([(t["above"], q_above)] if low else []) + [(t["down"], q_down)]
+    keys = [(0.0, q0), *down_keys, (t["release"], q_down), (t["open"], q_open), (t["out"], q_out), *retreat,
+            (t["end"], q_stand)]
     yield from ctx.run(keyframe_trajectory("place", keys, hand_forces=forces))
     ctx.info["released_s"] = ctx.t - t["end"] + t["release"]
     ctx.held = None
     ctx.box_positions[box.name] = center_w
+
+
+BOX_OVER_TOP_M = 0.08
+"""A box carried to a support goes with its bottom at least this far above the support's top."""
+
+
+def raise_over(ctx: GoalContext, support: Block, posture: np.ndarray, carry_shift: np.ndarray) -> Iterator[None]:
+    """Before carrying the held box to `support`: raise it (standing still) until its bottom is
+    BOX_OVER_TOP_M above the top, else refuse (the box stays held). Carried at the pick's height, the
+    box came into a 0.90 m table's side on the last steps of the carry and the robot fell (bench
+    objects seed 7, trial 0)."""
+    held = ctx.held
+    assert held is not None
+    q0 = ctx.hold_q()
+    soles = flat_soles(ctx.ik, q0)
+    hands_z = min(float(ctx.poses.hand_point(q0, i)[2]) for i in range(2))
+    need = support.height_m + BOX_OVER_TOP_M + held.hand_dz_m + held.box.size[2] / 2
+    if hands_z >= need:
+        return
+    heading = stance_heading(soles)
+    up = yield from ctx.compute("raise", raised_pose, q0, soles, heading, need - hands_z, carry_shift, float(q0[2]))
+    if up.residual_m > 0.03 or up.com_error_m > 0.03:
+        raise GoalFailed(f"box '{held.box.name}' cannot be held above '{support.name}' ({support.height_m:.2f} m): "
+                         f"the hands get only within {up.residual_m * 100:.1f} cm of {need:.2f} m up "
+                         f"(CoM {up.com_error_m * 100:.1f} cm off)")
+    q_up = up.q
+    forces = held_forces(ctx, heading)
+    move = _move_s(q0, q_up, 1.5)
+    yield from ctx.run(keyframe_trajectory("raise", [(0.0, q0), (move, q_up), (move + 0.5, q_up)],
+                                           hand_forces=lambda _t: forces))
 
 
 def carry(ctx: GoalContext, mid_xy: np.ndarray, heading: float, posture: np.ndarray, weight: float,

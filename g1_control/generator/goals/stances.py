@@ -10,6 +10,9 @@ on the floor. The candidates:
   gap       from the middle of the soles to the box's near face
   pelvis    standing (nominal height), then lower in steps down to a squat at 0.42 m
   torso     upright, or leaning forward (pelvis pitched 0.4 rad, waist pulled forward 0.45 rad)
+  standing leaning  last, for a light box held at SQUAT_BELOW_M or higher on a support: standing off its edge
+            (soles' middle STAND_LEAN_GAPS_M from the box, the pelvis beyond MIN_EDGE_CLEARANCE_M),
+            the pelvis pitched STAND_LEAN_PELVIS_RAD and the waist leaning to reach in
 Each candidate is solved from the standing pose at its stance: both hands on the grasp points
 (and, for a pick, again lifted), the CoM over the soles shifted for the box's weight; it is kept
 when the hands are within FEASIBLE_RESIDUAL_M, the CoM within FEASIBLE_COM_M of its target and no
@@ -32,6 +35,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from functools import lru_cache
+from itertools import pairwise
 
 import numpy as np
 
@@ -59,6 +63,16 @@ LEAN_WAIST_RAD = 0.45
 """Leaning: the waist's pitch pull (its limit is 0.52)."""
 LEAN_PELVIS_RAD = 0.4
 """Leaning: the pelvis's pitch target (a soft one)."""
+UPRIGHT, LEAN, STAND_LEAN = 0, 1, 2
+"""How a candidate bends (Candidate.lean): upright, leaning (squatting), or leaning standing."""
+STAND_LEAN_PELVIS_RAD = 0.15
+"""Standing leaning: the pelvis's pitch target (the waist pulls LEAN_WAIST_RAD). Only for hands at
+SQUAT_BELOW_M or higher (stop 34, objects34: a 1.0 kg box on a 0.63 m table, hands at 0.72 m, kept
+only standing leaning and the robot fell stepping in)."""
+STAND_LEAN_GAPS_M = (0.28, 0.34)
+"""Standing leaning: the soles' middle this far from the box (a box whose near face is within ~0.15 m
+of a table's edge leaves an upright stance's pelvis closer than MIN_EDGE_CLEARANCE_M: bench objects
+seeds 7, 8, 9, 13-15: 15 of 60 picks from 0.72-0.95 m tables were refused so)."""
 CONTINUATION_STEP_M = 0.08
 SQUAT_PELVIS_M = (0.66, 0.60, 0.55)
 """Pelvis heights tried below standing (the fall monitor calls 0.40 m a fall; a leaning squat
@@ -149,7 +163,8 @@ class Candidate:
     mid_xy: np.ndarray
     gap_m: float
     pelvis_z_m: float
-    lean: bool
+    lean: int
+    """UPRIGHT, LEAN or STAND_LEAN."""
     preferred: bool = False
     residual_m: float = math.inf
     com_error_m: float = math.inf
@@ -167,7 +182,7 @@ class Candidate:
 
     def describe(self) -> str:
         return (f"heading {math.degrees(self.heading):.0f} deg, soles' middle {self.gap_m:.2f} m from the box, pelvis "
-                f"{self.pelvis_z_m:.2f} m, {'leaning' if self.lean else 'upright'}: hands "
+                f"{self.pelvis_z_m:.2f} m, {BENDS[int(self.lean)]}: hands "
                 f"{self.residual_m * 100:.1f} cm off, CoM {self.com_error_m * 100:.1f} cm off"
                 + (f", {self.collision}" if self.collision else ""))
 
@@ -191,7 +206,7 @@ class StancePlan:
         return self.chosen.pelvis_z_m
 
     @property
-    def lean(self) -> bool:
+    def lean(self) -> int:
         return self.chosen.lean
 
 
@@ -266,7 +281,7 @@ class StancePlanner:
             depth = grasp_width(box, heading + math.pi / 2)
             gap = max(GAPS_M[1], PREFERRED_CENTER_M - depth / 2)
             fwd = np.array([math.cos(heading), math.sin(heading)])
-            cand = Candidate(heading, center_w[:2] - (gap + depth / 2) * fwd, gap, ground_z + SQUAT_PELVIS_M[-1], True)
+            cand = Candidate(heading, center_w[:2] - (gap + depth / 2) * fwd, gap, ground_z + SQUAT_PELVIS_M[-1], LEAN)
             self._evaluate(cand, box, center_w, support, grasp_width(box, heading), dz, mass, ground_z, lift_m,
                            press_m)
             raise StanceRefused(f"{size}: no stance can {what}: the hands would hold it {grasp_z:.2f} m above the "
@@ -274,19 +289,25 @@ class StancePlanner:
                                 f"the search reaches is {LOWEST_GRASP_M:.2f} m; closest: {cand.describe()}")
         # squatting lowers the hands for a box below the waist; above it, it only costs
         levels = [nominal] + ([ground_z + z for z in SQUAT_PELVIS_M] if grasp_z < SQUAT_BELOW_M else [])
+        bent: list[tuple[int, ...]] = [(UPRIGHT, LEAN)] * len(levels)
+        if support is not None and support.height_m > KNEE_HEIGHT_M and mass < LEAN_MAX_KG and grasp_z >= SQUAT_BELOW_M:
+            levels.append(nominal)  # last: standing off the support's edge, leaning to reach in
+            bent.append((STAND_LEAN,))
         best: Candidate | None = None
         tried = 0
-        for pelvis_z in levels:
+        for pelvis_z, bends in zip(levels, bent, strict=True):
             kept: list[Candidate] = []
             for heading in headings:
                 fwd = np.array([math.cos(heading), math.sin(heading)])
                 width = grasp_width(box, heading)
                 depth = grasp_width(box, heading + math.pi / 2)
-                for lean in (False, True):
-                    if lean and (grasp_z > LEAN_BELOW_M or pelvis_z >= nominal - 1e-6 or mass >= LEAN_MAX_KG):
+                for lean in bends:
+                    if lean == LEAN and (grasp_z > LEAN_BELOW_M or pelvis_z >= nominal - 1e-6 or mass >= LEAN_MAX_KG):
                         continue  # leaning only helps below the waist, squatting
                     preferred = max(GAPS_M[1], PREFERRED_CENTER_M - depth / 2)
                     gaps = (preferred, *(g for g in GAPS_M if abs(g - preferred) > 0.02))
+                    if lean == STAND_LEAN:
+                        gaps = STAND_LEAN_GAPS_M
                     for gap in gaps if pelvis_z >= nominal - 1e-6 else [g for g in gaps if g >= 0.2]:
                         mid = center_w[:2] - (gap + depth / 2) * fwd
                         cand = Candidate(heading, mid, gap, pelvis_z, lean, preferred=gap == preferred)
@@ -304,7 +325,7 @@ class StancePlanner:
         why = best.collision if best.collision and best.residual_m <= FEASIBLE_RESIDUAL_M else \
             f"the hands get only within {best.residual_m * 100:.1f} cm" if best.residual_m > FEASIBLE_RESIDUAL_M else \
             f"the CoM is {best.com_error_m * 100:.1f} cm from over the feet"
-        raise StanceRefused(f"{size}: no stance can {what} ({tried} tried, pelvis down to {levels[-1]:.2f} m): {why}; "
+        raise StanceRefused(f"{size}: no stance can {what} ({tried} tried, pelvis down to {min(levels):.2f} m): {why}; "
                             f"closest: {best.describe()}")
 
     def _evaluate(self, cand: Candidate, box: Box, center_w: np.ndarray, support: Block | None, width: float,
@@ -340,10 +361,10 @@ class StancePlanner:
         cand.residual_m, cand.com_error_m = worst_res, worst_com
 
     def hold(self, q0: np.ndarray, soles: list[Sole], targets: tuple[np.ndarray, np.ndarray], heading: float,
-             com_shift_h: np.ndarray, pelvis_z: float, lean: bool) -> HoldPose:
+             com_shift_h: np.ndarray, pelvis_z: float, lean: int) -> HoldPose:
         """Both hands at `targets` (palms in across the heading), the pelvis at pelvis_z, the CoM over the
-        soles (shifted by com_shift_h, heading frame); lean: the pelvis may pitch and the waist leans
-        forward. Solved by continuation from q0: the pelvis and the hands move there in steps of at
+        soles (shifted by com_shift_h, heading frame); lean (LEAN, STAND_LEAN): the pelvis may pitch
+        (STAND_LEAN less) and the waist leans forward. Solved by continuation from q0: the pelvis and the hands move there in steps of at
         most CONTINUATION_STEP_M, each step's IK from the last (one jump into a deep squat lands in
         a wrong local solution, measured: hands 10-60 cm off where the steps get within 1 cm)."""
         pp = self.poses
@@ -354,7 +375,7 @@ class StancePlanner:
         weights[WAIST] = 0.5
         com = pp.com_over(soles, com_shift_h)
         rot = rot_z(np.asarray(heading))
-        pitch = LEAN_PELVIS_RAD if lean else 0.0
+        pitch = {UPRIGHT: 0.0, LEAN: LEAN_PELVIS_RAD, STAND_LEAN: STAND_LEAN_PELVIS_RAD}[int(lean)]
         pelvis_rot = rot @ np.array([[math.cos(pitch), 0.0, math.sin(pitch)], [0.0, 1.0, 0.0],
                                      [-math.sin(pitch), 0.0, math.cos(pitch)]])
         z_cap = min(p[2] for p, _ in soles) + pp.nominal_pelvis_m + PELVIS_CAP_ABOVE_NOMINAL_M
@@ -426,8 +447,8 @@ def plan_stance(poses: PosePlanner, box: Box, center_w: np.ndarray, support: Blo
                                       press_m=press_m, what=what)
 
 
-HoldStep = tuple[str, tuple[np.ndarray, np.ndarray], np.ndarray, float, bool]
-"""(name, the hands' two points, CoM shift (heading frame), pelvis height, leaning)."""
+HoldStep = tuple[str, tuple[np.ndarray, np.ndarray], np.ndarray, float, int]
+"""(name, the hands' two points, CoM shift (heading frame), pelvis height, bend: UPRIGHT/LEAN/STAND_LEAN)."""
 
 
 def grasp_hold_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float, steps: list[HoldStep],
@@ -453,7 +474,7 @@ def grasp_hold_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], head
 
 def release_hold_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float,
                        points: tuple[tuple[np.ndarray, np.ndarray], ...], shift: np.ndarray, pelvis_z: float,
-                       lean: bool, low: bool, planned: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                       lean: int, low: bool, planned: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
                                                                      np.ndarray]:
     """A place's poses (above where the box goes, from a squat; set down; hands opened; hands out;
     standing): the box set down at the planned squat and lean; StanceRefused when the hands get no
@@ -470,6 +491,125 @@ def release_hold_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], he
     ground_z = min(p[2] for p, _ in soles)
     q_stand = poses.stand(q_out, soles, ground_z + poses.nominal_pelvis_m, g1.DEFAULT_Q_RAD)
     return q_above, down_pose.q, q_open, q_out, q_stand
+
+
+CLEAR_MARGIN_M = 0.02
+"""A hand (or a held box) moving past a support keeps this far from its outline, and a hand 1 cm
+above its top (CLEAR_ABOVE_M) or below its underside less this."""
+CLEAR_ABOVE_M = 0.01
+HAND_TIP_M = 0.08
+"""The rubber hand reaches this far beyond the hand point (the palm's middle) along the hand frame's x."""
+DETOUR_SPACING_M = 0.05
+"""A detour's hand points are solved this far apart (the keyframes blend in joint space between)."""
+PATH_SAMPLES = 24
+BOX_SINK_M = 0.01
+"""A held box's bottom counts as in a support's top this far below it."""
+ELBOWS = ("left_elbow_link", "right_elbow_link")
+
+
+def _probes(poses: PosePlanner, q: np.ndarray, heading: float, box_probes: tuple[tuple[float, float], ...],
+            tips: bool = True) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """The points that must stay clear of a support in pose q: (each hand point, its tip and the
+    elbows; with a box held, the box's points (forward, down) from the middle between the hands)."""
+    fwd = np.array([math.cos(heading), math.sin(heading), 0.0])
+    frames = [poses.ik.frame_pose(q, HAND_FRAMES[i]) for i in range(2)]
+    hands = [p for p, _ in frames]
+    body = [*hands, *(poses.ik.frame_pose(q, f)[0] for f in ELBOWS)]
+    if tips:
+        body += [p + HAND_TIP_M * r[:, 0] for p, r in frames]
+    mid = (hands[0] + hands[1]) / 2
+    return body, [mid + f * fwd - np.array([0.0, 0.0, d]) for f, d in box_probes]
+
+
+def path_meets(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, heading: float, block: Block,
+               box_probes: tuple[tuple[float, float], ...] = (), tips: bool = True) -> bool:
+    """Whether the straight configuration-space move from q_a to q_b (the way keyframes blend) takes
+    a hand, its tip or an elbow into `block`'s top (within CLEAR_MARGIN_M of its outline, between its
+    underside less CLEAR_MARGIN_M and CLEAR_ABOVE_M above it), or the held box's points (`box_probes`, see _probes)
+    below its top (a box set down on it ends resting there). tips: the hands' tips too."""
+    top, under = block.height_m + CLEAR_ABOVE_M, block.height_m - TABLE_TOP_THICKNESS_M - CLEAR_MARGIN_M
+    for s in np.linspace(0.0, 1.0, PATH_SAMPLES):
+        q = q_a + s * (q_b - q_a)
+        q[3:7] /= np.linalg.norm(q[3:7])
+        body, box = _probes(poses, q, heading, box_probes, tips)
+        for p in body:
+            if under < p[2] < top and block.distance_xy(p[:2]) < CLEAR_MARGIN_M:
+                return True
+        for p in box:
+            if under < p[2] < block.height_m - BOX_SINK_M and block.distance_xy(p[:2]) < CLEAR_MARGIN_M:
+                return True
+    return False
+
+
+def detour_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: list[Sole], heading: float,
+                 shift: np.ndarray, pelvis_z: float, lean: int, block: Block, clear_z_m: float,
+                 box_probes: tuple[tuple[float, float], ...] = (), tips: bool = True, strict: bool = False
+                 ) -> list[np.ndarray]:
+    """Poses to put between q_a and q_b so that the hands (and a held box) go around `block` instead
+    of through it; [] where the straight move keeps clear (path_meets). The hands move at the higher of their
+    two heights and clear_z_m: straight up, across, straight down, solved every DETOUR_SPACING_M from
+    the pose before (one IK branch: independent solutions blend through other ones). Measured: a
+    straight move from the arms hanging to above a box on a 0.95 m table swung a hand into the
+    table's top from below, the arm caught and the robot fell stepping back (bench objects seed 12,
+    trial 3). Two ways are tried, by their corners alone, then each solved every DETOUR_SPACING_M
+    back from q_b (keeping its IK branch) and on from q_a, the first whose every blend keeps clear kept, else (strict: StanceRefused, before the hands
+    move) the one with the fewest that do not: across below, then straight up or down; straight up
+    (or down) to the higher height, across, straight down."""
+    if not path_meets(poses, q_a, q_b, heading, block, box_probes, tips):
+        return []
+    a = [poses.hand_point(q_a, i) for i in range(2)]
+    b = [poses.hand_point(q_b, i) for i in range(2)]
+    high = max(a[0][2], a[1][2], b[0][2], b[1][2], clear_z_m)
+    ways = ([a, [np.array([*p[:2], a[0][2]]) for p in b], b],  # across below, then up (or down)
+            [a, [np.array([*p[:2], high]) for p in a], [np.array([*p[:2], high]) for p in b], b])
+    best: tuple[int, list[np.ndarray]] | None = None
+    # the corners alone first (fewest keyframes), then every DETOUR_SPACING_M, solved from q_b back
+    # (keeping its IK branch) or from q_a on
+    tries = [(math.inf, ways[0], False), (math.inf, ways[1], False),
+             *((DETOUR_SPACING_M, way, back) for way in ways for back in (True, False))]
+    for spacing, corners, backward in tries:
+        if backward:
+            chain = _along(poses, q_b, corners[::-1], soles, heading, shift, pelvis_z, lean, spacing)[:-1][::-1]
+        else:
+            chain = _along(poses, q_a, corners, soles, heading, shift, pelvis_z, lean, spacing)[:-1]
+        path = [q_a, *chain, q_b]
+        bad = sum(path_meets(poses, u, v, heading, block, box_probes, tips) for u, v in pairwise(path))
+        if best is None or bad < best[0]:
+            best = (bad, chain)
+        if bad == 0:
+            return chain
+    assert best is not None
+    if strict:  # a 5.6 kg box on a 0.84 m table: the way kept with a blend through the top caught a hand
+        # under it and the robot fell at the lift (bench objects seed 12, trial 1)
+        raise StanceRefused(f"the hands find no way around the top of '{block.name}' ({block.height_m:.2f} m): "
+                            f"every way tried passes within {CLEAR_MARGIN_M * 100:.0f} cm of it")
+    return best[1]
+
+
+def raised_pose(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float, dz_m: float,
+                shift: np.ndarray, pelvis_z: float) -> HoldPose:
+    """The hold pose with both hands dz_m above where they are in q0 (a held box raised), upright."""
+    targets = tuple(poses.hand_point(q0, i) + np.array([0.0, 0.0, dz_m]) for i in range(2))
+    return stance_planner(poses).hold(q0, soles, (targets[0], targets[1]), heading, shift, pelvis_z, UPRIGHT)
+
+
+def _along(poses: PosePlanner, q: np.ndarray, corners: list[list[np.ndarray]], soles: list[Sole], heading: float,
+           shift: np.ndarray, pelvis_z: float, lean: int, spacing: float = DETOUR_SPACING_M) -> list[np.ndarray]:
+    """Poses with the hands every `spacing` along the polyline `corners` (pairs of hand points; at
+    least at each corner), each solved from the one before."""
+    hold = stance_planner(poses).hold
+    out: list[np.ndarray] = []
+    for p0, p1 in pairwise(corners):
+        n = max(1, math.ceil(max(float(np.linalg.norm(p1[i] - p0[i])) for i in range(2)) / spacing))
+        for j in range(1, n + 1):
+            u = j / n
+            targets = (p0[0] + u * (p1[0] - p0[0]), p0[1] + u * (p1[1] - p0[1]))
+            q = hold(q, soles, targets, heading, shift, pelvis_z, lean).q
+            out.append(q)
+    return out
+
+
+BENDS = {UPRIGHT: "upright", LEAN: "leaning", STAND_LEAN: "standing leaning"}
 
 
 def _part(a: str, b: str) -> str:
@@ -504,6 +644,6 @@ def place_heading(support: Block | None, xy: np.ndarray, robot_xy: np.ndarray) -
     return math.atan2(-n[1], -n[0])
 
 
-__all__ = ["Candidate", "StancePlan", "StancePlanner", "StanceRefused", "box_com_shift", "edge_normal", "face_normals",
-           "grasp_hold_poses", "hand_height", "pick_headings", "place_heading", "plan_stance", "release_hold_poses",
-           "stance_planner"]
+__all__ = ["LEAN", "STAND_LEAN", "UPRIGHT", "Candidate", "StancePlan", "StancePlanner", "StanceRefused", "box_com_shift", "detour_poses", "edge_normal",
+           "face_normals", "grasp_hold_poses", "hand_height", "path_meets", "pick_headings", "place_heading", "plan_stance",
+           "raised_pose", "release_hold_poses", "stance_planner"]
