@@ -33,6 +33,10 @@ class TerrainConfig:
     riser_gap_m: float = 0.08
     """Nothing higher than the sole may stand within this ahead of its toe: the stance shin leans
     forward over the toe as the body passes (it caught a riser's edge 3.5 cm ahead, measured)."""
+    drop_gap_m: float = 0.08
+    """Nothing higher than the sole may stand within this behind its heel: a leg reaching down past a
+    platform's edge to the floor passes that edge (landing 0.1 m beyond it, the straightened leg's knee
+    struck the edge, measured: `g1 bench stairs --only platform` seed 0)."""
     max_shift_m: float = 0.25
     """Snapping moves a landing point at most this far; past it the point stays where it was."""
     shift_step_m: float = 0.01
@@ -44,7 +48,7 @@ class TerrainConfig:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise WbcConfigError(f"TerrainConfig.{name} must be a finite number > 0; got {value}")
-        for name in ("edge_margin_m", "riser_gap_m", "max_shift_m", "level_tolerance_m"):
+        for name in ("edge_margin_m", "riser_gap_m", "drop_gap_m", "max_shift_m", "level_tolerance_m"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0):
                 raise WbcConfigError(f"TerrainConfig.{name} must be a finite number >= 0; got {value}")
@@ -73,6 +77,10 @@ class Terrain:
         gx, gy = np.meshgrid(ahead, u[::2] * (c.sole_half_width_m + c.edge_margin_m))
         self._toe_points = np.stack([gx.ravel(), gy.ravel()], axis=1)
         """Points ahead of the toe (sole axes) that may not stand higher than the sole."""
+        behind = -(c.sole_half_length_m + np.linspace(c.edge_margin_m, max(c.drop_gap_m, c.edge_margin_m), 4))
+        gx, gy = np.meshgrid(behind, u[::2] * (c.sole_half_width_m + c.edge_margin_m))
+        self._heel_points = np.stack([gx.ravel(), gy.ravel()], axis=1)
+        """Points behind the heel (sole axes) that may not stand higher than the sole."""
 
     @classmethod
     def of_scene(cls, scene: SceneConfig, config: TerrainConfig | None = None) -> Terrain:
@@ -107,12 +115,15 @@ class Terrain:
         return float(self._sole_heights(xy_m, yaw_rad).max())
 
     def is_level(self, xy_m: np.ndarray, yaw_rad: float) -> bool:
-        """Whether a sole there lies on one level, clear of its edges and of a riser ahead of it."""
+        """Whether a sole there lies on one level, clear of its edges, of a riser ahead of it and of a
+        higher level's edge behind it (TerrainConfig.riser_gap_m, drop_gap_m)."""
         h = self._sole_heights(xy_m, yaw_rad)
         tol = self.config.level_tolerance_m
         if h.max() - h.min() > tol:
             return False
-        return bool(self._sole_heights(xy_m, yaw_rad, self._toe_points).max() <= h.max() + tol)
+        if self._sole_heights(xy_m, yaw_rad, self._toe_points).max() > h.max() + tol:
+            return False
+        return bool(self._sole_heights(xy_m, yaw_rad, self._heel_points).max() <= h.max() + tol)
 
     def snap(self, xy_m: np.ndarray, yaw_rad: float, heading_rad: float,
              forward_only: bool = False, backward_only: bool = False,
