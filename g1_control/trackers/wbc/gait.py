@@ -35,7 +35,9 @@ arriving a little before touchdown; the height is a smooth bump of `swing_height
 velocity and acceleration at both ends.
 
 Steps and platforms (terrain.py, the scene's map): a landing is snapped onto one tread and keeps
-the level it chose for its step; the DCM's plan moves with the snapped landing; a step onto another
+the level it chose for its step (once swinging, whatever the DCM asks); a foot on another level than
+the stance foot lands on the stance foot's level (step-to: never two treads in one swing); the DCM's
+plan moves with the snapped landing; a step onto another
 level is not made sooner and swings long enough to cross (terrain_swing_speed_mps); the double
 support before it lasts until the DCM is over the stance sole (terrain_max_wait_s); near a step the
 CoP may go further sideways (terrain_cop_limit_y_m).

@@ -7,7 +7,8 @@ highest top over it, the floor (0) elsewhere. Positions are the controller's odo
 starts at the world's origin as the scene does (the robot spawns there facing +x).
 
 A foothold is snapped so the whole sole, with a margin, lies on one level: a sole across a tread's
-edge tips over it. The landing point moves along the walking heading to the nearest place where
+edge tips over it; a higher level may not stand just ahead of its toe (the shin leans over it) nor
+just behind its heel (the leg reaching down past that edge strikes it). The landing point moves along the walking heading to the nearest place where
 it does (forward or back, whichever is nearer), within `max_shift_m`.
 """
 

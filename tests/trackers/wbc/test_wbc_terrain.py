@@ -81,5 +81,7 @@ def test_named_errors():
         TerrainConfig(sole_half_length_m=0.0)
     with pytest.raises(WbcConfigError, match="TerrainConfig.riser_gap_m must be a finite number >= 0"):
         TerrainConfig(riser_gap_m=-0.1)
+    with pytest.raises(WbcConfigError, match="TerrainConfig.drop_gap_m must be a finite number >= 0"):
+        TerrainConfig(drop_gap_m=-0.1)
     with pytest.raises(WbcConfigError, match="half sizes > 0"):
         Terrain([(np.zeros(2), np.array([0.0, 0.3]), 0.0, 0.1)])
