@@ -33,7 +33,12 @@ class TerrainConfig:
     """A snapped sole keeps this far from a tread's edge, all round."""
     riser_gap_m: float = 0.08
     """Nothing higher than the sole may stand within this ahead of its toe: the stance shin leans
-    forward over the toe as the body passes (it caught a riser's edge 3.5 cm ahead, measured)."""
+    forward over the toe as the body passes (it caught a riser's edge 3.5 cm ahead, measured). Before
+    the 0.20 m platform the bent stance knee still strikes its edge while the other leg swings up
+    (`g1 bench stairs --only platform`, 4 of seeds 0-4, 100-104, 200-204, 300-304). Tried, not kept
+    (stop 35): nothing over 0.17 m above the sole within 0.15 m of the toe; the lead step onto the
+    platform then grew to ~0.42 m: top reached 4, 5, 3, 2 of 5 on those four seed ranges against 4, 4, 3,
+    4 without it, up and down 0/20 against 3/20 (measured)."""
     drop_gap_m: float = 0.08
     """Nothing higher than the sole may stand within this behind its heel: a leg reaching down past a
     platform's edge to the floor passes that edge (landing 0.1 m beyond it, the straightened leg's knee
