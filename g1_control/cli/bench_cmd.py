@@ -71,6 +71,8 @@ def register(subparsers) -> None:
     parser.add_argument("--trials", type=int, default=None,
                         help="stairs: seeded draws per course (default 5); objects: drawn scenes (default 10)")
     parser.add_argument("--video", metavar="DIR", help="execution: a video per behaviour into DIR")
+    parser.add_argument("--trace", metavar="DIR", help="stairs: a CSV per trial into DIR (every 0.02 s: soles, "
+                        "swing reference, DCM, CoP, CoM height, fastest joint)")
     parser.add_argument("--write", action="store_true", help="envelope: write the measured envelope next to the "
                         "policy spec (the loop builder's command limits)")
     add_fanout_arguments(parser, what="/".join(FANS_OUT) + " trials")

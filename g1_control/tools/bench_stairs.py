@@ -17,6 +17,7 @@ once), across (both soles back on the floor beyond the structure). Draws: angle 
     g1 bench stairs --seed 100 --trials 10              # seeds 100..109, both courses
     g1 bench stairs --only platform --seed 100 --trials 5
     g1 bench stairs --only step --seed 100 --trials 10
+    g1 bench stairs --only stairs --seed 0 --trials 1 --trace /tmp/trace   # per-tick CSV per trial
 """
 
 from __future__ import annotations
@@ -86,8 +87,44 @@ def draw(seed: int) -> tuple[float, float]:
     return float(rng.uniform(-MAX_ANGLE_DEG, MAX_ANGLE_DEG)), float(rng.uniform(-MAX_OFFSET_M, MAX_OFFSET_M))
 
 
-def run_course(course: str, seed: int, *, speed_mps: float = 0.3, duration_s: float = 40.0) -> StairsTrial:
-    """Stand 1 s, then walk +x at speed_mps until the robot is across (or falls, or duration_s)."""
+TRACE_COLUMNS = ("t_s", "mode", "stance", "swing_foot", "swing_progress",
+                 "left_along_m", "left_z_m", "right_along_m", "right_z_m",
+                 "swing_ref_along_m", "swing_ref_z_m", "landing_z_m", "dcm_error_m",
+                 "com_z_m", "com_ref_z_m", "dcm_along_m", "dcm_across_m", "cop_along_m", "cop_across_m",
+                 "pelvis_above_ground_m", "fastest_joint", "speed_fraction")
+"""`--trace` columns, every 0.02 s. Soles (along the course's axis from its near edge, and height),
+the pelvis above the ground under it and the fastest joint (|dq| over its velocity limit) are the
+simulator's ground truth; the rest is the controller's own view (odometry frame): its gait's phase,
+swing reference and landing height, the DCM's distance from its plan, the CoM's height and target,
+the DCM and the CoP asked relative to the stance sole (course axes)."""
+
+
+def _trace_row(t_s: float, tracker, d, feet: list[int], axis: np.ndarray, origin: np.ndarray,
+               scene: SceneConfig) -> list:
+    from g1_control.robot import g1
+
+    gait = tracker.gait
+    gt = gait.targets
+    perp = np.array([-axis[1], axis[0]])
+    soles = [d.xpos[f].copy() for f in feet]
+    for p in soles:
+        p[2] -= SOLE_BELOW_ANKLE_M
+    stance = tracker.sole_positions_m[gait.stance, :2]
+    diag = tracker.diagnostics
+    dcm, cop = diag.com_ref_m[:2] - stance, gt.cop_xy_m - stance  # walking by its gait, com_ref's xy is the DCM
+    speed = np.abs(d.qvel[6:6 + g1.NUM_JOINTS]) / g1.VELOCITY_LIMIT_RADPS
+    j = int(np.argmax(speed))
+    return [round(t_s, 3), gait.mode, gait.stance, gt.swing_foot, gt.swing_progress,
+            float((soles[0][:2] - origin) @ axis), soles[0][2], float((soles[1][:2] - origin) @ axis), soles[1][2],
+            float((gt.swing_pos_m[:2] - origin) @ axis), gt.swing_pos_m[2], gt.landing_m[2], gt.dcm_error_m,
+            diag.com_m[2], diag.com_ref_m[2], float(dcm @ axis), float(dcm @ perp), float(cop @ axis), float(cop @ perp),
+            float(d.qpos[2] - _ground_under(scene, d.qpos[:2])), g1.JOINT_NAMES[j], float(speed[j])]
+
+
+def run_course(course: str, seed: int, *, speed_mps: float = 0.3, duration_s: float = 40.0,
+               trace: list[list] | None = None) -> StairsTrial:
+    """Stand 1 s, then walk +x at speed_mps until the robot is across (or falls, or duration_s).
+    trace: a list that gets one row (TRACE_COLUMNS) every 0.02 s."""
     import mujoco
 
     from g1_control.launch.builder import build_loop
@@ -112,6 +149,8 @@ def run_course(course: str, seed: int, *, speed_mps: float = 0.3, duration_s: fl
     try:
         while loop.time_s < duration_s - 1e-9:
             loop.run(0.02)
+            if trace is not None:
+                trace.append(_trace_row(loop.time_s, loop.tracker, d, feet, axis, origin, scene))
             soles = np.array([d.xpos[f] for f in feet])
             soles[:, 2] -= SOLE_BELOW_ANKLE_M
             on_top = all(abs(z - top_m) < 0.03 for z in soles[:, 2])
@@ -136,6 +175,16 @@ def run_course(course: str, seed: int, *, speed_mps: float = 0.3, duration_s: fl
     return StairsTrial(course, seed, angle_deg, offset_m, fell, top, across, detail, float(loop.time_s), wall)
 
 
+def _write_trace(path: Path, rows: list[list]) -> None:
+    import csv
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("w", newline="") as f:
+        out = csv.writer(f)
+        out.writerow(TRACE_COLUMNS)
+        out.writerows([f"{v:.4f}" if isinstance(v, float) else v for v in row] for row in rows)
+
+
 def _ground_under(scene: SceneConfig, xy: np.ndarray) -> float:
     return scene.ground_height(np.asarray(xy, dtype=float))
 
@@ -150,8 +199,11 @@ def main(args) -> int:
     print(f"{'course':9s} {'seed':>4s} {'angle':>7s} {'offset':>7s} {'top':>4s} {'across':>6s} {'fell':>4s}  detail")
     for course in courses:
         for seed in range(first, first + count):
-            r = run_course(course, seed)
+            trace: list[list] | None = [] if getattr(args, "trace", None) else None
+            r = run_course(course, seed, trace=trace)
             rows.append(r)
+            if trace is not None:
+                _write_trace(Path(args.trace) / f"{course}_{seed}.csv", trace)
             print(f"{r.course:9s} {r.seed:4d} {r.angle_deg:6.1f}° {r.offset_m:6.2f}m {str(r.top)[0]:>4s} "
                   f"{str(r.across)[0]:>6s} {str(r.fell)[0]:>4s}  {r.detail}  ({r.sim_s:.1f} s sim, {r.wall_s:.0f} s wall)",
                   flush=True)
@@ -164,4 +216,4 @@ def main(args) -> int:
     return 1 if any(r.fell for r in rows) else 0
 
 
-__all__ = ["COURSES", "StairsTrial", "course_scene", "draw", "main", "run_course"]
+__all__ = ["COURSES", "TRACE_COLUMNS", "StairsTrial", "course_scene", "draw", "main", "run_course"]

@@ -36,3 +36,26 @@ def test_draws_repeat_per_seed_within_bounds():
 def test_unknown_course_is_named():
     with pytest.raises(ValueError, match="unknown course 'ramp'; known: stairs, platform, step"):
         course_scene("ramp", 0.0, 0.0)
+
+
+def test_a_trial_traces_the_feet_the_gait_and_the_balance_every_50th_of_a_second(tmp_path):
+    import csv
+
+    from g1_control.tools.bench_stairs import TRACE_COLUMNS, _write_trace, run_course
+
+    rows: list = []
+    trial = run_course("step", 0, duration_s=2.0, trace=rows)
+    assert not trial.fell and len(rows) == 100 and all(len(r) == len(TRACE_COLUMNS) for r in rows)
+    col = {name: i for i, name in enumerate(TRACE_COLUMNS)}
+    times = np.array([r[col["t_s"]] for r in rows])
+    np.testing.assert_allclose(np.diff(times), 0.02, atol=1e-6)
+    assert rows[0][col["mode"]] == "stand" and rows[-1][col["mode"]] in ("start", "walk")
+    start = rows[0]
+    # standing on the floor 1 m before the course's near edge (0.3 m beside its axis at most)
+    assert abs(start[col["left_z_m"]]) < 0.01 and abs(start[col["right_z_m"]]) < 0.01
+    assert -1.3 < start[col["left_along_m"]] < -0.6 and 0.6 < start[col["pelvis_above_ground_m"]] < 0.85
+    assert all(0.0 <= r[col["speed_fraction"]] < 1.0 for r in rows)
+    _write_trace(tmp_path / "t" / "step_0.csv", rows)
+    with (tmp_path / "t" / "step_0.csv").open() as f:
+        read = list(csv.reader(f))
+    assert tuple(read[0]) == TRACE_COLUMNS and len(read) == 101 and read[1][col["mode"]] == "stand"

@@ -35,7 +35,9 @@ arriving a little before touchdown; the height is a smooth bump of `swing_height
 velocity and acceleration at both ends.
 
 Steps and platforms (terrain.py, the scene's map): a landing is snapped onto one tread and keeps
-the level it chose for its step; the DCM's plan moves with the snapped landing; a step onto another
+the level it chose for its step (once swinging, whatever the DCM asks); a foot on another level than
+the stance foot lands on the stance foot's level (step-to: never two treads in one swing); the DCM's
+plan moves with the snapped landing; a step onto another
 level is not made sooner and swings long enough to cross (terrain_swing_speed_mps); the double
 support before it lasts until the DCM is over the stance sole (terrain_max_wait_s); near a step the
 CoP may go further sideways (terrain_cop_limit_y_m).
@@ -171,10 +173,17 @@ class GaitConfig:
     terrain_max_wait_s: float = 0.4
     """Near a step, the double support lasts at most this much longer while the DCM is short of the
     stance sole's centre (VelocityGait._dcm_short_of_stance)."""
+    terrain_lift_dcm_margin_m: float = 0.03
+    """... the other foot lifts once the DCM is no more than this behind the stance sole's centre: the
+    trailing leg swinging up and forward then carries it on (lifted with the DCM at the centre, the
+    DCM ran past the CoP's front limit in the trailing swing up, measured: `g1 bench stairs` seed 0)."""
     terrain_cop_limit_y_m: float = 0.03
     """Near a step, the CoP may leave the stance sole's centre this far sideways (cop_limit_y_m on flat
     ground): the longer single supports there let a sideways DCM error grow past what 1.5 cm caught
     (`g1 bench stairs --only step` seeds 0-4: 1 of 5 up and down without a fall, 0 with 1.5 cm)."""
+    terrain_level_reach_m: float = 0.45
+    """How far along the heading a landing may move to stay on the level it must keep (a foot below the
+    stance foot's level comes onto that level; a swing keeps its foothold's level)."""
     terrain_swing_speed_mps: float = 1.5
     terrain_max_single_support_s: float = 0.8
     """A step onto another level swings longer when its foot has far to go: its horizontal crossing
@@ -690,21 +699,49 @@ class VelocityGait:
                                                max_shift_m=reach)
                 if terrain.is_level(ahead, self._landing_yaw):
                     xy, ground_l = ahead, ground_a
+        tol = terrain.config.level_tolerance_m
+        ground_f = terrain.height(swing_sole[:2])
+        ground_o = terrain.height((self._swing_from if self._swinging else swing_sole)[:2])  # where it lifted from
+        if abs(ground_o - ground_s) > tol and abs(ground_l - ground_s) > tol:
+            # a foot below (or above) the stance foot's level comes onto that level, beside it: never
+            # past it onto the next tread (the trailing foot swung from the first tread onto the top,
+            # 0.3 m up and 0.8 m on, measured)
+            xy, ground_l = self._on_level(want, heading_td, ground_s)
+        elif self._swinging and self._snap_shift_at == self._t0 and abs(ground_l - self._foothold_ground) > tol:
+            # a swing keeps the level its foothold had (its timing and apex were chosen for it at
+            # lift-off): a same-level step whose landing moved onto the next tread mid-swing came down
+            # on that tread's edge (measured)
+            xy, ground_l = self._on_level(want, heading_td, self._foothold_ground)
         shift = float((xy - want) @ forward)
         if self._snap_shift_at != self._t0 or self._snap_dir == 0:
             self._snap_dir = 1 if shift > 1e-9 else -1 if shift < -1e-9 else 0
         self._snap_shift = xy - want
         self._snap_shift_at = self._t0
         self._foothold, self._foothold_ground = xy.copy(), ground_l
-        ground_f = terrain.height(swing_sole[:2])
         self._level_change = max(abs(ground_l - ground_s), abs(ground_l - ground_f)) > self.config.step_change_m
         self._landing[:2] = xy
         self._landing[2] = u[2] + ground_l - ground_s
         start = self._swing_from[:2] if self._swinging else self._landing[:2]
         self._path_top = terrain.max_height_along(start, xy, self._landing_yaw) - ground_s
 
+    def _on_level(self, want: np.ndarray, heading_td: float, level_m: float) -> tuple[np.ndarray, float]:
+        """The foothold nearest `want` along the heading (within terrain_level_reach_m) whose whole sole
+        lies on the level `level_m`; the last foothold when there is none."""
+        terrain = self.terrain
+        tol, step = terrain.config.level_tolerance_m, terrain.config.shift_step_m
+        direction = np.array([math.cos(heading_td), math.sin(heading_td)])
+        for k in range(int(self.config.terrain_level_reach_m / step) + 1):
+            for sign in ((1.0,) if k == 0 else (1.0, -1.0)):
+                p = want + sign * k * step * direction
+                if terrain.is_level(p, self._landing_yaw):
+                    ground = terrain.sole_height(p, self._landing_yaw)
+                    if abs(ground - level_m) <= tol:
+                        return p, ground
+        return self._foothold.copy(), self._foothold_ground
+
     def _dcm_short_of_stance(self, command_h: np.ndarray, soles_m: np.ndarray, dcm_xy: np.ndarray) -> bool:
-        """Near a step, whether the DCM lies behind the stance sole's centre along the motion: lifting
+        """Near a step, whether the DCM lies behind the stance sole's centre along the motion (by more than
+        GaitConfig.terrain_lift_dcm_margin_m): lifting
         the other foot then, the DCM runs back off the sole's heel (after a long step up onto a tread
         the trailing foot lifted with the DCM 0.13 m short of the front sole and the robot fell back,
         measured)."""
@@ -712,7 +749,7 @@ class VelocityGait:
             return False
         direction = self.heading + math.atan2(command_h[1], command_h[0])
         along = np.array([math.cos(direction), math.sin(direction)])
-        return float((dcm_xy - soles_m[self.stance, :2]) @ along) < 0.0
+        return float((dcm_xy - soles_m[self.stance, :2]) @ along) < -self.config.terrain_lift_dcm_margin_m
 
     def _in_swing(self, t_s: float) -> bool:
         return t_s - self._t0 >= self.active.double_support_s

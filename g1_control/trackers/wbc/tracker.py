@@ -230,6 +230,13 @@ class WholeBodyTracker(Tracker):
         self._held_posture_weights[list(g1.UPPER_BODY_JOINTS)] = self.config.walking_held_upper_weight
         self.reset()
 
+    @property
+    def sole_positions_m(self) -> np.ndarray:
+        """This tick's sole positions (2, 3), left then right, in the odometry frame (read-only view)."""
+        view = self._sole_pos.view()
+        view.flags.writeable = False
+        return view
+
     def _standing_heights(self) -> tuple[float, float]:
         """CoM and pelvis heights above the soles in the default pose (the gait's nominal)."""
         pin, m, d = self._pin, self.dyn.model, self.ref_data

@@ -333,3 +333,47 @@ def test_on_flat_ground_a_height_drift_of_the_feet_is_not_a_step(drift_m):
     assert out.swing_foot >= 0
     # by 0.3 of the single support (the terrain's hold is 0.4) the foot is well under way across
     assert max(moved) > 0.3
+
+
+def _two_treads():
+    """Stairs from x = 1.0: a 0.15 m tread 0.45 m deep, then a 0.30 m one."""
+    from g1_control.scene import Platform, SceneConfig
+    from g1_control.trackers.wbc.terrain import Terrain
+
+    return Terrain.of_scene(SceneConfig(platforms=[Platform("tread1", (1.225, 0.0), (0.45, 1.4), 0.15),
+                                                   Platform("tread2", (1.675, 0.0), (0.45, 1.4), 0.30)]))
+
+
+def test_a_trailing_foot_comes_onto_the_stance_foot_level_not_past_it():
+    """The stance foot on the first tread, the swing foot on the floor behind, the DCM asking a long
+    step (its landing would lie on the second tread): the trailing foot comes onto the first tread,
+    whole sole on it, never two treads up in one swing."""
+    terrain = _two_treads()
+    gait = VelocityGait(GaitConfig(), terrain)
+    soles, yaws = _feet()
+    soles[LEFT] = (1.2, 0.11, 0.15)
+    soles[RIGHT] = (0.8, -0.11, 0.0)
+    t = _into_single_support(gait, soles, yaws)
+    assert gait.stance == LEFT
+    out = gait.update(t, 0.004, soles, yaws, soles[LEFT, :2] + np.array([0.35, -0.05]), OMEGA)
+    assert out.landing_m[2] == pytest.approx(0.15)
+    assert terrain.is_level(out.landing_m[:2], 0.0) and terrain.height(out.landing_m[:2]) == pytest.approx(0.15)
+
+
+def test_a_swing_keeps_the_level_its_foothold_had():
+    """Both feet on the first tread, a short step under way: the DCM then running ahead moves the
+    landing forward, but not onto the next tread (its swing was planned for this level)."""
+    terrain = _two_treads()
+    gait = VelocityGait(GaitConfig(), terrain)
+    soles, yaws = _feet()
+    soles[:, 0] = 1.16
+    soles[:, 2] = 0.15
+    t = _into_single_support(gait, soles, yaws)
+    out = gait.update(t, 0.004, soles, yaws, soles[LEFT, :2] + np.array([0.0, -0.05]), OMEGA)
+    assert out.landing_m[2] == pytest.approx(0.15)
+    for ahead in (0.4, 0.3, 0.5):  # the landing asked lies on (or beyond the riser of) the second tread
+        t += 0.004
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+        out = gait.update(t, 0.004, soles, yaws, soles[LEFT, :2] + np.array([ahead, -0.05]), OMEGA)
+        assert out.landing_m[2] == pytest.approx(0.15), ahead
+        assert terrain.is_level(out.landing_m[:2], 0.0) and terrain.height(out.landing_m[:2]) == pytest.approx(0.15)

@@ -1,6 +1,7 @@
 """The whole-body controller's own gait climbs a 0.15 m step it knows from the scene's map, in MuJoCo
 (the full loop, safety included), approached at an angle: the lead foot lands with its whole sole on
-the tread and both feet get up without a fall. Ground truth is read for the checks only."""
+the tread and both feet get up without a fall; walked on, it comes down the far side. Ground truth is
+read for the checks only."""
 
 import math
 
@@ -51,3 +52,13 @@ def test_a_015_m_step_approached_at_an_angle_is_climbed_with_the_whole_sole_on_t
         loop.backend.close()
     # every sole resting at the tread's height had its heel on the tread too (not straddling its edge)
     assert heels_on_tread and min(heels_on_tread) == top_m
+
+
+def test_a_015_m_step_is_walked_up_and_down_without_a_fall():
+    # seed 3 of `g1 bench stairs --only step`: approached at -20.7 deg, 0.16 m off the axis; main
+    # fbb26fd fell stepping down off it (its knee struck the step's edge at 10.55 s: the foot landed
+    # with its heel 0.1 m past the edge)
+    from g1_control.tools.bench_stairs import run_course
+
+    trial = run_course("step", 3, duration_s=16.0)
+    assert trial.top and trial.across and not trial.fell, trial

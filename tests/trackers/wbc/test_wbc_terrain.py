@@ -57,6 +57,19 @@ def test_a_riser_close_ahead_of_the_toe_is_not_level_but_an_edge_behind_the_heel
     assert t.is_level(np.array([1.0 + c.sole_half_length_m + c.edge_margin_m + 0.01, 0.0]), math.pi)
 
 
+def test_a_sole_stepping_down_off_an_edge_keeps_its_heel_clear_of_it():
+    """Walking down off the first tread (facing -x) onto the floor: a sole whose heel lies within
+    drop_gap_m of the tread's edge is not level (the leg reaching down would strike the edge)."""
+    t = stairs()
+    c = t.config
+    close = 1.0 - c.sole_half_length_m - c.edge_margin_m - 0.01
+    assert t.height(np.array([close, 0.0])) == 0.0 and not t.is_level(np.array([close, 0.0]), math.pi)
+    clear = 1.0 - c.sole_half_length_m - c.drop_gap_m - 0.01
+    assert t.is_level(np.array([clear, 0.0]), math.pi)
+    xy, height = t.snap(np.array([close, 0.0]), math.pi, math.pi)  # walking on: the landing moves away from it
+    assert height == 0.0 and xy[0] <= clear + c.shift_step_m
+
+
 def test_clearance_along_a_swing_path_sees_the_tread_in_between():
     t = stairs()
     assert t.max_height_along(np.array([0.8, 0.0]), np.array([1.5, 0.0]), 0.0) == pytest.approx(0.30)
@@ -68,5 +81,7 @@ def test_named_errors():
         TerrainConfig(sole_half_length_m=0.0)
     with pytest.raises(WbcConfigError, match="TerrainConfig.riser_gap_m must be a finite number >= 0"):
         TerrainConfig(riser_gap_m=-0.1)
+    with pytest.raises(WbcConfigError, match="TerrainConfig.drop_gap_m must be a finite number >= 0"):
+        TerrainConfig(drop_gap_m=-0.1)
     with pytest.raises(WbcConfigError, match="half sizes > 0"):
         Terrain([(np.zeros(2), np.array([0.0, 0.3]), 0.0, 0.1)])
