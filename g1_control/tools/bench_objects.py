@@ -14,7 +14,8 @@ a pick and a place goal. Judged from the simulator's ground truth only (not the 
   held      it was still >= 5 cm up when the pick ended
   placed    its centre ended within 10 cm (xy) of the target and within 3 cm of resting on it
   upright   it ended tilted < 10 deg
-  dropped   it sank > 5 cm relative to the hands between the lift and the release
+  dropped   it sank > 5 cm relative to the hands between the lift and the release (the place's, or
+            the set-back of a pick whose box did not come up with the hands)
   fell      the pelvis went below 0.30 m (a squat stays above ~0.40 m) or the loop's fall monitor
 A refused goal (the planner said no before moving) counts as a failure; its reason is listed.
 
@@ -221,7 +222,9 @@ def judge(drawn: dict, a: dict[str, np.ndarray], info: dict, messages: dict, pel
     dropped = False
     if lifted:
         start = int(np.argmax(rise >= LIFT_M))
-        end_s = place.get("released_s", place.get("end_s"))
+        # the hands let go at the place's release, or where a pick whose box did not come up set it
+        # back down (handling.pick's lift check): after that the hands leave the box on purpose
+        end_s = place.get("released_s", place.get("end_s")) if place else pick.get("released_s")
         end = len(t) if end_s is None else max(start + 1, int(np.searchsorted(t, end_s)))
         rel = box[start:end, 2] - a["hands_w_m"][start:end, :, 2].mean(axis=1)
         dropped = bool(len(rel) and rel.min() < rel[0] - DROP_M)

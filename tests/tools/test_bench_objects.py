@@ -71,3 +71,21 @@ def test_judge_sees_a_drop_a_tilt_a_miss_and_a_fall():
                     {"g0": {"kind": "pick", "status": "failed"}}, {"g0": "no stance can pick it up"}, 0.7, False,
                     index=0)
     assert refused["refused"] == ["pick: no stance can pick it up"] and not refused["lifted"]
+
+
+def test_judge_a_box_set_back_by_a_failed_pick_is_not_a_drop():
+    """A pick whose box did not come up with the hands sets it back down and opens the hands
+    (handling.pick's lift check): the hands leaving it after that is not a drop; sinking out of
+    the hands before the set-back still is."""
+    z = [0.15, 0.15, 0.2, 0.21, 0.21, 0.15, 0.15, 0.15, 0.15, 0.15, 0.15]  # came up 6 cm, set back at 0.5 s
+    hands = [0.5, 0.3, 0.2, 0.21, 0.21, 0.15, 0.3, 0.5, 0.5, 0.5, 0.5]  # then the hands go away
+    failed = {"g0": {"kind": "pick", "status": "failed", "end_s": 0.95, "released_s": 0.45}}
+    r = judge(DRAWN, _arrays(z, hands, [3.0, 0.0]), failed, {"g0": "did not come up"}, 0.7, False, index=0)
+    assert r["lifted"] and not r["dropped"] and not r["success"]
+    # without the set-back's time the hands going away reads as a drop (what the bench said before)
+    unmarked = {"g0": {k: v for k, v in failed["g0"].items() if k != "released_s"}}
+    assert judge(DRAWN, _arrays(z, hands, [3.0, 0.0]), unmarked, {}, 0.7, False, index=0)["dropped"]
+    # a box that slid out of the hands before the set-back is still a drop
+    slid = [0.15, 0.15, 0.2, 0.21, 0.15, 0.15, 0.15, 0.15, 0.15, 0.15, 0.15]
+    assert judge(DRAWN, _arrays(slid, [0.5, 0.3, 0.2, 0.21, 0.3, 0.3, 0.3, 0.5, 0.5, 0.5, 0.5], [3.0, 0.0]),
+                 failed, {}, 0.7, False, index=0)["dropped"]

@@ -270,6 +270,7 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
             a = 1.0 - float(smoothstep((tk - 1.2) / 0.8))
             return a * squeeze_only + b * (full - squeeze_only)
 
+        ctx.info["released_s"] = ctx.t  # set down on purpose from here (g1 bench objects: not a drop)
         yield from ctx.run(keyframe_trajectory("let go", back, hand_forces=letting_go))
         raise GoalFailed(f"box '{box.name}' ({box.mass_kg:.1f} kg) did not come up with the hands: after the lift "
                          f"they were {lag * 100:.0f} cm off the plan; set back down, the hands opened")
