@@ -129,6 +129,19 @@ class GaitConfig:
     to 0.12 s) survived 5/20 (waiting for the late foot lengthens the single support while the DCM runs
     away); a minimum swing growing with the distance to go 1/20; a 0.02 s double support after a
     recovery step 9/20 but 8/20 at 120 N against 10/20 (measured)."""
+    recovery_max_width_m: float = 0.6
+    """A recovery step (recovery_dcm_error_m) may land this far sideways from the stance foot (sole centre
+    to sole centre; max_width_m otherwise): pushed sideways, the foot on the side the DCM runs to landed
+    at the 0.45 m limit with the DCM 8 cm beyond it (measured). `g1 bench locomotion --only wbc/push`
+    with WbcConfig.recovery_com_lower_m 0.08: 0.45 m 10/20, 0.6 m 11/20 (alone, without the lowering:
+    8/20 against 7/20). Tried, not kept (stop 35): the landing and the touchdown time chosen together
+    under a model of the swing foot's reach (2 m/s from where it is, touchdown up to 0.1 s later or as
+    soon as min_swing_s allows, least DCM error left at touchdown) 2/20, only sooner 5/20, and with
+    the lowering 4/20 (the later touchdowns found the foot already on the ground; the reach-limited
+    landing asked the foot less than it could do); a step that would cross the stance foot made as
+    soon as it may, with a 0.02-0.07 s double support after it: 7/20 (with the lowering 11/20, other
+    cases); a CoP target up to 0.1 / 0.08 m off the sole in recovery steps (for the trunk's angular
+    momentum) 6/20 (measured, one machine)."""
     speed_feedback_gain: float = 0.3
     """Per stride, this fraction of the error between the command and the stride's speed (from the
     feet's measured touchdowns) is added to the speed the steps are planned for: the pendulum model
@@ -211,6 +224,9 @@ class GaitConfig:
             raise WbcConfigError(f"GaitConfig needs 0 < fast_single_support_s <= single_support_s and 0 < "
                                  f"fast_double_support_s <= double_support_s; got {self.fast_single_support_s}, "
                                  f"{self.single_support_s}, {self.fast_double_support_s}, {self.double_support_s}")
+        if not (np.isfinite(self.recovery_max_width_m) and self.recovery_max_width_m > 0):
+            raise WbcConfigError(f"GaitConfig.recovery_max_width_m must be a finite number > 0; got "
+                                 f"{self.recovery_max_width_m}")
         if not self.max_width_m <= self.fast_max_width_m:
             raise WbcConfigError(f"GaitConfig needs max_width_m <= fast_max_width_m; got {self.max_width_m}, "
                                  f"{self.fast_max_width_m}")
@@ -839,8 +855,11 @@ class VelocityGait:
             if excess > cfg.timing_adjust_excess_m and self._swinging:
                 self._recovery_at = self._t0  # latched: the rest of the step is a recovery step
             side = _SIDE[f]
+            widest = cfg.max_width_m
+            if self._recovery_at == self._t0 and self._swinging:
+                widest = max(widest, cfg.recovery_max_width_m)
             rel[0] = min(max(rel[0], -cfg.max_backward_m), cfg.max_forward_m)
-            rel[1] = side * min(max(side * rel[1], cfg.min_width_m), cfg.max_width_m)
+            rel[1] = side * min(max(side * rel[1], cfg.min_width_m), widest)
             self._landing[:2] = u[:2] + _rot2(heading_td) @ rel
             self._landing[2] = u[2]
             yaw_s = float(sole_yaws[s])
