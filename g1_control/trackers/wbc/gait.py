@@ -130,7 +130,7 @@ class GaitConfig:
     away); a minimum swing growing with the distance to go 1/20; a 0.02 s double support after a
     recovery step 9/20 but 8/20 at 120 N against 10/20 (measured)."""
     recovery_max_width_m: float = 0.6
-    """A recovery step (recovery_dcm_error_m) may land this far sideways from the stance foot (sole centre
+    """A recovery step made so by the DCM's error (GaitTargets.pushed) may land this far sideways from the stance foot (sole centre
     to sole centre; max_width_m otherwise): pushed sideways, the foot on the side the DCM runs to landed
     at the 0.45 m limit with the DCM 8 cm beyond it (measured). `g1 bench locomotion --only wbc/push`
     with WbcConfig.recovery_com_lower_m 0.08: 0.45 m 10/20, 0.6 m 11/20 (alone, without the lowering:
@@ -264,6 +264,9 @@ class GaitTargets:
     mode: str = "stand"
     recovery: bool = False
     """The step under way is a recovery step (GaitConfig.recovery_dcm_error_m): a push, say."""
+    pushed: bool = False
+    """... made so by the DCM's error (not only by a landing beyond the step limits): walking fast, steps
+    near their limits are recovery steps without a push."""
     dcm_error_m: float = 0.0
     """How far the DCM is from its nominal plan this tick (walking; 0 otherwise)."""
 
@@ -494,6 +497,8 @@ class VelocityGait:
         """The _t0 of the step whose swing has started (nan: none)."""
         self._recovery_at = math.nan
         """The _t0 of the step that is a recovery step (GaitConfig.recovery_dcm_error_m; nan: none)."""
+        self._pushed_at = math.nan
+        """... and made one by the DCM's error (GaitTargets.pushed)."""
         self.command_h = np.zeros(3)
         """The command being walked: the operator's, rate limited (GaitConfig.max_accel)."""
         self.speed_correction_h = np.zeros(2)
@@ -775,7 +780,7 @@ class VelocityGait:
         out.yaw_rate_radps = 0.0 if self.mode == "stand" else float(command_h[2])
         out.swing_foot = -1
         out.swing_progress = 0.0
-        out.recovery = False
+        out.recovery = out.pushed = False
         out.dcm_error_m = 0.0
         mid = (soles_m[0, :2] + soles_m[1, :2]) / 2
         centre = mid + _rot2(self.heading) @ np.array([cfg.com_offset_x_m, 0.0])
@@ -817,7 +822,7 @@ class VelocityGait:
             xi_nom = xi_nom + self._snap_shift * math.exp(-omega * t_r)
         out.dcm_error_m = float(np.hypot(*(dcm_xy - xi_nom)))
         if self._swinging and t_in >= Tds and out.dcm_error_m > cfg.recovery_dcm_error_m:
-            self._recovery_at = self._t0
+            self._recovery_at = self._pushed_at = self._t0
         if t_in < Tds or not self._swinging:
             # double support: the CoP anywhere between the feet, to take out the DCM's error
             # before the other foot lifts (its offset then grows by e^{w T_ss} until touchdown)
@@ -856,7 +861,7 @@ class VelocityGait:
                 self._recovery_at = self._t0  # latched: the rest of the step is a recovery step
             side = _SIDE[f]
             widest = cfg.max_width_m
-            if self._recovery_at == self._t0 and self._swinging:
+            if self._pushed_at == self._t0 and self._swinging:
                 widest = max(widest, cfg.recovery_max_width_m)
             rel[0] = min(max(rel[0], -cfg.max_backward_m), cfg.max_forward_m)
             rel[1] = side * min(max(side * rel[1], cfg.min_width_m), widest)
@@ -872,6 +877,7 @@ class VelocityGait:
         if not self._swinging:
             return out
         out.recovery = bool(self._recovery_at == self._t0)
+        out.pushed = bool(self._pushed_at == self._t0)
         # the swing foot: horizontal and yaw by re-planned minimum jerk once the foot is off the
         # ground, height up early, across, down late (a foot moving forward low trips on its toe)
         out.swing_foot = f

@@ -119,7 +119,8 @@ class WbcConfig:
     did not help: x0.1, x0.3, x0.5 and x2 each survived 1/20 of the push grid (front_4; 2/20 unscaled,
     measured), so the trunk's orientation task is not what kicks the leg."""
     recovery_com_lower_m: float = 0.08
-    """In a recovery step (the gait's GaitTargets.recovery), the CoM is held this much lower still: the
+    """In a recovery step made so by the DCM's error (the gait's GaitTargets.pushed), the CoM is held this
+    much lower still: the
     bent stance leg lets the swing foot reach further, and holds the body down where, pushed, both
     knees straightened and the CoM rose 7 cm while the swing hip was at its torque limit (measured).
     `g1 bench locomotion --only wbc/push` with GaitConfig.recovery_max_width_m 0.6: 0 (off) 8/20,
@@ -515,7 +516,7 @@ class WholeBodyTracker(Tracker):
         h = cfg.com_height
         speed = float(np.hypot(*self.gait.command_h[:2]))
         lower = cfg.walking_com_lower_m + cfg.walking_com_lower_per_mps * speed
-        if gt.recovery:
+        if gt.pushed:
             lower += cfg.recovery_com_lower_m
         height = self._com_height_m - lower
         lean = 0.0
