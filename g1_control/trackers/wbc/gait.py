@@ -129,8 +129,15 @@ class GaitConfig:
     to 0.12 s) survived 5/20 (waiting for the late foot lengthens the single support while the DCM runs
     away); a minimum swing growing with the distance to go 1/20; a 0.02 s double support after a
     recovery step 9/20 but 8/20 at 120 N against 10/20 (measured)."""
+    pushed_dcm_error_m: float = 0.2
+    """A recovery step during whose swing the DCM strays this far from its plan is a pushed one
+    (GaitTargets.pushed): it may land wider (recovery_max_width_m) and the tracker holds the CoM lower
+    (WbcConfig.recovery_com_lower_m); a step that is a recovery step only because its landing lies
+    beyond the step limits is not. The DCM strays 0.2 m walking 1.0 m/s too: `g1 bench locomotion
+    --only wbc/push` / forward_1.0's speed: 0.2: 11/20 / 0.841 m/s; 0.25: 9/20 / 0.849 (bit-identical
+    to without); 0.3: 7/20 (measured, one machine)."""
     recovery_max_width_m: float = 0.6
-    """A recovery step made so by the DCM's error (GaitTargets.pushed) may land this far sideways from the stance foot (sole centre
+    """A pushed recovery step (GaitTargets.pushed) may land this far sideways from the stance foot (sole centre
     to sole centre; max_width_m otherwise): pushed sideways, the foot on the side the DCM runs to landed
     at the 0.45 m limit with the DCM 8 cm beyond it (measured). `g1 bench locomotion --only wbc/push`
     with WbcConfig.recovery_com_lower_m 0.08: 0.45 m 10/20, 0.6 m 11/20 (alone, without the lowering:
@@ -265,8 +272,8 @@ class GaitTargets:
     recovery: bool = False
     """The step under way is a recovery step (GaitConfig.recovery_dcm_error_m): a push, say."""
     pushed: bool = False
-    """... made so by the DCM's error (not only by a landing beyond the step limits): walking fast, steps
-    near their limits are recovery steps without a push."""
+    """... with the DCM GaitConfig.pushed_dcm_error_m off its plan: walking fast, steps near their limits
+    are recovery steps without a push."""
     dcm_error_m: float = 0.0
     """How far the DCM is from its nominal plan this tick (walking; 0 otherwise)."""
 
@@ -498,7 +505,7 @@ class VelocityGait:
         self._recovery_at = math.nan
         """The _t0 of the step that is a recovery step (GaitConfig.recovery_dcm_error_m; nan: none)."""
         self._pushed_at = math.nan
-        """... and made one by the DCM's error (GaitTargets.pushed)."""
+        """... and a pushed one (GaitConfig.pushed_dcm_error_m)."""
         self.command_h = np.zeros(3)
         """The command being walked: the operator's, rate limited (GaitConfig.max_accel)."""
         self.speed_correction_h = np.zeros(2)
@@ -822,7 +829,9 @@ class VelocityGait:
             xi_nom = xi_nom + self._snap_shift * math.exp(-omega * t_r)
         out.dcm_error_m = float(np.hypot(*(dcm_xy - xi_nom)))
         if self._swinging and t_in >= Tds and out.dcm_error_m > cfg.recovery_dcm_error_m:
-            self._recovery_at = self._pushed_at = self._t0
+            self._recovery_at = self._t0
+            if out.dcm_error_m > cfg.pushed_dcm_error_m:
+                self._pushed_at = self._t0
         if t_in < Tds or not self._swinging:
             # double support: the CoP anywhere between the feet, to take out the DCM's error
             # before the other foot lifts (its offset then grows by e^{w T_ss} until touchdown)

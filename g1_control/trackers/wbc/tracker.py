@@ -119,8 +119,8 @@ class WbcConfig:
     did not help: x0.1, x0.3, x0.5 and x2 each survived 1/20 of the push grid (front_4; 2/20 unscaled,
     measured), so the trunk's orientation task is not what kicks the leg."""
     recovery_com_lower_m: float = 0.08
-    """In a recovery step made so by the DCM's error (the gait's GaitTargets.pushed), the CoM is held this
-    much lower still: the bent stance leg lets the swing foot reach further, and holds the body down
+    """In a pushed recovery step (the gait's GaitTargets.pushed, GaitConfig.pushed_dcm_error_m), the CoM
+    is held this much lower still: the bent stance leg lets the swing foot reach further, and holds the body down
     where, pushed, both knees straightened and the CoM rose 7 cm while the swing hip was at its torque
     limit (measured).
     `g1 bench locomotion --only wbc/push` with GaitConfig.recovery_max_width_m 0.6: 0 (off) 8/20,
