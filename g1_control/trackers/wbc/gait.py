@@ -27,7 +27,9 @@ the step). The landing point is frozen late in the swing so the foot can get the
 Recovery steps: a step whose DCM strays GaitConfig.recovery_dcm_error_m from its plan during the
 swing, or whose landing stays beyond the step limits after its timing was adjusted (a push), is
 marked (GaitTargets.recovery) until it lands; the tracker then holds the swing foot to its path
-harder (WbcConfig.recovery_swing_weight), so the QP steps rather than swinging the leg back.
+harder (WbcConfig.recovery_swing_weight), so the QP steps rather than swinging the leg back. One the
+DCM's error made (GaitConfig.pushed_dcm_error_m: GaitTargets.pushed) may land wider
+(recovery_max_width_m), and the tracker holds the CoM lower in it (WbcConfig.recovery_com_lower_m).
 
 Swing feet: the horizontal path and the yaw are re-planned each tick as a minimum-jerk segment
 from the reference's current position, velocity and acceleration to the (moving) landing point,
@@ -137,8 +139,8 @@ class GaitConfig:
     --only wbc/push` / forward_1.0's speed: 0.2: 11/20 / 0.841 m/s; 0.25: 9/20 / 0.849 (bit-identical
     to without); 0.3: 7/20 (measured, one machine)."""
     recovery_max_width_m: float = 0.6
-    """A pushed recovery step (GaitTargets.pushed) may land this far sideways from the stance foot (sole centre
-    to sole centre; max_width_m otherwise): pushed sideways, the foot on the side the DCM runs to landed
+    """A pushed recovery step (GaitTargets.pushed) may land this far sideways from the stance foot (sole
+    centre to sole centre; max_width_m otherwise): pushed sideways, the foot on the side the DCM runs to landed
     at the 0.45 m limit with the DCM 8 cm beyond it (measured). `g1 bench locomotion --only wbc/push`
     with WbcConfig.recovery_com_lower_m 0.08: 0.45 m 10/20, 0.6 m 11/20 (alone, without the lowering:
     8/20 against 7/20). Tried, not kept (stop 35): the landing and the touchdown time chosen together
