@@ -137,14 +137,16 @@ class GaitConfig:
     (WbcConfig.recovery_com_lower_m); a step that is a recovery step only because its landing lies
     beyond the step limits is not. The DCM strays 0.2 m walking 1.0 m/s and in the random timelines
     too: `g1 bench locomotion --only wbc/push`, forward_1.0's speed, wbc/random walked: 0.2: 11/20,
-    0.841 m/s, 9/10 (random_s1 fell); 0.25: 9/20, 0.849 (bit-identical to without), 10/10; 0.3: 7/20
-    (measured, one machine)."""
+    0.841 m/s, 9/10 (random_s1 fell); 0.25: 9/20, 0.849 (bit-identical to without), 10/10; 0.3: 7/20.
+    At 0.25, pushes this stop did not tune on (150 N at phases shifted by 0.1 stride; 120 N; walking
+    0.3 m/s, two phase sets; 0.7 m/s), without -> with the lowering and the width: 8 -> 10, 8 -> 10,
+    10 -> 8 and 8 -> 10, 2 -> 10 of 20 each (measured, one machine)."""
     recovery_max_width_m: float = 0.6
     """A pushed recovery step (GaitTargets.pushed) may land this far sideways from the stance foot (sole
     centre to sole centre; max_width_m otherwise): pushed sideways, the foot on the side the DCM runs to landed
     at the 0.45 m limit with the DCM 8 cm beyond it (measured). `g1 bench locomotion --only wbc/push`
-    with WbcConfig.recovery_com_lower_m 0.08: 0.45 m 10/20, 0.6 m 11/20 (alone, without the lowering:
-    8/20 against 7/20). Tried, not kept (stop 35): the landing and the touchdown time chosen together
+    (swept with pushed_dcm_error_m 0.2) with WbcConfig.recovery_com_lower_m 0.08: 0.45 m 10/20, 0.6 m
+    11/20 (alone, without the lowering: 8/20 against 7/20). Tried, not kept (stop 35): the landing and the touchdown time chosen together
     under a model of the swing foot's reach (2 m/s from where it is, touchdown up to 0.1 s later or as
     soon as min_swing_s allows, least DCM error left at touchdown) 2/20, only sooner 5/20, and with
     the lowering 4/20 (the later touchdowns found the foot already on the ground; the reach-limited

@@ -123,7 +123,7 @@ class WbcConfig:
     is held this much lower still: the bent stance leg lets the swing foot reach further, and it holds
     the body down where, pushed, both knees straightened and the CoM rose 7 cm while the swing hip was
     at its torque limit (measured). `g1 bench locomotion --only wbc/push` with
-    GaitConfig.recovery_max_width_m 0.6: 0 (off) 8/20,
+    GaitConfig.recovery_max_width_m 0.6 (swept with GaitConfig.pushed_dcm_error_m 0.2): 0 (off) 8/20,
     0.03 9/20, 0.05 10/20, 0.08 11/20, 0.12 7/20 (0.08 with the 0.45 m width: 10/20; measured, one
     machine)."""
     swing_max_accel_mps2: float = 60.0
