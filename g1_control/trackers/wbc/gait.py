@@ -140,7 +140,8 @@ class GaitConfig:
     0.841 m/s, 9/10 (random_s1 fell); 0.25: 9/20, 0.849 (bit-identical to without), 10/10; 0.3: 7/20.
     At 0.25, pushes this stop did not tune on (150 N at phases shifted by 0.1 stride; 120 N; walking
     0.3 m/s, two phase sets; 0.7 m/s), without -> with the lowering and the width: 8 -> 10, 8 -> 10,
-    10 -> 8 and 8 -> 10, 2 -> 10 of 20 each (measured, one machine)."""
+    10 -> 8 and 8 -> 10, 2 -> 10 of 20 each. `g1 bench robust --only wbc`: 2 -> 3 falls of 10 (draw s2
+    fell at 15.3 s, tilted; measured, one machine)."""
     recovery_max_width_m: float = 0.6
     """A pushed recovery step (GaitTargets.pushed) may land this far sideways from the stance foot (sole
     centre to sole centre; max_width_m otherwise): pushed sideways, the foot on the side the DCM runs to landed
