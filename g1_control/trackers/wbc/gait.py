@@ -27,7 +27,9 @@ the step). The landing point is frozen late in the swing so the foot can get the
 Recovery steps: a step whose DCM strays GaitConfig.recovery_dcm_error_m from its plan during the
 swing, or whose landing stays beyond the step limits after its timing was adjusted (a push), is
 marked (GaitTargets.recovery) until it lands; the tracker then holds the swing foot to its path
-harder (WbcConfig.recovery_swing_weight), so the QP steps rather than swinging the leg back.
+harder (WbcConfig.recovery_swing_weight), so the QP steps rather than swinging the leg back. One the
+DCM's error made (GaitConfig.pushed_dcm_error_m: GaitTargets.pushed) may land wider
+(recovery_max_width_m), and the tracker holds the CoM lower in it (WbcConfig.recovery_com_lower_m).
 
 Swing feet: the horizontal path and the yaw are re-planned each tick as a minimum-jerk segment
 from the reference's current position, velocity and acceleration to the (moving) landing point,
@@ -131,6 +133,30 @@ class GaitConfig:
     to 0.12 s) survived 5/20 (waiting for the late foot lengthens the single support while the DCM runs
     away); a minimum swing growing with the distance to go 1/20; a 0.02 s double support after a
     recovery step 9/20 but 8/20 at 120 N against 10/20 (measured)."""
+    pushed_dcm_error_m: float = 0.25
+    """A recovery step during whose swing the DCM strays this far from its plan is a pushed one
+    (GaitTargets.pushed): it may land wider (recovery_max_width_m) and the tracker holds the CoM lower
+    (WbcConfig.recovery_com_lower_m); a step that is a recovery step only because its landing lies
+    beyond the step limits is not. The DCM strays 0.2 m walking 1.0 m/s and in the random timelines
+    too: `g1 bench locomotion --only wbc/push`, forward_1.0's speed, wbc/random walked: 0.2: 11/20,
+    0.841 m/s, 9/10 (random_s1 fell); 0.25: 9/20, 0.849 (bit-identical to without), 10/10; 0.3: 7/20.
+    At 0.25, pushes this stop did not tune on (150 N at phases shifted by 0.1 stride; 120 N; walking
+    0.3 m/s, two phase sets; 0.7 m/s), without -> with the lowering and the width: 8 -> 10, 8 -> 10,
+    10 -> 8 and 8 -> 10, 2 -> 10 of 20 each. `g1 bench robust --only wbc`: 2 -> 3 falls of 10 (draw s2
+    fell at 15.3 s, tilted; measured, one machine)."""
+    recovery_max_width_m: float = 0.6
+    """A pushed recovery step (GaitTargets.pushed) may land this far sideways from the stance foot (sole
+    centre to sole centre; max_width_m otherwise): pushed sideways, the foot on the side the DCM runs to landed
+    at the 0.45 m limit with the DCM 8 cm beyond it (measured). `g1 bench locomotion --only wbc/push`
+    (swept with pushed_dcm_error_m 0.2) with WbcConfig.recovery_com_lower_m 0.08: 0.45 m 10/20, 0.6 m
+    11/20 (alone, without the lowering: 8/20 against 7/20). Tried, not kept (stop 35): the landing and the touchdown time chosen together
+    under a model of the swing foot's reach (2 m/s from where it is, touchdown up to 0.1 s later or as
+    soon as min_swing_s allows, least DCM error left at touchdown) 2/20, only sooner 5/20, and with
+    the lowering 4/20 (the later touchdowns found the foot already on the ground; the reach-limited
+    landing asked the foot less than it could do); a step that would cross the stance foot made as
+    soon as it may, with a 0.02-0.07 s double support after it: 7/20 (with the lowering 11/20, other
+    cases); a CoP target up to 0.1 / 0.08 m off the sole in recovery steps (for the trunk's angular
+    momentum) 6/20 (measured, one machine)."""
     speed_feedback_gain: float = 0.3
     """Per stride, this fraction of the error between the command and the stride's speed (from the
     feet's measured touchdowns) is added to the speed the steps are planned for: the pendulum model
@@ -220,6 +246,9 @@ class GaitConfig:
             raise WbcConfigError(f"GaitConfig needs 0 < fast_single_support_s <= single_support_s and 0 < "
                                  f"fast_double_support_s <= double_support_s; got {self.fast_single_support_s}, "
                                  f"{self.single_support_s}, {self.fast_double_support_s}, {self.double_support_s}")
+        if not (np.isfinite(self.recovery_max_width_m) and self.recovery_max_width_m > 0):
+            raise WbcConfigError(f"GaitConfig.recovery_max_width_m must be a finite number > 0; got "
+                                 f"{self.recovery_max_width_m}")
         if not self.max_width_m <= self.fast_max_width_m:
             raise WbcConfigError(f"GaitConfig needs max_width_m <= fast_max_width_m; got {self.max_width_m}, "
                                  f"{self.fast_max_width_m}")
@@ -257,6 +286,9 @@ class GaitTargets:
     mode: str = "stand"
     recovery: bool = False
     """The step under way is a recovery step (GaitConfig.recovery_dcm_error_m): a push, say."""
+    pushed: bool = False
+    """... with the DCM GaitConfig.pushed_dcm_error_m off its plan: walking fast, steps near their limits
+    are recovery steps without a push."""
     dcm_error_m: float = 0.0
     """How far the DCM is from its nominal plan this tick (walking; 0 otherwise)."""
 
@@ -487,6 +519,8 @@ class VelocityGait:
         """The _t0 of the step whose swing has started (nan: none)."""
         self._recovery_at = math.nan
         """The _t0 of the step that is a recovery step (GaitConfig.recovery_dcm_error_m; nan: none)."""
+        self._pushed_at = math.nan
+        """... and a pushed one (GaitConfig.pushed_dcm_error_m)."""
         self.command_h = np.zeros(3)
         """The command being walked: the operator's, rate limited (GaitConfig.max_accel)."""
         self.speed_correction_h = np.zeros(2)
@@ -796,7 +830,7 @@ class VelocityGait:
         out.yaw_rate_radps = 0.0 if self.mode == "stand" else float(command_h[2])
         out.swing_foot = -1
         out.swing_progress = 0.0
-        out.recovery = False
+        out.recovery = out.pushed = False
         out.dcm_error_m = 0.0
         mid = (soles_m[0, :2] + soles_m[1, :2]) / 2
         centre = mid + _rot2(self.heading) @ np.array([cfg.com_offset_x_m, 0.0])
@@ -839,6 +873,8 @@ class VelocityGait:
         out.dcm_error_m = float(np.hypot(*(dcm_xy - xi_nom)))
         if self._swinging and t_in >= Tds and out.dcm_error_m > cfg.recovery_dcm_error_m:
             self._recovery_at = self._t0
+            if out.dcm_error_m > cfg.pushed_dcm_error_m:
+                self._pushed_at = self._t0
         if t_in < Tds or not self._swinging:
             # double support: the CoP anywhere between the feet, to take out the DCM's error
             # before the other foot lifts (its offset then grows by e^{w T_ss} until touchdown)
@@ -876,8 +912,11 @@ class VelocityGait:
             if excess > cfg.timing_adjust_excess_m and self._swinging:
                 self._recovery_at = self._t0  # latched: the rest of the step is a recovery step
             side = _SIDE[f]
+            widest = cfg.max_width_m
+            if self._pushed_at == self._t0 and self._swinging:
+                widest = max(widest, cfg.recovery_max_width_m)
             rel[0] = min(max(rel[0], -cfg.max_backward_m), cfg.max_forward_m)
-            rel[1] = side * min(max(side * rel[1], cfg.min_width_m), cfg.max_width_m)
+            rel[1] = side * min(max(side * rel[1], cfg.min_width_m), widest)
             self._landing[:2] = u[:2] + _rot2(heading_td) @ rel
             self._landing[2] = u[2]
             yaw_s = float(sole_yaws[s])
@@ -890,6 +929,7 @@ class VelocityGait:
         if not self._swinging:
             return out
         out.recovery = bool(self._recovery_at == self._t0)
+        out.pushed = bool(self._pushed_at == self._t0)
         # the swing foot: horizontal and yaw by re-planned minimum jerk once the foot is off the
         # ground, height up early, across, down late (a foot moving forward low trips on its toe)
         out.swing_foot = f

@@ -118,6 +118,14 @@ class WbcConfig:
     Scaling the pelvis's and torso's orientation weights in recovery steps (to let the trunk lean)
     did not help: x0.1, x0.3, x0.5 and x2 each survived 1/20 of the push grid (front_4; 2/20 unscaled,
     measured), so the trunk's orientation task is not what kicks the leg."""
+    recovery_com_lower_m: float = 0.08
+    """In a pushed recovery step (the gait's GaitTargets.pushed, GaitConfig.pushed_dcm_error_m), the CoM
+    is held this much lower still: the bent stance leg lets the swing foot reach further, and it holds
+    the body down where, pushed, both knees straightened and the CoM rose 7 cm while the swing hip was
+    at its torque limit (measured). `g1 bench locomotion --only wbc/push` with
+    GaitConfig.recovery_max_width_m 0.6 (swept with GaitConfig.pushed_dcm_error_m 0.2): 0 (off) 8/20,
+    0.03 9/20, 0.05 10/20, 0.08 11/20, 0.12 7/20 (0.08 with the 0.45 m width: 10/20; measured, one
+    machine)."""
     swing_max_accel_mps2: float = 60.0
     """Walking by its own gait, the swing foot's reference acceleration (the feedforward of its task) is
     scaled down to at most this magnitude. The gait re-plans the swing as a minimum-jerk segment to a
@@ -164,7 +172,7 @@ class WbcConfig:
         if self.rate_hz <= 0:
             raise WbcConfigError(f"WbcConfig.rate_hz must be > 0; got {self.rate_hz}")
         for name in ("kp_scale", "kd_scale", "contact_ramp_s", "liftoff_unload_s", "capture_point_gain", "com_xy_weight",
-                     "swing_max_accel_mps2"):
+                     "swing_max_accel_mps2", "recovery_com_lower_m"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise WbcConfigError(f"WbcConfig.{name} must be a finite number >= 0; got {value}")
@@ -515,6 +523,8 @@ class WholeBodyTracker(Tracker):
         h = cfg.com_height
         speed = float(np.hypot(*self.gait.command_h[:2]))
         lower = cfg.walking_com_lower_m + cfg.walking_com_lower_per_mps * speed
+        if gt.pushed:
+            lower += cfg.recovery_com_lower_m
         height = self._com_height_m - lower
         lean = 0.0
         if reference.pelvis_height_m is not None:

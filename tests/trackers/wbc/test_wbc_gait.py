@@ -221,6 +221,19 @@ def test_a_dcm_far_off_its_plan_makes_the_step_a_recovery_step_until_it_lands():
     assert later.swing_foot >= 0 and not later.recovery
 
 
+@pytest.mark.parametrize("widest", [0.6, 0.45])
+def test_a_recovery_step_lands_as_wide_as_recovery_max_width(widest):
+    """Pushed hard sideways towards the swing foot's side, the recovery step lands at
+    GaitConfig.recovery_max_width_m from the stance foot (a plain step's limit is max_width_m, 0.45)."""
+    soles, yaws = _feet()
+    gait = VelocityGait(GaitConfig(recovery_max_width_m=widest))
+    t = _into_single_support(gait, soles, yaws)
+    assert gait.stance == LEFT
+    out = gait.update(t, 0.004, soles, yaws, soles[LEFT, :2] + np.array([0.05, -1.0]), OMEGA)
+    assert out.recovery and out.swing_foot == RIGHT
+    assert soles[LEFT, 1] - out.landing_m[1] == pytest.approx(widest, abs=1e-9)
+
+
 @pytest.mark.parametrize("kwargs, text", [
     ({"single_support_s": 0.0}, "single_support_s must be a finite number > 0"),
     ({"min_width_m": 0.3}, "min_width_m <= step_width_m <= max_width_m"),
@@ -228,6 +241,7 @@ def test_a_dcm_far_off_its_plan_makes_the_step_a_recovery_step_until_it_lands():
     ({"fast_double_support_s": 0.1}, "fast_double_support_s <= double_support_s"),
     ({"cadence_reach_from": 1.2}, "cadence_reach_from < cadence_reach_full"),
     ({"fast_max_width_m": 0.4}, "max_width_m <= fast_max_width_m"),
+    ({"recovery_max_width_m": 0.0}, "recovery_max_width_m must be a finite number > 0"),
 ])
 def test_bad_gait_config_is_refused(kwargs, text):
     with pytest.raises(WbcConfigError, match=text):

@@ -61,7 +61,9 @@ def test_reference_without_any_contact_is_refused():
 
 @pytest.mark.parametrize("kwargs, text", [({"rate_hz": 0.0}, "rate_hz must be > 0"),
                                           ({"kp_scale": -0.1}, "kp_scale must be a finite number >= 0"),
-                                          ({"contact_ramp_s": float("nan")}, "contact_ramp_s")])
+                                          ({"contact_ramp_s": float("nan")}, "contact_ramp_s"),
+                                          ({"recovery_com_lower_m": -0.01},
+                                           "recovery_com_lower_m must be a finite number >= 0")])
 def test_bad_config_is_refused(kwargs, text):
     with pytest.raises(WbcConfigError, match=text):
         WbcConfig(**kwargs)
