@@ -99,16 +99,14 @@ swing reference and landing height, the DCM's distance from its plan, the CoM's 
 the DCM and the CoP asked relative to the stance sole (course axes)."""
 
 
-def _trace_row(t_s: float, tracker, d, feet: list[int], axis: np.ndarray, origin: np.ndarray,
+def _trace_row(t_s: float, tracker, d, soles: np.ndarray, axis: np.ndarray, origin: np.ndarray,
                scene: SceneConfig) -> list:
+    """soles: (2, 3) ground-truth sole positions, left then right (run_course's)."""
     from g1_control.robot import g1
 
     gait = tracker.gait
     gt = gait.targets
     perp = np.array([-axis[1], axis[0]])
-    soles = [d.xpos[f].copy() for f in feet]
-    for p in soles:
-        p[2] -= SOLE_BELOW_ANKLE_M
     stance = tracker.sole_positions_m[gait.stance, :2]
     diag = tracker.diagnostics
     dcm, cop = diag.com_ref_m[:2] - stance, gt.cop_xy_m - stance  # walking by its gait, com_ref's xy is the DCM
@@ -149,10 +147,10 @@ def run_course(course: str, seed: int, *, speed_mps: float = 0.3, duration_s: fl
     try:
         while loop.time_s < duration_s - 1e-9:
             loop.run(0.02)
-            if trace is not None:
-                trace.append(_trace_row(loop.time_s, loop.tracker, d, feet, axis, origin, scene))
             soles = np.array([d.xpos[f] for f in feet])
             soles[:, 2] -= SOLE_BELOW_ANKLE_M
+            if trace is not None:
+                trace.append(_trace_row(loop.time_s, loop.tracker, d, soles, axis, origin, scene))
             on_top = all(abs(z - top_m) < 0.03 for z in soles[:, 2])
             top = top or on_top
             beyond = all(float((p[:2] - origin) @ axis) > far_m for p in soles)
