@@ -10,6 +10,12 @@ on the floor. The candidates:
   gap       from the middle of the soles to the box's near face
   pelvis    standing (nominal height), then lower in steps down to a squat at 0.42 m
   torso     upright, or leaning forward (pelvis pitched 0.4 rad, waist pulled forward 0.45 rad)
+  deep      hands below DEEP_BELOW_M, a box under DEEP_MAX_KG: a deep squat (pelvis DEEP_PELVIS_M, knees
+            forward, heels down, pelvis pitched DEEP_PELVIS_RAD, waist DEEP_WAIST_RAD), the only kind
+            tried for hands below LOWEST_GRASP_M (a floor box, a low table's); kept when, besides the
+            checks below, the soles stay flat on the ground (FLAT_SOLE_M / FLAT_SOLE_RAD), every joint
+            stays DEEP_LIMIT_MARGIN_RAD inside its limits, the pelvis stays at DEEP_MIN_PELVIS_M or higher
+            (above the fall monitor's 0.40 m) and tilts DEEP_MAX_TILT_RAD at most
   standing leaning  last, for a light box held at SQUAT_BELOW_M or higher on a support: standing off its edge
             (soles' middle STAND_LEAN_GAPS_M from the box, the pelvis beyond MIN_EDGE_CLEARANCE_M),
             the pelvis pitched STAND_LEAN_PELVIS_RAD and the waist leaning to reach in
@@ -50,7 +56,7 @@ from g1_control.generator.goals.poses import (
 )
 from g1_control.ik.whole_body import LEG_LIGHT_POSTURE_WEIGHT
 from g1_control.robot import g1
-from g1_control.robot.dynamics import HAND_FRAMES
+from g1_control.robot.dynamics import HAND_FRAMES, SOLE_FRAMES
 from g1_control.rotations import rot_z
 from g1_control.scene import Block, Box
 
@@ -63,8 +69,34 @@ LEAN_WAIST_RAD = 0.45
 """Leaning: the waist's pitch pull (its limit is 0.52)."""
 LEAN_PELVIS_RAD = 0.4
 """Leaning: the pelvis's pitch target (a soft one)."""
-UPRIGHT, LEAN, STAND_LEAN = 0, 1, 2
-"""How a candidate bends (Candidate.lean): upright, leaning (squatting), or leaning standing."""
+UPRIGHT, LEAN, STAND_LEAN, DEEP = 0, 1, 2, 3
+"""How a candidate bends (Candidate.lean): upright, leaning (squatting), leaning standing, or a deep squat."""
+DEEP_PELVIS_M = (0.50, 0.47)
+"""Deep squat: the pelvis heights tried (above the ground; the IK lets it give FEASIBLE_PELVIS_M below,
+DEEP_MIN_PELVIS_M is the least it may end at)."""
+DEEP_PELVIS_RAD = 0.7
+"""Deep squat: the pelvis's pitch target (a soft one; its tilt stays within DEEP_MAX_TILT_RAD)."""
+DEEP_WAIST_RAD = 0.5
+"""Deep squat: the waist's pitch pull (its limit is 0.52)."""
+DEEP_BELOW_M = 0.50
+"""Hands below this (above the ground): the deep squat is tried too (the squats reach ~0.45 m at best)."""
+DEEP_MIN_PELVIS_M = 0.44
+"""A deep squat's pose keeps the pelvis this high: the fall monitor calls 0.40 m a fall (FallConfig), and
+the whole-body controller sank a planned squat ~3 cm below its plan (measured, stop 34)."""
+DEEP_MAX_TILT_RAD = 0.85
+"""A deep squat's pelvis tilt at most (the safety layer calls 1.0 rad a fall)."""
+DEEP_MAX_KG = 1.0
+"""The deep squat only with a box lighter than this: in lockstep MuJoCo (stop 34, a 0.35 m floor cube)
+the whole-body controller lifted 0.3 and 0.8 kg from it; 1.0 kg rose and dropped, 1.2-2.0 kg did not
+come up (hips and wrists ~0.2 rad behind the plan), 3 kg fell."""
+DEEP_LIMIT_MARGIN_RAD = 0.05
+"""A deep squat's leg joints this far inside their position limits at least, room for the controller
+to move them (the IK keeps 0.02 rad; hip pitch works at ~-2.2 of -2.53 rad, ankle pitch ~-0.5 of -0.87;
+the waist is pulled to DEEP_WAIST_RAD, near its 0.52, on purpose)."""
+FLAT_SOLE_M = 0.005
+FLAT_SOLE_RAD = 0.03
+"""A deep squat's soles within this of where they stand, flat (the heels down: the ankles' dorsiflexion
+limit otherwise lifts them)."""
 STAND_LEAN_PELVIS_RAD = 0.15
 """Standing leaning: the pelvis's pitch target (the waist pulls LEAN_WAIST_RAD). Only for hands at
 SQUAT_BELOW_M or higher (stop 34, objects34: a 1.0 kg box on a 0.63 m table, hands at 0.72 m, kept
@@ -91,11 +123,11 @@ LEAN_MAX_KG = 3.0
 """Leaning only with a box lighter than this: leaning squats picking 3.2 and 5.6 kg boxes fell at the
 lift (bench objects seeds 8 and 9; a 0.5 kg box was picked leaning)."""
 MIN_HAND_Z_M = 0.10
+"""Hands no lower above the ground (below, the rubber hands strike the floor: a fall by body contact)."""
 LOWEST_GRASP_M = 0.40
-"""Below this (hands above the ground) the search is not run: with the pelvis at MIN_PELVIS_M or
+"""Below this (hands above the ground) only the deep squat is tried: with the pelvis at MIN_PELVIS_M or
 higher, no candidate held a box lower than ~0.45 m (measured over the issue 25 scenes and the
 tests' boxes); it only cost 5-10 s of CPU to find that out each time."""
-"""Hands no lower above the ground (below, the rubber hands strike the floor: a fall by body contact)."""
 FEASIBLE_RESIDUAL_M = 0.02
 """Kept within this (the grasp itself refuses beyond 3 cm from the stance the steps end in)."""
 FEASIBLE_COM_M = 0.02
@@ -276,20 +308,27 @@ class StancePlanner:
             raise StanceRefused(f"{size}: no stance can {what}: the hands would hold it {grasp_z * 100:.0f} cm above "
                                 f"the ground (the hands strike the ground below {MIN_HAND_Z_M * 100:.0f} cm); "
                                 "closest: none tried")
-        if grasp_z < LOWEST_GRASP_M:  # one candidate, the deepest, for the closest pose
+        deep = mass < DEEP_MAX_KG
+        if grasp_z < LOWEST_GRASP_M and not deep:  # one candidate, the deepest, for the closest pose
             heading = headings[0]
             depth = grasp_width(box, heading + math.pi / 2)
             gap = max(GAPS_M[1], PREFERRED_CENTER_M - depth / 2)
             fwd = np.array([math.cos(heading), math.sin(heading)])
-            cand = Candidate(heading, center_w[:2] - (gap + depth / 2) * fwd, gap, ground_z + SQUAT_PELVIS_M[-1], LEAN)
+            cand = Candidate(heading, center_w[:2] - (gap + depth / 2) * fwd, gap, ground_z + DEEP_PELVIS_M[-1], DEEP)
             self._evaluate(cand, box, center_w, support, grasp_width(box, heading), dz, mass, ground_z, lift_m,
                            press_m)
             raise StanceRefused(f"{size}: no stance can {what}: the hands would hold it {grasp_z:.2f} m above the "
-                                f"ground; squatting no lower than the pelvis at {MIN_PELVIS_M:.2f} m, the lowest "
-                                f"the search reaches is {LOWEST_GRASP_M:.2f} m; closest: {cand.describe()}")
+                                f"ground; below {LOWEST_GRASP_M:.2f} m only the deep squat reaches (pelvis down to "
+                                f"{DEEP_MIN_PELVIS_M:.2f} m), and the controller lifts only a box under "
+                                f"{DEEP_MAX_KG:.1f} kg from it; closest: {cand.describe()}")
         # squatting lowers the hands for a box below the waist; above it, it only costs
         levels = [nominal] + ([ground_z + z for z in SQUAT_PELVIS_M] if grasp_z < SQUAT_BELOW_M else [])
         bent: list[tuple[int, ...]] = [(UPRIGHT, LEAN)] * len(levels)
+        if grasp_z < LOWEST_GRASP_M:  # no squat reaches so low (LOWEST_GRASP_M): the deep squat only
+            levels, bent = [], []
+        if grasp_z < DEEP_BELOW_M and deep:
+            levels += [ground_z + z for z in DEEP_PELVIS_M]
+            bent += [(DEEP,)] * len(DEEP_PELVIS_M)
         if support is not None and support.height_m > KNEE_HEIGHT_M and mass < LEAN_MAX_KG and grasp_z >= SQUAT_BELOW_M:
             levels.append(nominal)  # last: standing off the support's edge, leaning to reach in
             bent.append((STAND_LEAN,))
@@ -308,7 +347,7 @@ class StancePlanner:
                     gaps = (preferred, *(g for g in GAPS_M if abs(g - preferred) > 0.02))
                     if lean == STAND_LEAN:
                         gaps = STAND_LEAN_GAPS_M
-                    for gap in gaps if pelvis_z >= nominal - 1e-6 else [g for g in gaps if g >= 0.2]:
+                    for gap in gaps if pelvis_z >= nominal - 1e-6 or lean == DEEP else [g for g in gaps if g >= 0.2]:
                         mid = center_w[:2] - (gap + depth / 2) * fwd
                         cand = Candidate(heading, mid, gap, pelvis_z, lean, preferred=gap == preferred)
                         self._evaluate(cand, box, center_w, support, width, dz, mass, ground_z, lift_m, press_m)
@@ -345,9 +384,13 @@ class StancePlanner:
             worst_res = max(worst_res, r.residual_m)
             worst_com = max(worst_com, r.com_error_m)
             squat = cand.pelvis_z_m < ground_z + self.poses.nominal_pelvis_m - 1e-6
-            if (squat and r.pelvis_error_m > FEASIBLE_PELVIS_M) or r.tilt_rad > MAX_TILT_RAD or \
-                    r.q[2] - ground_z < MIN_PELVIS_M:
+            deep = cand.lean == DEEP
+            if (squat and r.pelvis_error_m > FEASIBLE_PELVIS_M) or \
+                    r.tilt_rad > (DEEP_MAX_TILT_RAD if deep else MAX_TILT_RAD) or \
+                    r.q[2] - ground_z < (DEEP_MIN_PELVIS_M if deep else MIN_PELVIS_M):
                 cand.collision = cand.collision or f"the pelvis ends at {r.q[2]:.2f} m, tilted {r.tilt_rad:.2f} rad"
+            if deep:
+                cand.collision = cand.collision or self.deep_fault(r.q, soles)
             if not squat and cand.pelvis_z_m - r.q[2] > STANDING_GIVE_M:
                 cand.collision = cand.collision or (f"standing, the pelvis sinks to {r.q[2] - ground_z:.2f} m "
                                                     "(a squat, tried as one)")
@@ -360,6 +403,22 @@ class StancePlanner:
                 cand.collision = self.collision(q, box, center_w, support)
         cand.residual_m, cand.com_error_m = worst_res, worst_com
 
+    def deep_fault(self, q: np.ndarray, soles: list[Sole]) -> str | None:
+        """What keeps a deep squat's pose from being held (None: nothing): a sole off the ground or
+        tipped (the heels up), or a joint within DEEP_LIMIT_MARGIN_RAD of its position limit."""
+        for (p, rot), frame in zip(soles, SOLE_FRAMES, strict=True):
+            at, r = self.ik.frame_pose(q, frame)
+            off = float(np.linalg.norm(at - p))
+            tipped = float(np.arccos(np.clip((np.trace(rot.T @ r) - 1.0) / 2.0, -1.0, 1.0)))
+            if off > FLAT_SOLE_M or tipped > FLAT_SOLE_RAD:
+                return f"the {frame.split('_')[0]} sole is {off * 100:.1f} cm off its place, tipped {tipped:.2f} rad"
+        legs = np.array(g1.LEG_JOINTS)
+        room = np.minimum(q[7 + legs] - g1.Q_MIN_RAD[legs], g1.Q_MAX_RAD[legs] - q[7 + legs])
+        k = int(np.argmin(room))
+        if room[k] < DEEP_LIMIT_MARGIN_RAD:
+            return f"{g1.JOINT_NAMES[legs[k]]} is {room[k]:.3f} rad from its limit"
+        return None
+
     def hold(self, q0: np.ndarray, soles: list[Sole], targets: tuple[np.ndarray, np.ndarray], heading: float,
              com_shift_h: np.ndarray, pelvis_z: float, lean: int) -> HoldPose:
         """Both hands at `targets` (palms in across the heading), the pelvis at pelvis_z, the CoM over the
@@ -370,12 +429,12 @@ class StancePlanner:
         pp = self.poses
         posture = g1.DEFAULT_Q_RAD.copy()
         if lean:
-            posture[WAIST_PITCH] = LEAN_WAIST_RAD
+            posture[WAIST_PITCH] = DEEP_WAIST_RAD if lean == DEEP else LEAN_WAIST_RAD
         weights = LEG_LIGHT_POSTURE_WEIGHT.copy()
         weights[WAIST] = 0.5
         com = pp.com_over(soles, com_shift_h)
         rot = rot_z(np.asarray(heading))
-        pitch = {UPRIGHT: 0.0, LEAN: LEAN_PELVIS_RAD, STAND_LEAN: STAND_LEAN_PELVIS_RAD}[int(lean)]
+        pitch = {UPRIGHT: 0.0, LEAN: LEAN_PELVIS_RAD, STAND_LEAN: STAND_LEAN_PELVIS_RAD, DEEP: DEEP_PELVIS_RAD}[int(lean)]
         pelvis_rot = rot @ np.array([[math.cos(pitch), 0.0, math.sin(pitch)], [0.0, 1.0, 0.0],
                                      [-math.sin(pitch), 0.0, math.cos(pitch)]])
         z_cap = min(p[2] for p, _ in soles) + pp.nominal_pelvis_m + PELVIS_CAP_ABOVE_NOMINAL_M
@@ -609,7 +668,7 @@ def _along(poses: PosePlanner, q: np.ndarray, corners: list[list[np.ndarray]], s
     return out
 
 
-BENDS = {UPRIGHT: "upright", LEAN: "leaning", STAND_LEAN: "standing leaning"}
+BENDS = {UPRIGHT: "upright", LEAN: "leaning", STAND_LEAN: "standing leaning", DEEP: "deep squat"}
 
 
 def _part(a: str, b: str) -> str:
@@ -644,6 +703,6 @@ def place_heading(support: Block | None, xy: np.ndarray, robot_xy: np.ndarray) -
     return math.atan2(-n[1], -n[0])
 
 
-__all__ = ["LEAN", "STAND_LEAN", "UPRIGHT", "Candidate", "StancePlan", "StancePlanner", "StanceRefused", "box_com_shift", "detour_poses", "edge_normal",
+__all__ = ["DEEP", "LEAN", "STAND_LEAN", "UPRIGHT", "Candidate", "StancePlan", "StancePlanner", "StanceRefused", "box_com_shift", "detour_poses", "edge_normal",
            "face_normals", "grasp_hold_poses", "hand_height", "path_meets", "pick_headings", "place_heading", "plan_stance",
            "raised_pose", "release_hold_poses", "stance_planner"]
