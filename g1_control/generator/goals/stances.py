@@ -10,12 +10,14 @@ on the floor. The candidates:
   gap       from the middle of the soles to the box's near face
   pelvis    standing (nominal height), then lower in steps down to a squat at 0.42 m
   torso     upright, or leaning forward (pelvis pitched 0.4 rad, waist pulled forward 0.45 rad)
-  deep      hands below DEEP_BELOW_M, a box under DEEP_MAX_KG: a deep squat (pelvis DEEP_PELVIS_M, knees
-            forward, heels down, pelvis pitched DEEP_PELVIS_RAD, waist DEEP_WAIST_RAD), the only kind
-            tried for hands below LOWEST_GRASP_M (a floor box, a low table's); kept when, besides the
-            checks below, the soles stay flat on the ground (FLAT_SOLE_M / FLAT_SOLE_RAD), every joint
-            stays DEEP_LIMIT_MARGIN_RAD inside its limits, the pelvis stays at DEEP_MIN_PELVIS_M or higher
-            (above the fall monitor's 0.40 m) and tilts DEEP_MAX_TILT_RAD at most
+  deep      hands below DEEP_BELOW_M: a deep squat (pelvis DEEP_PELVIS_M, knees forward, heels down), the
+            trunk bent as DEEP_BENDS says, most upright first; the only kind tried for hands below
+            LOWEST_GRASP_M (a floor box, a low table's); kept when, besides the checks below, the soles
+            stay flat on the ground (FLAT_SOLE_M / FLAT_SOLE_RAD), the leg joints stay
+            DEEP_LIMIT_MARGIN_RAD inside their limits, the pelvis stays at DEEP_MIN_PELVIS_M or higher
+            (above the fall monitor's 0.40 m), tilts DEEP_MAX_TILT_RAD at most, and every joint's static
+            torque (gravity, the box's weight at the hands, the ground's reaction under the CoM) is
+            within its actuator's limit (`static_torques`)
   standing leaning  last, for a light box held at SQUAT_BELOW_M or higher on a support: standing off its edge
             (soles' middle STAND_LEAN_GAPS_M from the box, the pelvis beyond MIN_EDGE_CLEARANCE_M),
             the pelvis pitched STAND_LEAN_PELVIS_RAD and the waist leaning to reach in
@@ -70,14 +72,15 @@ LEAN_WAIST_RAD = 0.45
 LEAN_PELVIS_RAD = 0.4
 """Leaning: the pelvis's pitch target (a soft one)."""
 UPRIGHT, LEAN, STAND_LEAN, DEEP = 0, 1, 2, 3
-"""How a candidate bends (Candidate.lean): upright, leaning (squatting), leaning standing, or a deep squat."""
+"""How a candidate bends (Candidate.lean): upright, leaning (squatting), leaning standing, or a deep squat
+(DEEP + k: its trunk bent as DEEP_BENDS[k])."""
+DEEP_BENDS = ((0.3, 0.0), (0.45, 0.15), (0.6, 0.3), (0.7, 0.5))
+"""Deep squat: (the pelvis's pitch target, the waist's pitch pull) rad, most upright first. The waist
+pitch (35 N m) carries the trunk: at the trunk's full bend (0.7 + 0.5, stop 34's squat) the upper body
+alone needs ~35 N m of it, and in lockstep MuJoCo the trunk rested on the joint's 0.52 rad stop."""
 DEEP_PELVIS_M = (0.50, 0.47)
 """Deep squat: the pelvis heights tried (above the ground; the IK lets it give FEASIBLE_PELVIS_M below,
 DEEP_MIN_PELVIS_M is the least it may end at)."""
-DEEP_PELVIS_RAD = 0.7
-"""Deep squat: the pelvis's pitch target (a soft one; its tilt stays within DEEP_MAX_TILT_RAD)."""
-DEEP_WAIST_RAD = 0.5
-"""Deep squat: the waist's pitch pull (its limit is 0.52)."""
 DEEP_BELOW_M = 0.50
 """Hands below this (above the ground): the deep squat is tried too (the squats reach ~0.45 m at best)."""
 DEEP_MIN_PELVIS_M = 0.44
@@ -85,14 +88,15 @@ DEEP_MIN_PELVIS_M = 0.44
 the whole-body controller sank a planned squat ~3 cm below its plan (measured, stop 34)."""
 DEEP_MAX_TILT_RAD = 0.85
 """A deep squat's pelvis tilt at most (the safety layer calls 1.0 rad a fall)."""
-DEEP_MAX_KG = 1.0
-"""The deep squat only with a box lighter than this: in lockstep MuJoCo (stop 34, a 0.35 m floor cube)
-the whole-body controller lifted 0.3 and 0.8 kg from it; 1.0 kg rose and dropped, 1.2-2.0 kg did not
-come up (hips and wrists ~0.2 rad behind the plan), 3 kg fell."""
+DEEP_TORQUE_SHARE = 1.0
+"""A deep squat's static joint torques at most this share of the actuators' limits (g1.EFFORT_LIMIT_NM).
+Stop 34 lifted 0.3 and 0.8 kg floor boxes from its squat (trunk 0.7 + 0.5 rad) but not 1.2-2.0 kg
+(hips and wrists ~0.2 rad behind the plan; 3 kg fell); the waist pitch needs 35 N m there without a
+box, 41 N m with 1.5 kg (measured, this search's poses)."""
 DEEP_LIMIT_MARGIN_RAD = 0.05
 """A deep squat's leg joints this far inside their position limits at least, room for the controller
 to move them (the IK keeps 0.02 rad; hip pitch works at ~-2.2 of -2.53 rad, ankle pitch ~-0.5 of -0.87;
-the waist is pulled to DEEP_WAIST_RAD, near its 0.52, on purpose)."""
+the waist may be pulled near its 0.52, DEEP_BENDS)."""
 FLAT_SOLE_M = 0.005
 FLAT_SOLE_RAD = 0.03
 """A deep squat's soles within this of where they stand, flat (the heels down: the ankles' dorsiflexion
@@ -308,27 +312,14 @@ class StancePlanner:
             raise StanceRefused(f"{size}: no stance can {what}: the hands would hold it {grasp_z * 100:.0f} cm above "
                                 f"the ground (the hands strike the ground below {MIN_HAND_Z_M * 100:.0f} cm); "
                                 "closest: none tried")
-        deep = mass < DEEP_MAX_KG
-        if grasp_z < LOWEST_GRASP_M and not deep:  # one candidate, the deepest, for the closest pose
-            heading = headings[0]
-            depth = grasp_width(box, heading + math.pi / 2)
-            gap = max(GAPS_M[1], PREFERRED_CENTER_M - depth / 2)
-            fwd = np.array([math.cos(heading), math.sin(heading)])
-            cand = Candidate(heading, center_w[:2] - (gap + depth / 2) * fwd, gap, ground_z + DEEP_PELVIS_M[-1], DEEP)
-            self._evaluate(cand, box, center_w, support, grasp_width(box, heading), dz, mass, ground_z, lift_m,
-                           press_m)
-            raise StanceRefused(f"{size}: no stance can {what}: the hands would hold it {grasp_z:.2f} m above the "
-                                f"ground; below {LOWEST_GRASP_M:.2f} m only the deep squat reaches (pelvis down to "
-                                f"{DEEP_MIN_PELVIS_M:.2f} m), and the controller lifts only a box under "
-                                f"{DEEP_MAX_KG:.1f} kg from it; closest: {cand.describe()}")
         # squatting lowers the hands for a box below the waist; above it, it only costs
         levels = [nominal] + ([ground_z + z for z in SQUAT_PELVIS_M] if grasp_z < SQUAT_BELOW_M else [])
         bent: list[tuple[int, ...]] = [(UPRIGHT, LEAN)] * len(levels)
         if grasp_z < LOWEST_GRASP_M:  # no squat reaches so low (LOWEST_GRASP_M): the deep squat only
             levels, bent = [], []
-        if grasp_z < DEEP_BELOW_M and deep:
+        if grasp_z < DEEP_BELOW_M:
             levels += [ground_z + z for z in DEEP_PELVIS_M]
-            bent += [(DEEP,)] * len(DEEP_PELVIS_M)
+            bent += [tuple(DEEP + k for k in range(len(DEEP_BENDS)))] * len(DEEP_PELVIS_M)
         if support is not None and support.height_m > KNEE_HEIGHT_M and mass < LEAN_MAX_KG and grasp_z >= SQUAT_BELOW_M:
             levels.append(nominal)  # last: standing off the support's edge, leaning to reach in
             bent.append((STAND_LEAN,))
@@ -347,7 +338,7 @@ class StancePlanner:
                     gaps = (preferred, *(g for g in GAPS_M if abs(g - preferred) > 0.02))
                     if lean == STAND_LEAN:
                         gaps = STAND_LEAN_GAPS_M
-                    for gap in gaps if pelvis_z >= nominal - 1e-6 or lean == DEEP else [g for g in gaps if g >= 0.2]:
+                    for gap in gaps if pelvis_z >= nominal - 1e-6 or lean >= DEEP else [g for g in gaps if g >= 0.2]:
                         mid = center_w[:2] - (gap + depth / 2) * fwd
                         cand = Candidate(heading, mid, gap, pelvis_z, lean, preferred=gap == preferred)
                         self._evaluate(cand, box, center_w, support, width, dz, mass, ground_z, lift_m, press_m)
@@ -384,13 +375,14 @@ class StancePlanner:
             worst_res = max(worst_res, r.residual_m)
             worst_com = max(worst_com, r.com_error_m)
             squat = cand.pelvis_z_m < ground_z + self.poses.nominal_pelvis_m - 1e-6
-            deep = cand.lean == DEEP
+            deep = cand.lean >= DEEP
             if (squat and r.pelvis_error_m > FEASIBLE_PELVIS_M) or \
                     r.tilt_rad > (DEEP_MAX_TILT_RAD if deep else MAX_TILT_RAD) or \
                     r.q[2] - ground_z < (DEEP_MIN_PELVIS_M if deep else MIN_PELVIS_M):
                 cand.collision = cand.collision or f"the pelvis ends at {r.q[2]:.2f} m, tilted {r.tilt_rad:.2f} rad"
             if deep:
-                cand.collision = cand.collision or self.deep_fault(r.q, soles)
+                cand.collision = cand.collision or self.deep_fault(r.q, soles) or \
+                    self.torque_fault(r.q, soles, mass if len(cand.poses) > 1 or lift_m is None else 0.0)
             if not squat and cand.pelvis_z_m - r.q[2] > STANDING_GIVE_M:
                 cand.collision = cand.collision or (f"standing, the pelvis sinks to {r.q[2] - ground_z:.2f} m "
                                                     "(a squat, tried as one)")
@@ -419,6 +411,42 @@ class StancePlanner:
             return f"{g1.JOINT_NAMES[legs[k]]} is {room[k]:.3f} rad from its limit"
         return None
 
+    def static_torques(self, q: np.ndarray, soles: list[Sole], box_kg: float) -> np.ndarray:
+        """The joint torques (N m, g1 order) that hold pose q still: gravity, a box of box_kg hanging
+        from the two hands in equal shares, and the ground's reaction split equally between the soles,
+        its centre of pressure under the CoM of robot and box together."""
+        ik, pin = self.ik, self.ik.pin
+        model, data = ik.model, ik.data
+        pin.computeJointJacobians(model, data, q)
+        pin.framesForwardKinematics(model, data, q)
+        tau = pin.computeGeneralizedGravity(model, data, q).copy()
+        weight = np.array([0.0, 0.0, -box_kg * 9.81 / 2])
+        hands = []
+        for h in HAND_FRAMES:
+            fid = model.getFrameId(h)
+            hands.append(data.oMf[fid].translation[:2].copy())
+            tau -= pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)[:3].T @ weight
+        robot_kg = self.poses.mass_kg
+        com = (robot_kg * pin.centerOfMass(model, data, q)[:2] + box_kg * np.mean(hands, axis=0)) / (robot_kg + box_kg)
+        mid = np.mean([p[:2] for p, _ in soles], axis=0)
+        up = np.array([0.0, 0.0, (robot_kg + box_kg) * 9.81 / 2])
+        for (p, _), frame in zip(soles, SOLE_FRAMES, strict=True):
+            fid = model.getFrameId(frame)
+            at = np.array([*(p[:2] + com - mid), p[2]])
+            wrench = np.concatenate([up, np.cross(at - data.oMf[fid].translation, up)])
+            tau -= pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED).T @ wrench
+        return tau[6:]
+
+    def torque_fault(self, q: np.ndarray, soles: list[Sole], box_kg: float) -> str | None:
+        """A joint whose static torque (`static_torques`) is beyond DEEP_TORQUE_SHARE of its limit (None: none)."""
+        tau = self.static_torques(q, soles, box_kg)
+        share = np.abs(tau) / g1.EFFORT_LIMIT_NM
+        k = int(np.argmax(share))
+        if share[k] > DEEP_TORQUE_SHARE:
+            return (f"{g1.JOINT_NAMES[k]} needs {abs(tau[k]):.0f} N m to hold still (its limit "
+                    f"{g1.EFFORT_LIMIT_NM[k]:.0f} N m)")
+        return None
+
     def hold(self, q0: np.ndarray, soles: list[Sole], targets: tuple[np.ndarray, np.ndarray], heading: float,
              com_shift_h: np.ndarray, pelvis_z: float, lean: int) -> HoldPose:
         """Both hands at `targets` (palms in across the heading), the pelvis at pelvis_z, the CoM over the
@@ -429,12 +457,13 @@ class StancePlanner:
         pp = self.poses
         posture = g1.DEFAULT_Q_RAD.copy()
         if lean:
-            posture[WAIST_PITCH] = DEEP_WAIST_RAD if lean == DEEP else LEAN_WAIST_RAD
+            posture[WAIST_PITCH] = DEEP_BENDS[lean - DEEP][1] if lean >= DEEP else LEAN_WAIST_RAD
         weights = LEG_LIGHT_POSTURE_WEIGHT.copy()
         weights[WAIST] = 0.5
         com = pp.com_over(soles, com_shift_h)
         rot = rot_z(np.asarray(heading))
-        pitch = {UPRIGHT: 0.0, LEAN: LEAN_PELVIS_RAD, STAND_LEAN: STAND_LEAN_PELVIS_RAD, DEEP: DEEP_PELVIS_RAD}[int(lean)]
+        pitch = DEEP_BENDS[lean - DEEP][0] if lean >= DEEP else \
+            {UPRIGHT: 0.0, LEAN: LEAN_PELVIS_RAD, STAND_LEAN: STAND_LEAN_PELVIS_RAD}[int(lean)]
         pelvis_rot = rot @ np.array([[math.cos(pitch), 0.0, math.sin(pitch)], [0.0, 1.0, 0.0],
                                      [-math.sin(pitch), 0.0, math.cos(pitch)]])
         z_cap = min(p[2] for p, _ in soles) + pp.nominal_pelvis_m + PELVIS_CAP_ABOVE_NOMINAL_M
@@ -668,7 +697,8 @@ def _along(poses: PosePlanner, q: np.ndarray, corners: list[list[np.ndarray]], s
     return out
 
 
-BENDS = {UPRIGHT: "upright", LEAN: "leaning", STAND_LEAN: "standing leaning", DEEP: "deep squat"}
+BENDS = {UPRIGHT: "upright", LEAN: "leaning", STAND_LEAN: "standing leaning",
+         **{DEEP + k: f"deep squat (pelvis pitched {p:.2f}, waist {w:.2f} rad)" for k, (p, w) in enumerate(DEEP_BENDS)}}
 
 
 def _part(a: str, b: str) -> str:
