@@ -130,3 +130,10 @@ def test_a_lockstep_pick_lifts_a_floor_box_from_the_deep_squat():
     assert r["pelvis_min_m"] < MIN_PELVIS_M
     assert r["rise_end_m"] > 0.3, f"box {r['rise_end_m'] * 100:.0f} cm up at the end (max {r['rise_max_m'] * 100:.0f} cm)"
     assert r["box_to_hands_end_m"] < 0.1
+
+
+def test_a_place_below_the_squats_reach_is_refused_the_deep_squat_picks_only(stances):
+    with pytest.raises(StanceRefused, match=r"0\.5 kg.*no stance can set it down there: the hands would hold it 0\.26 m "
+                                            r"above the ground; below 0\.40 m only a deep squat reaches, and it only "
+                                            r"picks \(a carry into one fell: DEEP_PICKS_ONLY\); closest: .*deep squat"):
+        stances.plan(_box(0.5), CENTER, None, [0.0], lift_m=None, what="set it down there")

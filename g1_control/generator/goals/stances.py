@@ -17,7 +17,7 @@ on the floor. The candidates:
             DEEP_LIMIT_MARGIN_RAD inside their limits, the pelvis stays at DEEP_MIN_PELVIS_M or higher
             (above the fall monitor's 0.40 m), tilts DEEP_MAX_TILT_RAD at most, and every joint's static
             torque (gravity, the box's weight at the hands, the ground's reaction under the CoM) is
-            within its actuator's limit (`static_torques`)
+            within its actuator's limit (`static_torques`); picks only (DEEP_PICKS_ONLY)
   standing leaning  last, for a light box held at SQUAT_BELOW_M or higher on a support: standing off its edge
             (soles' middle STAND_LEAN_GAPS_M from the box, the pelvis beyond MIN_EDGE_CLEARANCE_M),
             the pelvis pitched STAND_LEAN_PELVIS_RAD and the waist leaning to reach in
@@ -88,6 +88,12 @@ DEEP_MIN_PELVIS_M = 0.44
 the whole-body controller sank a planned squat ~3 cm below its plan (measured, stop 34)."""
 DEEP_MAX_TILT_RAD = 0.85
 """A deep squat's pelvis tilt at most (the safety layer calls 1.0 rad a fall)."""
+DEEP_PICKS_ONLY = True
+"""The deep squat picks; a place is not planned from it (a place's hands below LOWEST_GRASP_M stay
+refused). Measured (bench objects seed 9 trial 1, stops 34 and 36: a 0.5 kg, 0.45 m tall box picked
+leaning from a 0.23 m table, to go on the floor from a deep squat): the robot fell in the correcting
+steps at the end of the carry, the trunk leaning (waist 0.31 rad, ~24 N m) with the box held high;
+seed 8 trial 3 set its box down from a deep squat (2.4 cm)."""
 DEEP_TORQUE_SHARE = 1.0
 """A deep squat's static joint torques at most this share of the actuators' limits (g1.EFFORT_LIMIT_NM).
 Stop 34 lifted 0.3 and 0.8 kg floor boxes from its squat (trunk 0.7 + 0.5 rad) but not 1.2-2.0 kg
@@ -312,12 +318,25 @@ class StancePlanner:
             raise StanceRefused(f"{size}: no stance can {what}: the hands would hold it {grasp_z * 100:.0f} cm above "
                                 f"the ground (the hands strike the ground below {MIN_HAND_Z_M * 100:.0f} cm); "
                                 "closest: none tried")
+        deep = lift_m is not None or not DEEP_PICKS_ONLY
+        if grasp_z < LOWEST_GRASP_M and not deep:  # one candidate, the deepest, for the closest pose
+            heading = headings[0]
+            depth = grasp_width(box, heading + math.pi / 2)
+            gap = max(GAPS_M[1], PREFERRED_CENTER_M - depth / 2)
+            fwd = np.array([math.cos(heading), math.sin(heading)])
+            cand = Candidate(heading, center_w[:2] - (gap + depth / 2) * fwd, gap, ground_z + DEEP_PELVIS_M[-1],
+                             DEEP + len(DEEP_BENDS) - 1)
+            self._evaluate(cand, box, center_w, support, grasp_width(box, heading), dz, mass, ground_z, lift_m,
+                           press_m)
+            raise StanceRefused(f"{size}: no stance can {what}: the hands would hold it {grasp_z:.2f} m above the "
+                                f"ground; below {LOWEST_GRASP_M:.2f} m only a deep squat reaches, and it only picks "
+                                f"(a carry into one fell: DEEP_PICKS_ONLY); closest: {cand.describe()}")
         # squatting lowers the hands for a box below the waist; above it, it only costs
         levels = [nominal] + ([ground_z + z for z in SQUAT_PELVIS_M] if grasp_z < SQUAT_BELOW_M else [])
         bent: list[tuple[int, ...]] = [(UPRIGHT, LEAN)] * len(levels)
         if grasp_z < LOWEST_GRASP_M:  # no squat reaches so low (LOWEST_GRASP_M): the deep squat only
             levels, bent = [], []
-        if grasp_z < DEEP_BELOW_M:
+        if grasp_z < DEEP_BELOW_M and deep:
             levels += [ground_z + z for z in DEEP_PELVIS_M]
             bent += [tuple(DEEP + k for k in range(len(DEEP_BENDS)))] * len(DEEP_PELVIS_M)
         if support is not None and support.height_m > KNEE_HEIGHT_M and mass < LEAN_MAX_KG and grasp_z >= SQUAT_BELOW_M:
