@@ -206,7 +206,7 @@ class Candidate:
     gap_m: float
     pelvis_z_m: float
     lean: int
-    """UPRIGHT, LEAN or STAND_LEAN."""
+    """UPRIGHT, LEAN, STAND_LEAN or DEEP + k (DEEP_BENDS[k])."""
     preferred: bool = False
     residual_m: float = math.inf
     com_error_m: float = math.inf
@@ -555,7 +555,7 @@ def plan_stance(poses: PosePlanner, box: Box, center_w: np.ndarray, support: Blo
 
 
 HoldStep = tuple[str, tuple[np.ndarray, np.ndarray], np.ndarray, float, int]
-"""(name, the hands' two points, CoM shift (heading frame), pelvis height, bend: UPRIGHT/LEAN/STAND_LEAN)."""
+"""(name, the hands' two points, CoM shift (heading frame), pelvis height, bend: UPRIGHT/LEAN/STAND_LEAN/DEEP + k)."""
 
 
 def grasp_hold_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float, steps: list[HoldStep],
