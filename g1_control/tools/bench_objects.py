@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import time
 from collections import defaultdict
 from pathlib import Path
@@ -262,6 +263,33 @@ def summary(results: list[dict]) -> dict:
     return {k: {"success": rows[k][0], "trials": rows[k][1]} for k in order if k in rows}
 
 
+def refusal_reason(text: str) -> str:
+    """A refusal's reason, numbers written as '#' so that alike reasons count together: without the
+    box's description, the "no stance can ..." lead and the closest or planned pose ("pick: box 'box'
+    (...): no stance can pick it up (22 tried, ...): the hands get only within 4.5 cm; closest: ..." ->
+    "pick: the hands get only within # cm")."""
+    kind, _, rest = text.partition(": ")
+    rest = re.sub(r"^box '[^']*'( \([^)]*\))?:? ", "", rest)
+    rest = re.sub(r"^no stance can [^(:]*( \([^)]*\))?: ", "", rest)
+    rest = rest.split("; closest")[0].split(" (planned:")[0]
+    return f"{kind}: " + re.sub(r"-?\d+(\.\d+)?", "#", rest).strip()
+
+
+def refusal_table(results: list[dict]) -> dict[str, dict[str, int]]:
+    """Per bucket (a pick's by where the box stood, a place's by where it was to go), how often each
+    refusal reason (`refusal_reason`) ended a trial; "place: holding no box" after a refused or failed
+    pick is left out (the pick's reason is counted)."""
+    table: dict[str, dict[str, int]] = defaultdict(lambda: defaultdict(int))
+    for r in results:
+        for text in r["refused"]:
+            reason = refusal_reason(text)
+            if reason == "place: holding no box":
+                continue
+            bucket = r["source" if reason.startswith("pick") else "target"]["bucket"]
+            table[f"{'from' if reason.startswith('pick') else 'to'} {bucket}"][reason] += 1
+    return {k: dict(sorted(v.items(), key=lambda kv: -kv[1])) for k, v in sorted(table.items())}
+
+
 def main(args) -> int:
     n, seed = int(args.trials if args.trials is not None else 10), int(args.seed)
     from g1_control.fanout import fan_out
@@ -281,8 +309,15 @@ def main(args) -> int:
         print("refusals:")
         for i, x in refused:
             print(f"  trial {i}: {x}")
+    reasons = refusal_table(results)
+    if reasons:
+        print("refusal reasons per bucket:")
+        for bucket, counts in reasons.items():
+            for reason, count in counts.items():
+                print(f"  {bucket:11s} {count:3d}  {reason}")
     if args.json:
-        Path(args.json).write_text(json.dumps({"seed": seed, "trials": n, "table": table, "results": results},
+        Path(args.json).write_text(json.dumps({"seed": seed, "trials": n, "table": table, "reasons": reasons,
+                                               "results": results},
                                               indent=1, default=float))
     return 0
 
@@ -299,4 +334,4 @@ def _print_trial(r: dict) -> None:
           f"[{r['sim_s']:.0f} s sim, {r['wall_s']:.0f} s wall]", flush=True)
 
 
-__all__ = ["draw_scene", "judge", "main", "run_trial", "summary"]
+__all__ = ["draw_scene", "judge", "main", "refusal_reason", "refusal_table", "run_trial", "summary"]

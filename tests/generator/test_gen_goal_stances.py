@@ -75,11 +75,18 @@ def test_box_on_a_low_table_gets_a_squat_the_ik_reaches(stances):
     assert stances.collision(contact, box, center, table) is None
 
 
-def test_box_on_the_floor_needing_a_squat_below_the_fall_limit_is_refused(stances):
-    box = Box("box", (1.2, 0.0), size_m=(0.3, 0.3, 0.45), mass_kg=1.0)
-    with pytest.raises(StanceRefused, match=r"no stance can pick it up: the hands would hold it 0.34 m above the "
-                                            r"ground; squatting no lower than .*closest: heading 0 deg.*pelvis 0.55 m"):
-        stances.plan(box, np.array([1.2, 0.0, 0.225]), None, [0.0], lift_m=0.1, what="pick it up")
+def test_box_on_the_floor_below_the_squats_is_picked_from_a_deep_squat_or_refused_by_its_torque(stances):
+    """Hands at 0.34 m: no squat reaches (they stop ~0.45 m); the deep squat does for 1.0 kg, and for
+    2.0 kg the waist pitch would need more than its 35 N m: refused, naming it (stop 35 refused both
+    for the hands' height alone)."""
+    light = Box("box", (1.2, 0.0), size_m=(0.3, 0.3, 0.45), mass_kg=1.0)
+    plan = stances.plan(light, np.array([1.2, 0.0, 0.225]), None, [0.0], lift_m=0.1, what="pick it up")
+    assert "deep squat" in plan.chosen.describe() and plan.pelvis_z_m <= 0.50
+    heavy = Box("box", (1.2, 0.0), size_m=(0.3, 0.3, 0.45), mass_kg=2.0)
+    with pytest.raises(StanceRefused, match=r"no stance can pick it up \(\d+ tried, pelvis down to 0.47 m\): "
+                                            r"waist_pitch_joint needs 3\d N m to hold still \(its limit 35 N m\); "
+                                            r"closest: heading 0 deg.*deep squat"):
+        stances.plan(heavy, np.array([1.2, 0.0, 0.225]), None, [0.0], lift_m=0.1, what="pick it up")
 
 
 def test_collision_sees_a_knee_in_the_box(stances):

@@ -5,7 +5,15 @@ import math
 
 import numpy as np
 
-from g1_control.tools.bench_objects import HEIGHT_BUCKETS_M, draw_scene, height_bucket, judge, summary
+from g1_control.tools.bench_objects import (
+    HEIGHT_BUCKETS_M,
+    draw_scene,
+    height_bucket,
+    judge,
+    refusal_reason,
+    refusal_table,
+    summary,
+)
 
 
 def test_scenes_are_a_function_of_seed_and_index_within_the_ranges():
@@ -89,3 +97,19 @@ def test_judge_a_box_set_back_by_a_failed_pick_is_not_a_drop():
     slid = [0.15, 0.15, 0.2, 0.21, 0.15, 0.15, 0.15, 0.15, 0.15, 0.15, 0.15]
     assert judge(DRAWN, _arrays(slid, [0.5, 0.3, 0.2, 0.21, 0.3, 0.3, 0.3, 0.5, 0.5, 0.5, 0.5], [3.0, 0.0]),
                  failed, {}, 0.7, False, index=0)["dropped"]
+
+
+def test_refusals_are_counted_per_bucket_by_reason_numbers_aside():
+    pick = ("pick: box 'box' (0.30x0.34x0.24 m, 4.7 kg, centre 0.12 m up): no stance can pick it up (32 tried, pelvis "
+            "down to 0.47 m): waist_pitch_joint needs {} N m to hold still (its limit 35 N m); closest: heading -25 deg, "
+            "pelvis 0.47 m")
+    rows = [{"source": {"bucket": "floor"}, "target": {"bucket": "high"}, "refused": [pick.format(38), "place: holding no box"]},
+            {"source": {"bucket": "floor"}, "target": {"bucket": "low"}, "refused": [pick.format(41)]},
+            {"source": {"bucket": "table"}, "target": {"bucket": "floor"},
+             "refused": ["place: from the stance the carry ended in, the hands get only within 3.4 cm of where the box "
+                         "goes (planned: pelvis 0.50 m)"]},
+            {"source": {"bucket": "low"}, "target": {"bucket": "low"}, "refused": []}]
+    assert refusal_reason(pick.format(38)) == "pick: waist_pitch_joint needs # N m to hold still (its limit # N m)"
+    assert refusal_table(rows) == {
+        "from floor": {"pick: waist_pitch_joint needs # N m to hold still (its limit # N m)": 2},
+        "to floor": {"place: from the stance the carry ended in, the hands get only within # cm of where the box goes": 1}}

@@ -10,6 +10,14 @@ on the floor. The candidates:
   gap       from the middle of the soles to the box's near face
   pelvis    standing (nominal height), then lower in steps down to a squat at 0.42 m
   torso     upright, or leaning forward (pelvis pitched 0.4 rad, waist pulled forward 0.45 rad)
+  deep      hands below DEEP_BELOW_M: a deep squat (pelvis DEEP_PELVIS_M, knees forward, heels down), the
+            trunk bent as DEEP_BENDS says, most upright first; the only kind tried for hands below
+            LOWEST_GRASP_M (a floor box, a low table's); kept when, besides the checks below, the soles
+            stay flat on the ground (FLAT_SOLE_M / FLAT_SOLE_RAD), the leg joints stay
+            DEEP_LIMIT_MARGIN_RAD inside their limits, the pelvis stays at DEEP_MIN_PELVIS_M or higher
+            (above the fall monitor's 0.40 m), tilts DEEP_MAX_TILT_RAD at most, and every joint's static
+            torque (gravity, the box's weight at the hands, the ground's reaction under the CoM) is
+            within its actuator's limit (`static_torques`); picks only (DEEP_PICKS_ONLY)
   standing leaning  last, for a light box held at SQUAT_BELOW_M or higher on a support: standing off its edge
             (soles' middle STAND_LEAN_GAPS_M from the box, the pelvis beyond MIN_EDGE_CLEARANCE_M),
             the pelvis pitched STAND_LEAN_PELVIS_RAD and the waist leaning to reach in
@@ -50,7 +58,7 @@ from g1_control.generator.goals.poses import (
 )
 from g1_control.ik.whole_body import LEG_LIGHT_POSTURE_WEIGHT
 from g1_control.robot import g1
-from g1_control.robot.dynamics import HAND_FRAMES
+from g1_control.robot.dynamics import HAND_FRAMES, SOLE_FRAMES
 from g1_control.rotations import rot_z
 from g1_control.scene import Block, Box
 
@@ -63,8 +71,42 @@ LEAN_WAIST_RAD = 0.45
 """Leaning: the waist's pitch pull (its limit is 0.52)."""
 LEAN_PELVIS_RAD = 0.4
 """Leaning: the pelvis's pitch target (a soft one)."""
-UPRIGHT, LEAN, STAND_LEAN = 0, 1, 2
-"""How a candidate bends (Candidate.lean): upright, leaning (squatting), or leaning standing."""
+UPRIGHT, LEAN, STAND_LEAN, DEEP = 0, 1, 2, 3
+"""How a candidate bends (Candidate.lean): upright, leaning (squatting), leaning standing, or a deep squat
+(DEEP + k: its trunk bent as DEEP_BENDS[k])."""
+DEEP_BENDS = ((0.3, 0.0), (0.45, 0.15), (0.6, 0.3), (0.7, 0.5))
+"""Deep squat: (the pelvis's pitch target, the waist's pitch pull) rad, most upright first. The waist
+pitch (35 N m) carries the trunk: at the trunk's full bend (0.7 + 0.5, stop 34's squat) the upper body
+alone needs ~35 N m of it, and in lockstep MuJoCo the trunk rested on the joint's 0.52 rad stop."""
+DEEP_PELVIS_M = (0.50, 0.47)
+"""Deep squat: the pelvis heights tried (above the ground; the IK lets it give FEASIBLE_PELVIS_M below,
+DEEP_MIN_PELVIS_M is the least it may end at)."""
+DEEP_BELOW_M = 0.50
+"""Hands below this (above the ground): the deep squat is tried too (the squats reach ~0.45 m at best)."""
+DEEP_MIN_PELVIS_M = 0.44
+"""A deep squat's pose keeps the pelvis this high: the fall monitor calls 0.40 m a fall (FallConfig), and
+the whole-body controller sank a planned squat ~3 cm below its plan (measured, stop 34)."""
+DEEP_MAX_TILT_RAD = 0.85
+"""A deep squat's pelvis tilt at most (the safety layer calls 1.0 rad a fall)."""
+DEEP_PICKS_ONLY = True
+"""The deep squat picks; a place is not planned from it (a place's hands below LOWEST_GRASP_M stay
+refused). Measured (bench objects seed 9 trial 1, stops 34 and 36: a 0.5 kg, 0.45 m tall box picked
+leaning from a 0.23 m table, to go on the floor from a deep squat): the robot fell in the correcting
+steps at the end of the carry, the trunk leaning (waist 0.31 rad, ~24 N m) with the box held high;
+seed 8 trial 3 set its box down from a deep squat (2.4 cm)."""
+DEEP_TORQUE_SHARE = 1.0
+"""A deep squat's static joint torques at most this share of the actuators' limits (g1.EFFORT_LIMIT_NM).
+Stop 34 lifted 0.3 and 0.8 kg floor boxes from its squat (trunk 0.7 + 0.5 rad) but not 1.2-2.0 kg
+(hips and wrists ~0.2 rad behind the plan; 3 kg fell); the waist pitch needs 35 N m there without a
+box, 41 N m with 1.5 kg (measured, this search's poses)."""
+DEEP_LIMIT_MARGIN_RAD = 0.05
+"""A deep squat's leg joints this far inside their position limits at least, room for the controller
+to move them (the IK keeps 0.02 rad; hip pitch works at ~-2.2 of -2.53 rad, ankle pitch ~-0.5 of -0.87;
+the waist may be pulled near its 0.52, DEEP_BENDS)."""
+FLAT_SOLE_M = 0.005
+FLAT_SOLE_RAD = 0.03
+"""A deep squat's soles within this of where they stand, flat (the heels down: the ankles' dorsiflexion
+limit otherwise lifts them)."""
 STAND_LEAN_PELVIS_RAD = 0.15
 """Standing leaning: the pelvis's pitch target (the waist pulls LEAN_WAIST_RAD). Only for hands at
 SQUAT_BELOW_M or higher (stop 34, objects34: a 1.0 kg box on a 0.63 m table, hands at 0.72 m, kept
@@ -91,11 +133,11 @@ LEAN_MAX_KG = 3.0
 """Leaning only with a box lighter than this: leaning squats picking 3.2 and 5.6 kg boxes fell at the
 lift (bench objects seeds 8 and 9; a 0.5 kg box was picked leaning)."""
 MIN_HAND_Z_M = 0.10
+"""Hands no lower above the ground (below, the rubber hands strike the floor: a fall by body contact)."""
 LOWEST_GRASP_M = 0.40
-"""Below this (hands above the ground) the search is not run: with the pelvis at MIN_PELVIS_M or
+"""Below this (hands above the ground) only the deep squat is tried: with the pelvis at MIN_PELVIS_M or
 higher, no candidate held a box lower than ~0.45 m (measured over the issue 25 scenes and the
 tests' boxes); it only cost 5-10 s of CPU to find that out each time."""
-"""Hands no lower above the ground (below, the rubber hands strike the floor: a fall by body contact)."""
 FEASIBLE_RESIDUAL_M = 0.02
 """Kept within this (the grasp itself refuses beyond 3 cm from the stance the steps end in)."""
 FEASIBLE_COM_M = 0.02
@@ -164,7 +206,7 @@ class Candidate:
     gap_m: float
     pelvis_z_m: float
     lean: int
-    """UPRIGHT, LEAN or STAND_LEAN."""
+    """UPRIGHT, LEAN, STAND_LEAN or DEEP + k (DEEP_BENDS[k])."""
     preferred: bool = False
     residual_m: float = math.inf
     com_error_m: float = math.inf
@@ -276,20 +318,27 @@ class StancePlanner:
             raise StanceRefused(f"{size}: no stance can {what}: the hands would hold it {grasp_z * 100:.0f} cm above "
                                 f"the ground (the hands strike the ground below {MIN_HAND_Z_M * 100:.0f} cm); "
                                 "closest: none tried")
-        if grasp_z < LOWEST_GRASP_M:  # one candidate, the deepest, for the closest pose
+        deep = lift_m is not None or not DEEP_PICKS_ONLY
+        if grasp_z < LOWEST_GRASP_M and not deep:  # one candidate, the deepest, for the closest pose
             heading = headings[0]
             depth = grasp_width(box, heading + math.pi / 2)
             gap = max(GAPS_M[1], PREFERRED_CENTER_M - depth / 2)
             fwd = np.array([math.cos(heading), math.sin(heading)])
-            cand = Candidate(heading, center_w[:2] - (gap + depth / 2) * fwd, gap, ground_z + SQUAT_PELVIS_M[-1], LEAN)
+            cand = Candidate(heading, center_w[:2] - (gap + depth / 2) * fwd, gap, ground_z + DEEP_PELVIS_M[-1],
+                             DEEP + len(DEEP_BENDS) - 1)
             self._evaluate(cand, box, center_w, support, grasp_width(box, heading), dz, mass, ground_z, lift_m,
                            press_m)
             raise StanceRefused(f"{size}: no stance can {what}: the hands would hold it {grasp_z:.2f} m above the "
-                                f"ground; squatting no lower than the pelvis at {MIN_PELVIS_M:.2f} m, the lowest "
-                                f"the search reaches is {LOWEST_GRASP_M:.2f} m; closest: {cand.describe()}")
+                                f"ground; below {LOWEST_GRASP_M:.2f} m only a deep squat reaches, and it only picks "
+                                f"(a carry into one fell: DEEP_PICKS_ONLY); closest: {cand.describe()}")
         # squatting lowers the hands for a box below the waist; above it, it only costs
         levels = [nominal] + ([ground_z + z for z in SQUAT_PELVIS_M] if grasp_z < SQUAT_BELOW_M else [])
         bent: list[tuple[int, ...]] = [(UPRIGHT, LEAN)] * len(levels)
+        if grasp_z < LOWEST_GRASP_M:  # no squat reaches so low (LOWEST_GRASP_M): the deep squat only
+            levels, bent = [], []
+        if grasp_z < DEEP_BELOW_M and deep:
+            levels += [ground_z + z for z in DEEP_PELVIS_M]
+            bent += [tuple(DEEP + k for k in range(len(DEEP_BENDS)))] * len(DEEP_PELVIS_M)
         if support is not None and support.height_m > KNEE_HEIGHT_M and mass < LEAN_MAX_KG and grasp_z >= SQUAT_BELOW_M:
             levels.append(nominal)  # last: standing off the support's edge, leaning to reach in
             bent.append((STAND_LEAN,))
@@ -308,7 +357,7 @@ class StancePlanner:
                     gaps = (preferred, *(g for g in GAPS_M if abs(g - preferred) > 0.02))
                     if lean == STAND_LEAN:
                         gaps = STAND_LEAN_GAPS_M
-                    for gap in gaps if pelvis_z >= nominal - 1e-6 else [g for g in gaps if g >= 0.2]:
+                    for gap in gaps if pelvis_z >= nominal - 1e-6 or lean >= DEEP else [g for g in gaps if g >= 0.2]:
                         mid = center_w[:2] - (gap + depth / 2) * fwd
                         cand = Candidate(heading, mid, gap, pelvis_z, lean, preferred=gap == preferred)
                         self._evaluate(cand, box, center_w, support, width, dz, mass, ground_z, lift_m, press_m)
@@ -345,9 +394,14 @@ class StancePlanner:
             worst_res = max(worst_res, r.residual_m)
             worst_com = max(worst_com, r.com_error_m)
             squat = cand.pelvis_z_m < ground_z + self.poses.nominal_pelvis_m - 1e-6
-            if (squat and r.pelvis_error_m > FEASIBLE_PELVIS_M) or r.tilt_rad > MAX_TILT_RAD or \
-                    r.q[2] - ground_z < MIN_PELVIS_M:
+            deep = cand.lean >= DEEP
+            if (squat and r.pelvis_error_m > FEASIBLE_PELVIS_M) or \
+                    r.tilt_rad > (DEEP_MAX_TILT_RAD if deep else MAX_TILT_RAD) or \
+                    r.q[2] - ground_z < (DEEP_MIN_PELVIS_M if deep else MIN_PELVIS_M):
                 cand.collision = cand.collision or f"the pelvis ends at {r.q[2]:.2f} m, tilted {r.tilt_rad:.2f} rad"
+            if deep:
+                cand.collision = cand.collision or self.deep_fault(r.q, soles) or \
+                    self.torque_fault(r.q, soles, mass if len(cand.poses) > 1 or lift_m is None else 0.0)
             if not squat and cand.pelvis_z_m - r.q[2] > STANDING_GIVE_M:
                 cand.collision = cand.collision or (f"standing, the pelvis sinks to {r.q[2] - ground_z:.2f} m "
                                                     "(a squat, tried as one)")
@@ -360,6 +414,58 @@ class StancePlanner:
                 cand.collision = self.collision(q, box, center_w, support)
         cand.residual_m, cand.com_error_m = worst_res, worst_com
 
+    def deep_fault(self, q: np.ndarray, soles: list[Sole]) -> str | None:
+        """What keeps a deep squat's pose from being held (None: nothing): a sole off the ground or
+        tipped (the heels up), or a joint within DEEP_LIMIT_MARGIN_RAD of its position limit."""
+        for (p, rot), frame in zip(soles, SOLE_FRAMES, strict=True):
+            at, r = self.ik.frame_pose(q, frame)
+            off = float(np.linalg.norm(at - p))
+            tipped = float(np.arccos(np.clip((np.trace(rot.T @ r) - 1.0) / 2.0, -1.0, 1.0)))
+            if off > FLAT_SOLE_M or tipped > FLAT_SOLE_RAD:
+                return f"the {frame.split('_')[0]} sole is {off * 100:.1f} cm off its place, tipped {tipped:.2f} rad"
+        legs = np.array(g1.LEG_JOINTS)
+        room = np.minimum(q[7 + legs] - g1.Q_MIN_RAD[legs], g1.Q_MAX_RAD[legs] - q[7 + legs])
+        k = int(np.argmin(room))
+        if room[k] < DEEP_LIMIT_MARGIN_RAD:
+            return f"{g1.JOINT_NAMES[legs[k]]} is {room[k]:.3f} rad from its limit"
+        return None
+
+    def static_torques(self, q: np.ndarray, soles: list[Sole], box_kg: float) -> np.ndarray:
+        """The joint torques (N m, g1 order) that hold pose q still: gravity, a box of box_kg hanging
+        from the two hands in equal shares, and the ground's reaction split equally between the soles,
+        its centre of pressure under the CoM of robot and box together."""
+        ik, pin = self.ik, self.ik.pin
+        model, data = ik.model, ik.data
+        pin.computeJointJacobians(model, data, q)
+        pin.framesForwardKinematics(model, data, q)
+        tau = pin.computeGeneralizedGravity(model, data, q).copy()
+        weight = np.array([0.0, 0.0, -box_kg * 9.81 / 2])
+        hands = []
+        for h in HAND_FRAMES:
+            fid = model.getFrameId(h)
+            hands.append(data.oMf[fid].translation[:2].copy())
+            tau -= pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)[:3].T @ weight
+        robot_kg = self.poses.mass_kg
+        com = (robot_kg * pin.centerOfMass(model, data, q)[:2] + box_kg * np.mean(hands, axis=0)) / (robot_kg + box_kg)
+        mid = np.mean([p[:2] for p, _ in soles], axis=0)
+        up = np.array([0.0, 0.0, (robot_kg + box_kg) * 9.81 / 2])
+        for (p, _), frame in zip(soles, SOLE_FRAMES, strict=True):
+            fid = model.getFrameId(frame)
+            at = np.array([*(p[:2] + com - mid), p[2]])
+            wrench = np.concatenate([up, np.cross(at - data.oMf[fid].translation, up)])
+            tau -= pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED).T @ wrench
+        return tau[6:]
+
+    def torque_fault(self, q: np.ndarray, soles: list[Sole], box_kg: float) -> str | None:
+        """A joint whose static torque (`static_torques`) is beyond DEEP_TORQUE_SHARE of its limit (None: none)."""
+        tau = self.static_torques(q, soles, box_kg)
+        share = np.abs(tau) / g1.EFFORT_LIMIT_NM
+        k = int(np.argmax(share))
+        if share[k] > DEEP_TORQUE_SHARE:
+            return (f"{g1.JOINT_NAMES[k]} needs {abs(tau[k]):.0f} N m to hold still (its limit "
+                    f"{g1.EFFORT_LIMIT_NM[k]:.0f} N m)")
+        return None
+
     def hold(self, q0: np.ndarray, soles: list[Sole], targets: tuple[np.ndarray, np.ndarray], heading: float,
              com_shift_h: np.ndarray, pelvis_z: float, lean: int) -> HoldPose:
         """Both hands at `targets` (palms in across the heading), the pelvis at pelvis_z, the CoM over the
@@ -370,12 +476,13 @@ class StancePlanner:
         pp = self.poses
         posture = g1.DEFAULT_Q_RAD.copy()
         if lean:
-            posture[WAIST_PITCH] = LEAN_WAIST_RAD
+            posture[WAIST_PITCH] = DEEP_BENDS[lean - DEEP][1] if lean >= DEEP else LEAN_WAIST_RAD
         weights = LEG_LIGHT_POSTURE_WEIGHT.copy()
         weights[WAIST] = 0.5
         com = pp.com_over(soles, com_shift_h)
         rot = rot_z(np.asarray(heading))
-        pitch = {UPRIGHT: 0.0, LEAN: LEAN_PELVIS_RAD, STAND_LEAN: STAND_LEAN_PELVIS_RAD}[int(lean)]
+        pitch = DEEP_BENDS[lean - DEEP][0] if lean >= DEEP else \
+            {UPRIGHT: 0.0, LEAN: LEAN_PELVIS_RAD, STAND_LEAN: STAND_LEAN_PELVIS_RAD}[int(lean)]
         pelvis_rot = rot @ np.array([[math.cos(pitch), 0.0, math.sin(pitch)], [0.0, 1.0, 0.0],
                                      [-math.sin(pitch), 0.0, math.cos(pitch)]])
         z_cap = min(p[2] for p, _ in soles) + pp.nominal_pelvis_m + PELVIS_CAP_ABOVE_NOMINAL_M
@@ -448,7 +555,7 @@ def plan_stance(poses: PosePlanner, box: Box, center_w: np.ndarray, support: Blo
 
 
 HoldStep = tuple[str, tuple[np.ndarray, np.ndarray], np.ndarray, float, int]
-"""(name, the hands' two points, CoM shift (heading frame), pelvis height, bend: UPRIGHT/LEAN/STAND_LEAN)."""
+"""(name, the hands' two points, CoM shift (heading frame), pelvis height, bend: UPRIGHT/LEAN/STAND_LEAN/DEEP + k)."""
 
 
 def grasp_hold_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float, steps: list[HoldStep],
@@ -609,7 +716,8 @@ def _along(poses: PosePlanner, q: np.ndarray, corners: list[list[np.ndarray]], s
     return out
 
 
-BENDS = {UPRIGHT: "upright", LEAN: "leaning", STAND_LEAN: "standing leaning"}
+BENDS = {UPRIGHT: "upright", LEAN: "leaning", STAND_LEAN: "standing leaning",
+         **{DEEP + k: f"deep squat (pelvis pitched {p:.2f}, waist {w:.2f} rad)" for k, (p, w) in enumerate(DEEP_BENDS)}}
 
 
 def _part(a: str, b: str) -> str:
@@ -644,6 +752,6 @@ def place_heading(support: Block | None, xy: np.ndarray, robot_xy: np.ndarray) -
     return math.atan2(-n[1], -n[0])
 
 
-__all__ = ["LEAN", "STAND_LEAN", "UPRIGHT", "Candidate", "StancePlan", "StancePlanner", "StanceRefused", "box_com_shift", "detour_poses", "edge_normal",
+__all__ = ["DEEP", "LEAN", "STAND_LEAN", "UPRIGHT", "Candidate", "StancePlan", "StancePlanner", "StanceRefused", "box_com_shift", "detour_poses", "edge_normal",
            "face_normals", "grasp_hold_poses", "hand_height", "path_meets", "pick_headings", "place_heading", "plan_stance",
            "raised_pose", "release_hold_poses", "stance_planner"]
