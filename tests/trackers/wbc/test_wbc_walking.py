@@ -122,3 +122,17 @@ def test_a_reference_through_the_ik_does_not_throw_the_walk():
             break
     assert lowest > FALL_HEIGHT_M, f"fell at {state.t_s:.2f} s"
     assert state.t_s > 4.9 and state.base_pos_w_m[0] > 1.5
+
+
+def test_walks_forward_at_1_0_within_ten_percent():
+    """Forward 1.0 m/s (ground truth, whole strides): the crouch that grows with speed stops at
+    WbcConfig.walking_com_lower_speed_cap_mps; crouched further (uncapped) the robot walked 0.85 m/s."""
+    tracker, trace = walk((1.0, 0.0, 0.0), 5.6)
+    t, pos = trace[:, 0], trace[:, 1:4]
+    assert t[-1] > 5.5, f"fell at {t[-1]:.2f} s"
+    stride = 2 * step_duration_for(tracker.config.gait, np.array([1.0, 0.0]))
+    a, b = np.searchsorted(t, 3.2), np.searchsorted(t, 3.2 + 3 * stride)
+    velocity = (pos[b, :2] - pos[a, :2]) / (t[b] - t[a])
+    assert abs(velocity[0] - 1.0) < 0.1, f"walked {velocity[0]:.3f} m/s forward for 1.0"
+    assert abs(velocity[1]) < 0.05
+    assert tracker.diagnostics.unsolved_ticks == 0
