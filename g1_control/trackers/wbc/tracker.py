@@ -104,6 +104,15 @@ class WbcConfig:
     0.849 m/s for 1.0. Capped, `g1 bench locomotion`'s forward 1.0 walks 1.024 m/s; forward 0.8 / 0.9 /
     1.1 / 1.2 walked 0.831 / 0.931 / 0.973 / 0.953 (uncapped 0.9: 0.835, 1.1 fell); slower walking
     (<= 0.6 m/s) is unchanged bit for bit (measured, one machine)."""
+    walking_heading_lag_steps: float = 1.0
+    """Walking by its own gait while turning, the pelvis and torso face this many steps' turn (wz times the
+    step's duration) behind the gait's heading: the body's direction of travel lags the heading by about
+    one step's turn (the feet land turned to the heading at their touchdown), and facing the heading the
+    pelvis walked 0.094 m/s sideways in its own frame at 0.6 m/s + 0.5 rad/s (`g1 bench locomotion`'s
+    combined row; 0.5 steps: 0.048, 1.0: 0.003, measured). Straight walking (wz 0) is unchanged."""
+    walking_heading_lag_full_speed_mps: float = 0.3
+    """... in full from this horizontal speed walked, in proportion below it: turning in place the body
+    does not travel, and the pelvis turns with the feet (the turning row is unchanged)."""
     walking_com_weight: tuple[float, float] = (1000.0, 1000.0)
     """QP weights of the CoM task's horizontal and vertical rows when walking by the gait."""
     ground_follow_s: float = 0.12
@@ -181,10 +190,14 @@ class WbcConfig:
         if self.rate_hz <= 0:
             raise WbcConfigError(f"WbcConfig.rate_hz must be > 0; got {self.rate_hz}")
         for name in ("kp_scale", "kd_scale", "contact_ramp_s", "liftoff_unload_s", "capture_point_gain", "com_xy_weight",
-                     "swing_max_accel_mps2", "recovery_com_lower_m", "walking_com_lower_speed_cap_mps"):
+                     "swing_max_accel_mps2", "recovery_com_lower_m", "walking_com_lower_speed_cap_mps",
+                     "walking_heading_lag_steps"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise WbcConfigError(f"WbcConfig.{name} must be a finite number >= 0; got {value}")
+        if not (np.isfinite(self.walking_heading_lag_full_speed_mps) and self.walking_heading_lag_full_speed_mps > 0):
+            raise WbcConfigError(f"WbcConfig.walking_heading_lag_full_speed_mps must be a finite number > 0; got "
+                                 f"{self.walking_heading_lag_full_speed_mps}")
 
 
 def _stance_height(sole_pos: np.ndarray, stance: np.ndarray) -> float:
@@ -561,7 +574,11 @@ class WholeBodyTracker(Tracker):
         diag.com_ref_m = np.array([*self._dcm_xy, ground_z + height])
         wxy, wz = cfg.walking_com_weight
         tasks = [AccelerationTask("com", dyn.com_jac, a_com - dyn.com_drift, np.array([wxy, wxy, wz]))]
-        heading_rot = yaw_rotation(gt.heading_rad)
+        walked = self.gait.command_h
+        travel = min(float(np.hypot(walked[0], walked[1])) / cfg.walking_heading_lag_full_speed_mps, 1.0)
+        # the pelvis faces where the body travels, one step's turn behind the gait's heading
+        heading_rot = yaw_rotation(gt.heading_rad - cfg.walking_heading_lag_steps * travel * float(walked[2])
+                                   * self.gait.step_T)
         if lean > 0.0:
             c, sn = np.cos(lean), np.sin(lean)
             heading_rot = heading_rot @ np.array([[c, 0.0, sn], [0.0, 1.0, 0.0], [-sn, 0.0, c]])
