@@ -106,10 +106,12 @@ class WbcConfig:
     (<= 0.6 m/s) is unchanged bit for bit (measured, one machine)."""
     walking_heading_lag_steps: float = 1.0
     """Walking by its own gait while turning, the pelvis and torso face this many steps' turn (wz times the
-    step's duration) behind the gait's heading: the body's direction of travel lags the heading by about
-    one step's turn (the feet land turned to the heading at their touchdown), and facing the heading the
+    step's duration) behind the gait's heading: walking and turning, the body's direction of travel lags
+    the heading by about one step's turn (measured; why was not found), and facing the heading the
     pelvis walked 0.094 m/s sideways in its own frame at 0.6 m/s + 0.5 rad/s (`g1 bench locomotion`'s
-    combined row; 0.5 steps: 0.048, 1.0: 0.003, measured). Straight walking (wz 0) is unchanged."""
+    combined row; 0.5 steps: 0.048, 1.0: 0.010). 0.4 + 0.8, 0.8 + 0.4, 0.6 - 0.5, 0.3 + 0.5 (m/s + rad/s):
+    sideways -0.110, -0.111, +0.092, -0.052 facing the heading; -0.003, -0.001, -0.004, +0.001 one step
+    behind (measured, one machine). Straight walking (wz 0) is unchanged bit for bit."""
     walking_heading_lag_full_speed_mps: float = 0.3
     """... in full from this horizontal speed walked, in proportion below it: turning in place the body
     does not travel, and the pelvis turns with the feet (the turning row is unchanged)."""
