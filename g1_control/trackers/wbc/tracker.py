@@ -95,6 +95,26 @@ class WbcConfig:
     walking_com_lower_per_mps: float = 0.05
     """... and further by this per m/s of horizontal speed walked: longer steps need more knee bend (at
     0.77 m/s the trailing knee straightened in double support, then overspeeds at lift-off, measured)."""
+    walking_com_lower_speed_cap_mps: float = 0.6
+    """... up to this speed only (faster, the lowering stays walking_com_lower_m + 0.6
+    walking_com_lower_per_mps = 0.06 m). Crouched further at speed, the stance knee bends more (1.24-1.42
+    rad late in single support at 1.0 m/s uncapped, 1.04-1.29 capped) and the shank's forward tilt runs
+    the stance ankle into its -0.87 rad dorsiflexion limit from ~80 % of the single support on: the body
+    stops gaining speed there (pelvis at most ~1.0 m/s in each step, 1.27 capped) and the robot walked
+    0.849 m/s for 1.0. Capped, `g1 bench locomotion`'s forward 1.0 walks 1.024 m/s; forward 0.8 / 0.9 /
+    1.1 / 1.2 walked 0.831 / 0.931 / 0.973 / 0.953 (uncapped 0.9: 0.835, 1.1 fell); slower walking
+    (<= 0.6 m/s) is unchanged bit for bit (measured, one machine)."""
+    walking_heading_lag_steps: float = 1.0
+    """Walking by its own gait while turning, the pelvis and torso face this many steps' turn (wz times the
+    step's duration) behind the gait's heading: walking and turning, the body's direction of travel lags
+    the heading by about one step's turn (measured; why was not found), and facing the heading the
+    pelvis walked 0.094 m/s sideways in its own frame at 0.6 m/s + 0.5 rad/s (`g1 bench locomotion`'s
+    combined row; 0.5 steps: 0.048, 1.0: 0.010). 0.4 + 0.8, 0.8 + 0.4, 0.6 - 0.5, 0.3 + 0.5 (m/s + rad/s):
+    sideways -0.110, -0.111, +0.092, -0.052 facing the heading; -0.003, -0.001, -0.004, +0.001 one step
+    behind (measured, one machine). Straight walking (wz 0) is unchanged bit for bit."""
+    walking_heading_lag_full_speed_mps: float = 0.3
+    """... in full from this horizontal speed walked, in proportion below it: turning in place the body
+    does not travel, and the pelvis turns with the feet (the turning row is unchanged)."""
     walking_com_weight: tuple[float, float] = (1000.0, 1000.0)
     """QP weights of the CoM task's horizontal and vertical rows when walking by the gait."""
     ground_follow_s: float = 0.12
@@ -172,10 +192,14 @@ class WbcConfig:
         if self.rate_hz <= 0:
             raise WbcConfigError(f"WbcConfig.rate_hz must be > 0; got {self.rate_hz}")
         for name in ("kp_scale", "kd_scale", "contact_ramp_s", "liftoff_unload_s", "capture_point_gain", "com_xy_weight",
-                     "swing_max_accel_mps2", "recovery_com_lower_m"):
+                     "swing_max_accel_mps2", "recovery_com_lower_m", "walking_com_lower_speed_cap_mps",
+                     "walking_heading_lag_steps"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise WbcConfigError(f"WbcConfig.{name} must be a finite number >= 0; got {value}")
+        if not (np.isfinite(self.walking_heading_lag_full_speed_mps) and self.walking_heading_lag_full_speed_mps > 0):
+            raise WbcConfigError(f"WbcConfig.walking_heading_lag_full_speed_mps must be a finite number > 0; got "
+                                 f"{self.walking_heading_lag_full_speed_mps}")
 
 
 def _stance_height(sole_pos: np.ndarray, stance: np.ndarray) -> float:
@@ -521,7 +545,7 @@ class WholeBodyTracker(Tracker):
         gt = self.gait.update(state.t_s, dt, self._sole_pos, self._sole_yaw,
                               self._dcm_xy, omega)
         h = cfg.com_height
-        speed = float(np.hypot(*self.gait.command_h[:2]))
+        speed = min(float(np.hypot(*self.gait.command_h[:2])), cfg.walking_com_lower_speed_cap_mps)
         lower = cfg.walking_com_lower_m + cfg.walking_com_lower_per_mps * speed
         if gt.pushed:
             lower += cfg.recovery_com_lower_m
@@ -552,7 +576,11 @@ class WholeBodyTracker(Tracker):
         diag.com_ref_m = np.array([*self._dcm_xy, ground_z + height])
         wxy, wz = cfg.walking_com_weight
         tasks = [AccelerationTask("com", dyn.com_jac, a_com - dyn.com_drift, np.array([wxy, wxy, wz]))]
-        heading_rot = yaw_rotation(gt.heading_rad)
+        walked = self.gait.command_h
+        travel = min(float(np.hypot(walked[0], walked[1])) / cfg.walking_heading_lag_full_speed_mps, 1.0)
+        # the pelvis faces where the body travels, one step's turn behind the gait's heading
+        heading_rot = yaw_rotation(gt.heading_rad - cfg.walking_heading_lag_steps * travel * float(walked[2])
+                                   * self.gait.step_T)
         if lean > 0.0:
             c, sn = np.cos(lean), np.sin(lean)
             heading_rot = heading_rot @ np.array([[c, 0.0, sn], [0.0, 1.0, 0.0], [-sn, 0.0, c]])

@@ -63,7 +63,12 @@ def test_reference_without_any_contact_is_refused():
                                           ({"kp_scale": -0.1}, "kp_scale must be a finite number >= 0"),
                                           ({"contact_ramp_s": float("nan")}, "contact_ramp_s"),
                                           ({"recovery_com_lower_m": -0.01},
-                                           "recovery_com_lower_m must be a finite number >= 0")])
+                                           "recovery_com_lower_m must be a finite number >= 0"),
+                                          ({"walking_com_lower_speed_cap_mps": float("nan")},
+                                           "walking_com_lower_speed_cap_mps must be a finite number >= 0"),
+                                          ({"walking_heading_lag_steps": -1.0}, "walking_heading_lag_steps"),
+                                          ({"walking_heading_lag_full_speed_mps": 0.0},
+                                           "walking_heading_lag_full_speed_mps must be a finite number > 0")])
 def test_bad_config_is_refused(kwargs, text):
     with pytest.raises(WbcConfigError, match=text):
         WbcConfig(**kwargs)

@@ -122,3 +122,38 @@ def test_a_reference_through_the_ik_does_not_throw_the_walk():
             break
     assert lowest > FALL_HEIGHT_M, f"fell at {state.t_s:.2f} s"
     assert state.t_s > 4.9 and state.base_pos_w_m[0] > 1.5
+
+
+def test_walks_forward_at_1_0_within_ten_percent():
+    """Forward 1.0 m/s (ground truth, whole strides): the crouch that grows with speed stops at
+    WbcConfig.walking_com_lower_speed_cap_mps; crouched further (uncapped) the robot walked 0.85 m/s."""
+    tracker, trace = walk((1.0, 0.0, 0.0), 5.6)
+    t, pos = trace[:, 0], trace[:, 1:4]
+    assert t[-1] > 5.5, f"fell at {t[-1]:.2f} s"
+    stride = 2 * step_duration_for(tracker.config.gait, np.array([1.0, 0.0]))
+    a, b = np.searchsorted(t, 3.2), np.searchsorted(t, 3.2 + 3 * stride)
+    velocity = (pos[b, :2] - pos[a, :2]) / (t[b] - t[a])
+    assert abs(velocity[0] - 1.0) < 0.1, f"walked {velocity[0]:.3f} m/s forward for 1.0"
+    assert abs(velocity[1]) < 0.05
+    assert tracker.diagnostics.unsolved_ticks == 0
+
+
+def heading_frame_velocity(trace: np.ndarray, t_from_s: float, t_to_s: float) -> np.ndarray:
+    """Mean ground-truth pelvis velocity (vx, vy) in the pelvis's own heading frame between two times."""
+    t, pos, yaw = trace[:, 0], trace[:, 1:3], trace[:, 4]
+    a, b = np.searchsorted(t, t_from_s), np.searchsorted(t, t_to_s)
+    v_w = np.diff(pos[a:b + 1], axis=0) / np.diff(t[a:b + 1])[:, None]
+    c, s = np.cos(yaw[a:b]), np.sin(yaw[a:b])
+    return np.array([(c * v_w[:, 0] + s * v_w[:, 1]).mean(), (-s * v_w[:, 0] + c * v_w[:, 1]).mean()])
+
+
+def test_walking_and_turning_the_pelvis_faces_its_direction_of_travel():
+    """0.6 m/s forward turning 0.5 rad/s: the pelvis faces one step's turn behind the gait's heading
+    (WbcConfig.walking_heading_lag_steps), where the body travels; facing the heading it walked ~0.09 m/s
+    sideways in its own frame (issue 23's uncommanded-axis limit is 0.05)."""
+    tracker, trace = walk((0.6, 0.0, 0.5), 5.6)
+    assert trace[-1, 0] > 5.5, f"fell at {trace[-1, 0]:.2f} s"
+    stride = 2 * step_duration_for(tracker.config.gait, np.array([0.6, 0.0]))
+    velocity = heading_frame_velocity(trace, 3.2, 3.2 + 3 * stride)
+    assert abs(velocity[1]) < 0.05, f"walked {velocity[1]:+.3f} m/s sideways in the pelvis's frame"
+    assert abs(velocity[0] - 0.6) < 0.06, f"walked {velocity[0]:.3f} m/s forward for 0.6"
