@@ -196,10 +196,13 @@ def _memory_bytes(method) -> int:
     if name == "learned_motion_matching":
         return (Path(method.folder) / "lmm.onnx").stat().st_size
     if name.startswith("backbone"):
-        inner = getattr(method, "inner", method)
-        size = Path(inner.path).stat().st_size
-        if hasattr(method, "feedback"):
-            size += (Path(inner.path).parent / "feedback.npz").stat().st_size
+        layers = [method]  # wrappers (feedback, foot lock) hold the network in .inner
+        while hasattr(layers[-1], "inner"):
+            layers.append(layers[-1].inner)
+        path = Path(layers[-1].path)
+        size = path.stat().st_size
+        if any(hasattr(m, "feedback") for m in layers):
+            size += (path.parent / "feedback.npz").stat().st_size
         return size
     return 0
 
@@ -407,6 +410,7 @@ def main(args) -> int:
 
     from g1_control.generator.baselines import InterpolationInbetweener, MotionMatchingInbetweener
     from g1_control.generator.feedback import FeedbackInbetweener, ReferenceFeedback
+    from g1_control.generator.foot_lock import FootLockedInbetweener
     from g1_control.generator.learned import SHIPPED_DIR, OnnxInbetweener
     from g1_control.generator.lmm import SHIPPED_LMM_DIR, LearnedMotionMatchingInbetweener
     from g1_control.generator.runtime import InbetweeningGenerator
@@ -432,7 +436,8 @@ def main(args) -> int:
           f"LMM {lmm_dir if lmm else '(none: g1 train lmm)'}")
     print(f"load average at start: {os.getloadavg()[0]:.2f} (2 cores shared: wall timings are noisy; CPU-time "
           "figures count this process' own core time)\n")
-    methods: list = [interp, mm] + ([lmm] if lmm else []) + [backbone, with_fb]
+    methods: list = [interp, mm] + ([lmm] if lmm else []) + [backbone, with_fb, FootLockedInbetweener(backbone),
+                                                              FootLockedInbetweener(with_fb)]
     windows = {gap: E.make_windows(test_f, test_s, gap) for gap in (15, 30)}
     if "quality" in sections:
         table: dict = {}
@@ -467,6 +472,17 @@ def main(args) -> int:
             print(f"  learned motion matching keeps {table['learned_motion_matching']['memory_bytes'] / 2**20:.2f} MB of "
                   f"weights against motion matching's {mt['memory_bytes'] / 2**20:.1f} MB database "
                   f"({mt['memory_bytes'] / table['learned_motion_matching']['memory_bytes']:.0f}x less)")
+        w30 = windows[30]
+        judged = {}
+        for m in methods:
+            if m.name in ("motion_matching", "backbone", "backbone+foot lock", "backbone+feedback+foot lock"):
+                pred = np.concatenate([m.infill(w30.context[a:a + 256], w30.target[a:a + 256],
+                                                np.ones((len(w30.frames[a:a + 256]), F.DIM), bool), 30,
+                                                w30.style[a:a + 256]) for a in range(0, len(w30.frames), 256)])
+                judged[m.name] = E.skate_on_true_stance(pred, w30.truth, 30.0)
+        figures["skate_on_true_stance_30"] = judged
+        print("  foot skating at gap 30 on the ground truth's stance frames (m/s): " + ", ".join(
+            f"{k} {v:.3f}" for k, v in judged.items()) + f", ground truth {truth[0]:.3f}")
         errs = []
         for gap, w in windows.items():
             n = min(256, len(w.frames))
