@@ -27,6 +27,7 @@ kinematic tree (generator/fk.py), no pinocchio.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,7 +45,7 @@ _LEG_BODY = (6, 12)
 class FootLockConfig:
     band_m: float = CONTACT_BAND_M
     max_shift_m: float = 0.15
-    iterations: int = 2
+    iterations: int = 1
     floor_tolerance_m: float = 0.005
     damping: float = 1e-4
 
@@ -57,24 +58,34 @@ class FootLockConfig:
             raise ValueError(f"FootLockConfig.iterations must be >= 1, got {self.iterations}")
 
 
+@functools.cache
+def _leg_tree() -> tuple:
+    """The legs' part of the kinematic tree, arranged for _leg_fk: per joint its parent, placement,
+    whether the placement rotates, and the index arrays that write all 12 joint rotations at once."""
+    tree = kinematic_tree()
+    axes = np.array(tree.axis[:12])
+    planes = np.array([[(1, 2), (2, 0), (0, 1)][a] for a in axes])
+    k = np.arange(12)
+    unrotated = tuple(bool(np.allclose(r, np.eye(3))) for r in tree.offset_rot[:12])
+    return tree.parent[:12], tree.offset_pos[:12], tree.offset_rot[:12], unrotated, (k, axes, planes[:, 0], planes[:, 1])
+
+
 def _leg_fk(root_pos: np.ndarray, root_rot: np.ndarray, legs: np.ndarray):
     """(..., 3), (..., 3, 3), (..., 12) -> positions (..., 13, 3), rotations (..., 13, 3, 3) of the
     pelvis and the 12 leg bodies (the tree's first 12 joints are the two legs)."""
-    tree = kinematic_tree()
+    parent, offset_pos, offset_rot, unrotated, (k, a, i, j) = _leg_tree()
+    cos, sin = np.cos(legs), np.sin(legs)
+    m = np.zeros(legs.shape + (3, 3))  # every joint's rotation about its axis
+    m[..., k, a, a] = 1.0
+    m[..., k, i, i] = cos
+    m[..., k, j, j] = cos
+    m[..., k, i, j] = -sin
+    m[..., k, j, i] = sin
     pos, rot = [root_pos], [root_rot]
-    for k in range(12):
-        p, r = pos[tree.parent[k]], rot[tree.parent[k]]
-        pos.append(p + np.einsum("...ij,j->...i", r, tree.offset_pos[k]))
-        c, s = np.cos(legs[..., k]), np.sin(legs[..., k])
-        m = np.zeros(legs.shape[:-1] + (3, 3))
-        a = tree.axis[k]
-        i, j = [(1, 2), (2, 0), (0, 1)][a]
-        m[..., a, a] = 1.0
-        m[..., i, i] = c
-        m[..., j, j] = c
-        m[..., i, j] = -s
-        m[..., j, i] = s
-        rot.append(r @ tree.offset_rot[k] @ m)
+    for n in range(12):
+        p, r = pos[parent[n]], rot[parent[n]]
+        pos.append(p + r @ offset_pos[n])
+        rot.append((r if unrotated[n] else r @ offset_rot[n]) @ m[..., n, :, :])
     return np.stack(pos, axis=-2), np.stack(rot, axis=-3)
 
 
@@ -142,7 +153,8 @@ def lock_feet(frames: np.ndarray, context_last: np.ndarray, end: np.ndarray, end
         end_given = np.ones(b, dtype=bool)
     last = np.where(end_given[:, None], end, frames[:, -1])
     seq = np.concatenate([context_last[:, None], frames, last[:, None]], axis=1)  # (B, T + 2, D)
-    feet, feet_rot = feet_of(seq)
+    seq_pos, seq_rot = _leg_fk(seq[..., F.ROOT_POS], F.rot6d_to_matrix(seq[..., F.ROOT_ROT]), seq[..., 9:21])
+    feet, feet_rot = seq_pos[..., _LEG_BODY, :], seq_rot[..., _LEG_BODY, :, :]
     contact = feet[..., 2] < STANCE_ANKLE_Z_M + cfg.band_m  # (B, T + 2, 2)
     off = np.zeros(feet.shape[:-1] + (2,))
     for i in range(b):
@@ -166,23 +178,35 @@ def lock_feet(frames: np.ndarray, context_last: np.ndarray, end: np.ndarray, end
     root_rot = F.rot6d_to_matrix(out[..., F.ROOT_ROT])
     legs = out[..., 9:21].copy()
     lo, hi = g1.Q_MIN_RAD[:12], g1.Q_MAX_RAD[:12]
-    tree = kinematic_tree()
-    unit = np.eye(3)
-    for _ in range(cfg.iterations):
-        pos, rot = _leg_fk(root_pos, root_rot, legs)
-        for s, body in enumerate(_LEG_BODY):
-            joints = range(6 * s, 6 * s + 6)
-            e = np.concatenate([goal[..., s, :] - pos[..., body, :], _rot_error(goal_rot[..., s, :, :], rot[..., body, :, :])], -1)
-            cols = []
-            for k in joints:
-                axis = rot[..., k + 1, :, :] @ unit[tree.axis[k]]  # the joint's axis in the world
-                cols.append(np.concatenate([np.cross(axis, pos[..., body, :] - pos[..., k + 1, :]), axis], -1))
-            jac = np.stack(cols, -1)  # (B, T, 6, 6)
-            jt = np.swapaxes(jac, -1, -2)
-            dq = np.linalg.solve(jt @ jac + cfg.damping * np.eye(6), (jt @ e[..., None]))[..., 0]
-            legs[..., 6 * s:6 * s + 6] = np.clip(legs[..., 6 * s:6 * s + 6] + dq, lo[6 * s:6 * s + 6], hi[6 * s:6 * s + 6])
+    unit_axis = np.eye(3)[list(kinematic_tree().axis[:12])]  # (12, 3): each leg joint's axis, its own frame
+    body_of = np.arange(1, 13)
+    foot_of = np.repeat(np.array(_LEG_BODY), 6)  # each leg joint's foot
+    damp = cfg.damping * np.eye(6)
+    pos, rot = seq_pos[:, 1:-1], seq_rot[:, 1:-1]  # the gap's legs as generated
+    moved = np.zeros(goal.shape)  # (B, T, 2, 3): how far each foot moved
+    for it in range(cfg.iterations):
+        if it:
+            pos, rot = _leg_fk(root_pos, root_rot, legs)
+        feet_pos, feet_rot = pos[..., _LEG_BODY, :], rot[..., _LEG_BODY, :, :]
+        e = np.concatenate([goal - feet_pos, _rot_error(goal_rot, feet_rot)], -1)  # (B, T, 2, 6)
+        axes = np.einsum("...kij,kj->...ki", rot[..., body_of, :, :], unit_axis)  # (B, T, 12, 3): joint axes, world
+        lever = pos[..., foot_of, :] - pos[..., body_of, :]
+        cross = np.stack([axes[..., 1] * lever[..., 2] - axes[..., 2] * lever[..., 1],
+                          axes[..., 2] * lever[..., 0] - axes[..., 0] * lever[..., 2],
+                          axes[..., 0] * lever[..., 1] - axes[..., 1] * lever[..., 0]], -1)
+        cols = np.concatenate([cross, axes], -1).reshape(cross.shape[:-2] + (2, 6, 6))  # (B, T, leg, joint, 6)
+        jac = np.swapaxes(cols, -1, -2)  # (B, T, leg, 6 rows, 6 joints)
+        jt = cols
+        step = np.linalg.solve(jt @ jac + damp, jt @ e[..., None])[..., 0]  # (B, T, 2, 6)
+        new = np.clip(legs + step.reshape(step.shape[:-2] + (12,)), lo, hi)
+        moved += (jac @ (new - legs).reshape(step.shape)[..., None])[..., :3, 0]  # to first order
+        legs = new
     out[..., 9:21] = legs
-    return F.fix_effectors(out)
+    # the foot effectors move with the feet, to first order (the runtime keeps the effectors as the
+    # in-betweener made them, runtime.py; an FK here would cost as much as the solve)
+    for s, name in enumerate(g1.FOOT_BODIES):
+        out[..., F.effector_slice(name)] += moved[..., s, :]
+    return out
 
 
 def end_given(target_mask: np.ndarray) -> np.ndarray:

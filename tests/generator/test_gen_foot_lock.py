@@ -43,6 +43,8 @@ def test_planted_feet_of_a_sliding_gap_stay_where_they_stood():
     assert np.allclose(out[:, F.ROOT], frames[:, F.ROOT])  # the root is the plan's
     assert np.abs(out[:, 9:21] - frames[:, 9:21]).max() > 0.05  # the legs took the slide
     assert np.allclose(out[:, 21:38], frames[:, 21:38])  # waist and arms untouched
+    for k, name in enumerate(g1.FOOT_BODIES):  # the foot effectors moved with the feet (to first order)
+        assert np.abs(out[:, F.effector_slice(name)] - after[:, k]).max() < 5e-3
     speed = E.foot_quality(out[None], 30.0)[0]
     assert speed < 0.1 * E.foot_quality(frames[None], 30.0)[0]
 
