@@ -16,9 +16,9 @@ anchor, and move the leg by inverse kinematics so the foot stays on its anchor. 
 3. The correction (anchor minus generated position) is spread over the swing frames between two
    runs linearly, so a swing leaves from its anchor and arrives at the next, and is 0 at the
    fixed frames.
-4. Each leg (hip pitch .. ankle roll, 6 joints) is solved by damped Gauss-Newton on the foot's
-   position and orientation (the generated orientation kept) with the root fixed, within the
-   joint limits. A correction beyond `max_shift_m` is scaled down to it (a leg is not asked for
+4. Each leg (hip pitch .. ankle roll, 6 joints) takes one damped Gauss-Newton step (`iterations`)
+   on the foot's position and orientation (the generated orientation kept) with the root fixed,
+   within the joint limits; the foot effectors move with it to first order. A correction beyond `max_shift_m` is scaled down to it (a leg is not asked for
    more than a short reach).
 
 Everything is vectorised over the batch and the frames; it runs on numpy and the generator's own

@@ -570,7 +570,7 @@ def main(args) -> int:
         nl = lat_rows["backbone+feedback, no foot lock"]
         print(f"  backbone+feedback / interpolation replan (CPU p50): {bf['cpu_p50'] / ip['cpu_p50']:.2f}x; "
               f"the foot lock's share: {bf['cpu_p50'] / nl['cpu_p50']:.2f}x (p50), {bf['cpu_p99'] / nl['cpu_p99']:.2f}x "
-              f"(p99); goal p50 <= 1 ms, p99 <= 1.5 ms without the foot lock")
+              f"(p99); goal p50 <= 1 ms, p99 <= 1.5 ms")
         thr = {}
         for m in [interp] + ([lmm] if lmm else []) + [backbone]:
             thr[m.name] = _throughput(m, windows[30])
