@@ -471,9 +471,6 @@ class InbetweeningGenerator(Generator):
         frames_c = self.model.infill(ctx_c, tgt_c, key.given[None], key.gap, np.array([style_id(key.style)]))
         frames = F.transform_one(frames_c[0], origin, yaw, inverse=True)
         frames = self._stabilize(frames, key)
-        if cfg.foot_lock:
-            frames = lock_feet(frames[None], self.history[-1][None], key.values[None],
-                               end_given(key.given[None]))[0] * self.present
         if self._gap_goals:
             self._update_goal_errors(frames)
         # cross-fade: the old plan's frames still ahead (same times) blend into the new plan
@@ -482,6 +479,9 @@ class InbetweeningGenerator(Generator):
         if n:
             w = (np.arange(1, n + 1) / (n + 1))[:, None]
             frames[:n] = (1 - w) * old[:n] + w * frames[:n]
+        if cfg.foot_lock:  # after the cross-fade: blending two plans' feet slides them
+            frames = lock_feet(frames[None], self.history[-1][None], key.values[None],
+                               end_given(key.given[None]))[0] * self.present
         self.plan = frames
         self._frame_targets = key.frame_targets_w
         self._style = key.style
