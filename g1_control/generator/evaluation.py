@@ -27,7 +27,9 @@ from g1_control.robot import g1
 
 WINDOW_STRIDE = 20
 STANCE_ANKLE_Z_M = 0.034
+"""The ankle-roll link origin's height over the floor when the sole is flat on it."""
 CONTACT_BAND_M = 0.025
+"""A foot whose ankle is within this of its standing height is on the ground (stance)."""
 PENETRATION_M = 0.02
 
 
@@ -106,6 +108,21 @@ def foot_quality(feats: np.ndarray, fps: float) -> tuple[float, float]:
     skate = float(speed[contact].mean()) if contact.any() else 0.0
     pen = float((feet[..., 2].min(axis=-1) < STANCE_ANKLE_Z_M - PENETRATION_M).mean())
     return skate, pen
+
+
+def skate_on_true_stance(feats: np.ndarray, truth: np.ndarray, fps: float) -> float:
+    """Foot skating judged on the ground truth's stance frames instead of the prediction's own: mean
+    horizontal ankle speed (m/s) of the predicted feet where the true ankle is at stance height (a
+    second reading of foot_quality's skating that a method cannot lower by lifting its feet)."""
+    pos, _ = F.bodies_of(feats)
+    true_pos, _ = F.bodies_of(truth)
+    from g1_control.motion.kinematics import default_body_names
+
+    names = default_body_names()
+    idx = [names.index(b) for b in g1.FOOT_BODIES]
+    speed = np.linalg.norm(np.diff(pos[..., idx, :2], axis=1), axis=-1) * fps
+    contact = true_pos[:, 1:, idx, 2] < STANCE_ANKLE_Z_M + CONTACT_BAND_M
+    return float(speed[contact].mean()) if contact.any() else 0.0
 
 
 @dataclass

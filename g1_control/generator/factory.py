@@ -47,10 +47,11 @@ def make_inbetweener(kind: str, *, model: str | Path | None = None, skeleton: st
 
 
 def make_generator(kind: str, *, model: str | Path | None = None, limits: CommandLimits | None = None,
-                   skeleton: str = "g1_29dof", feedback: bool = True) -> Generator:
+                   skeleton: str = "g1_29dof", feedback: bool = True, foot_lock: bool = True) -> Generator:
     """The generator; `limits`: the operator command range (the loop builder's one source of
     velocity limits, g1_control/launch/builder.py); `skeleton`: the robot's (generator/skeleton.py);
-    `feedback`: reference-guided feedback when the model ships mixtures."""
+    `feedback`: reference-guided feedback when the model ships mixtures; `foot_lock`: plans' stance
+    feet held (foot_lock.py)."""
     from g1_control.generator.velocity import VelocityReferenceGenerator
 
     if kind == "velocity":
@@ -67,7 +68,7 @@ def make_generator(kind: str, *, model: str | Path | None = None, limits: Comman
     styles = load_style_stats(model_dir / "style_stats.json")
     mixtures = model_dir / "feedback.npz"
     fb = ReferenceFeedback.load(mixtures, skeleton) if feedback and mixtures.is_file() else None
-    config = RuntimeConfig()
+    config = RuntimeConfig(foot_lock=foot_lock)
     if limits is not None:
         config.spring.max_vx_mps = min(config.spring.max_vx_mps, max(-limits.vx_mps[0], limits.vx_mps[1]))
         config.spring.max_vy_mps = min(config.spring.max_vy_mps, max(-limits.vy_mps[0], limits.vy_mps[1]))

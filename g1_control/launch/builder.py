@@ -145,7 +145,8 @@ def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
         from g1_control.generator.skeleton import skeleton_for_robot
 
         skeleton = skeleton_for_robot(launch.backend.expected_variant, launch.backend.hands)
-    generator = make_named(cfg.type, model=cfg.model or None, limits=limits, skeleton=skeleton, feedback=cfg.feedback)
+    generator = make_named(cfg.type, model=cfg.model or None, limits=limits, skeleton=skeleton, feedback=cfg.feedback,
+                           foot_lock=cfg.foot_lock)
     if not launch.executes_goals:
         return generator
     from g1_control.generator.goals.executor import GoalConfig, GoalGenerator

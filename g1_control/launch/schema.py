@@ -255,6 +255,9 @@ class GeneratorConfig:
     (backend.expected_variant, backend.hands): it is checked when the launch file is read."""
     feedback: bool = True
     """Reference-guided feedback toward the style's library poses (generator/feedback.py)."""
+    foot_lock: bool = True
+    """Hold each plan's stance feet where they stand (generator/foot_lock.py); false: the
+    in-betweener's feet as it made them (they slide about 0.2 m/s at a 30-frame gap)."""
     reference: str = "stand"
     """type scripted: which reference (stand, arm_wave, crouch, lean_reach, step_in_place, walk)."""
     reference_params: dict[str, float] = field(default_factory=dict)

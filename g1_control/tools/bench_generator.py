@@ -196,10 +196,13 @@ def _memory_bytes(method) -> int:
     if name == "learned_motion_matching":
         return (Path(method.folder) / "lmm.onnx").stat().st_size
     if name.startswith("backbone"):
-        inner = getattr(method, "inner", method)
-        size = Path(inner.path).stat().st_size
-        if hasattr(method, "feedback"):
-            size += (Path(inner.path).parent / "feedback.npz").stat().st_size
+        layers = [method]  # wrappers (feedback, foot lock) hold the network in .inner
+        while hasattr(layers[-1], "inner"):
+            layers.append(layers[-1].inner)
+        path = Path(layers[-1].path)
+        size = path.stat().st_size
+        if any(hasattr(m, "feedback") for m in layers):
+            size += (path.parent / "feedback.npz").stat().st_size
         return size
     return 0
 
@@ -407,6 +410,7 @@ def main(args) -> int:
 
     from g1_control.generator.baselines import InterpolationInbetweener, MotionMatchingInbetweener
     from g1_control.generator.feedback import FeedbackInbetweener, ReferenceFeedback
+    from g1_control.generator.foot_lock import FootLockedInbetweener
     from g1_control.generator.learned import SHIPPED_DIR, OnnxInbetweener
     from g1_control.generator.lmm import SHIPPED_LMM_DIR, LearnedMotionMatchingInbetweener
     from g1_control.generator.runtime import InbetweeningGenerator
@@ -432,7 +436,8 @@ def main(args) -> int:
           f"LMM {lmm_dir if lmm else '(none: g1 train lmm)'}")
     print(f"load average at start: {os.getloadavg()[0]:.2f} (2 cores shared: wall timings are noisy; CPU-time "
           "figures count this process' own core time)\n")
-    methods: list = [interp, mm] + ([lmm] if lmm else []) + [backbone, with_fb]
+    methods: list = [interp, mm] + ([lmm] if lmm else []) + [backbone, with_fb, FootLockedInbetweener(backbone),
+                                                              FootLockedInbetweener(with_fb)]
     windows = {gap: E.make_windows(test_f, test_s, gap) for gap in (15, 30)}
     if "quality" in sections:
         table: dict = {}
@@ -444,7 +449,7 @@ def main(args) -> int:
                              "cpu_us_per_frame": 1e6 / cps}
             figures["quality"] += [r15.__dict__, r30.__dict__]
         truth = E.foot_quality(windows[30].truth, 30.0)
-        header = (f"{'method':<24} {'L2P@15':>7} {'L2Q@15':>7} {'NPSS@15':>8} {'L2P@30':>7} {'L2Q@30':>7} {'NPSS@30':>8} "
+        header = (f"{'method':<28} {'L2P@15':>7} {'L2Q@15':>7} {'NPSS@15':>8} {'L2P@30':>7} {'L2Q@30':>7} {'NPSS@30':>8} "
                   f"{'skate@30':>9} {'memory':>9} {'us/frame':>9}")
         print("held-out in-betweening (Harvey et al. protocol), 29-DoF G1; skate = stance-foot speed m/s (gap 30); "
               "memory = database or weights; us/frame = CPU time per frame, batched 256 x 30")
@@ -452,10 +457,10 @@ def main(args) -> int:
         print("-" * len(header))
         for name, row in table.items():
             a, b = row["15"], row["30"]
-            print(f"{name:<24} {a['l2p']:>7.3f} {a['l2q']:>7.3f} {a['npss']:>8.5f} {b['l2p']:>7.3f} {b['l2q']:>7.3f} "
+            print(f"{name:<28} {a['l2p']:>7.3f} {a['l2q']:>7.3f} {a['npss']:>8.5f} {b['l2p']:>7.3f} {b['l2q']:>7.3f} "
                   f"{b['npss']:>8.5f} {b['skate_mps']:>9.3f} {row['memory_bytes'] / 2**20:>7.2f}MB "
                   f"{row['cpu_us_per_frame']:>9.2f}")
-        print(f"{'(ground truth)':<24} {'':>7} {'':>7} {'':>8} {'':>7} {'':>7} {'':>8} {truth[0]:>9.3f}")
+        print(f"{'(ground truth)':<28} {'':>7} {'':>7} {'':>8} {'':>7} {'':>7} {'':>8} {truth[0]:>9.3f}")
         figures["quality_table"] = table
         bb, ip, mt = table["backbone"], table["interpolation"], table["motion_matching"]
         for key in ("15", "30"):
@@ -467,6 +472,17 @@ def main(args) -> int:
             print(f"  learned motion matching keeps {table['learned_motion_matching']['memory_bytes'] / 2**20:.2f} MB of "
                   f"weights against motion matching's {mt['memory_bytes'] / 2**20:.1f} MB database "
                   f"({mt['memory_bytes'] / table['learned_motion_matching']['memory_bytes']:.0f}x less)")
+        w30 = windows[30]
+        judged = {}
+        for m in methods:
+            if m.name in ("motion_matching", "backbone", "backbone+foot lock", "backbone+feedback+foot lock"):
+                pred = np.concatenate([m.infill(w30.context[a:a + 256], w30.target[a:a + 256],
+                                                np.ones((len(w30.frames[a:a + 256]), F.DIM), bool), 30,
+                                                w30.style[a:a + 256]) for a in range(0, len(w30.frames), 256)])
+                judged[m.name] = E.skate_on_true_stance(pred, w30.truth, 30.0)
+        figures["skate_on_true_stance_30"] = judged
+        print("  foot skating at gap 30 on the ground truth's stance frames (m/s): " + ", ".join(
+            f"{k} {v:.3f}" for k, v in judged.items()) + f", ground truth {truth[0]:.3f}")
         errs = []
         for gap, w in windows.items():
             n = min(256, len(w.frames))
@@ -477,10 +493,11 @@ def main(args) -> int:
         print(f"  duration head on held-out 15- and 30-frame transitions: mean error {figures['duration_mae_frames']:.1f} "
               "frames (a constant guess of 22.5 frames: 7.5)\n")
 
-    def runtime(inbetweener, fb=None, goal_error: bool = True):
+    def runtime(inbetweener, fb=None, goal_error: bool = True, foot_lock: bool = True):
         from g1_control.generator.runtime import RuntimeConfig
 
-        config = RuntimeConfig() if goal_error else RuntimeConfig(goal_error_gain=0.0)
+        config = RuntimeConfig(foot_lock=foot_lock) if goal_error else RuntimeConfig(goal_error_gain=0.0,
+                                                                                      foot_lock=foot_lock)
         return InbetweeningGenerator(inbetweener, styles, config, feedback=fb)
 
     if "goals" in sections:
@@ -533,23 +550,27 @@ def main(args) -> int:
               f"(L2P {floor.l2p:.3f})\n")
     if "speed" in sections:
         print("speed (this CPU, 1 inference thread): replan = primitives + model + feedback + stabilization")
-        speed_methods = [("interpolation", interp, None), ("backbone", backbone, None),
-                         ("backbone+feedback", backbone, ReferenceFeedback.load(fb_path, "g1_29dof"))]
+        fb30 = ReferenceFeedback.load(fb_path, "g1_29dof")
+        speed_methods = [("interpolation", interp, None, True), ("backbone", backbone, None, True),
+                         ("backbone+feedback", backbone, fb30, True),
+                         ("backbone+feedback, no foot lock", backbone, fb30, False)]
         if lmm:
-            speed_methods.insert(1, ("learned_motion_matching", lmm, None))
+            speed_methods.insert(1, ("learned_motion_matching", lmm, None, True))
         lat_rows = {}
-        for label, m, fb in speed_methods:
-            lat, cpu = _latency(lambda m=m, fb=fb: _fresh(runtime(m, fb)))
+        for label, m, fb, lock in speed_methods:
+            lat, cpu = _latency(lambda m=m, fb=fb, lock=lock: _fresh(runtime(m, fb, foot_lock=lock)))
             row = {"wall_p50": float(np.percentile(lat, 50)), "wall_p99": float(np.percentile(lat, 99)),
                    "cpu_p50": float(np.percentile(cpu, 50)), "cpu_p99": float(np.percentile(cpu, 99))}
             lat_rows[label] = row
             figures[f"replan_ms_{label}"] = row
-            print(f"  replan {label:<24} wall p50 {row['wall_p50']:6.3f} ms  p99 {row['wall_p99']:6.3f} ms   | CPU time "
+            print(f"  replan {label:<32} wall p50 {row['wall_p50']:6.3f} ms  p99 {row['wall_p99']:6.3f} ms   | CPU time "
                   f"p50 {row['cpu_p50']:6.3f} ms  p99 {row['cpu_p99']:6.3f} ms")
         ip = lat_rows["interpolation"]
         bf = lat_rows["backbone+feedback"]
+        nl = lat_rows["backbone+feedback, no foot lock"]
         print(f"  backbone+feedback / interpolation replan (CPU p50): {bf['cpu_p50'] / ip['cpu_p50']:.2f}x; "
-              f"goal p50 <= 1 ms, p99 <= 1.5 ms")
+              f"the foot lock's share: {bf['cpu_p50'] / nl['cpu_p50']:.2f}x (p50), {bf['cpu_p99'] / nl['cpu_p99']:.2f}x "
+              f"(p99); goal p50 <= 1 ms, p99 <= 1.5 ms")
         thr = {}
         for m in [interp] + ([lmm] if lmm else []) + [backbone]:
             thr[m.name] = _throughput(m, windows[30])
