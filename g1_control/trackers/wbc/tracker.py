@@ -107,6 +107,8 @@ class WbcConfig:
     """On steps, the CoM's vertical acceleration asked for is clipped to this (m/s^2): asked to rise a
     tread at once, the QP lifted the CoM by kicking the swing leg up (measured) rather than with the
     bent stance knee, which is near its torque limit."""
+    terrain_com_height_weight: float = 1000.0
+    """On steps, the QP weight of the CoM task's vertical row (the flat gait's is `walking_com_weight`'s)."""
     terrain_swing_weight: float = 1000.0
     """On steps, the swing foot's task weight (the flat gait's is `swing_foot`'s)."""
     recovery_swing_weight: float = 300.0
@@ -322,7 +324,7 @@ class WholeBodyTracker(Tracker):
             tasks += self._motion_tasks(reference, state, stance, shift, dt)
         else:
             tasks = self._walking_tasks(reference, state, stance, shift, dt)
-        sol = self._solve(tasks, stance, load, state.dq_radps, dt)
+        sol = self._solve(tasks, stance, load, state.dq_radps, dt, state.q_rad)
         if sol is None:
             return self._command if self.diagnostics.solution is not None else self._hold(state)
         return self._motor_command(sol, state, dt)
@@ -551,6 +553,8 @@ class WholeBodyTracker(Tracker):
         diag.com_m, diag.cop_des_xy_m = com, gt.cop_xy_m.copy()
         diag.com_ref_m = np.array([*self._dcm_xy, ground_z + height])
         wxy, wz = cfg.walking_com_weight
+        if terrain:
+            wz = cfg.terrain_com_height_weight
         tasks = [AccelerationTask("com", dyn.com_jac, a_com - dyn.com_drift, np.array([wxy, wxy, wz]))]
         heading_rot = yaw_rotation(gt.heading_rad)
         if lean > 0.0:
@@ -622,14 +626,15 @@ class WholeBodyTracker(Tracker):
         return self._ground_ref_m
 
     def _solve(self, tasks: list[AccelerationTask], stance: np.ndarray, load: np.ndarray, dq_radps: np.ndarray,
-               dt: float) -> IdSolution | None:
-        """Step 5: the inverse-dynamics QP (joint speeds bounded one tick ahead); None when even the
-        relaxed retry fails."""
+               dt: float, q_rad: np.ndarray | None = None) -> IdSolution | None:
+        """Step 5: the inverse-dynamics QP (joint speeds bounded one tick ahead, also by the joints'
+        position margins with q_rad); None when even the relaxed retry fails."""
         diag = self.diagnostics
         diag.ticks += 1
         diag.base_pos_w_m = self._q[:3].copy()
         try:
-            sol = self.qp.solve(self.dyn, tasks, stance, load, joint_velocity_radps=dq_radps, dt_s=dt)
+            sol = self.qp.solve(self.dyn, tasks, stance, load, joint_velocity_radps=dq_radps, dt_s=dt,
+                                joint_position_rad=q_rad)
         except WbcSolveError:
             # Seen at touchdown: a foot landing fast cannot be stopped at once within the torque
             # and force limits while its load is still ramping in. Retry with the contact
@@ -638,7 +643,7 @@ class WholeBodyTracker(Tracker):
             diag.solve_failures += 1
             try:
                 sol = self.qp.resolve(self.dyn, stance, np.ones(2), contact_damping_per_s=0.0,
-                                      joint_velocity_radps=dq_radps, dt_s=dt)
+                                      joint_velocity_radps=dq_radps, dt_s=dt, joint_position_rad=q_rad)
             except WbcSolveError:
                 try:
                     sol = self.qp.resolve(self.dyn, stance, np.ones(2), contact_damping_per_s=0.0)
