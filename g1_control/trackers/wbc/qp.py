@@ -65,6 +65,8 @@ class QpConfig:
     """Joint speeds one tick ahead stay within this fraction of g1.VELOCITY_LIMIT_RADPS."""
     position_limits: bool = True
     """Bound the joints' positions (below) when solve() is given them; off, only their speeds."""
+    position_limit_joints: tuple[int, ...] | None = tuple(j for j in range(29) if j not in (4, 5, 10, 11))
+    """The joints (indices into g1.JOINT_NAMES) whose positions are bounded; None: every joint."""
     position_limit_margin_rad: float = 0.05
     """Joint position bounds (with joint positions given to solve()): each joint stays this far inside
     g1.Q_MIN_RAD..Q_MAX_RAD."""
@@ -114,6 +116,14 @@ class InverseDynamicsQP:
                 raise WbcConfigError(f"QpConfig.{name} must be a finite number > 0; got {value}")
         self._pos_lo = np.zeros(nv - 6)
         self._pos_hi = np.zeros(nv - 6)
+        joints = self.config.position_limit_joints
+        self._pos_free = np.zeros(nv - 6, dtype=bool)
+        if joints is not None:
+            bad = [j for j in joints if not 0 <= j < nv - 6]
+            if bad:
+                raise WbcConfigError(f"QpConfig.position_limit_joints {bad} are not joint indices 0..{nv - 7}")
+            self._pos_free[:] = True
+            self._pos_free[list(joints)] = False
         self._vel_rows = slice(nv - 6 + 2 * ROWS_PER_FOOT, 2 * (nv - 6) + 2 * ROWS_PER_FOOT)
         self._vel_diag = (np.arange(self._vel_rows.start, self._vel_rows.stop), np.arange(6, nv))
         self._foot_rows = wrench_constraint_rows(self.config.foot)
@@ -269,8 +279,8 @@ class InverseDynamicsQP:
         np.maximum(np.sqrt(2.0 * a * d_max) - dq, -cap, out=self._pos_hi)
         np.minimum(-np.sqrt(2.0 * a * d_min) - dq, cap, out=self._pos_lo)
         zone = c.position_limit_zone_rad
-        self._pos_hi[d_max > zone] = _FREE
-        self._pos_lo[d_min > zone] = -_FREE
+        self._pos_hi[(d_max > zone) | self._pos_free] = _FREE
+        self._pos_lo[(d_min > zone) | self._pos_free] = -_FREE
 
     def _solve(self, model: WbcModel, stance: np.ndarray) -> IdSolution:
         nv = self.nv

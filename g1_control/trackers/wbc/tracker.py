@@ -107,10 +107,14 @@ class WbcConfig:
     """On steps, the CoM's vertical acceleration asked for is clipped to this (m/s^2): asked to rise a
     tread at once, the QP lifted the CoM by kicking the swing leg up (measured) rather than with the
     bent stance knee, which is near its torque limit."""
+    terrain_com_speed_mps: float = float("inf")
+    """On steps, the CoM's vertical speed asked for is at most this (m/s)."""
     terrain_com_height_weight: float = 1000.0
     """On steps, the QP weight of the CoM task's vertical row (the flat gait's is `walking_com_weight`'s)."""
     terrain_swing_weight: float = 1000.0
     """On steps, the swing foot's task weight (the flat gait's is `swing_foot`'s)."""
+    terrain_swing_rot_weight: float = 1000.0
+    """On steps (outside recovery steps), the swing foot's orientation task weight."""
     recovery_swing_weight: float = 300.0
     """In a recovery step (the gait's GaitTargets.recovery: a push), the swing foot's task weight (the
     flat gait's is `swing_foot`'s): at 100 against the CoM task's 1000 the QP swung the leg backwards
@@ -547,7 +551,8 @@ class WholeBodyTracker(Tracker):
             # knee straight, measured); the speed asked is what the clip can still stop in half the gap
             a_max = cfg.terrain_com_accel_mps2
             err = ground_z + height - com[2]
-            v_des = float(np.sign(err)) * min(h.kp / h.kd * abs(err), float(np.sqrt(a_max * abs(err))))
+            v_des = float(np.sign(err)) * min(h.kp / h.kd * abs(err), float(np.sqrt(a_max * abs(err))),
+                                              cfg.terrain_com_speed_mps)
             a_com[2] = min(max(h.kd * (v_des - com_vel[2]), -a_max), a_max)
         diag = self.diagnostics
         diag.com_m, diag.cop_des_xy_m = com, gt.cop_xy_m.copy()
@@ -582,9 +587,12 @@ class WholeBodyTracker(Tracker):
                 acc = acc * (cfg.swing_max_accel_mps2 / norm)
             tasks.append(position_task("swing_foot", ft.jac_w[:3], ft.drift_w[:3], ft.pos_w_m + shift, ft.vel_w[:3],
                                        gt.swing_pos_m, gt.swing_vel_mps, acc, swing))
+            swing_rot = swing
+            if terrain and not gt.recovery:
+                swing_rot = TaskGains(swing.kp, swing.kd, cfg.terrain_swing_rot_weight)
             tasks.append(orientation_task("swing_foot_rot", ft.jac_w[3:], ft.drift_w[3:], ft.rot_w, ft.vel_w[3:],
                                           yaw_rotation(gt.swing_yaw_rad), np.array([0.0, 0.0, gt.swing_yaw_rate_radps]),
-                                          swing))
+                                          swing_rot))
         if load_kg > 0.0:
             tasks += self._held_hand_tasks(shift)
         weights = self._held_posture_weights if load_kg > 0.0 else self._posture_weights

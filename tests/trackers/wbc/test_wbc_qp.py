@@ -186,3 +186,12 @@ def test_position_limit_settings_are_checked(model):
         InverseDynamicsQP(model.nv, QpConfig(position_limit_margin_rad=0.3))
     with pytest.raises(WbcConfigError, match="position_limit_brake_radps2"):
         InverseDynamicsQP(model.nv, QpConfig(position_limit_brake_radps2=0.0))
+
+
+def test_only_the_chosen_joints_are_position_bounded(model):
+    # the knee left out: the task drives it on into its stop as without position limits
+    c = QpConfig(position_limit_joints=tuple(j for j in range(29) if j != 3))
+    _, _, _, change = _knee_driven_straight(model, c)
+    assert change < 0.0
+    with pytest.raises(WbcConfigError, match="position_limit_joints"):
+        InverseDynamicsQP(model.nv, QpConfig(position_limit_joints=(3, 29)))

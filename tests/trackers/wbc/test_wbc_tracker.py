@@ -67,3 +67,30 @@ def test_reference_without_any_contact_is_refused():
 def test_bad_config_is_refused(kwargs, text):
     with pytest.raises(WbcConfigError, match=text):
         WbcConfig(**kwargs)
+
+
+@pytest.mark.parametrize("bounded", [True, False])
+def test_a_joint_driven_at_its_stop_is_braked_by_the_position_bounds(bounded):
+    """The tracker hands the measured joint positions to the QP: an elbow 0.02 rad inside its position
+    margin, closing on its stop at 2 rad/s with its reference past the stop, is commanded to slow by
+    the QP's deceleration cap in the tick (without the bounds it keeps its speed)."""
+    from g1_control.robot import g1
+    from g1_control.trackers.wbc.qp import QpConfig
+
+    backend = MujocoBackend()
+    state = backend.reset()
+    qp = QpConfig(position_limits=bounded)
+    tracker = WholeBodyTracker(WbcConfig(qp=qp))
+    tracker.reset(state)
+    elbow = g1.JOINT_NAMES.index("left_elbow_joint")
+    q, dq = state.q_rad.copy(), state.dq_radps.copy()
+    q[elbow] = g1.Q_MIN_RAD[elbow] + qp.position_limit_margin_rad + 0.02
+    dq[elbow] = -2.0
+    ref = R.stand(1.0).sample(0.0)
+    ref.q_rad[elbow] = -1.5
+    cmd = tracker.act(ref, dataclasses.replace(state, q_rad=q, dq_radps=dq))
+    cap = qp.position_limit_max_brake_radps2 / tracker.config.rate_hz
+    if bounded:
+        assert cmd.dq_radps[elbow] >= -2.0 + cap - 1e-4  # the solver's tolerance
+    else:
+        assert cmd.dq_radps[elbow] < -1.95
