@@ -107,14 +107,15 @@ class WbcConfig:
     """On steps, the CoM's vertical acceleration asked for is clipped to this (m/s^2): asked to rise a
     tread at once, the QP lifted the CoM by kicking the swing leg up (measured) rather than with the
     bent stance knee, which is near its torque limit."""
-    terrain_com_speed_mps: float = float("inf")
-    """On steps, the CoM's vertical speed asked for is at most this (m/s)."""
-    terrain_com_height_weight: float = 1000.0
-    """On steps, the QP weight of the CoM task's vertical row (the flat gait's is `walking_com_weight`'s)."""
+    terrain_com_brake_mps2: float = 6.0
+    """On steps, the CoM's downward acceleration asked for is clipped to this (m/s^2; at least
+    `terrain_com_accel_mps2`; terrain_com_height_accel). Rising onto a tread the CoM lagged its
+    rising target by 7-8 cm, caught up at 0.4 m/s and, braked at 2 m/s^2 like its rise, went 6.5 cm
+    over (ground truth, `g1 bench stairs` seed 2, 6.9-7.14 s): the stance knee straightened into its
+    stop and the trailing leg lifted straight (a straight leg lifts its foot only by lifting the body).
+    At 6 the CoM stopped 0.9 cm over and both knees stayed bent through the trailing step."""
     terrain_swing_weight: float = 1000.0
     """On steps, the swing foot's task weight (the flat gait's is `swing_foot`'s)."""
-    terrain_swing_rot_weight: float = 1000.0
-    """On steps (outside recovery steps), the swing foot's orientation task weight."""
     recovery_swing_weight: float = 300.0
     """In a recovery step (the gait's GaitTargets.recovery: a push), the swing foot's task weight (the
     flat gait's is `swing_foot`'s): at 100 against the CoM task's 1000 the QP swung the leg backwards
@@ -178,10 +179,22 @@ class WbcConfig:
         if self.rate_hz <= 0:
             raise WbcConfigError(f"WbcConfig.rate_hz must be > 0; got {self.rate_hz}")
         for name in ("kp_scale", "kd_scale", "contact_ramp_s", "liftoff_unload_s", "capture_point_gain", "com_xy_weight",
-                     "swing_max_accel_mps2", "recovery_com_lower_m"):
+                     "swing_max_accel_mps2", "recovery_com_lower_m", "terrain_com_brake_mps2"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise WbcConfigError(f"WbcConfig.{name} must be a finite number >= 0; got {value}")
+
+
+def terrain_com_height_accel(err_m: float, vz_mps: float, gains: TaskGains, accel_mps2: float,
+                             brake_mps2: float) -> float:
+    """On steps, the CoM's vertical acceleration asked for, err_m below its target height and rising
+    at vz_mps: the height's PD (gains) with a braking speed. Clipped alone, the PD rose a tread's
+    height at 0.5 m/s and could not stop within the clip (7 cm overshoot on a 0.15 m step, stance
+    knee straight, measured); the speed asked is what accel_mps2 can still stop in half the gap. The
+    upward acceleration is clipped to accel_mps2, the downward one to brake_mps2 (at least
+    accel_mps2): stopping a rise only unloads the stance leg."""
+    v_des = float(np.sign(err_m)) * min(gains.kp / gains.kd * abs(err_m), float(np.sqrt(accel_mps2 * abs(err_m))))
+    return min(max(gains.kd * (v_des - vz_mps), -max(accel_mps2, brake_mps2)), accel_mps2)
 
 
 def _stance_height(sole_pos: np.ndarray, stance: np.ndarray) -> float:
@@ -546,20 +559,12 @@ class WholeBodyTracker(Tracker):
         a_com[2] = h.kp * (ground_z + height - com[2]) - h.kd * com_vel[2]
         terrain = not self.gait.terrain.flat
         if terrain:
-            # the height's PD with a braking speed: clipped alone, the PD rose a tread's height at
-            # 0.5 m/s and could not stop within the clip (7 cm overshoot on a 0.15 m step, stance
-            # knee straight, measured); the speed asked is what the clip can still stop in half the gap
-            a_max = cfg.terrain_com_accel_mps2
-            err = ground_z + height - com[2]
-            v_des = float(np.sign(err)) * min(h.kp / h.kd * abs(err), float(np.sqrt(a_max * abs(err))),
-                                              cfg.terrain_com_speed_mps)
-            a_com[2] = min(max(h.kd * (v_des - com_vel[2]), -a_max), a_max)
+            a_com[2] = terrain_com_height_accel(ground_z + height - com[2], float(com_vel[2]), h,
+                                                cfg.terrain_com_accel_mps2, cfg.terrain_com_brake_mps2)
         diag = self.diagnostics
         diag.com_m, diag.cop_des_xy_m = com, gt.cop_xy_m.copy()
         diag.com_ref_m = np.array([*self._dcm_xy, ground_z + height])
         wxy, wz = cfg.walking_com_weight
-        if terrain:
-            wz = cfg.terrain_com_height_weight
         tasks = [AccelerationTask("com", dyn.com_jac, a_com - dyn.com_drift, np.array([wxy, wxy, wz]))]
         heading_rot = yaw_rotation(gt.heading_rad)
         if lean > 0.0:
@@ -587,12 +592,9 @@ class WholeBodyTracker(Tracker):
                 acc = acc * (cfg.swing_max_accel_mps2 / norm)
             tasks.append(position_task("swing_foot", ft.jac_w[:3], ft.drift_w[:3], ft.pos_w_m + shift, ft.vel_w[:3],
                                        gt.swing_pos_m, gt.swing_vel_mps, acc, swing))
-            swing_rot = swing
-            if terrain and not gt.recovery:
-                swing_rot = TaskGains(swing.kp, swing.kd, cfg.terrain_swing_rot_weight)
             tasks.append(orientation_task("swing_foot_rot", ft.jac_w[3:], ft.drift_w[3:], ft.rot_w, ft.vel_w[3:],
                                           yaw_rotation(gt.swing_yaw_rad), np.array([0.0, 0.0, gt.swing_yaw_rate_radps]),
-                                          swing_rot))
+                                          swing))
         if load_kg > 0.0:
             tasks += self._held_hand_tasks(shift)
         weights = self._held_posture_weights if load_kg > 0.0 else self._posture_weights
