@@ -13,6 +13,14 @@ would give the same optimum at roughly twice the solve time). Constraints:
   joint velocity limits    |dq + ddq dt| <= fraction * dq_max, one tick ahead (29 inequalities;
                            the safety layer damps the robot at dq_max: a fast recovery step
                            drove a knee there, measured)
+  joint position limits    on the same rows: one tick ahead a joint moves towards its range's
+                           edge (less a margin) no faster than it can still stop at a braking
+                           deceleration, dq + ddq dt <= sqrt(2 a (q_max - margin - q)) (and the
+                           mirror at q_min). Without them, once a knee reached its stop (`g1 bench
+                           stairs` seed 2, trailing step up, 7.16 s) the QP went on asking it for
+                           -2000 rad/s^2 into the stop at its -139 N m torque limit and planned the
+                           rest of the body on accelerations MuJoCo's stop did not allow (hip
+                           pitch: +700 planned, +30 measured; measured)
   per stance foot          friction pyramid, CoP in the sole, yaw torque, normal-force bounds
                            (contacts.py; 11 inequalities per foot, relaxed for a swing foot)
 
@@ -30,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from g1_control.errors import WbcSolveError
+from g1_control.errors import WbcConfigError, WbcSolveError
 from g1_control.robot import g1
 from g1_control.robot.dynamics import WbcModel
 from g1_control.trackers.wbc.contacts import (
@@ -56,6 +64,25 @@ class QpConfig:
     effort_limit_nm: tuple[float, ...] = tuple(g1.EFFORT_LIMIT_NM)
     velocity_limit_fraction: float = 0.75
     """Joint speeds one tick ahead stay within this fraction of g1.VELOCITY_LIMIT_RADPS."""
+    position_limits: bool = True
+    """Bound the joints' positions (below) when solve() is given them; off, only their speeds."""
+    position_limit_joints: tuple[int, ...] | None = tuple(j for j in range(29) if j not in (4, 5, 10, 11))
+    """The joints (indices into g1.JOINT_NAMES) whose positions are bounded; None: every joint. The
+    default leaves the ankles out: with the swing ankle's dorsiflexion bounded (it runs into its stop
+    keeping a lifted foot flat) the QP lifted the whole body with the stance leg instead (stance ankle
+    at its torque limit), and `g1 bench stairs` seeds 0-4 fell 15/15 with the step's top 0/5 (main
+    13/15, 5/5); every joint but the ankles: 14/15, 5/5 (measured)."""
+    position_limit_margin_rad: float = 0.05
+    """Joint position bounds (with joint positions given to solve()): each joint stays this far inside
+    g1.Q_MIN_RAD..Q_MAX_RAD."""
+    position_limit_brake_radps2: float = 30.0
+    """... moving towards that bound no faster than it can stop at this deceleration ..."""
+    position_limit_zone_rad: float = 0.15
+    """... once within this distance of it (farther away only the speed bound holds: a flat walk whose
+    joints keep away from their stops solves the same problem, bit for bit, as without the bounds)."""
+    position_limit_max_brake_radps2: float = 200.0
+    """A joint faster than that towards its bound is asked to slow by at most this much (rad/s^2) in a
+    tick, so the bound stays within what the torques can do."""
     eps_abs: float = 1e-5
     max_iter: int = 200
 
@@ -83,6 +110,25 @@ class InverseDynamicsQP:
         self.n_in = 2 * (nv - 6) + 2 * ROWS_PER_FOOT
         self.effort_limit = np.asarray(self.config.effort_limit_nm, dtype=float)
         self.velocity_limit = self.config.velocity_limit_fraction * np.asarray(g1.VELOCITY_LIMIT_RADPS, dtype=float)
+        margin = self.config.position_limit_margin_rad
+        self.position_min = np.asarray(g1.Q_MIN_RAD, dtype=float) + margin
+        self.position_max = np.asarray(g1.Q_MAX_RAD, dtype=float) - margin
+        if not np.all(self.position_min < self.position_max):
+            raise WbcConfigError(f"QpConfig.position_limit_margin_rad {margin} leaves a joint no range")
+        for name in ("position_limit_brake_radps2", "position_limit_max_brake_radps2", "position_limit_zone_rad"):
+            value = getattr(self.config, name)
+            if not (np.isfinite(value) and value > 0):
+                raise WbcConfigError(f"QpConfig.{name} must be a finite number > 0; got {value}")
+        self._pos_lo = np.zeros(nv - 6)
+        self._pos_hi = np.zeros(nv - 6)
+        joints = self.config.position_limit_joints
+        self._pos_free = np.zeros(nv - 6, dtype=bool)
+        if joints is not None:
+            bad = [j for j in joints if not 0 <= j < nv - 6]
+            if bad:
+                raise WbcConfigError(f"QpConfig.position_limit_joints {bad} are not joint indices 0..{nv - 7}")
+            self._pos_free[:] = True
+            self._pos_free[list(joints)] = False
         self._vel_rows = slice(nv - 6 + 2 * ROWS_PER_FOOT, 2 * (nv - 6) + 2 * ROWS_PER_FOOT)
         self._vel_diag = (np.arange(self._vel_rows.start, self._vel_rows.stop), np.arange(6, nv))
         self._foot_rows = wrench_constraint_rows(self.config.foot)
@@ -130,21 +176,25 @@ class InverseDynamicsQP:
 
     def solve(self, model: WbcModel, tasks: list[AccelerationTask], stance: np.ndarray,
               load_fraction: np.ndarray, contact_damping_per_s: float | None = None,
-              joint_velocity_radps: np.ndarray | None = None, dt_s: float = 0.0) -> IdSolution:
+              joint_velocity_radps: np.ndarray | None = None, dt_s: float = 0.0,
+              joint_position_rad: np.ndarray | None = None) -> IdSolution:
         """Solve for the state last passed to model.update(). stance: (2,) bool; load_fraction:
         (2,) 0..1, each stance foot's share of the full normal-force allowance (contact ramps);
         contact_damping_per_s overrides the configured value for this solve; joint_velocity_radps
-        and dt_s (> 0): bound the joint speeds one tick of dt_s ahead (else unbounded)."""
+        and dt_s (> 0): bound the joint speeds one tick of dt_s ahead (else unbounded); with
+        joint_position_rad as well, bound them also by the joints' position margins (QpConfig)."""
         self._set_cost(tasks)
-        self._set_constraints(model, stance, load_fraction, contact_damping_per_s, joint_velocity_radps, dt_s)
+        self._set_constraints(model, stance, load_fraction, contact_damping_per_s, joint_velocity_radps, dt_s,
+                              joint_position_rad)
         return self._solve(model, stance)
 
     def resolve(self, model: WbcModel, stance: np.ndarray, load_fraction: np.ndarray,
                 contact_damping_per_s: float | None = None, joint_velocity_radps: np.ndarray | None = None,
-                dt_s: float = 0.0) -> IdSolution:
+                dt_s: float = 0.0, joint_position_rad: np.ndarray | None = None) -> IdSolution:
         """solve() again with the last solve()'s tasks (its cost is kept, not rebuilt) and these
-        contact and speed settings: a retry after a failed solve, at the same state."""
-        self._set_constraints(model, stance, load_fraction, contact_damping_per_s, joint_velocity_radps, dt_s)
+        contact, speed and position settings: a retry after a failed solve, at the same state."""
+        self._set_constraints(model, stance, load_fraction, contact_damping_per_s, joint_velocity_radps, dt_s,
+                              joint_position_rad)
         return self._solve(model, stance)
 
     def _set_cost(self, tasks: list[AccelerationTask]) -> None:
@@ -167,7 +217,7 @@ class InverseDynamicsQP:
 
     def _set_constraints(self, model: WbcModel, stance: np.ndarray, load_fraction: np.ndarray,
                          contact_damping_per_s: float | None, joint_velocity_radps: np.ndarray | None,
-                         dt_s: float) -> None:
+                         dt_s: float, joint_position_rad: np.ndarray | None = None) -> None:
         """Writes only what changes from tick to tick: the feet's wrench rows in C are constant
         (__init__), a swing foot's equality rows are constant while it swings."""
         nv = self.nv
@@ -190,6 +240,11 @@ class InverseDynamicsQP:
             # a joint already past its bound need only not speed up further (ddq = 0 stays feasible)
             np.minimum(-self.velocity_limit - joint_velocity_radps, 0.0, out=l[vr])
             np.maximum(self.velocity_limit - joint_velocity_radps, 0.0, out=u[vr])
+            if joint_position_rad is not None and self.config.position_limits:
+                self._position_bounds(joint_position_rad, joint_velocity_radps, dt_s)
+                # only where tighter than the speed bound: elsewhere the rows are exactly as without
+                np.maximum(l[vr], self._pos_lo, out=l[vr])
+                np.minimum(u[vr], self._pos_hi, out=u[vr])
         else:
             if self._vel_dt is not None:
                 C[vr] = 0.0
@@ -215,6 +270,22 @@ class InverseDynamicsQP:
                     self._eq_stance[i] = False
                 b[eq] = 0.0
                 l[rows], u[rows] = -_FREE, _FREE
+
+    def _position_bounds(self, q: np.ndarray, dq: np.ndarray, dt_s: float) -> None:
+        """Fills _pos_lo/_pos_hi: the bounds on dt ddq (the speed change in a tick) that the
+        position margins set: the speed one tick ahead towards a bound at most sqrt(2 a d), d the
+        distance left to it (zero at or past it); a joint faster than that slows by at most
+        position_limit_max_brake_radps2 in the tick (the bound stays within reach of the torques).
+        Beyond position_limit_zone_rad from a bound, none (+-_FREE)."""
+        c = self.config
+        a, cap = c.position_limit_brake_radps2, c.position_limit_max_brake_radps2 * dt_s
+        d_max = np.maximum(self.position_max - q, 0.0)
+        d_min = np.maximum(q - self.position_min, 0.0)
+        np.maximum(np.sqrt(2.0 * a * d_max) - dq, -cap, out=self._pos_hi)
+        np.minimum(-np.sqrt(2.0 * a * d_min) - dq, cap, out=self._pos_lo)
+        zone = c.position_limit_zone_rad
+        self._pos_hi[(d_max > zone) | self._pos_free] = _FREE
+        self._pos_lo[(d_min > zone) | self._pos_free] = -_FREE
 
     def _solve(self, model: WbcModel, stance: np.ndarray) -> IdSolution:
         nv = self.nv

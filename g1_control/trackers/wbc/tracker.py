@@ -127,6 +127,13 @@ class WbcConfig:
     """On steps, the CoM's vertical acceleration asked for is clipped to this (m/s^2): asked to rise a
     tread at once, the QP lifted the CoM by kicking the swing leg up (measured) rather than with the
     bent stance knee, which is near its torque limit."""
+    terrain_com_brake_mps2: float = 6.0
+    """On steps, the CoM's downward acceleration asked for is clipped to this (m/s^2; at least
+    `terrain_com_accel_mps2`; terrain_com_height_accel). Rising onto a tread the CoM lagged its
+    rising target by 7-8 cm, caught up at 0.4 m/s and, braked at 2 m/s^2 like its rise, went 6.5 cm
+    over (ground truth, `g1 bench stairs` seed 2, 6.9-7.14 s): the stance knee straightened into its
+    stop and the trailing leg lifted straight (a straight leg lifts its foot only by lifting the body).
+    At 6 the CoM stopped 0.9 cm over and both knees stayed bent through the trailing step."""
     terrain_swing_weight: float = 1000.0
     """On steps, the swing foot's task weight (the flat gait's is `swing_foot`'s)."""
     recovery_swing_weight: float = 300.0
@@ -193,13 +200,25 @@ class WbcConfig:
             raise WbcConfigError(f"WbcConfig.rate_hz must be > 0; got {self.rate_hz}")
         for name in ("kp_scale", "kd_scale", "contact_ramp_s", "liftoff_unload_s", "capture_point_gain", "com_xy_weight",
                      "swing_max_accel_mps2", "recovery_com_lower_m", "walking_com_lower_speed_cap_mps",
-                     "walking_heading_lag_steps"):
+                     "walking_heading_lag_steps", "terrain_com_brake_mps2"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise WbcConfigError(f"WbcConfig.{name} must be a finite number >= 0; got {value}")
         if not (np.isfinite(self.walking_heading_lag_full_speed_mps) and self.walking_heading_lag_full_speed_mps > 0):
             raise WbcConfigError(f"WbcConfig.walking_heading_lag_full_speed_mps must be a finite number > 0; got "
                                  f"{self.walking_heading_lag_full_speed_mps}")
+
+
+def terrain_com_height_accel(err_m: float, vz_mps: float, gains: TaskGains, accel_mps2: float,
+                             brake_mps2: float) -> float:
+    """On steps, the CoM's vertical acceleration asked for, err_m below its target height and rising
+    at vz_mps: the height's PD (gains) with a braking speed. Clipped alone, the PD rose a tread's
+    height at 0.5 m/s and could not stop within the clip (7 cm overshoot on a 0.15 m step, stance
+    knee straight, measured); the speed asked is what accel_mps2 can still stop in half the gap. The
+    upward acceleration is clipped to accel_mps2, the downward one to brake_mps2 (at least
+    accel_mps2): stopping a rise only unloads the stance leg."""
+    v_des = float(np.sign(err_m)) * min(gains.kp / gains.kd * abs(err_m), float(np.sqrt(accel_mps2 * abs(err_m))))
+    return min(max(gains.kd * (v_des - vz_mps), -max(accel_mps2, brake_mps2)), accel_mps2)
 
 
 def _stance_height(sole_pos: np.ndarray, stance: np.ndarray) -> float:
@@ -346,7 +365,7 @@ class WholeBodyTracker(Tracker):
             tasks += self._motion_tasks(reference, state, stance, shift, dt)
         else:
             tasks = self._walking_tasks(reference, state, stance, shift, dt)
-        sol = self._solve(tasks, stance, load, state.dq_radps, dt)
+        sol = self._solve(tasks, stance, load, state.dq_radps, dt, state.q_rad)
         if sol is None:
             return self._command if self.diagnostics.solution is not None else self._hold(state)
         return self._motor_command(sol, state, dt)
@@ -564,13 +583,8 @@ class WholeBodyTracker(Tracker):
         a_com[2] = h.kp * (ground_z + height - com[2]) - h.kd * com_vel[2]
         terrain = not self.gait.terrain.flat
         if terrain:
-            # the height's PD with a braking speed: clipped alone, the PD rose a tread's height at
-            # 0.5 m/s and could not stop within the clip (7 cm overshoot on a 0.15 m step, stance
-            # knee straight, measured); the speed asked is what the clip can still stop in half the gap
-            a_max = cfg.terrain_com_accel_mps2
-            err = ground_z + height - com[2]
-            v_des = float(np.sign(err)) * min(h.kp / h.kd * abs(err), float(np.sqrt(a_max * abs(err))))
-            a_com[2] = min(max(h.kd * (v_des - com_vel[2]), -a_max), a_max)
+            a_com[2] = terrain_com_height_accel(ground_z + height - com[2], float(com_vel[2]), h,
+                                                cfg.terrain_com_accel_mps2, cfg.terrain_com_brake_mps2)
         diag = self.diagnostics
         diag.com_m, diag.cop_des_xy_m = com, gt.cop_xy_m.copy()
         diag.com_ref_m = np.array([*self._dcm_xy, ground_z + height])
@@ -650,14 +664,15 @@ class WholeBodyTracker(Tracker):
         return self._ground_ref_m
 
     def _solve(self, tasks: list[AccelerationTask], stance: np.ndarray, load: np.ndarray, dq_radps: np.ndarray,
-               dt: float) -> IdSolution | None:
-        """Step 5: the inverse-dynamics QP (joint speeds bounded one tick ahead); None when even the
-        relaxed retry fails."""
+               dt: float, q_rad: np.ndarray | None = None) -> IdSolution | None:
+        """Step 5: the inverse-dynamics QP (joint speeds bounded one tick ahead, also by the joints'
+        position margins with q_rad); None when even the relaxed retry fails."""
         diag = self.diagnostics
         diag.ticks += 1
         diag.base_pos_w_m = self._q[:3].copy()
         try:
-            sol = self.qp.solve(self.dyn, tasks, stance, load, joint_velocity_radps=dq_radps, dt_s=dt)
+            sol = self.qp.solve(self.dyn, tasks, stance, load, joint_velocity_radps=dq_radps, dt_s=dt,
+                                joint_position_rad=q_rad)
         except WbcSolveError:
             # Seen at touchdown: a foot landing fast cannot be stopped at once within the torque
             # and force limits while its load is still ramping in. Retry with the contact
@@ -666,7 +681,7 @@ class WholeBodyTracker(Tracker):
             diag.solve_failures += 1
             try:
                 sol = self.qp.resolve(self.dyn, stance, np.ones(2), contact_damping_per_s=0.0,
-                                      joint_velocity_radps=dq_radps, dt_s=dt)
+                                      joint_velocity_radps=dq_radps, dt_s=dt, joint_position_rad=q_rad)
             except WbcSolveError:
                 try:
                     sol = self.qp.resolve(self.dyn, stance, np.ones(2), contact_damping_per_s=0.0)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from g1_control.errors import WbcSolveError
+from g1_control.errors import WbcConfigError, WbcSolveError
 from g1_control.robot import description, g1
 from g1_control.robot.dynamics import WbcModel
 from g1_control.trackers.wbc.contacts import FootGeometry, cop_of
@@ -139,3 +139,59 @@ def test_resolve_keeps_the_last_cost_and_takes_new_contact_settings(model):
         np.testing.assert_array_equal(a, b)
     check_dynamics(model, again)
     check_dynamics(model, once)
+
+
+def _knee_driven_straight(model, config):
+    """The left knee 0.02 rad inside its position margin, straightening at 2 rad/s, its posture task
+    pulling it far past its stop: the QP's knee speed change in one tick (dt ddq)."""
+    q = g1.DEFAULT_Q_RAD.copy()
+    q[3] = g1.Q_MIN_RAD[3] + QpConfig().position_limit_margin_rad + 0.02
+    dq = np.zeros(29)
+    dq[3] = -2.0
+    q_ref = g1.DEFAULT_Q_RAD.copy()
+    q_ref[3] = -1.5
+    task = posture_task(model.nv, q, dq, q_ref, np.zeros(29), TaskGains(400, 40, 100))
+    dt = 0.004
+    sol = InverseDynamicsQP(model.nv, config).solve(model, [task], np.array([False, True]), np.ones(2),
+                                                     joint_velocity_radps=dq, dt_s=dt, joint_position_rad=q)
+    return q, dq, dt, sol.ddq[6 + 3] * dt
+
+
+def test_position_limits_brake_a_joint_before_its_stop(model):
+    c = QpConfig()
+    q, dq, dt, change = _knee_driven_straight(model, c)
+    distance = q[3] - (g1.Q_MIN_RAD[3] + c.position_limit_margin_rad)
+    speed_allowed = np.sqrt(2 * c.position_limit_brake_radps2 * distance)  # 1.1 rad/s at most towards the stop
+    # it cannot slow from 2 to 1.1 rad/s in one tick within the deceleration cap: it slows by the cap
+    assert dq[3] + change == pytest.approx(min(-speed_allowed, dq[3] + c.position_limit_max_brake_radps2 * dt), abs=1e-5)
+    # without position limits the task drives it on into the stop
+    _, _, _, unbounded = _knee_driven_straight(model, QpConfig(position_limits=False))
+    assert unbounded < 0.0
+
+
+def test_position_limits_leave_the_problem_unchanged_away_from_the_stops(model):
+    """Where no joint is near its position margin the QP's matrices are bit for bit those without
+    positions (a change that acts only near the stops leaves flat walking's runs bit-identical)."""
+    dq = np.full(29, 0.5)
+    args = ([posture(model)], np.array([True, True]), np.ones(2))
+    with_q, without = InverseDynamicsQP(model.nv), InverseDynamicsQP(model.nv)
+    with_q.solve(model, *args, joint_velocity_radps=dq, dt_s=0.004, joint_position_rad=g1.DEFAULT_Q_RAD)
+    without.solve(model, *args, joint_velocity_radps=dq, dt_s=0.004)
+    for a, b in zip(_problem(with_q), _problem(without)):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_position_limit_settings_are_checked(model):
+    with pytest.raises(WbcConfigError, match="position_limit_margin_rad"):
+        InverseDynamicsQP(model.nv, QpConfig(position_limit_margin_rad=0.3))
+    with pytest.raises(WbcConfigError, match="position_limit_brake_radps2"):
+        InverseDynamicsQP(model.nv, QpConfig(position_limit_brake_radps2=0.0))
+
+
+def test_only_the_chosen_joints_are_position_bounded(model):
+    # the knee left out: the task drives it on into its stop as without position limits
+    c = QpConfig(position_limit_joints=tuple(j for j in range(29) if j != 3))
+    _, _, _, change = _knee_driven_straight(model, c)
+    assert change < 0.0
+    with pytest.raises(WbcConfigError, match="position_limit_joints"):
+        InverseDynamicsQP(model.nv, QpConfig(position_limit_joints=(3, 29)))
