@@ -157,6 +157,12 @@ class GaitConfig:
     soon as it may, with a 0.02-0.07 s double support after it: 7/20 (with the lowering 11/20, other
     cases); a CoP target up to 0.1 / 0.08 m off the sole in recovery steps (for the trunk's angular
     momentum) 6/20 (measured, one machine)."""
+    after_push_steps: int = 1
+    """The steps after a pushed step (GaitTargets.after_push, this many, from the touchdown of the pushed
+    step; 0: none) are held like it: the CoM stays lowered (WbcConfig.recovery_com_lower_m) and the
+    landing may be as wide (recovery_max_width_m). Pushed from behind, the capture step caught the DCM,
+    then the CoM rose 5 cm again while the trailing foot had 0.7 m to swing: its knee at the torque
+    limit, the foot stayed behind and the robot rolled over the stance foot (measured)."""
     speed_feedback_gain: float = 0.3
     """Per stride, this fraction of the error between the command and the stride's speed (from the
     feet's measured touchdowns) is added to the speed the steps are planned for: the pendulum model
@@ -249,6 +255,8 @@ class GaitConfig:
         if not (np.isfinite(self.recovery_max_width_m) and self.recovery_max_width_m > 0):
             raise WbcConfigError(f"GaitConfig.recovery_max_width_m must be a finite number > 0; got "
                                  f"{self.recovery_max_width_m}")
+        if not (isinstance(self.after_push_steps, int) and self.after_push_steps >= 0):
+            raise WbcConfigError(f"GaitConfig.after_push_steps must be an integer >= 0; got {self.after_push_steps!r}")
         if not self.max_width_m <= self.fast_max_width_m:
             raise WbcConfigError(f"GaitConfig needs max_width_m <= fast_max_width_m; got {self.max_width_m}, "
                                  f"{self.fast_max_width_m}")
@@ -289,6 +297,8 @@ class GaitTargets:
     pushed: bool = False
     """... with the DCM GaitConfig.pushed_dcm_error_m off its plan: walking fast, steps near their limits
     are recovery steps without a push."""
+    after_push: bool = False
+    """The step under way (double support included) follows a pushed one (GaitConfig.after_push_steps)."""
     dcm_error_m: float = 0.0
     """How far the DCM is from its nominal plan this tick (walking; 0 otherwise)."""
 
@@ -521,6 +531,10 @@ class VelocityGait:
         """The _t0 of the step that is a recovery step (GaitConfig.recovery_dcm_error_m; nan: none)."""
         self._pushed_at = math.nan
         """... and a pushed one (GaitConfig.pushed_dcm_error_m)."""
+        self._after_push_at = math.nan
+        """The _t0 of a step after a pushed one (GaitConfig.after_push_steps; nan: none) ..."""
+        self._after_push_left = 0
+        """... and how many such steps are left, that one included."""
         self.command_h = np.zeros(3)
         """The command being walked: the operator's, rate limited (GaitConfig.max_accel)."""
         self.speed_correction_h = np.zeros(2)
@@ -572,8 +586,13 @@ class VelocityGait:
                 self.touchdowns.append((t_s, 1 - self.stance, self._landing.copy()))
                 self._correct_speed(t_s, 1 - self.stance, soles_m[1 - self.stance, :2])
                 self.steps += 1
+                pushed, after = self._pushed_at == self._t0, self._after_push_at == self._t0
                 self.stance = 1 - self.stance
                 self._t0 += self.step_T
+                if pushed or after:
+                    self._after_push_left = cfg.after_push_steps if pushed else self._after_push_left - 1
+                    if self._after_push_left > 0:
+                        self._after_push_at = self._t0
                 self.active = self._timing_for(soles_m)
                 self.step_T = self.active.step_s
                 if not moving and self._side_by_side(soles_m, sole_yaws):
@@ -830,7 +849,7 @@ class VelocityGait:
         out.yaw_rate_radps = 0.0 if self.mode == "stand" else float(command_h[2])
         out.swing_foot = -1
         out.swing_progress = 0.0
-        out.recovery = out.pushed = False
+        out.recovery = out.pushed = out.after_push = False
         out.dcm_error_m = 0.0
         mid = (soles_m[0, :2] + soles_m[1, :2]) / 2
         centre = mid + _rot2(self.heading) @ np.array([cfg.com_offset_x_m, 0.0])
@@ -913,7 +932,7 @@ class VelocityGait:
                 self._recovery_at = self._t0  # latched: the rest of the step is a recovery step
             side = _SIDE[f]
             widest = cfg.max_width_m
-            if self._pushed_at == self._t0 and self._swinging:
+            if (self._pushed_at == self._t0 and self._swinging) or self._after_push_at == self._t0:
                 widest = max(widest, cfg.recovery_max_width_m)
             rel[0] = min(max(rel[0], -cfg.max_backward_m), cfg.max_forward_m)
             rel[1] = side * min(max(side * rel[1], cfg.min_width_m), widest)
@@ -926,6 +945,7 @@ class VelocityGait:
             if not self.terrain.flat:
                 self._on_terrain(u, soles_m[f], heading_td)
         out.landing_m[:] = self._landing
+        out.after_push = bool(self._after_push_at == self._t0)
         if not self._swinging:
             return out
         out.recovery = bool(self._recovery_at == self._t0)
