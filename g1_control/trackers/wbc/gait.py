@@ -163,6 +163,9 @@ class GaitConfig:
     landing may be as wide (recovery_max_width_m). Pushed from behind, the capture step caught the DCM,
     then the CoM rose 5 cm again while the trailing foot had 0.7 m to swing: its knee at the torque
     limit, the foot stayed behind and the robot rolled over the stance foot (measured)."""
+    early_lift_dcm_error_m: float = 0.2
+    """In a step's double support, the DCM this far off its plan lifts the swing foot at once (its
+    double support ends, the single support keeps its length, inf: never)."""
     speed_feedback_gain: float = 0.3
     """Per stride, this fraction of the error between the command and the stride's speed (from the
     feet's measured touchdowns) is added to the speed the steps are planned for: the pendulum model
@@ -534,6 +537,8 @@ class VelocityGait:
         self._after_push_at = math.nan
         """The _t0 of a step after a pushed one (GaitConfig.after_push_steps; nan: none) ..."""
         self._after_push_left = 0
+        self._dcm_error_at = math.nan
+        """The _t0 of the step GaitTargets.dcm_error_m was last measured in (nan: none)."""
         """... and how many such steps are left, that one included."""
         self.command_h = np.zeros(3)
         """The command being walked: the operator's, rate limited (GaitConfig.max_accel)."""
@@ -598,6 +603,14 @@ class VelocityGait:
                 if not moving and self._side_by_side(soles_m, sole_yaws):
                     self.mode, self._t0 = "stop", t_s
                     self._dcm_from = np.array(dcm_xy, dtype=float)
+            elif (not self._swinging and self._dcm_error_at == self._t0 and not self._in_swing(t_s)
+                  and self.targets.dcm_error_m > cfg.early_lift_dcm_error_m):
+                # pushed in the double support: the swing foot lifts now
+                t_in = t_s - self._t0
+                self.step_T -= self.active.double_support_s - t_in
+                self.active = dataclasses.replace(self.active, double_support_s=t_in,
+                                                  fast_double_support_s=min(t_in, self.active.fast_double_support_s))
+                self._lift(soles_m, sole_yaws)
             elif self._in_swing(t_s) and not self._swinging:
                 if self._dcm_short_of_stance(command_h, soles_m, dcm_xy) and (
                         self.active.double_support_s < cfg.double_support_s + cfg.terrain_max_wait_s):
@@ -890,6 +903,7 @@ class VelocityGait:
             # touchdown is to lie that much further, so its plan now is that much e^{-w t_r} further
             xi_nom = xi_nom + self._snap_shift * math.exp(-omega * t_r)
         out.dcm_error_m = float(np.hypot(*(dcm_xy - xi_nom)))
+        self._dcm_error_at = self._t0
         if self._swinging and t_in >= Tds and out.dcm_error_m > cfg.recovery_dcm_error_m:
             self._recovery_at = self._t0
             if out.dcm_error_m > cfg.pushed_dcm_error_m:
