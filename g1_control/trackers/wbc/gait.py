@@ -157,15 +157,26 @@ class GaitConfig:
     soon as it may, with a 0.02-0.07 s double support after it: 7/20 (with the lowering 11/20, other
     cases); a CoP target up to 0.1 / 0.08 m off the sole in recovery steps (for the trunk's angular
     momentum) 6/20 (measured, one machine)."""
-    after_push_steps: int = 1
-    """The steps after a pushed step (GaitTargets.after_push, this many, from the touchdown of the pushed
-    step; 0: none) are held like it: the CoM stays lowered (WbcConfig.recovery_com_lower_m) and the
-    landing may be as wide (recovery_max_width_m). Pushed from behind, the capture step caught the DCM,
-    then the CoM rose 5 cm again while the trailing foot had 0.7 m to swing: its knee at the torque
-    limit, the foot stayed behind and the robot rolled over the stance foot (measured)."""
-    early_lift_dcm_error_m: float = 0.2
+    after_push_steps: int = 0
+    """In the steps after a pushed step (GaitTargets.after_push, this many, from the touchdown of the
+    pushed step, double support included; 0: none) the tracker keeps the CoM lowered
+    (WbcConfig.recovery_com_lower_m). Pushed from behind, the capture step caught the DCM, then the
+    CoM rose 5 cm again while the trailing foot had 0.7 m to swing: its knee at its torque limit, the
+    foot stayed behind and the robot rolled over the stance foot (measured). `g1 bench locomotion
+    --only wbc/push`: 0: 9/20, 1: 12/20, 2: 11/20; with the pushed width (recovery_max_width_m) in
+    the after-push step too: the same 12 (13 with early_lift_dcm_error_m), but front_3 then tripped
+    (ankle over-speed) 3 s after its push (measured, one machine). Off (0) by default: the random
+    velocity timelines have pushed steps without a push (the DCM 0.25-0.48 m off its plan turning or
+    slowing down, as off as in the bench's pushes), and with 1 random_s1 and random_s6 of `--only
+    wbc/random` fell (10/10 with 0); a push needs telling from a command change first."""
+    early_lift_dcm_error_m: float = math.inf
     """In a step's double support, the DCM this far off its plan lifts the swing foot at once (its
-    double support ends, the single support keeps its length, inf: never)."""
+    double support ends, the single support keeps its length, inf: never): pushed late in a swing, the
+    swing foot landed where it was going and the other foot waited out the double support (0.11 s)
+    while the DCM ran off. `g1 bench locomotion --only wbc/push` (with after_push_steps 1): inf 12/20,
+    0.1 12/20, 0.15 and 0.2 13/20 (right_3 survives), alone (after_push_steps 0) 9/20, the same nine
+    (measured, one machine). Never sooner than fast_double_support_s into the double support (the
+    load needs moving onto the other foot). Off (inf) by default, with after_push_steps."""
     speed_feedback_gain: float = 0.3
     """Per stride, this fraction of the error between the command and the stride's speed (from the
     feet's measured touchdowns) is added to the speed the steps are planned for: the pendulum model
@@ -260,6 +271,9 @@ class GaitConfig:
                                  f"{self.recovery_max_width_m}")
         if not (isinstance(self.after_push_steps, int) and self.after_push_steps >= 0):
             raise WbcConfigError(f"GaitConfig.after_push_steps must be an integer >= 0; got {self.after_push_steps!r}")
+        if not self.early_lift_dcm_error_m > 0:  # inf: never
+            raise WbcConfigError(f"GaitConfig.early_lift_dcm_error_m must be > 0 (inf: never); got "
+                                 f"{self.early_lift_dcm_error_m}")
         if not self.max_width_m <= self.fast_max_width_m:
             raise WbcConfigError(f"GaitConfig needs max_width_m <= fast_max_width_m; got {self.max_width_m}, "
                                  f"{self.fast_max_width_m}")
@@ -301,7 +315,8 @@ class GaitTargets:
     """... with the DCM GaitConfig.pushed_dcm_error_m off its plan: walking fast, steps near their limits
     are recovery steps without a push."""
     after_push: bool = False
-    """The step under way (double support included) follows a pushed one (GaitConfig.after_push_steps)."""
+    """The step under way (double support included) follows a pushed one (GaitConfig.after_push_steps):
+    the tracker keeps the CoM lowered."""
     dcm_error_m: float = 0.0
     """How far the DCM is from its nominal plan this tick (walking; 0 otherwise)."""
 
@@ -604,6 +619,7 @@ class VelocityGait:
                     self.mode, self._t0 = "stop", t_s
                     self._dcm_from = np.array(dcm_xy, dtype=float)
             elif (not self._swinging and self._dcm_error_at == self._t0 and not self._in_swing(t_s)
+                  and t_s - self._t0 >= cfg.fast_double_support_s
                   and self.targets.dcm_error_m > cfg.early_lift_dcm_error_m):
                 # pushed in the double support: the swing foot lifts now
                 t_in = t_s - self._t0
@@ -946,7 +962,7 @@ class VelocityGait:
                 self._recovery_at = self._t0  # latched: the rest of the step is a recovery step
             side = _SIDE[f]
             widest = cfg.max_width_m
-            if (self._pushed_at == self._t0 and self._swinging) or self._after_push_at == self._t0:
+            if self._pushed_at == self._t0 and self._swinging:
                 widest = max(widest, cfg.recovery_max_width_m)
             rel[0] = min(max(rel[0], -cfg.max_backward_m), cfg.max_forward_m)
             rel[1] = side * min(max(side * rel[1], cfg.min_width_m), widest)
