@@ -30,6 +30,10 @@ marked (GaitTargets.recovery) until it lands; the tracker then holds the swing f
 harder (WbcConfig.recovery_swing_weight), so the QP steps rather than swinging the leg back. One the
 DCM's error made (GaitConfig.pushed_dcm_error_m: GaitTargets.pushed) may land wider
 (recovery_max_width_m), and the tracker holds the CoM lower in it (WbcConfig.recovery_com_lower_m).
+Options, off by default (they save pushes but break random velocity timelines, whose command
+changes make pushed steps too): the CoM held lower in the step after a pushed one too
+(GaitConfig.after_push_steps, GaitTargets.after_push), and the swing foot lifted at once when the
+DCM strays in a double support (GaitConfig.early_lift_dcm_error_m).
 
 Swing feet: the horizontal path and the yaw are re-planned each tick as a minimum-jerk segment
 from the reference's current position, velocity and acceleration to the (moving) landing point,
