@@ -30,6 +30,10 @@ marked (GaitTargets.recovery) until it lands; the tracker then holds the swing f
 harder (WbcConfig.recovery_swing_weight), so the QP steps rather than swinging the leg back. One the
 DCM's error made (GaitConfig.pushed_dcm_error_m: GaitTargets.pushed) may land wider
 (recovery_max_width_m), and the tracker holds the CoM lower in it (WbcConfig.recovery_com_lower_m).
+Options, off by default (they save pushes but break random velocity timelines, whose command
+changes make pushed steps too): the CoM held lower in the step after a pushed one too
+(GaitConfig.after_push_steps, GaitTargets.after_push), and the swing foot lifted at once when the
+DCM strays in a double support (GaitConfig.early_lift_dcm_error_m).
 
 Swing feet: the horizontal path and the yaw are re-planned each tick as a minimum-jerk segment
 from the reference's current position, velocity and acceleration to the (moving) landing point,
@@ -157,6 +161,26 @@ class GaitConfig:
     soon as it may, with a 0.02-0.07 s double support after it: 7/20 (with the lowering 11/20, other
     cases); a CoP target up to 0.1 / 0.08 m off the sole in recovery steps (for the trunk's angular
     momentum) 6/20 (measured, one machine)."""
+    after_push_steps: int = 0
+    """In the steps after a pushed step (GaitTargets.after_push, this many, from the touchdown of the
+    pushed step, double support included; 0: none) the tracker keeps the CoM lowered
+    (WbcConfig.recovery_com_lower_m). Pushed from behind, the capture step caught the DCM, then the
+    CoM rose 5 cm again while the trailing foot had 0.7 m to swing: its knee at its torque limit, the
+    foot stayed behind and the robot rolled over the stance foot (measured). `g1 bench locomotion
+    --only wbc/push`: 0: 9/20, 1: 12/20, 2: 11/20; with the pushed width (recovery_max_width_m) in
+    the after-push step too: the same 12 (13 with early_lift_dcm_error_m), but front_3 then tripped
+    (ankle over-speed) 3 s after its push (measured, one machine). Off (0) by default: the random
+    velocity timelines have pushed steps without a push (the DCM 0.25-0.48 m off its plan turning or
+    slowing down, as off as in the bench's pushes), and with 1 random_s1 and random_s6 of `--only
+    wbc/random` fell (10/10 with 0); a push needs telling from a command change first."""
+    early_lift_dcm_error_m: float = math.inf
+    """In a step's double support, the DCM this far off its plan lifts the swing foot at once (its
+    double support ends, the single support keeps its length, inf: never): pushed late in a swing, the
+    swing foot landed where it was going and the other foot waited out the double support (0.11 s)
+    while the DCM ran off. `g1 bench locomotion --only wbc/push` (with after_push_steps 1): inf 12/20,
+    0.1 12/20, 0.15 and 0.2 13/20 (right_3 survives), alone (after_push_steps 0) 9/20, the same nine
+    (measured, one machine). Never sooner than fast_double_support_s into the double support (the
+    load needs moving onto the other foot). Off (inf) by default, with after_push_steps."""
     speed_feedback_gain: float = 0.3
     """Per stride, this fraction of the error between the command and the stride's speed (from the
     feet's measured touchdowns) is added to the speed the steps are planned for: the pendulum model
@@ -249,6 +273,11 @@ class GaitConfig:
         if not (np.isfinite(self.recovery_max_width_m) and self.recovery_max_width_m > 0):
             raise WbcConfigError(f"GaitConfig.recovery_max_width_m must be a finite number > 0; got "
                                  f"{self.recovery_max_width_m}")
+        if not (isinstance(self.after_push_steps, int) and self.after_push_steps >= 0):
+            raise WbcConfigError(f"GaitConfig.after_push_steps must be an integer >= 0; got {self.after_push_steps!r}")
+        if not self.early_lift_dcm_error_m > 0:  # inf: never
+            raise WbcConfigError(f"GaitConfig.early_lift_dcm_error_m must be > 0 (inf: never); got "
+                                 f"{self.early_lift_dcm_error_m}")
         if not self.max_width_m <= self.fast_max_width_m:
             raise WbcConfigError(f"GaitConfig needs max_width_m <= fast_max_width_m; got {self.max_width_m}, "
                                  f"{self.fast_max_width_m}")
@@ -289,6 +318,9 @@ class GaitTargets:
     pushed: bool = False
     """... with the DCM GaitConfig.pushed_dcm_error_m off its plan: walking fast, steps near their limits
     are recovery steps without a push."""
+    after_push: bool = False
+    """The step under way (double support included) follows a pushed one (GaitConfig.after_push_steps):
+    the tracker keeps the CoM lowered."""
     dcm_error_m: float = 0.0
     """How far the DCM is from its nominal plan this tick (walking; 0 otherwise)."""
 
@@ -521,6 +553,12 @@ class VelocityGait:
         """The _t0 of the step that is a recovery step (GaitConfig.recovery_dcm_error_m; nan: none)."""
         self._pushed_at = math.nan
         """... and a pushed one (GaitConfig.pushed_dcm_error_m)."""
+        self._after_push_at = math.nan
+        """The _t0 of a step after a pushed one (GaitConfig.after_push_steps; nan: none) ..."""
+        self._after_push_left = 0
+        self._dcm_error_at = math.nan
+        """The _t0 of the step GaitTargets.dcm_error_m was last measured in (nan: none)."""
+        """... and how many such steps are left, that one included."""
         self.command_h = np.zeros(3)
         """The command being walked: the operator's, rate limited (GaitConfig.max_accel)."""
         self.speed_correction_h = np.zeros(2)
@@ -572,13 +610,27 @@ class VelocityGait:
                 self.touchdowns.append((t_s, 1 - self.stance, self._landing.copy()))
                 self._correct_speed(t_s, 1 - self.stance, soles_m[1 - self.stance, :2])
                 self.steps += 1
+                pushed, after = self._pushed_at == self._t0, self._after_push_at == self._t0
                 self.stance = 1 - self.stance
                 self._t0 += self.step_T
+                if pushed or after:
+                    self._after_push_left = cfg.after_push_steps if pushed else self._after_push_left - 1
+                    if self._after_push_left > 0:
+                        self._after_push_at = self._t0
                 self.active = self._timing_for(soles_m)
                 self.step_T = self.active.step_s
                 if not moving and self._side_by_side(soles_m, sole_yaws):
                     self.mode, self._t0 = "stop", t_s
                     self._dcm_from = np.array(dcm_xy, dtype=float)
+            elif (not self._swinging and self._dcm_error_at == self._t0 and not self._in_swing(t_s)
+                  and t_s - self._t0 >= cfg.fast_double_support_s
+                  and self.targets.dcm_error_m > cfg.early_lift_dcm_error_m):
+                # pushed in the double support: the swing foot lifts now
+                t_in = t_s - self._t0
+                self.step_T -= self.active.double_support_s - t_in
+                self.active = dataclasses.replace(self.active, double_support_s=t_in,
+                                                  fast_double_support_s=min(t_in, self.active.fast_double_support_s))
+                self._lift(soles_m, sole_yaws)
             elif self._in_swing(t_s) and not self._swinging:
                 if self._dcm_short_of_stance(command_h, soles_m, dcm_xy) and (
                         self.active.double_support_s < cfg.double_support_s + cfg.terrain_max_wait_s):
@@ -830,7 +882,7 @@ class VelocityGait:
         out.yaw_rate_radps = 0.0 if self.mode == "stand" else float(command_h[2])
         out.swing_foot = -1
         out.swing_progress = 0.0
-        out.recovery = out.pushed = False
+        out.recovery = out.pushed = out.after_push = False
         out.dcm_error_m = 0.0
         mid = (soles_m[0, :2] + soles_m[1, :2]) / 2
         centre = mid + _rot2(self.heading) @ np.array([cfg.com_offset_x_m, 0.0])
@@ -871,6 +923,7 @@ class VelocityGait:
             # touchdown is to lie that much further, so its plan now is that much e^{-w t_r} further
             xi_nom = xi_nom + self._snap_shift * math.exp(-omega * t_r)
         out.dcm_error_m = float(np.hypot(*(dcm_xy - xi_nom)))
+        self._dcm_error_at = self._t0
         if self._swinging and t_in >= Tds and out.dcm_error_m > cfg.recovery_dcm_error_m:
             self._recovery_at = self._t0
             if out.dcm_error_m > cfg.pushed_dcm_error_m:
@@ -926,6 +979,7 @@ class VelocityGait:
             if not self.terrain.flat:
                 self._on_terrain(u, soles_m[f], heading_td)
         out.landing_m[:] = self._landing
+        out.after_push = bool(self._after_push_at == self._t0)
         if not self._swinging:
             return out
         out.recovery = bool(self._recovery_at == self._t0)

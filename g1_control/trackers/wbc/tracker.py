@@ -566,7 +566,7 @@ class WholeBodyTracker(Tracker):
         h = cfg.com_height
         speed = min(float(np.hypot(*self.gait.command_h[:2])), cfg.walking_com_lower_speed_cap_mps)
         lower = cfg.walking_com_lower_m + cfg.walking_com_lower_per_mps * speed
-        if gt.pushed:
+        if gt.pushed or gt.after_push:
             lower += cfg.recovery_com_lower_m
         height = self._com_height_m - lower
         lean = 0.0

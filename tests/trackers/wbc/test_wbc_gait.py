@@ -234,6 +234,63 @@ def test_a_recovery_step_lands_as_wide_as_recovery_max_width(widest):
     assert soles[LEFT, 1] - out.landing_m[1] == pytest.approx(widest, abs=1e-9)
 
 
+def _to_touchdown(gait, t, soles, yaws):
+    """Schedule ticks until the swing foot under way lands; the time of the touchdown tick."""
+    first = gait.steps
+    while gait.steps == first:
+        t += 0.004
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+    return t
+
+
+@pytest.mark.parametrize("steps", [1, 0])
+def test_the_step_after_a_pushed_step_is_held_like_it(steps):
+    """GaitConfig.after_push_steps: the step after a pushed step (double support included) is an
+    after-push step (the tracker keeps the CoM lowered); the step after that is a plain step again."""
+    soles, yaws = _feet()
+    gait = VelocityGait(GaitConfig(after_push_steps=steps))
+    t = _into_single_support(gait, soles, yaws)
+    out = gait.update(t, 0.004, soles, yaws, soles[LEFT, :2] + np.array([0.05, -1.0]), OMEGA)
+    assert out.pushed and not out.after_push
+    t = _to_touchdown(gait, t, soles, yaws)
+    assert gait.stance == RIGHT and gait.targets.contacts.all()  # the next step's double support
+    out = gait.update(t, 0.004, soles, yaws, soles[RIGHT, :2] + np.array([0.05, 0.03]), OMEGA)
+    assert out.after_push == bool(steps) and not out.pushed
+    t = _to_touchdown(gait, t, soles, yaws)
+    out = gait.update(t, 0.004, soles, yaws, soles[LEFT, :2], OMEGA)
+    assert not out.after_push and not out.pushed
+
+
+@pytest.mark.parametrize("threshold", [0.2, math.inf])
+def test_a_dcm_far_off_its_plan_in_the_double_support_lifts_the_swing_foot_at_once(threshold):
+    """GaitConfig.early_lift_dcm_error_m: pushed in a step's double support, the swing foot lifts once
+    fast_double_support_s of it has passed (the load moves onto the other foot first); the single
+    support keeps its length, so the step lands that much sooner."""
+    soles, yaws = _feet()
+    gait = VelocityGait(GaitConfig(early_lift_dcm_error_m=threshold))
+    cfg = gait.config
+    t = _to_touchdown(gait, _into_single_support(gait, soles, yaws), soles, yaws)
+    step_before = gait.step_T
+    # on its plan, the double support goes on
+    out = gait.update(t, 0.004, soles, yaws, soles[RIGHT, :2] + np.array([0.05, 0.03]), OMEGA)
+    assert out.dcm_error_m < 0.2
+    assert gait.schedule(t + 0.004, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2)).all()
+    lifted_at = None
+    while t - gait._t0 < cfg.double_support_s - 0.008:
+        t += 0.004
+        out = gait.update(t, 0.004, soles, yaws, soles[RIGHT, :2] + np.array([0.4, 0.0]), OMEGA)
+        assert out.dcm_error_m > 0.2
+        if not gait.schedule(t + 0.004, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2)).all():
+            lifted_at = t + 0.004 - gait._t0
+            break
+    if math.isfinite(threshold):
+        assert lifted_at is not None and gait.targets.contacts.tolist() == [False, True]
+        assert cfg.fast_double_support_s <= lifted_at < cfg.fast_double_support_s + 0.005
+        assert gait.step_T == pytest.approx(step_before - (cfg.double_support_s - lifted_at))
+    else:
+        assert lifted_at is None and gait.step_T == step_before
+
+
 @pytest.mark.parametrize("kwargs, text", [
     ({"single_support_s": 0.0}, "single_support_s must be a finite number > 0"),
     ({"min_width_m": 0.3}, "min_width_m <= step_width_m <= max_width_m"),
@@ -242,6 +299,10 @@ def test_a_recovery_step_lands_as_wide_as_recovery_max_width(widest):
     ({"cadence_reach_from": 1.2}, "cadence_reach_from < cadence_reach_full"),
     ({"fast_max_width_m": 0.4}, "max_width_m <= fast_max_width_m"),
     ({"recovery_max_width_m": 0.0}, "recovery_max_width_m must be a finite number > 0"),
+    ({"after_push_steps": -1}, "after_push_steps must be an integer >= 0; got -1"),
+    ({"after_push_steps": 1.5}, "after_push_steps must be an integer >= 0; got 1.5"),
+    ({"early_lift_dcm_error_m": 0.0}, r"early_lift_dcm_error_m must be > 0 \(inf: never\); got 0.0"),
+    ({"early_lift_dcm_error_m": math.nan}, "early_lift_dcm_error_m must be > 0"),
 ])
 def test_bad_gait_config_is_refused(kwargs, text):
     with pytest.raises(WbcConfigError, match=text):

@@ -14,7 +14,14 @@ that saves some of them is taken away in turn (so a test goes red without it):
                                    and left_1 fell);
   WbcConfig.swing_max_accel_mps2   the swing foot's re-planned reference acceleration capped (uncapped:
                                    right_0 fell, ankle pitch over-speed; left_2 and back_2 trip too,
-                                   left_2 after the settling time)."""
+                                   left_2 after the settling time).
+Two options, off by default (they break random velocity timelines, gait.py), are shown to save pushes
+that fall without them:
+  GaitConfig.after_push_steps 1    the step after a pushed step keeps the CoM lowered (front_1 survives;
+                                   it falls with the defaults);
+  GaitConfig.early_lift_dcm_error_m  with it, the DCM 0.2 m off its plan in a double support lifts the
+                                   swing foot at once (right_3 survives; with after_push_steps alone it
+                                   falls)."""
 
 import functools
 
@@ -78,3 +85,21 @@ def test_with_recovery_steps_no_wider_than_plain_steps_left_1_fell(monkeypatch):
     assert run_push("push_left_1").pushes_survived == 1
     without(monkeypatch, gait=GaitConfig(recovery_max_width_m=GaitConfig().max_width_m))
     assert_fell(["push_left_1"])
+
+
+PUSH_OPTIONS = {"after_push_steps": 1, "early_lift_dcm_error_m": 0.2}
+
+
+def test_with_the_step_after_a_push_held_low_front_1_survives(monkeypatch):
+    assert_fell(["push_front_1"])
+    without(monkeypatch, gait=GaitConfig(**PUSH_OPTIONS))
+    row = run_push("push_front_1")
+    assert row.pushes_survived == 1 and not row.fell and not row.trip, row.trip
+
+
+def test_with_the_early_lift_too_right_3_survives(monkeypatch):
+    without(monkeypatch, gait=GaitConfig(**{**PUSH_OPTIONS, "early_lift_dcm_error_m": float("inf")}))
+    assert_fell(["push_right_3"])
+    without(monkeypatch, gait=GaitConfig(**PUSH_OPTIONS))
+    row = run_push("push_right_3")
+    assert row.pushes_survived == 1 and not row.fell and not row.trip, row.trip
