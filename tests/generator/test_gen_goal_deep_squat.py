@@ -132,8 +132,9 @@ def test_a_lockstep_pick_lifts_a_floor_box_from_the_deep_squat():
     assert r["box_to_hands_end_m"] < 0.1
 
 
-def test_a_place_below_the_squats_reach_is_refused_the_deep_squat_picks_only(stances):
-    with pytest.raises(StanceRefused, match=r"0\.5 kg.*no stance can set it down there: the hands would hold it 0\.26 m "
-                                            r"above the ground; below 0\.40 m only a deep squat reaches, and it only "
-                                            r"picks \(a carry into one fell: DEEP_PICKS_ONLY\); closest: .*deep squat"):
-        stances.plan(_box(0.5), CENTER, None, [0.0], lift_m=None, what="set it down there")
+def test_a_place_below_the_squats_reach_is_planned_from_a_deep_squat(stances):
+    """A place whose hands are below every squat's reach (LOWEST_GRASP_M) sets the box down from a deep
+    squat (a carry into one fell until stepping.LEVEL_CHANGE_M; then DEEP_PICKS_ONLY refused it)."""
+    plan = stances.plan(_box(0.5), CENTER, None, [0.0], lift_m=None, what="set it down there")
+    assert plan.lean >= DEEP and "deep squat" in plan.chosen.describe()
+    assert DEEP_MIN_PELVIS_M <= plan.chosen.poses[0][2] < MIN_PELVIS_M

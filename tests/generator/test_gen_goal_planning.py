@@ -114,3 +114,22 @@ def test_step_up_and_down_plans_keep_the_feet_on_target_and_the_knees_bent(plann
     assert plan.pelvis_z_m[first_swing] < 0.15 + cfg.pelvis_above_ground_m - 0.05
     assert plan.pelvis_z_m[-1] == pytest.approx(cfg.pelvis_above_ground_m, abs=1e-3)
     assert plan.trajectory.q_rad[:, knees].min() > 0.2
+
+
+@pytest.mark.parametrize("above_m", [1e-5, 5e-3])
+def test_a_stance_a_hair_above_the_floor_steps_on_level(planner, above_m):
+    """A whole-body pose's soles sit micrometres off the floor (IK residual: +7.5 um at the end of
+    a carry). Steps from there onto the floor are level steps: no forward lean, no lowered pelvis
+    (read as a step down, they leaned the pelvis 0.3 rad before the first correcting step after a
+    carry, and the robot fell)."""
+    ik = planner.ik
+    q0 = ik.nominal()
+    q0[2] += above_m
+    cfg = SteppingConfig(max_advance_m=0.10, max_turn_rad=0.18, single_support_s=0.6, double_support_s=0.25)
+    stance = Stance.of(ik, q0)
+    steps = walk_steps(stance, stance.mid_xy + np.array([0.06, 0.0]), stance.heading, cfg)
+    assert steps and all(s.pos_w_m[2] == 0.0 for s in steps)
+    plan = stepping_trajectory(ik, q0, steps, cfg)
+    assert plan.sole_error_m < 0.01
+    assert np.abs(plan.trajectory.root_rpy_rad[:, 1]).max() < 0.02
+    assert plan.pelvis_z_m.min() > cfg.pelvis_above_ground_m - 0.002

@@ -17,7 +17,7 @@ on the floor. The candidates:
             DEEP_LIMIT_MARGIN_RAD inside their limits, the pelvis stays at DEEP_MIN_PELVIS_M or higher
             (above the fall monitor's 0.40 m), tilts DEEP_MAX_TILT_RAD at most, and every joint's static
             torque (gravity, the box's weight at the hands, the ground's reaction under the CoM) is
-            within its actuator's limit (`static_torques`); picks only (DEEP_PICKS_ONLY)
+            within its actuator's limit (`static_torques`); picks and places (DEEP_PICKS_ONLY: picks only)
   standing leaning  last, for a light box held at SQUAT_BELOW_M or higher on a support: standing off its edge
             (soles' middle STAND_LEAN_GAPS_M from the box, the pelvis beyond MIN_EDGE_CLEARANCE_M),
             the pelvis pitched STAND_LEAN_PELVIS_RAD and the waist leaning to reach in
@@ -88,12 +88,13 @@ DEEP_MIN_PELVIS_M = 0.44
 the whole-body controller sank a planned squat ~3 cm below its plan (measured, stop 34)."""
 DEEP_MAX_TILT_RAD = 0.85
 """A deep squat's pelvis tilt at most (the safety layer calls 1.0 rad a fall)."""
-DEEP_PICKS_ONLY = True
-"""The deep squat picks; a place is not planned from it (a place's hands below LOWEST_GRASP_M stay
-refused). Measured (bench objects seed 9 trial 1, stops 34 and 36: a 0.5 kg, 0.45 m tall box picked
-leaning from a 0.23 m table, to go on the floor from a deep squat): the robot fell in the correcting
-steps at the end of the carry, the trunk leaning (waist 0.31 rad, ~24 N m) with the box held high;
-seed 8 trial 3 set its box down from a deep squat (2.4 cm)."""
+DEEP_PICKS_ONLY = False
+"""True: the deep squat picks only; a place is not planned from it (a place's hands below
+LOWEST_GRASP_M stay refused). It was True while a carry into a deep-squat place fell in the
+correcting steps (bench objects seed 9 trial 1: a 0.5 kg, 0.45 m tall box to go on the floor); the
+cause was the footstep plan taking the soles' micrometres above the floor for a step down
+(stepping.LEVEL_CHANGE_M): it leaned the pelvis 0.3 rad with the box held high. With that fixed the
+same trial sets its box down (1.6 cm off); seed 8 trial 3 set its box down from a deep squat (2.4 cm)."""
 DEEP_TORQUE_SHARE = 1.0
 """A deep squat's static joint torques at most this share of the actuators' limits (g1.EFFORT_LIMIT_NM).
 Stop 34 lifted 0.3 and 0.8 kg floor boxes from its squat (trunk 0.7 + 0.5 rad) but not 1.2-2.0 kg

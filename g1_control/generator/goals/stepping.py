@@ -37,6 +37,11 @@ from g1_control.scene import Block
 LEFT, RIGHT = 0, 1
 SOLE_HALF_LENGTH_M = 0.085
 """From the sole frame's centre to the front (and rear) contact points (robot/dynamics.py)."""
+LEVEL_CHANGE_M = 0.02
+"""A step changes level when its sole lands more than this above or below where it was. Less is
+the same floor: a whole-body pose's soles sit a few micrometres off the ground (IK residual), and
+taking that for a step down leaned the pelvis 0.3 rad and lowered it 2 cm before the first
+correcting step after a carry, and the robot fell (launch: a floor box carried to a 0.75 m table)."""
 
 
 @dataclass(frozen=True)
@@ -254,7 +259,7 @@ class SteppingPlan:
 def _swing(p0: np.ndarray, p1: np.ndarray, tau: np.ndarray, cfg: SteppingConfig) -> tuple[np.ndarray, np.ndarray]:
     """Swing-foot positions (n, 3) and horizontal progress (n,) over tau in [0, 1]."""
     out = np.zeros((len(tau), 3))
-    if abs(p1[2] - p0[2]) < 0.02:
+    if abs(p1[2] - p0[2]) < LEVEL_CHANGE_M:
         a = smoothstep(tau)
         out[:] = p0 + a[:, None] * (p1 - p0)
         out[:, 2] += cfg.lift_m * (1 - np.cos(2 * np.pi * tau)) / 2
@@ -296,7 +301,7 @@ def stepping_trajectory(ik: WholeBodyIK, q0: np.ndarray, footsteps: list[Footste
     doubles = []
     level = stance.copy()
     for st in footsteps:
-        changes = abs(st.pos_w_m[2] - level.pos[st.foot, 2]) > 0.02
+        changes = abs(st.pos_w_m[2] - level.pos[st.foot, 2]) > LEVEL_CHANGE_M
         doubles.append(cfg.level_double_support_s if changes else cfg.double_support_s)
         level = level.apply(st)
     total = cfg.start_s + sum(durations) + sum(doubles) + cfg.double_support_s + cfg.end_s
@@ -308,14 +313,15 @@ def stepping_trajectory(ik: WholeBodyIK, q0: np.ndarray, footsteps: list[Footste
     zmp = np.repeat((stance.mid_xy + offset_w(stance.heading))[None], n, axis=0)
     # (double support from, swing from, touchdown, lowest sole before/after, mean sole height before/after,
     #  the other foot's height)
-    levels: list[tuple[float, ...]] = []
-    """Per step: (double support start, swing start, touchdown, lower foot before/after, mean before/after)."""
+    levels: list[tuple] = []
+    """Per step: (double support start, swing start, touchdown, lower foot before/after, mean before/after,
+    the other foot's height, whether it steps down by more than LEVEL_CHANGE_M)."""
     current = stance.copy()
     prev_zmp = zmp[0].copy()
     t0 = cfg.start_s
     for step, swing_s, ds_s in zip(footsteps, durations, doubles):
         other = 1 - step.foot
-        level_change = abs(step.pos_w_m[2] - current.pos[step.foot, 2]) > 0.02
+        level_change = abs(step.pos_w_m[2] - current.pos[step.foot, 2]) > LEVEL_CHANGE_M
         # Stepping up or down, the ZMP sits toward the heel: the hips stay nearer the lower foot.
         along = -cfg.level_zmp_back_m if level_change else com_offset_h_m[0]
         stance_zmp = current.pos[other, :2] + _rotate(np.array([along, 0.0]), current.yaw[other])
@@ -338,7 +344,8 @@ def stepping_trajectory(ik: WholeBodyIK, q0: np.ndarray, footsteps: list[Footste
         nxt = current.apply(step)
         nxt.yaw[step.foot] = yaw_to
         levels.append((t0, ts, ts + swing_s, current.pos[:, 2].min(), nxt.pos[:, 2].min(),
-                       current.pos[:, 2].mean(), nxt.pos[:, 2].mean(), current.pos[other, 2]))
+                       current.pos[:, 2].mean(), nxt.pos[:, 2].mean(), current.pos[other, 2],
+                       level_change and step.pos_w_m[2] < current.pos[step.foot, 2]))
         current = nxt
         prev_zmp = stance_zmp
         t0 = ts + swing_s
@@ -362,8 +369,8 @@ def stepping_trajectory(ik: WholeBodyIK, q0: np.ndarray, footsteps: list[Footste
         margin[g1.JOINT_INDEX[joint]] = cfg.knee_margin_rad
     ankles = [g1.JOINT_INDEX[joint] for joint in ("left_ankle_pitch_joint", "right_ankle_pitch_joint")]
     lean = np.zeros(n)
-    for t_ds, t_sw, t_td, _lo0, _lo1, m0, m1, _z in levels:
-        if m1 < m0 - 1e-6:
+    for t_ds, t_sw, t_td, _lo0, _lo1, _m0, _m1, _z, down in levels:
+        if down:
             lean += cfg.descent_lean_rad * (smoothstep((t - t_ds) / max(t_sw - t_ds + 0.3 * (t_td - t_sw), 1e-6))
                                             - smoothstep((t - t_td) / (cfg.double_support_s + 0.3)))
     weights = np.full((2, 6), 1000.0)
@@ -417,9 +424,9 @@ def _pelvis_heights(t: np.ndarray, levels, stance: Stance, cfg: SteppingConfig) 
     g = STRAIGHT_KNEE_GUARD_M
     mean_moves: list[tuple[float, float, float]] = []
     extra_moves: list[tuple[float, float, float]] = []
-    for t_ds, t_sw, t_td, _lo0, lo1, m0, m1, _z_stance in levels:
+    for t_ds, t_sw, t_td, _lo0, lo1, m0, m1, _z_stance, down in levels:
         settle = t_td + cfg.double_support_s + 0.3
-        if m1 < m0 - 1e-6:  # stepping down
+        if down:  # stepping down (by more than LEVEL_CHANGE_M)
             before = t_sw + 0.7 * (t_td - t_sw)
             mean_moves.append((t_ds, before, m1))
             extra_moves.append((t_ds, before, min(0.0, lo1 + g - cfg.descend_below_m - m1)))
