@@ -226,7 +226,7 @@ class DdsLink(Link):
                  history_depth: int = 32):
         super().__init__(side)
         self.interface, self.domain_id, self.partition = interface, int(domain_id), partition
-        participant = domain_participant(interface, self.domain_id)
+        import_cyclonedds()
         from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState, WaitSet
         from cyclonedds.pub import DataWriter, Publisher
         from cyclonedds.qos import Policy, Qos
@@ -235,22 +235,24 @@ class DdsLink(Link):
 
         from g1_control.hardware.unitree import idl as unitree_idl
 
-        cmd_topic = Topic(participant, LOWCMD_TOPIC, unitree_idl.LowCmd_)
-        state_topic = Topic(participant, LOWSTATE_TOPIC, unitree_idl.LowState_)
-        out_topic, in_topic = (cmd_topic, state_topic) if side == "host" else (state_topic, cmd_topic)
-        # A partition isolates concurrent test runs that share loopback and domain 1 on one host;
-        # the robot itself publishes in the default partition, so real use passes None.
-        group_qos = Qos(Policy.Partition([partition])) if partition else None
-        self._participant = participant
-        # LowCmd_ out and LowState_ in on the host side, the reverse on the robot side.
-        self._writer: DataWriter[Any] = DataWriter(Publisher(participant, qos=group_qos), out_topic)
-        self._reader: DataReader[Any] = DataReader(
-            Subscriber(participant, qos=group_qos), in_topic,
-            qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(history_depth)),
-        )
-        self._waitset = WaitSet(participant)
-        self._condition = ReadCondition(self._reader, SampleState.Any | ViewState.Any | InstanceState.Any)
-        self._waitset.attach(self._condition)
+        with _ENTITY_LOCK:  # made under the process-wide lock, as they are used and deleted
+            participant = domain_participant(interface, self.domain_id)
+            cmd_topic = Topic(participant, LOWCMD_TOPIC, unitree_idl.LowCmd_)
+            state_topic = Topic(participant, LOWSTATE_TOPIC, unitree_idl.LowState_)
+            out_topic, in_topic = (cmd_topic, state_topic) if side == "host" else (state_topic, cmd_topic)
+            # A partition isolates concurrent test runs that share loopback and domain 1 on one host;
+            # the robot itself publishes in the default partition, so real use passes None.
+            group_qos = Qos(Policy.Partition([partition])) if partition else None
+            self._participant = participant
+            # LowCmd_ out and LowState_ in on the host side, the reverse on the robot side.
+            self._writer: DataWriter[Any] = DataWriter(Publisher(participant, qos=group_qos), out_topic)
+            self._reader: DataReader[Any] = DataReader(
+                Subscriber(participant, qos=group_qos), in_topic,
+                qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(history_depth)),
+            )
+            self._waitset = WaitSet(participant)
+            self._condition = ReadCondition(self._reader, SampleState.Any | ViewState.Any | InstanceState.Any)
+            self._waitset.attach(self._condition)
         self._depth = history_depth
         from cyclonedds._clayer import ddspy_take, ddspy_write
 
