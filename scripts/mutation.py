@@ -101,7 +101,11 @@ GROUPS: dict[str, dict[str, list[str]]] = {
     },
 }
 # The loop group with the robot path's deploys over DDS too (hours; a machine with nothing else on it).
-GROUPS["loop-dds"] = {**GROUPS["loop"], "pytest_args": [],
+# Workers fork from mutmut's fork server, not from its main process: the main process ran the suite
+# for its stats, DDS tests included, and a child forked after Cyclone DDS made a domain has none of
+# Cyclone's threads, so its first entity deletion waits forever (a DdsLink closed in a forked child
+# hangs; every mutant whose tests reach a deploy over DDS did).
+GROUPS["loop-dds"] = {**GROUPS["loop"], "pytest_args": [], "process_isolation": "forkserver",
                      "tests": [*GROUPS["loop"]["tests"], "tests/deploy/test_deploy_runtime_trips.py",
                                "tests/deploy/test_deploy_state_validation.py", "tests/deploy/test_deploy_run_folder.py"]}
 
@@ -122,6 +126,8 @@ def configure(dest: Path, group: dict) -> None:
     text += (f"\n[tool.mutmut]\nsource_paths = [\"g1_control\"]\nonly_mutate = [{listed}]\n"
              f"tests_dir = [{tests}]\npytest_add_cli_args = [{pytest_args}]\n"
              "also_copy = [\"g1_control\", \"launch\", \"tests\"]\n")
+    if "process_isolation" in group:
+        text += f"process_isolation = \"{group['process_isolation']}\"\n"
     toml.write_text(text)
 
 

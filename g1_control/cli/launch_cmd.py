@@ -6,6 +6,32 @@ import argparse
 import os
 from pathlib import Path
 
+EXIT_OK, EXIT_FAILED, EXIT_TRIPPED = 0, 1, 3
+"""g1 launch's exit status: the run as planned; a fall, a goal not reached (or an error before the run);
+the safety layer tripped (damping) and the robot did not fall. A signal N ends it with 128 + N."""
+
+EXIT_STATUS = ("exit status:\n"
+               "  0  the run completed: no fall, no safety trip, every goal reached\n"
+               "  1  the robot fell (whatever tripped before), a goal was not reached, or an error\n"
+               "     (e.g. an invalid launch file)\n"
+               "  3  the safety layer tripped (damping) and the robot did not fall (summary.json's\n"
+               "     status \"fault\", end_reason naming the trip)\n"
+               "  128 + N  a signal N ended the run (130 SIGINT, 143 SIGTERM)")
+
+
+def exit_status(result) -> int:
+    """EXIT_FAILED on a fall (whatever tripped before it), else EXIT_TRIPPED on an unplanned safety trip
+    (found by its type, as the run folder's "fault" status is), else EXIT_FAILED when a goal was not
+    reached, else EXIT_OK."""
+    from g1_control.loop.control_loop import first_fault
+
+    if result.fell:
+        return EXIT_FAILED
+    if first_fault(result.events) is not None:
+        return EXIT_TRIPPED
+    missed = [g for g in result.extra.get("goals", []) if g["status"] != "reached"]
+    return EXIT_FAILED if missed else EXIT_OK
+
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
@@ -16,7 +42,7 @@ def register(subparsers) -> None:
         "folder with log.npz, velocity.png and, where headless rendering works, video.mp4 (with an overlay "
         "of command, achieved velocity and safety state). FILE is a path or the name of a launch file "
         "that comes with g1-control (g1 launch --list; g1 init DIR copies them for editing).",
-        epilog="examples:\n  g1 launch sim_walk\n  g1 launch launch/sim_walk.yaml --check\n"
+        epilog=EXIT_STATUS + "\n\nexamples:\n  g1 launch sim_walk\n  g1 launch launch/sim_walk.yaml --check\n"
         "  g1 launch sim_random --seed 3 --no-video\n"
         "  g1 launch sim_walk --set tracker.policy=holosoma_loco_fastsac --set output.video_fps=20\n"
         "  g1 launch sim_walk --web        # watch it in the browser (http://127.0.0.1:8080)\n"
@@ -108,5 +134,4 @@ def _run(args) -> int:
     print(format_summary(result))
     if result.run_dir is not None:
         print(f"look again: g1 replay {result.run_dir}")
-    missed = [g for g in result.extra.get("goals", []) if g["status"] != "reached"]
-    return 1 if result.fell or missed else 0
+    return exit_status(result)

@@ -349,6 +349,8 @@ class Preflight:
                                    "its remote), skip the release: --no-release-motion-service (or "
                                    f"backend.release_motion_service: false) ({exc})", overridable=False)
             return self.record(name, SKIP, f"{silent}: debug mode assumed (backend.release_motion_service false)")
+        finally:
+            client.close()  # its entities deleted now, under the process-wide DDS entity lock
         if not mode:
             return self.record(name, PASS, "no built-in controller active: ready for low-level control")
         if b.release_motion_service:

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from g1_control.errors import MalformedMessageError, RobotNotConnectedError
-from g1_control.hardware.links.dds import domain_participant, import_cyclonedds
+from g1_control.hardware.links.dds import DdsEntities, domain_participant, import_cyclonedds
 from g1_control.robot import dex3
 from g1_control.types import FingerCommand, FingerState
 
@@ -66,21 +66,24 @@ class Dex3HandLink:
         self.interface, self.domain_id, self.partition, self.sides = interface, int(domain_id), partition, sides
         self.command_period_s = 1.0 / command_rate_hz
         self.damping_kd, self.close_damping_s = damping_kd, close_damping_s
-        participant = domain_participant(interface, self.domain_id)
-        group_qos = Qos(Policy.Partition([partition])) if partition else None
-        publisher, subscriber = Publisher(participant, qos=group_qos), Subscriber(participant, qos=group_qos)
-        self._writers: dict[str, Any] = {}
-        self._readers: dict[str, Any] = {}
-        self._waitset = WaitSet(participant)
-        self._conditions = []
-        for side in sides:
-            self._writers[side] = DataWriter(publisher, Topic(participant, dex3.cmd_topic(side), HandCmd_))
-            reader = DataReader(subscriber, Topic(participant, dex3.state_topic(side), HandState_),
-                                qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(16)))
-            self._readers[side] = reader
-            cond = ReadCondition(reader, SampleState.Any | ViewState.Any | InstanceState.Any)
-            self._waitset.attach(cond)
-            self._conditions.append(cond)
+        # Made, used and deleted under the process-wide DDS entity lock (hardware/links/dds.py: DdsEntities);
+        # closed at interpreter exit (damping first) if nobody closed the link.
+        self._dds = DdsEntities(on_exit=self.close)
+        with self._dds.lock():
+            participant = self._dds.add("participant", domain_participant(interface, self.domain_id))
+            group_qos = Qos(Policy.Partition([partition])) if partition else None
+            publisher = self._dds.add("publisher", Publisher(participant, qos=group_qos))
+            subscriber = self._dds.add("subscriber", Subscriber(participant, qos=group_qos))
+            self._dds.add("waitset", WaitSet(participant))
+            for side in sides:
+                self._dds.add(f"writer:{side}", DataWriter(publisher, Topic(participant, dex3.cmd_topic(side),
+                                                                            HandCmd_)))
+                reader = self._dds.add(f"reader:{side}", DataReader(
+                    subscriber, Topic(participant, dex3.state_topic(side), HandState_),
+                    qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(16))))
+                self._dds.add(f"condition:{side}",
+                              ReadCondition(reader, SampleState.Any | ViewState.Any | InstanceState.Any))
+                self._dds.attach("waitset", f"condition:{side}")
         self._lock = threading.Lock()
         self._commands: dict[str, Any] = {}
         self._last_command: dict[str, FingerCommand] = {}
@@ -181,10 +184,9 @@ class Dex3HandLink:
             self._stop.set()
             for thread in self._threads:
                 thread.join(timeout=2.0)
-            for cond in self._conditions:
-                self._waitset.detach(cond)
-            self._writers.clear()
-            self._readers.clear()
+            # Under the process-wide lock; a thread that outlived its join finds the entities closed
+            # (no write, no take, no wait) and ends at its next look at the stop event.
+            self._dds.close()
 
     def __enter__(self) -> Dex3HandLink:
         return self
@@ -203,9 +205,9 @@ class Dex3HandLink:
         from g1_control.hardware.unitree.hand_messages import handstate_to_finger_state
 
         while not self._stop.is_set():
-            self._waitset.wait(50_000_000)
-            for side, reader in list(self._readers.items()):
-                for sample in reader.take(N=16):
+            self._dds.wait("waitset", 0.05)
+            for side in self.sides:
+                for sample in self._dds.take(f"reader:{side}", 16):  # [] once closed
                     if not isinstance(sample, HandState_):  # an InvalidSample: the hand's writer went away
                         continue
                     now = time.monotonic()
@@ -231,7 +233,8 @@ class Dex3HandLink:
             with self._lock:
                 commands = list(self._commands.items())
             for side, sample in commands:
-                self._writers[side].write(sample)
+                if not self._dds.write(f"writer:{side}", sample):  # closed
+                    return
                 with self._lock:
                     self._sent[side] += 1
             next_t += self.command_period_s

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from g1_control.errors import NetworkInterfaceError
-from g1_control.hardware.links.dds import domain_participant, import_cyclonedds
+from g1_control.hardware.links.dds import DdsEntities, domain_participant, import_cyclonedds
 from g1_control.hardware.links.network import LOOPBACK
 from g1_control.robot import dex3
 from g1_control.types import FingerCommand, FingerState
@@ -125,13 +125,20 @@ class Dex3HandsEmulator:
         self.hands = {s: EmulatedHand(s) for s in sides}
         self.period_s = 1.0 / state_rate_hz
         self.rng = np.random.default_rng(seed)
-        participant = domain_participant(interface, domain_id)
-        group_qos = Qos(Policy.Partition([partition])) if partition else None
-        pub, sub = Publisher(participant, qos=group_qos), Subscriber(participant, qos=group_qos)
-        self._writers = {s: DataWriter(pub, Topic(participant, dex3.state_topic(s), HandState_)) for s in sides}
-        self._readers = {s: DataReader(sub, Topic(participant, dex3.cmd_topic(s), HandCmd_),
-                                       qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(4)))
-                         for s in sides}
+        self.sides = sides
+        # Made, used and deleted under the process-wide DDS entity lock (hardware/links/dds.py: DdsEntities);
+        # closed at interpreter exit if nobody closed the emulator.
+        self._dds = DdsEntities(on_exit=self.close)
+        with self._dds.lock():
+            participant = self._dds.add("participant", domain_participant(interface, domain_id))
+            group_qos = Qos(Policy.Partition([partition])) if partition else None
+            pub = self._dds.add("publisher", Publisher(participant, qos=group_qos))
+            sub = self._dds.add("subscriber", Subscriber(participant, qos=group_qos))
+            for s in sides:
+                self._dds.add(f"writer:{s}", DataWriter(pub, Topic(participant, dex3.state_topic(s), HandState_)))
+                self._dds.add(f"reader:{s}", DataReader(sub, Topic(participant, dex3.cmd_topic(s), HandCmd_),
+                                                        qos=Qos(Policy.Reliability.BestEffort,
+                                                                Policy.History.KeepLast(4))))
         self.frozen: set[str] = set()
         self.silent: set[str] = set()
         self.miscalibrated: set[str] = set()
@@ -201,8 +208,7 @@ class Dex3HandsEmulator:
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=2.0)
-        self._writers.clear()
-        self._readers.clear()
+        self._dds.close()  # a thread that outlived the join finds the entities closed: no take, no write
 
     def _run(self) -> None:
         last, behind_s = time.monotonic(), 0.0
@@ -231,8 +237,8 @@ class Dex3HandsEmulator:
         from g1_control.hardware.unitree.hand_idl import HandCmd_
         from g1_control.hardware.unitree.hand_messages import handcmd_to_finger_command
 
-        for side, reader in list(self._readers.items()):
-            for sample in reader.take(N=8):
+        for side in self.sides:
+            for sample in self._dds.take(f"reader:{side}", 8):  # [] once closed
                 if not isinstance(sample, HandCmd_):  # an InvalidSample: a writer went away
                     continue
                 try:
@@ -250,7 +256,7 @@ class Dex3HandsEmulator:
     def _publish(self) -> None:
         from g1_control.hardware.unitree.hand_messages import finger_state_to_handstate
 
-        for side, writer in list(self._writers.items()):
+        for side in self.sides:
             with self._lock:
                 if side in self.silent:
                     continue
@@ -272,5 +278,6 @@ class Dex3HandsEmulator:
                         self._frozen_sample[side] = sample
                 else:
                     sample = frozen
-            writer.write(sample)
+            if not self._dds.write(f"writer:{side}", sample):  # closed
+                return
             self.states_sent[side] += 1

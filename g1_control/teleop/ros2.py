@@ -75,18 +75,23 @@ class Ros2Bridge(InputDevice):
         from cyclonedds.sub import DataReader, Subscriber
         from cyclonedds.topic import Topic
 
-        from g1_control.hardware.links.dds import domain_participant
+        from g1_control.hardware.links.dds import DdsEntities, domain_participant
         from g1_control.hardware.ros2 import messages as m
 
         self.limits, self.stale_after_s, self.period_s = limits, float(stale_after_s), 1.0 / float(publish_hz)
         self._m = m
-        self._participant: Any = domain_participant(interface, domain)
-        group = Qos(Policy.Partition([partition])) if partition else None
-        sub, pub = Subscriber(self._participant, qos=group), Publisher(self._participant, qos=group)
-        self._twist = DataReader(sub, Topic(self._participant, m.TOPIC_PREFIX + cmd_vel, m.Twist_))
-        self._joints = DataWriter(pub, Topic(self._participant, m.TOPIC_PREFIX + "joint_states", m.JointState_))
-        self._odom = DataWriter(pub, Topic(self._participant, m.TOPIC_PREFIX + "odom", m.Odometry_))
-        self._tf = DataWriter(pub, Topic(self._participant, m.TOPIC_PREFIX + "tf", m.TFMessage_))
+        # Made, used and deleted under the process-wide DDS entity lock (hardware/links/dds.py: DdsEntities);
+        # closed at interpreter exit if nobody closed the bridge.
+        self._dds = DdsEntities()
+        with self._dds.lock():
+            participant = self._dds.add("participant", domain_participant(interface, domain))
+            group = Qos(Policy.Partition([partition])) if partition else None
+            sub = self._dds.add("subscriber", Subscriber(participant, qos=group))
+            pub = self._dds.add("publisher", Publisher(participant, qos=group))
+            self._dds.add("twist", DataReader(sub, Topic(participant, m.TOPIC_PREFIX + cmd_vel, m.Twist_)))
+            for name, topic, message in (("joints", "joint_states", m.JointState_), ("odom", "odom", m.Odometry_),
+                                         ("tf", "tf", m.TFMessage_)):
+                self._dds.add(name, DataWriter(pub, Topic(participant, m.TOPIC_PREFIX + topic, message)))
         self._lock = threading.Lock()
         self._velocity = (0.0, 0.0, 0.0)
         self._received_s = -math.inf
@@ -100,7 +105,7 @@ class Ros2Bridge(InputDevice):
 
     # -- in -------------------------------------------------------------------------------------------
     def poll(self, now_s: float) -> Command:
-        for twist in self._twist.take(64):
+        for twist in self._dds.take("twist", 64):  # [] once closed
             if not hasattr(twist, "linear"):
                 continue  # a sample-less info (writer gone)
             values = (twist.linear.x, twist.linear.y, twist.angular.z)
@@ -138,9 +143,9 @@ class Ros2Bridge(InputDevice):
         self._next_publish_s = t_s + self.period_s
         m = self._m
         stamp = m.stamp(t_s)
-        self._joints.write(m.JointState_(m.Header_(stamp, BASE_FRAME), self._names,
-                                         [float(v) for v in state.q_rad], [float(v) for v in state.dq_radps],
-                                         [float(v) for v in state.tau_nm]))
+        self._dds.write("joints", m.JointState_(m.Header_(stamp, BASE_FRAME), self._names,
+                                              [float(v) for v in state.q_rad],
+                                              [float(v) for v in state.dq_radps], [float(v) for v in state.tau_nm]))
         quat = estimate.base_quat_wxyz if estimate is not None else state.imu_quat_wxyz
         w, x, y, z = (float(v) for v in quat)
         orientation = m.Quaternion_(x, y, z, w)
@@ -153,9 +158,9 @@ class Ros2Bridge(InputDevice):
         odom = m.Odometry_(m.Header_(stamp, ODOM_FRAME), BASE_FRAME)
         odom.pose.pose = m.Pose_(m.Point_(px, py, pz), orientation)
         odom.twist.twist = m.Twist_(m.Vector3_(vx, vy, 0.0), m.Vector3_(wx, wy, wz))
-        self._odom.write(odom)
-        self._tf.write(m.TFMessage_([m.TransformStamped_(m.Header_(stamp, ODOM_FRAME), BASE_FRAME,
-                                                         m.Transform_(m.Vector3_(px, py, pz), orientation))]))
+        self._dds.write("odom", odom)
+        self._dds.write("tf", m.TFMessage_([m.TransformStamped_(m.Header_(stamp, ODOM_FRAME), BASE_FRAME,
+                                                                m.Transform_(m.Vector3_(px, py, pz), orientation))]))
         return True
 
     def _integrate(self, estimate: EstimatedState) -> None:
@@ -169,7 +174,6 @@ class Ros2Bridge(InputDevice):
             self._position_w_m[2] = estimate.pelvis_height_m
 
     def close(self) -> None:
-        # Entities are reclaimed with the participant; dropping the references is enough (as DdsLink does).
-        if self._participant is not None:
-            del self._twist, self._joints, self._odom, self._tf
-            self._participant = None
+        """Delete the bridge's entities under the process-wide DDS entity lock (afterwards a poll reads no
+        Twist and nothing is published)."""
+        self._dds.close()

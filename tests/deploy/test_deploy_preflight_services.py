@@ -60,8 +60,11 @@ class _Service:
     clock: ClassVar[list] = [0.0]
     answer: ClassVar[object] = ""
 
+    instances: ClassVar[list] = []
+
     def __init__(self, participant, partition=None, timeout_s=1.0):
         self.made.append((participant, partition, timeout_s))
+        self.instances.append(self)
         self.asked: list[str] = []
         self.timeout_s = timeout_s
 
@@ -76,6 +79,9 @@ class _Service:
     def release_mode(self):  # never: the preflight only asks
         raise AssertionError("the preflight released the motion service")
 
+    def close(self):
+        self.asked.append("close")
+
 
 @pytest.fixture
 def service(monkeypatch):
@@ -85,7 +91,7 @@ def service(monkeypatch):
     now = [10.0]
     monkeypatch.setattr(pf_module, "time", SimpleNamespace(monotonic=lambda: now[0],
                                                            sleep=lambda s: now.__setitem__(0, now[0] + s)))
-    _Service.made = []
+    _Service.made, _Service.instances = [], []
     _Service.clock = now
     _Service.answer = ""
     monkeypatch.setattr(motion_service, "MotionServiceClient", _Service)
@@ -97,7 +103,10 @@ SILENT = MotionServiceError("the robot's motion service did not answer api 1001 
 
 def _ask(launch, link=None):
     pf = Preflight(frozenset({"motion_service"}))  # overridden where it may be: every refusal below may not
+    made = len(_Service.made)
     ok = pf.check_motion_service(SimpleNamespace(link=link or _DdsLink()), launch)
+    asked = [client.asked for client in _Service.instances[made:]]
+    assert all(a == ["check_mode", "close"] for a in asked), f"each client asked once, then closed: {asked}"
     return ok, pf.results["motion_service"]
 
 

@@ -111,3 +111,52 @@ def test_g1_launch_ends_an_ik_without_solutions_as_a_fault_with_no_traceback(tmp
     kinds = [(r["kind"], r["trips"], round(r["t_s"], 3)) for r in lines if r.get("type") == "safety"]
     assert kinds[:2] == [("ik_hold", False, 0.5), ("ik_failure", True, 0.54)], kinds
     assert code == 1  # the damped robot then falls (g1 launch exits 1 on a fall)
+
+
+# -- g1 launch's exit status: clean 0, a trip without a fall 3, a fall 1 ------------------------------------
+def _g1_launch(tmp_path, *extra: str) -> tuple[int, dict]:
+    from g1_control.cli.main import main
+
+    code = main(["launch", str(LAUNCH_DIR / "sim_walk.yaml"), "--set", "generator.type=interpolation",
+                 "--set", "output.plot=false", "--out", str(tmp_path), "--no-video", "--quiet", "--viewer", "off",
+                 *extra])
+    [run_dir] = [p for p in tmp_path.iterdir() if p.is_dir()]
+    return code, json.loads((run_dir / "summary.json").read_text())
+
+
+def test_g1_launch_exits_0_on_a_clean_run(tmp_path):
+    code, summary = _g1_launch(tmp_path, "--duration", "1.0")
+    assert summary["status"] == "completed" and not summary["fell"], summary["end_reason"]
+    assert code == 0
+
+
+def test_g1_launch_exits_3_on_a_trip_without_a_fall(tmp_path, monkeypatch):
+    """The IK fails for good from its 26th tick: ik_failure trips at 0.54 s and the run ends at 0.7 s,
+    too soon for the damped robot to fall. Before, this exited 0 like a clean run."""
+    from g1_control.cli.launch_cmd import EXIT_TRIPPED
+
+    _IKFault(monkeypatch, after=25)
+    code, summary = _g1_launch(tmp_path, "--set", "safety.ik_hold_ticks=2", "--duration", "0.7")
+    assert summary["status"] == "fault" and summary["end_reason"].startswith("ik_failure: "), summary["end_reason"]
+    assert not summary["fell"], summary["fall"]
+    assert code == EXIT_TRIPPED == 3
+
+
+def test_the_exit_status_puts_a_fall_before_a_trip_and_a_trip_before_a_missed_goal(tripped):
+    """On the real tripped run's result (a joint over-speed trip, then the damped robot falls), with its
+    fall, trip and goals taken out or added one at a time."""
+    from g1_control.cli.launch_cmd import EXIT_FAILED, EXIT_OK, EXIT_TRIPPED, exit_status
+
+    _launch, result = tripped
+    no_fall = dataclasses.replace(result, fell=False, fall=None)
+    not_a_trip = [dict(e, trips=False) for e in result.events]
+    planned = [dict(e, planned=True) for e in result.events]
+    missed = {"goals": [{"name": "pick box", "status": "timeout"}]}
+    reached = {"goals": [{"name": "pick box", "status": "reached"}]}
+    assert exit_status(result) == EXIT_FAILED  # a fall, whatever tripped before it
+    assert exit_status(no_fall) == EXIT_TRIPPED
+    assert exit_status(dataclasses.replace(no_fall, extra=missed)) == EXIT_TRIPPED
+    assert exit_status(dataclasses.replace(no_fall, events=not_a_trip, extra=missed)) == EXIT_FAILED
+    assert exit_status(dataclasses.replace(no_fall, events=not_a_trip, extra=reached)) == EXIT_OK
+    assert exit_status(dataclasses.replace(no_fall, events=planned)) == EXIT_OK  # a planned ending is no fault
+    assert (EXIT_OK, EXIT_FAILED, EXIT_TRIPPED) == (0, 1, 3)

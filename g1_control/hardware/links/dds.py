@@ -90,6 +90,8 @@ emulator's state write while a host link closed). Uncontended it costs well unde
 
 _open_links: weakref.WeakSet[DdsLink] = weakref.WeakSet()
 """The links of this process not closed yet (closed at exit by _close_links_at_exit)."""
+_open_owners: weakref.WeakSet[DdsEntities] = weakref.WeakSet()
+"""The other owners of Cyclone entities not closed yet (DdsEntities: Dex3 hands, motion service, ROS 2)."""
 _exiting = False
 """Set at interpreter exit: a send on a link closed by the exit hook is dropped instead of raising."""
 
@@ -100,15 +102,119 @@ def _close_links_at_exit() -> None:
     threads (a link backend's 500 Hz writer, an emulator's state stream) may still write on them:
     deleting entities while another thread writes on the same domain has crashed this process before
     (see _ENTITY_LOCK). Closed here under that lock, the links' threads no longer reach Cyclone.
-    (CI's timing pass segfaulted once at exit after all its tests passed, stop 34.)"""
+    (CI's timing pass segfaulted once at exit after all its tests passed, stop 34.)
+    The other owners (DdsEntities) close first: some use a link's participant (the motion-service
+    emulator beside the emulated robot's link), which closing the link deletes."""
     global _exiting
     with _ENTITY_LOCK:
         _exiting = True
+    for owner in list(_open_owners):
+        owner.close_at_exit()
     for link in list(_open_links):
         link.close()
 
 
 atexit.register(_close_links_at_exit)
+
+
+class DdsEntities:
+    """The Cyclone entities (participant, topics, publishers, writers, readers, waitsets, conditions)
+    of one owner besides a DdsLink: the Dex3 hands' link and emulator, the motion service's client and
+    emulator, the ROS 2 bridge and topics. Like a DdsLink's, they are made, written, taken and deleted
+    under the process-wide _ENTITY_LOCK; once closed no call reaches Cyclone (a write is dropped, a
+    take is empty), so an owner's thread that outlived its join(timeout) stops touching them instead
+    of writing on deleted entities; an owner still open at interpreter exit is closed by
+    _close_links_at_exit (`on_exit`: the owner's own close, e.g. one that damps the hands first).
+
+        with entities.lock():            # making them: under the lock
+            entities.add("writer", DataWriter(...))
+            entities.attach("waitset", "condition")
+        entities.write("writer", sample)   # False (nothing sent) once closed
+        entities.take("reader", 16)        # [] once closed
+        entities.close()                   # under the lock: every entity deleted, newest first
+    """
+
+    def __init__(self, on_exit: Any = None):
+        """on_exit: a bound method of the owner (held weakly: an owner nobody holds is not kept alive)."""
+        self._entities: dict[str, Any] = {}
+        self._attached: list[tuple[str, str]] = []
+        self._closed = False
+        self._on_exit = weakref.WeakMethod(on_exit) if on_exit is not None else None
+        _open_owners.add(self)
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
+
+    def lock(self) -> threading.Lock:
+        """The lock to hold while the owner makes its entities (`with entities.lock(): ...`)."""
+        return _ENTITY_LOCK
+
+    def add(self, name: str, entity: Any) -> Any:
+        """Keep `entity` (call inside lock()); returns it."""
+        if self._closed:
+            raise TransportError(f"DDS entity '{name}' added after its owner closed")
+        self._entities[name] = entity
+        return entity
+
+    def attach(self, waitset: str, condition: str) -> None:
+        """Attach entity `condition` to waitset `waitset` (inside lock()); close() detaches it first."""
+        self._entities[waitset].attach(self._entities[condition])
+        self._attached.append((waitset, condition))
+
+    def get(self, name: str) -> Any:
+        """The entity `name` (TransportError once closed: for the owner's thread-less calls)."""
+        with _ENTITY_LOCK:
+            if self._closed:
+                raise TransportError(f"DDS entity '{name}' used after its owner closed")
+            return self._entities[name]
+
+    def write(self, name: str, sample: Any) -> bool:
+        """Write `sample` on writer `name` under the lock; False (nothing written) once closed."""
+        with _ENTITY_LOCK:
+            if self._closed:
+                return False
+            self._entities[name].write(sample)
+            return True
+
+    def take(self, name: str, n: int) -> list:
+        """Up to `n` samples of reader `name` under the lock; [] once closed."""
+        with _ENTITY_LOCK:
+            return [] if self._closed else list(self._entities[name].take(n))
+
+    def wait(self, name: str, timeout_s: float) -> None:
+        """Block on waitset `name` up to `timeout_s` (not under the lock, as DdsLink.receive waits);
+        returns at once once closed. The reference held while waiting is dropped under the lock."""
+        with _ENTITY_LOCK:
+            if self._closed:
+                return
+            waitset = self._entities[name]
+        try:
+            waitset.wait(int(timeout_s * 1e9))
+        finally:
+            with _ENTITY_LOCK:
+                del waitset
+
+    def close(self) -> bool:
+        """Delete every entity under the lock, newest first; False when already closed."""
+        with _ENTITY_LOCK:
+            if self._closed:
+                return False
+            self._closed = True
+            _open_owners.discard(self)
+            for waitset, condition in self._attached:
+                self._entities[waitset].detach(self._entities[condition])
+            while self._entities:
+                entity = self._entities.popitem()[1]
+                del entity
+        return True
+
+    def close_at_exit(self) -> None:
+        """What _close_links_at_exit calls: the owner's own close where it gave one, else close()."""
+        on_exit = self._on_exit() if self._on_exit is not None else None
+        if on_exit is not None and not self._closed:
+            on_exit()
+        self.close()
 
 
 class DdsLink(Link):
@@ -120,7 +226,7 @@ class DdsLink(Link):
                  history_depth: int = 32):
         super().__init__(side)
         self.interface, self.domain_id, self.partition = interface, int(domain_id), partition
-        participant = domain_participant(interface, self.domain_id)
+        import_cyclonedds()
         from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState, WaitSet
         from cyclonedds.pub import DataWriter, Publisher
         from cyclonedds.qos import Policy, Qos
@@ -129,22 +235,24 @@ class DdsLink(Link):
 
         from g1_control.hardware.unitree import idl as unitree_idl
 
-        cmd_topic = Topic(participant, LOWCMD_TOPIC, unitree_idl.LowCmd_)
-        state_topic = Topic(participant, LOWSTATE_TOPIC, unitree_idl.LowState_)
-        out_topic, in_topic = (cmd_topic, state_topic) if side == "host" else (state_topic, cmd_topic)
-        # A partition isolates concurrent test runs that share loopback and domain 1 on one host;
-        # the robot itself publishes in the default partition, so real use passes None.
-        group_qos = Qos(Policy.Partition([partition])) if partition else None
-        self._participant = participant
-        # LowCmd_ out and LowState_ in on the host side, the reverse on the robot side.
-        self._writer: DataWriter[Any] = DataWriter(Publisher(participant, qos=group_qos), out_topic)
-        self._reader: DataReader[Any] = DataReader(
-            Subscriber(participant, qos=group_qos), in_topic,
-            qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(history_depth)),
-        )
-        self._waitset = WaitSet(participant)
-        self._condition = ReadCondition(self._reader, SampleState.Any | ViewState.Any | InstanceState.Any)
-        self._waitset.attach(self._condition)
+        with _ENTITY_LOCK:  # made under the process-wide lock, as they are used and deleted
+            participant = domain_participant(interface, self.domain_id)
+            cmd_topic = Topic(participant, LOWCMD_TOPIC, unitree_idl.LowCmd_)
+            state_topic = Topic(participant, LOWSTATE_TOPIC, unitree_idl.LowState_)
+            out_topic, in_topic = (cmd_topic, state_topic) if side == "host" else (state_topic, cmd_topic)
+            # A partition isolates concurrent test runs that share loopback and domain 1 on one host;
+            # the robot itself publishes in the default partition, so real use passes None.
+            group_qos = Qos(Policy.Partition([partition])) if partition else None
+            self._participant = participant
+            # LowCmd_ out and LowState_ in on the host side, the reverse on the robot side.
+            self._writer: DataWriter[Any] = DataWriter(Publisher(participant, qos=group_qos), out_topic)
+            self._reader: DataReader[Any] = DataReader(
+                Subscriber(participant, qos=group_qos), in_topic,
+                qos=Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(history_depth)),
+            )
+            self._waitset = WaitSet(participant)
+            self._condition = ReadCondition(self._reader, SampleState.Any | ViewState.Any | InstanceState.Any)
+            self._waitset.attach(self._condition)
         self._depth = history_depth
         from cyclonedds._clayer import ddspy_take, ddspy_write
 

@@ -15,7 +15,8 @@ import math
 import re
 import time
 from dataclasses import dataclass
-from typing import Any
+
+from g1_control.hardware.links.dds import DdsEntities, domain_participant
 
 HISTORY_DEPTH = 64
 """Poses a reader keeps between takes (0.64 s of a 100 Hz motion capture, read every loop tick)."""
@@ -64,26 +65,27 @@ class PoseTopicReader:
         from cyclonedds.sub import DataReader, Subscriber
         from cyclonedds.topic import Topic
 
-        from g1_control.hardware.links.dds import domain_participant
         from g1_control.hardware.ros2 import messages as m
 
         problem = check_topic_name(topic)
         if problem:
             raise ValueError(f"external pose topic: {problem}")
         self.topic = topic
-        self._participant: Any = domain_participant(interface, domain)
-        # Every pose since the last take (DDS keeps only the latest by default): a late pose and a
-        # fresher one arriving together are each judged (the fusion refuses the stale one by name).
-        self._reader = DataReader(Subscriber(self._participant, qos=_group_qos(partition)),
-                                  Topic(self._participant, m.TOPIC_PREFIX + topic, m.PoseStamped_),
-                                  qos=Qos(Policy.History.KeepLast(HISTORY_DEPTH)))
+        self._dds = DdsEntities()  # made, taken and deleted under the process-wide DDS entity lock
+        with self._dds.lock():
+            participant = self._dds.add("participant", domain_participant(interface, domain))
+            # Every pose since the last take (DDS keeps only the latest by default): a late pose and a
+            # fresher one arriving together are each judged (the fusion refuses the stale one by name).
+            self._dds.add("reader", DataReader(Subscriber(participant, qos=_group_qos(partition)),
+                                               Topic(participant, m.TOPIC_PREFIX + topic, m.PoseStamped_),
+                                               qos=Qos(Policy.History.KeepLast(HISTORY_DEPTH))))
         self._seconds = m.seconds
         self.received = 0
 
     def take(self) -> list[PoseReading]:
         now = time.time()
         out = []
-        for msg in self._reader.take(HISTORY_DEPTH):
+        for msg in self._dds.take("reader", HISTORY_DEPTH):  # [] once closed
             if not hasattr(msg, "pose"):
                 continue  # a sample-less info (writer gone)
             stamp = self._seconds(msg.header.stamp)
@@ -93,9 +95,7 @@ class PoseTopicReader:
         return out
 
     def close(self) -> None:
-        if self._participant is not None:
-            del self._reader
-            self._participant = None
+        self._dds.close()
 
 
 class PoseTopicWriter:
@@ -106,7 +106,6 @@ class PoseTopicWriter:
         from cyclonedds.pub import DataWriter, Publisher
         from cyclonedds.topic import Topic
 
-        from g1_control.hardware.links.dds import domain_participant
         from g1_control.hardware.ros2 import messages as m
 
         problem = check_topic_name(topic)
@@ -114,23 +113,23 @@ class PoseTopicWriter:
             raise ValueError(f"pose topic: {problem}")
         self._m = m
         self.frame_id = frame_id
-        self._participant: Any = domain_participant(interface, domain)
-        self._writer = DataWriter(Publisher(self._participant, qos=_group_qos(partition)),
-                                  Topic(self._participant, m.TOPIC_PREFIX + topic, m.PoseStamped_))
+        self._dds = DdsEntities()  # made, written and deleted under the process-wide DDS entity lock
+        with self._dds.lock():
+            participant = self._dds.add("participant", domain_participant(interface, domain))
+            self._dds.add("writer", DataWriter(Publisher(participant, qos=_group_qos(partition)),
+                                               Topic(participant, m.TOPIC_PREFIX + topic, m.PoseStamped_)))
         self.sent = 0
 
     def write(self, stamp_s: float, position_m, quat_wxyz) -> None:
         m = self._m
         x, y, z = (float(v) for v in position_m)
         w, qx, qy, qz = (float(v) for v in quat_wxyz)
-        self._writer.write(m.PoseStamped_(m.Header_(m.stamp(stamp_s), self.frame_id),
-                                          m.Pose_(m.Point_(x, y, z), m.Quaternion_(qx, qy, qz, w))))
-        self.sent += 1
+        if self._dds.write("writer", m.PoseStamped_(m.Header_(m.stamp(stamp_s), self.frame_id),
+                                                    m.Pose_(m.Point_(x, y, z), m.Quaternion_(qx, qy, qz, w)))):
+            self.sent += 1  # not once closed
 
     def close(self) -> None:
-        if self._participant is not None:
-            del self._writer
-            self._participant = None
+        self._dds.close()
 
 
 @dataclass(frozen=True)
@@ -155,7 +154,8 @@ class PlatformsReading:
 
 
 def _perception_reader(interface: str, domain: int, topic: str, partition: str | None, message):
-    """(participant, DataReader) of `message` samples on rt/<topic> (keeps HISTORY_DEPTH between takes)."""
+    """The participant and DataReader ("reader") of `message` samples on rt/<topic> (keeps HISTORY_DEPTH between
+    takes), made under the process-wide DDS entity lock."""
     from cyclonedds.qos import Policy, Qos
     from cyclonedds.sub import DataReader, Subscriber
     from cyclonedds.topic import Topic
@@ -166,14 +166,18 @@ def _perception_reader(interface: str, domain: int, topic: str, partition: str |
     problem = check_topic_name(topic)
     if problem:
         raise ValueError(f"perception topic: {problem}")
-    participant = domain_participant(interface, domain)
-    reader = DataReader(Subscriber(participant, qos=_group_qos(partition)),
-                        Topic(participant, m.TOPIC_PREFIX + topic, message), qos=Qos(Policy.History.KeepLast(HISTORY_DEPTH)))
-    return participant, reader
+    entities = DdsEntities()
+    with entities.lock():
+        participant = entities.add("participant", domain_participant(interface, domain))
+        entities.add("reader", DataReader(Subscriber(participant, qos=_group_qos(partition)),
+                                          Topic(participant, m.TOPIC_PREFIX + topic, message),
+                                          qos=Qos(Policy.History.KeepLast(HISTORY_DEPTH))))
+    return entities
 
 
 def _perception_writer(interface: str, domain: int, topic: str, partition: str | None, message):
-    """(participant, DataWriter) of `message` samples on rt/<topic>."""
+    """The participant and DataWriter ("writer") of `message` samples on rt/<topic>, made under the process-wide
+    DDS entity lock."""
     from cyclonedds.pub import DataWriter, Publisher
     from cyclonedds.topic import Topic
 
@@ -183,9 +187,12 @@ def _perception_writer(interface: str, domain: int, topic: str, partition: str |
     problem = check_topic_name(topic)
     if problem:
         raise ValueError(f"perception topic: {problem}")
-    participant = domain_participant(interface, domain)
-    return participant, DataWriter(Publisher(participant, qos=_group_qos(partition)),
-                                   Topic(participant, m.TOPIC_PREFIX + topic, message))
+    entities = DdsEntities()
+    with entities.lock():
+        participant = entities.add("participant", domain_participant(interface, domain))
+        entities.add("writer", DataWriter(Publisher(participant, qos=_group_qos(partition)),
+                                          Topic(participant, m.TOPIC_PREFIX + topic, message)))
+    return entities
 
 
 def _xyz(p) -> tuple[float, float, float]:
@@ -205,15 +212,13 @@ class _PerceptionReader:
     def __init__(self, interface: str, domain: int, topic: str, partition: str | None = None):
         from g1_control.hardware.ros2 import messages as m
 
-        self._participant: Any
-        self._participant, self._reader = _perception_reader(interface, domain, topic, partition,
-                                                             getattr(m, self._message))
+        self._dds = _perception_reader(interface, domain, topic, partition, getattr(m, self._message))
         self._seconds = m.seconds
 
     def take(self) -> list:
         now = time.time()
         out = []
-        for msg in self._reader.take(HISTORY_DEPTH):
+        for msg in self._dds.take("reader", HISTORY_DEPTH):  # [] once closed
             if not hasattr(msg, self._field):
                 continue
             stamp = self._seconds(msg.header.stamp)
@@ -224,9 +229,7 @@ class _PerceptionReader:
         raise NotImplementedError
 
     def close(self) -> None:
-        if self._participant is not None:
-            del self._reader
-            self._participant = None
+        self._dds.close()
 
 
 class ObjectPosesReader(_PerceptionReader):
@@ -265,20 +268,16 @@ class _PerceptionWriter:
         from g1_control.hardware.ros2 import messages as m
 
         self._m = m
-        self._participant: Any
-        self._participant, self._writer = _perception_writer(interface, domain, topic, partition,
-                                                             getattr(m, self._message))
+        self._dds = _perception_writer(interface, domain, topic, partition, getattr(m, self._message))
         self.sent = 0
 
     def _send(self, stamp_s: float, *fields) -> None:
         m = self._m
-        self._writer.write(getattr(m, self._message)(m.Header_(m.stamp(stamp_s), "heading"), *fields))
-        self.sent += 1
+        if self._dds.write("writer", getattr(m, self._message)(m.Header_(m.stamp(stamp_s), "heading"), *fields)):
+            self.sent += 1  # not once closed
 
     def close(self) -> None:
-        if self._participant is not None:
-            del self._writer
-            self._participant = None
+        self._dds.close()
 
 
 class ObjectPosesWriter(_PerceptionWriter):

@@ -16,9 +16,9 @@ import json
 import logging
 import threading
 import time
-from typing import Any
 
 from g1_control.errors import MotionServiceError
+from g1_control.hardware.links.dds import DdsEntities
 
 log = logging.getLogger(__name__)
 
@@ -33,7 +33,9 @@ STATUS_OK = 0
 _ids = itertools.count(time.monotonic_ns())
 
 
-def _endpoints(participant, partition: str | None, serving: bool):
+def _endpoints(participant, partition: str | None, serving: bool) -> DdsEntities:
+    """The request/response writer ("writer") and reader ("reader"), made under the process-wide DDS
+    entity lock (hardware/links/dds.py: DdsEntities) on `participant`, which the caller owns."""
     from cyclonedds.pub import DataWriter, Publisher
     from cyclonedds.qos import Policy, Qos
     from cyclonedds.sub import DataReader, Subscriber
@@ -41,21 +43,27 @@ def _endpoints(participant, partition: str | None, serving: bool):
 
     from g1_control.hardware.unitree.idl import Request_, Response_
 
-    requests = Topic(participant, REQUEST_TOPIC, Request_)
-    responses = Topic(participant, RESPONSE_TOPIC, Response_)
-    group = Qos(Policy.Partition([partition])) if partition else None
-    reliable = Qos(Policy.Reliability.Reliable(1_000_000_000), Policy.History.KeepLast(16))
-    out_topic, in_topic = (responses, requests) if serving else (requests, responses)
-    # The sample type depends on the side (requests out and responses in, or the reverse).
-    writer: DataWriter[Any] = DataWriter(Publisher(participant, qos=group), out_topic, qos=reliable)
-    reader: DataReader[Any] = DataReader(Subscriber(participant, qos=group), in_topic, qos=reliable)
-    return writer, reader
+    entities = DdsEntities()
+    with entities.lock():
+        requests = Topic(participant, REQUEST_TOPIC, Request_)
+        responses = Topic(participant, RESPONSE_TOPIC, Response_)
+        group = Qos(Policy.Partition([partition])) if partition else None
+        reliable = Qos(Policy.Reliability.Reliable(1_000_000_000), Policy.History.KeepLast(16))
+        out_topic, in_topic = (responses, requests) if serving else (requests, responses)
+        # The sample type depends on the side (requests out and responses in, or the reverse).
+        entities.add("writer", DataWriter(Publisher(participant, qos=group), out_topic, qos=reliable))
+        entities.add("reader", DataReader(Subscriber(participant, qos=group), in_topic, qos=reliable))
+    return entities
 
 
 class MotionServiceClient:
     def __init__(self, participant, partition: str | None = None, timeout_s: float = 1.0):
-        self._writer, self._reader = _endpoints(participant, partition, serving=False)
+        self._dds = _endpoints(participant, partition, serving=False)
         self.timeout_s = timeout_s
+
+    def close(self) -> None:
+        """Delete the client's writer and reader (under the process-wide DDS entity lock)."""
+        self._dds.close()
 
     def call(self, api_id: int, parameter: str = "") -> tuple[int, str]:
         from g1_control.hardware.unitree.idl import (
@@ -72,10 +80,11 @@ class MotionServiceClient:
         # The first request may go out before discovery has matched the service; resend until
         # a response arrives or the time is up.
         while time.monotonic() < deadline:
-            self._writer.write(Request_(header, parameter, []))
+            if not self._dds.write("writer", Request_(header, parameter, [])):
+                raise MotionServiceError(f"motion service call (api {api_id}) on a closed client")
             resend_at = min(deadline, time.monotonic() + 0.1)
             while time.monotonic() < resend_at:
-                for response in self._reader.take(16):
+                for response in self._dds.take("reader", 16):
                     if getattr(response, "header", None) and response.header.identity.id == request_id:
                         return int(response.header.status.code), response.data
                 time.sleep(0.005)
@@ -106,15 +115,18 @@ def release_motion_service(participant, partition: str | None = None, timeout_s:
     client = MotionServiceClient(participant, partition, timeout_s=min(timeout_s, 2.0))
     released: list[str] = []
     deadline = time.monotonic() + timeout_s
-    while (name := client.check_mode()):
-        if time.monotonic() > deadline:
-            raise MotionServiceError(
-                f"the robot's motion service still runs '{name}' after {timeout_s:.0f} s of release requests; "
-                "stop it from the app or put the robot in debug mode with the remote")
-        log.info("releasing the robot's built-in controller '%s'", name)
-        client.release_mode()
-        released.append(name)
-        time.sleep(0.2)
+    try:
+        while (name := client.check_mode()):
+            if time.monotonic() > deadline:
+                raise MotionServiceError(
+                    f"the robot's motion service still runs '{name}' after {timeout_s:.0f} s of release requests; "
+                    "stop it from the app or put the robot in debug mode with the remote")
+            log.info("releasing the robot's built-in controller '%s'", name)
+            client.release_mode()
+            released.append(name)
+            time.sleep(0.2)
+    finally:
+        client.close()
     return released
 
 
@@ -124,7 +136,7 @@ class MotionServiceEmulator:
     def __init__(self, participant, partition: str | None = None, active_mode: str = "ai",
                  on_change=None):
         """on_change(active_mode) is called whenever a call changes the active mode."""
-        self._writer, self._reader = _endpoints(participant, partition, serving=True)
+        self._dds = _endpoints(participant, partition, serving=True)
         self.active_mode = active_mode
         self.on_change = on_change
         self.calls: list[int] = []
@@ -136,7 +148,7 @@ class MotionServiceEmulator:
         from g1_control.hardware.unitree.idl import Response_, ResponseHeader_, ResponseStatus_
 
         while not self._stop.wait(0.005):
-            for request in self._reader.take(16):
+            for request in self._dds.take("reader", 16):  # [] once closed
                 if not getattr(request, "header", None):
                     continue
                 api_id = int(request.header.identity.api_id)
@@ -154,8 +166,11 @@ class MotionServiceEmulator:
                 if self.active_mode != before and self.on_change is not None:
                     self.on_change(self.active_mode)
                 header = ResponseHeader_(request.header.identity, ResponseStatus_(code))
-                self._writer.write(Response_(header, data, []))
+                self._dds.write("writer", Response_(header, data, []))  # dropped once closed
 
     def close(self) -> None:
+        """Stop serving and delete the endpoints under the process-wide DDS entity lock: a serving thread
+        that outlives the join finds them closed (no take, no write) and ends at its next wait."""
         self._stop.set()
         self._thread.join(timeout=2.0)
+        self._dds.close()
