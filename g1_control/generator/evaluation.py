@@ -136,15 +136,19 @@ class Scores:
     penetration: float
 
 
-def score(method: Inbetweener, windows: Windows, stats: PositionStats, fps: float = 30.0,
-          batch: int = 256) -> Scores:
+def predict(method: Inbetweener, windows: Windows, batch: int = 256) -> np.ndarray:
+    """The method's gap frames (N, gap, D) for every window, full target keyframes, in batches."""
     mask = np.ones((len(windows.frames), F.DIM), dtype=bool)
     preds = []
     for a in range(0, len(windows.frames), batch):
         b = slice(a, a + batch)
         preds.append(method.infill(windows.context[b], windows.target[b], mask[b], windows.gap, windows.style[b]))
-    pred = np.concatenate(preds)
-    return score_predictions(method.name, pred, windows, stats, fps)
+    return np.concatenate(preds)
+
+
+def score(method: Inbetweener, windows: Windows, stats: PositionStats, fps: float = 30.0,
+          batch: int = 256) -> Scores:
+    return score_predictions(method.name, predict(method, windows, batch), windows, stats, fps)
 
 
 def score_predictions(name: str, pred: np.ndarray, windows: Windows, stats: PositionStats, fps: float) -> Scores:

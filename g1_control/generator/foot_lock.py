@@ -153,7 +153,8 @@ def lock_feet(frames: np.ndarray, context_last: np.ndarray, end: np.ndarray, end
         end_given = np.ones(b, dtype=bool)
     last = np.where(end_given[:, None], end, frames[:, -1])
     seq = np.concatenate([context_last[:, None], frames, last[:, None]], axis=1)  # (B, T + 2, D)
-    seq_pos, seq_rot = _leg_fk(seq[..., F.ROOT_POS], F.rot6d_to_matrix(seq[..., F.ROOT_ROT]), seq[..., 9:21])
+    seq_root_rot = F.rot6d_to_matrix(seq[..., F.ROOT_ROT])
+    seq_pos, seq_rot = _leg_fk(seq[..., F.ROOT_POS], seq_root_rot, seq[..., 9:21])
     feet, feet_rot = seq_pos[..., _LEG_BODY, :], seq_rot[..., _LEG_BODY, :, :]
     contact = feet[..., 2] < STANCE_ANKLE_Z_M + cfg.band_m  # (B, T + 2, 2)
     off = np.zeros(feet.shape[:-1] + (2,))
@@ -175,7 +176,7 @@ def lock_feet(frames: np.ndarray, context_last: np.ndarray, end: np.ndarray, end
     goal_rot = feet_rot[:, 1:-1]
     out = frames.copy()
     root_pos = out[..., F.ROOT_POS]
-    root_rot = F.rot6d_to_matrix(out[..., F.ROOT_ROT])
+    root_rot = seq_root_rot[:, 1:-1]
     legs = out[..., 9:21].copy()
     lo, hi = g1.Q_MIN_RAD[:12], g1.Q_MAX_RAD[:12]
     unit_axis = np.eye(3)[list(kinematic_tree().axis[:12])]  # (12, 3): each leg joint's axis, its own frame

@@ -50,16 +50,22 @@ def test_walks_forward_at_the_commanded_speed_without_falling():
     assert tracker.diagnostics.unsolved_ticks == 0
 
 
+def whole_strides_velocity(tracker, trace: np.ndarray, command_xy, t_from_s: float) -> np.ndarray:
+    """Ground-truth pelvis velocity (vx, vy, world) over three whole strides of the commanded walk from
+    t_from_s; the 5.6 s walk must not have fallen before 5.5 s."""
+    t, pos = trace[:, 0], trace[:, 1:4]
+    assert t[-1] > 5.5, f"fell at {t[-1]:.2f} s"
+    stride = 2 * step_duration_for(tracker.config.gait, np.array(command_xy))
+    a, b = np.searchsorted(t, t_from_s), np.searchsorted(t, t_from_s + 3 * stride)
+    return (pos[b, :2] - pos[a, :2]) / (t[b] - t[a])
+
+
 def test_walks_sideways_at_0_4_within_ten_percent():
     """Sideways 0.4 m/s (ground truth, whole strides): at the slow cadence within the slow width
     limit the gait allows 0.28 m/s at most (GaitConfig.speed_margin); the quicker, wider steps of
     fast walking (GaitConfig.fast_double_support_s, fast_max_width_m) leave the room for 0.4."""
     tracker, trace = walk((0.0, 0.4, 0.0), 5.6)
-    t, pos = trace[:, 0], trace[:, 1:4]
-    assert t[-1] > 5.5, f"fell at {t[-1]:.2f} s"
-    stride = 2 * step_duration_for(tracker.config.gait, np.array([0.0, 0.4]))
-    a, b = np.searchsorted(t, 3.0), np.searchsorted(t, 3.0 + 3 * stride)
-    velocity = (pos[b, :2] - pos[a, :2]) / (t[b] - t[a])
+    velocity = whole_strides_velocity(tracker, trace, (0.0, 0.4), 3.0)
     assert abs(velocity[1] - 0.4) < 0.04, f"walked {velocity[1]:.3f} m/s sideways for 0.4"
     assert abs(velocity[0]) < 0.05
     assert tracker.diagnostics.unsolved_ticks == 0
@@ -128,11 +134,7 @@ def test_walks_forward_at_1_0_within_ten_percent():
     """Forward 1.0 m/s (ground truth, whole strides): the crouch that grows with speed stops at
     WbcConfig.walking_com_lower_speed_cap_mps; crouched further (uncapped) the robot walked 0.85 m/s."""
     tracker, trace = walk((1.0, 0.0, 0.0), 5.6)
-    t, pos = trace[:, 0], trace[:, 1:4]
-    assert t[-1] > 5.5, f"fell at {t[-1]:.2f} s"
-    stride = 2 * step_duration_for(tracker.config.gait, np.array([1.0, 0.0]))
-    a, b = np.searchsorted(t, 3.2), np.searchsorted(t, 3.2 + 3 * stride)
-    velocity = (pos[b, :2] - pos[a, :2]) / (t[b] - t[a])
+    velocity = whole_strides_velocity(tracker, trace, (1.0, 0.0), 3.2)
     assert abs(velocity[0] - 1.0) < 0.1, f"walked {velocity[0]:.3f} m/s forward for 1.0"
     assert abs(velocity[1]) < 0.05
     assert tracker.diagnostics.unsolved_ticks == 0
