@@ -30,7 +30,9 @@ def register(subparsers) -> None:
         '  g1 say "take three steps back and turn around" --dry-run      # the program only\n'
         '  g1 say "walk forward 1 m while waving" --video                 # run folder with video.mp4\n'
         '  g1 say "walk to the door" --launch my_room.yaml                # places from a launch file\n'
-        "exit status: 0 every step met by ground truth and no fall; 1 otherwise (or a refused instruction)",
+        "exit status (as g1 launch's): 0 every step met by ground truth, no fall, no safety trip; 1 a fall\n"
+        "(whatever tripped before), a step missed, or a refused instruction; 3 the safety layer tripped\n"
+        "(damping) and the robot did not fall",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("instruction", help="the instruction, in quotes")
@@ -123,5 +125,19 @@ def _run(args) -> int:
 
         args.json.write_text(json.dumps({"instruction": args.instruction, "program": program.to_dict(),
                                          "fell": result.fell, **summary}, indent=2, default=float) + "\n")
+    return say_exit_status(result, summary)
+
+
+def say_exit_status(result, summary: dict) -> int:
+    """g1 launch's exit status (cli/launch_cmd.py) for a program run: EXIT_FAILED on a fall (whatever tripped
+    before it), else EXIT_TRIPPED on an unplanned safety trip, else EXIT_FAILED when the program did not
+    finish or a step was missed by ground truth, else EXIT_OK."""
+    from g1_control.cli.launch_cmd import EXIT_FAILED, EXIT_OK, EXIT_TRIPPED
+    from g1_control.loop.control_loop import first_fault
+
+    if result.fell:
+        return EXIT_FAILED
+    if first_fault(result.events) is not None:
+        return EXIT_TRIPPED
     met = all(s.get("verdict", {}).get("ok", s["status"] == "completed") for s in summary["steps"])
-    return 0 if (summary["finished"] and met and not result.fell) else 1
+    return EXIT_OK if (summary["finished"] and met) else EXIT_FAILED

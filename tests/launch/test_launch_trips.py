@@ -160,3 +160,24 @@ def test_the_exit_status_puts_a_fall_before_a_trip_and_a_trip_before_a_missed_go
     assert exit_status(dataclasses.replace(no_fall, events=not_a_trip, extra=reached)) == EXIT_OK
     assert exit_status(dataclasses.replace(no_fall, events=planned)) == EXIT_OK  # a planned ending is no fault
     assert (EXIT_OK, EXIT_FAILED, EXIT_TRIPPED) == (0, 1, 3)
+
+
+def test_g1_say_exits_as_g1_launch_does_fall_first_then_trip_then_a_missed_step(tripped):
+    """g1 say's exit status on the same real tripped run (before, a trip without a fall exited 1, as a
+    missed step does, not 3)."""
+    from g1_control.cli.launch_cmd import EXIT_FAILED, EXIT_OK, EXIT_TRIPPED
+    from g1_control.cli.say_cmd import say_exit_status
+
+    _launch, result = tripped
+    no_fall = dataclasses.replace(result, fell=False, fall=None)
+    not_a_trip = [dict(e, trips=False) for e in result.events]
+    done = {"finished": True, "steps": [{"status": "completed", "verdict": {"ok": True}}]}
+    missed = {"finished": True, "steps": [{"status": "completed", "verdict": {"ok": False}}]}
+    unfinished = {"finished": False, "steps": [{"status": "completed"}]}
+    assert say_exit_status(result, done) == EXIT_FAILED  # a fall, whatever tripped before it
+    assert say_exit_status(no_fall, done) == EXIT_TRIPPED
+    assert say_exit_status(no_fall, missed) == EXIT_TRIPPED
+    clean = dataclasses.replace(no_fall, events=not_a_trip)
+    assert say_exit_status(clean, missed) == EXIT_FAILED
+    assert say_exit_status(clean, unfinished) == EXIT_FAILED
+    assert say_exit_status(clean, done) == EXIT_OK
