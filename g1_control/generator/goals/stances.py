@@ -175,7 +175,19 @@ KNEE_HEIGHT_M = 0.35
 MIN_EDGE_CLEARANCE_M = 0.18
 """The pelvis stays this far from a support whose top is above the knees: issue 17's measured rule
 (box.MIN_EDGE_CLEARANCE_M); closer, the stepping-in knees met 0.53-0.63 m tables and the robot fell
-(g1 bench objects seed 8, measured)."""
+(g1 bench objects seed 8, measured). Not for a top the legs pass under (ABOVE_LEGS_M): there only the
+trunk can meet it (TRUNK_EDGE_CLEARANCE_M)."""
+ABOVE_LEGS_M = 0.02
+"""A table whose top's underside is this much or more above the pelvis (the hold pose's) is above the
+legs: the thighs, knees and shins stay below the pelvis stepping in (the stepping knee rises to
+~0.55 m), so they pass under its top and the knee and pelvis rules above do not apply; the 0.80-0.95 m
+tables (bench objects' "high") have their underside at 0.76-0.91 m, the standing pelvis at 0.756 m."""
+TRUNK_EDGE_CLEARANCE_M = 0.15
+"""The pelvis stays this far from a top above the legs: the trunk's widest at the top's height
+(pelvis to chest, 0.76-1.2 m standing) is 0.11 m from the pelvis's axis (the G1's collision meshes,
+measured in the nominal pose), plus 4 cm: the steps end within 3 cm of the planned stance (the grasp
+refuses beyond) and the trunk sways ~1 cm. With the 0.18 m rule, bench objects seeds 9-16 refused 11
+of 25 picks from 0.80-0.95 m tables, 4 of them at 0.15-0.18 m."""
 
 
 @dataclass
@@ -515,10 +527,11 @@ class StancePlanner:
         pos = {n: ik.data.oMf[f].translation for n, f in self._frames.items()}
         if support is not None and support.height_m > KNEE_HEIGHT_M:
             gap = support.distance_xy(q[:2])
-            if gap < MIN_EDGE_CLEARANCE_M:
-                return (f"the pelvis is {gap:.2f} m from '{support.name}' (stepping in needs "
-                        f">= {MIN_EDGE_CLEARANCE_M:.2f} m)")
-            for side in ("left", "right"):
+            above_legs = support.height_m - TABLE_TOP_THICKNESS_M - float(q[2]) >= ABOVE_LEGS_M
+            need = TRUNK_EDGE_CLEARANCE_M if above_legs else MIN_EDGE_CLEARANCE_M
+            if gap < need:
+                return f"the pelvis is {gap:.2f} m from '{support.name}' (stepping in needs >= {need:.2f} m)"
+            for side in () if above_legs else ("left", "right"):
                 knee_gap = support.distance_xy(pos[f"{side}_knee_link"][:2])
                 if knee_gap < KNEE_EDGE_CLEARANCE_M:
                     return (f"the {side} knee is {knee_gap:.2f} m from under '{support.name}' (stepping in needs "
@@ -601,6 +614,8 @@ def release_hold_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], he
     return q_above, down_pose.q, q_open, q_out, q_stand
 
 
+RAISE_AHEAD_M = 0.10
+"""Hands rise (and come back) this far ahead of the soles' middle, above the box, on their way to it."""
 CLEAR_MARGIN_M = 0.02
 """A hand (or a held box) moving past a support keeps this far from its outline, and a hand 1 cm
 above its top (CLEAR_ABOVE_M) or below its underside less this."""
@@ -694,6 +709,50 @@ def detour_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: li
     return best[1]
 
 
+def hands_rise_blocked(poses: PosePlanner, mid_xy: np.ndarray, heading: float, ground_z: float, grasp_w: np.ndarray,
+                       width_m: float, gap_m: float, block: Block, arms: np.ndarray) -> bool:
+    """Whether, standing at the stance (soles' middle mid_xy, facing heading) with the arms at `arms`
+    (the joints the robot steps in with), the hands find no way up to the pick's "via" points
+    (beside the box, RAISE_AHEAD_M ahead of the soles, 8 cm above the grasp point grasp_w) past
+    `block`'s top: every way `detour_poses` tries passes through it; checked at the stance and where
+    the steps may end instead (STANCE_SLACK_M nearer the box or to either side, STANCE_SLACK_RAD
+    turned): near the edge it depends on a centimetre (seed 11 trial 0: clear at the stance, blocked
+    3 cm to its right, and refused in physics)."""
+    fwd = np.array([math.cos(heading), math.sin(heading)])
+    side = np.array([-fwd[1], fwd[0]])
+    mid = np.asarray(mid_xy, dtype=float)
+    ends = [(mid, heading), (mid + STANCE_SLACK_M * fwd, heading), (mid + STANCE_SLACK_M * side, heading),
+            (mid - STANCE_SLACK_M * side, heading), (mid, heading + STANCE_SLACK_RAD),
+            (mid, heading - STANCE_SLACK_RAD)]
+    return any(_rise_blocked(poses, m, h, ground_z, grasp_w, width_m, gap_m, block, arms) for m, h in ends)
+
+
+STANCE_SLACK_M = 0.03
+"""The steps end within this of the planned stance (the grasp refuses beyond)."""
+STANCE_SLACK_RAD = 0.05
+"""... and turned this much (correct_stance's heading tolerance)."""
+
+
+def _rise_blocked(poses: PosePlanner, mid_xy: np.ndarray, heading: float, ground_z: float, grasp_w: np.ndarray,
+                  width_m: float, gap_m: float, block: Block, arms: np.ndarray) -> bool:
+    planner = stance_planner(poses)
+    q, soles = planner.stance(mid_xy, heading, ground_z)
+    q[7:] = arms
+    q = poses.stand(q, soles, ground_z + poses.nominal_pelvis_m, arms)
+    soles = flat_soles(poses.ik, q)
+    fwd = np.array([math.cos(heading), math.sin(heading)])
+    ahead = float((np.asarray(grasp_w[:2]) - np.asarray(mid_xy)) @ fwd)
+    via = hand_points(np.asarray(grasp_w, dtype=float), heading, width_m, gap_m + 0.03, dz_m=0.08,
+                      ahead_m=-(ahead - RAISE_AHEAD_M))
+    q_via = planner.hold(q, soles, via, heading, np.zeros(2), float(q[2]), UPRIGHT).q
+    try:
+        detour_poses(poses, q, q_via, soles, heading, np.zeros(2), float(q[2]), UPRIGHT, block,
+                     block.height_m + 2 * CLEAR_MARGIN_M, (), True, True)
+    except StanceRefused:
+        return True
+    return False
+
+
 def raised_pose(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float, dz_m: float,
                 shift: np.ndarray, pelvis_z: float) -> HoldPose:
     """The hold pose with both hands dz_m above where they are in q0 (a held box raised), upright."""
@@ -754,5 +813,5 @@ def place_heading(support: Block | None, xy: np.ndarray, robot_xy: np.ndarray) -
 
 
 __all__ = ["DEEP", "LEAN", "STAND_LEAN", "UPRIGHT", "Candidate", "StancePlan", "StancePlanner", "StanceRefused", "box_com_shift", "detour_poses", "edge_normal",
-           "face_normals", "grasp_hold_poses", "hand_height", "path_meets", "pick_headings", "place_heading", "plan_stance",
+           "face_normals", "grasp_hold_poses", "hand_height", "hands_rise_blocked", "path_meets", "pick_headings", "place_heading", "plan_stance",
            "raised_pose", "release_hold_poses", "stance_planner"]
