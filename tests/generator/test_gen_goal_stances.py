@@ -294,3 +294,35 @@ def test_a_high_tables_top_still_keeps_the_trunk_off(stances):
     assert near.distance_xy(q[:2]) < 0.15
     assert re.search(r"the pelvis is 0\.1\d m from 'table_a' \(stepping in needs >= 0\.15 m\)",
                      stances.collision(q, SEED11_0_BOX, center, near) or "")
+
+
+# bench objects seed 12 trial 9: a 4.9 kg box on a 0.92 m table, the stance's pelvis 0.155 m from
+# its edge and the table's edge running aslant: the left hand hangs under the top. Straight up, or
+# across below, it rises through the top; drawn back clear of the outline first, it goes around
+SEED12_9_TABLE = Table("table_a", (1.7162, 0.3425), (0.8336, 0.6), 0.9244, -2.6604)
+SEED12_9_BOX = Box("box", (1.5486, 0.3162), stands_on="table_a", size_m=(0.4306, 0.1781, 0.1681), mass_kg=4.94,
+                   yaw_rad=-2.9733)
+
+
+def test_hands_hanging_under_a_high_tables_top_are_drawn_back_before_they_rise(stances):
+    center, plan = _plan_pick(stances, SEED12_9_TABLE, SEED12_9_BOX)
+    h = plan.chosen.heading
+    q0, soles = stances.stance(plan.approach.mid_xy, h, 0.0)
+    q0[7:] = ARMS_BACK
+    q0 = stances.poses.stand(q0, soles, stances.poses.nominal_pelvis_m, ARMS_BACK)
+    soles = flat_soles(stances.ik, q0)
+    hands = [stances.poses.hand_point(q0, i) for i in range(2)]
+    assert min(SEED12_9_TABLE.distance_xy(p[:2]) for p in hands) < 0.02  # a hand under the top's edge
+    c = center + np.array([0.0, 0.0, plan.hand_dz_m])
+    ahead = float((c[:2] - plan.approach.mid_xy) @ np.array([math.cos(h), math.sin(h)]))
+    via = hand_points(c, h, plan.width_m, 0.095, dz_m=0.08, ahead_m=-(ahead - 0.10))  # handling.pick's "via"
+    (q_via,) = grasp_hold_poses(stances.poses, q0, soles, h, [("via", via, np.zeros(2), q0[2], 0)], "box", "")
+    around = detour_poses(stances.poses, q0, q_via, soles, h, np.zeros(2), q0[2], 0, SEED12_9_TABLE,
+                          SEED12_9_TABLE.height_m + 0.04, (), True, True)
+    path = [q0, *around, q_via]
+    assert not any(path_meets(stances.poses, a, b, h, SEED12_9_TABLE) for a, b in pairwise(path))
+    # the hands went back (against the heading) before rising past the top's height
+    fwd = np.array([math.cos(h), math.sin(h)])
+    low = [q for q in around if min(stances.poses.hand_point(q, i)[2] for i in range(2)) < SEED12_9_TABLE.height_m]
+    assert min(float((stances.poses.hand_point(q, 0)[:2] - q0[:2]) @ fwd) for q in low) < \
+        float((hands[0][:2] - q0[:2]) @ fwd) - 0.05

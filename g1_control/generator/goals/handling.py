@@ -27,11 +27,9 @@ from g1_control.generator.goals.context import GoalContext, GoalFailed, Held
 from g1_control.generator.goals.poses import PosePlanner, ReachRefused, flat_soles, stance_heading
 from g1_control.generator.goals.stances import (
     CLEAR_MARGIN_M,
-    RAISE_AHEAD_M,
     box_com_shift,
     detour_poses,
     grasp_hold_poses,
-    hands_rise_blocked,
     pick_headings,
     place_heading,
     plan_stance,
@@ -59,12 +57,8 @@ measured)."""
 for _side in ("left", "right"):
     ARMS_BACK[g1.JOINT_INDEX[f"{_side}_shoulder_pitch_joint"]] = 0.6
     ARMS_BACK[g1.JOINT_INDEX[f"{_side}_elbow_joint"]] = 0.4
-HANDS_UP_FIRST = True
-"""A pick from a support at standing height whose hands, hanging (ARMS_BACK) at the planned stance,
-find no way up past its top (stances.hands_rise_blocked: the stance is close to a high table's
-edge, the hands under its top): the hands rise first, short of the stance, and the robot steps in
-with them above the top (`hands_up`). False: such a pick is refused at the stance ("the hands find
-no way around the top")."""
+RAISE_AHEAD_M = 0.10
+"""Hands rise (and come back) this far ahead of the pelvis, above the box, on their way to it."""
 GRAVITY = 9.81
 CARRY_HANDS_Z_M = 0.80
 """A box picked low is raised, standing, until the hands are at least this high to carry it."""
@@ -198,23 +192,13 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
                                   cfg.press_m, "pick it up")
     ctx.note(f"pick stance: {plan.chosen.describe()} ({plan.tried} tried)")
     approach = plan.approach
-    low_plan = plan.pelvis_z_m < ctx.poses.nominal_pelvis_m + plan.ground_z_m - 0.02 or plan.lean
-    first = False
-    if HANDS_UP_FIRST and support is not None and not low_plan:
-        first = yield from ctx.compute("hands first", hands_rise_blocked, approach.mid_xy, approach.heading,
-                                       plan.ground_z_m, center + np.array([0.0, 0.0, plan.hand_dz_m]),
-                                       plan.width_m, cfg.pre_gap_m, support, ARMS_BACK)
     if ctx.phase != PHASE_WHOLE_BODY:
         yield from walk_to(ctx, approach, out_m=cfg.approach_offset_m)
         yield from enter_whole_body(ctx)
-    posture = ARMS_BACK
-    if first:  # the hands could not rise past the top from the stance: up first, then step in
-        ctx.note("the hands rise above the table's top before stepping in")
-        posture = yield from hands_up(ctx, center + np.array([0.0, 0.0, plan.hand_dz_m]), box)
     off = ctx.offset()
     yield from step_to(ctx, approach.mid_xy + off, approach.heading, cfg.steps, name="approach",
-                       posture=posture)
-    yield from correct_stance(ctx, approach.mid_xy, approach.heading, cfg.steps, posture=posture)
+                       posture=ARMS_BACK)
+    yield from correct_stance(ctx, approach.mid_xy, approach.heading, cfg.steps, posture=ARMS_BACK)
     # the grasp, from the stance the steps ended in, at the planned squat and lean
     q0 = ctx.hold_q()
     soles = flat_soles(ctx.ik, q0)
@@ -292,26 +276,6 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
                          f"they were {lag * 100:.0f} cm off the plan; set back down, the hands opened")
     ctx.held = Held(box, full, squeeze, heading_rad=heading, hand_dz_m=plan.hand_dz_m)
     ctx.box_positions[box.name] = None
-
-
-def hands_up(ctx: GoalContext, center_w: np.ndarray, box: Box) -> Iterator[np.ndarray]:
-    """Standing short of the pick's stance: the hands up to where the pick's "via" puts them relative
-    to the body (beside the box's sides, RAISE_AHEAD_M ahead of the soles, 8 cm above the grasp
-    height); returns the joints to step in with (the arms held there)."""
-    cfg = ctx.config
-    q0 = ctx.hold_q()
-    soles = flat_soles(ctx.ik, q0)
-    heading = stance_heading(soles)
-    c = center_w + np.append(ctx.offset(), 0.0)
-    mid = (soles[0][0][:2] + soles[1][0][:2]) / 2
-    ahead = float((c[:2] - mid) @ np.array([math.cos(heading), math.sin(heading)]))
-    up = hand_points(c, heading, grasp_width(box, heading), cfg.pre_gap_m + 0.03, dz_m=0.08,
-                     ahead_m=-(ahead - RAISE_AHEAD_M))
-    (q_up,) = yield from ctx.compute("hands up", grasp_hold_poses, q0, soles, heading,
-                                     [("via", up, np.zeros(2), float(q0[2]), 0)], box.name, "")
-    move = _move_s(q0, q_up, 1.5)
-    yield from ctx.run(keyframe_trajectory("hands up", [(0.0, q0), (move, q_up), (move + 0.5, q_up)]))
-    return q_up[7:].copy()
 
 
 def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:

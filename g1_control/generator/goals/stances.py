@@ -614,8 +614,6 @@ def release_hold_poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], he
     return q_above, down_pose.q, q_open, q_out, q_stand
 
 
-RAISE_AHEAD_M = 0.10
-"""Hands rise (and come back) this far ahead of the soles' middle, above the box, on their way to it."""
 CLEAR_MARGIN_M = 0.02
 """A hand (or a held box) moving past a support keeps this far from its outline, and a hand 1 cm
 above its top (CLEAR_ABOVE_M) or below its underside less this."""
@@ -624,6 +622,13 @@ HAND_TIP_M = 0.08
 """The rubber hand reaches this far beyond the hand point (the palm's middle) along the hand frame's x."""
 DETOUR_SPACING_M = 0.05
 """A detour's hand points are solved this far apart (the keyframes blend in joint space between)."""
+DETOUR_BACK_M = 0.06
+"""The last way a detour tries draws the hands this far back (against the heading) before they rise:
+hanging (the arms swung back) they are ~5 cm ahead of the pelvis and, raised palms in, their tips
+HAND_TIP_M beyond, so near a high table's edge (the pelvis 0.15-0.18 m from it, TRUNK_EDGE_CLEARANCE_M)
+the tips rose through its top on both other ways ("the hands find no way around", bench objects
+seed 11 trials 0, 6, 9)."""
+DETOUR_BACK_MAX_M = 0.2
 PATH_SAMPLES = 24
 BOX_SINK_M = 0.01
 """A held box's bottom counts as in a support's top this far below it."""
@@ -675,21 +680,26 @@ def detour_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: li
     straight move from the arms hanging to above a box on a 0.95 m table swung a hand into the
     table's top from below, the arm caught and the robot fell stepping back (bench objects seed 12,
     trial 3). Two ways are tried, by their corners alone, then each solved every DETOUR_SPACING_M
-    back from q_b (keeping its IK branch) and on from q_a, the first whose every blend keeps clear kept, else (strict: StanceRefused, before the hands
+    back from q_b (keeping its IK branch) and on from q_a, then a third so solved, the first whose every blend keeps clear kept, else (strict: StanceRefused, before the hands
     move) the one with the fewest that do not: across below, then straight up or down; straight up
-    (or down) to the higher height, across, straight down."""
+    (or down) to the higher height, across, straight down; drawn back DETOUR_BACK_M, then as the second."""
     if not path_meets(poses, q_a, q_b, heading, block, box_probes, tips):
         return []
     a = [poses.hand_point(q_a, i) for i in range(2)]
     b = [poses.hand_point(q_b, i) for i in range(2)]
     high = max(a[0][2], a[1][2], b[0][2], b[1][2], clear_z_m)
+    fwd = np.array([math.cos(heading), math.sin(heading), 0.0])
+    drawn = [p - _draw_back(block, p, fwd) * fwd for p in a]
     ways = ([a, [np.array([*p[:2], a[0][2]]) for p in b], b],  # across below, then up (or down)
-            [a, [np.array([*p[:2], high]) for p in a], [np.array([*p[:2], high]) for p in b], b])
+            [a, [np.array([*p[:2], high]) for p in a], [np.array([*p[:2], high]) for p in b], b],
+            # last: drawn back first, then up, across, down (the tips clear of a near edge)
+            [a, drawn, [np.array([*p[:2], high]) for p in drawn], [np.array([*p[:2], high]) for p in b], b])
     best: tuple[int, list[np.ndarray]] | None = None
     # the corners alone first (fewest keyframes), then every DETOUR_SPACING_M, solved from q_b back
     # (keeping its IK branch) or from q_a on
     tries = [(math.inf, ways[0], False), (math.inf, ways[1], False),
-             *((DETOUR_SPACING_M, way, back) for way in ways for back in (True, False))]
+             *((DETOUR_SPACING_M, way, back) for way in ways[:2] for back in (True, False)),
+             *((DETOUR_SPACING_M, ways[2], back) for back in (True, False))]
     for spacing, corners, backward in tries:
         if backward:
             chain = _along(poses, q_b, corners[::-1], soles, heading, shift, pelvis_z, lean, spacing)[:-1][::-1]
@@ -709,48 +719,15 @@ def detour_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: li
     return best[1]
 
 
-def hands_rise_blocked(poses: PosePlanner, mid_xy: np.ndarray, heading: float, ground_z: float, grasp_w: np.ndarray,
-                       width_m: float, gap_m: float, block: Block, arms: np.ndarray) -> bool:
-    """Whether, standing at the stance (soles' middle mid_xy, facing heading) with the arms at `arms`
-    (the joints the robot steps in with), the hands find no way up to the pick's "via" points
-    (beside the box, RAISE_AHEAD_M ahead of the soles, 8 cm above the grasp point grasp_w) past
-    `block`'s top: every way `detour_poses` tries passes through it; checked at the stance and where
-    the steps may end instead (STANCE_SLACK_M nearer the box or to either side, STANCE_SLACK_RAD
-    turned): near the edge it depends on a centimetre (seed 11 trial 0: clear at the stance, blocked
-    3 cm to its right, and refused in physics)."""
-    fwd = np.array([math.cos(heading), math.sin(heading)])
-    side = np.array([-fwd[1], fwd[0]])
-    mid = np.asarray(mid_xy, dtype=float)
-    ends = [(mid, heading), (mid + STANCE_SLACK_M * fwd, heading), (mid + STANCE_SLACK_M * side, heading),
-            (mid - STANCE_SLACK_M * side, heading), (mid, heading + STANCE_SLACK_RAD),
-            (mid, heading - STANCE_SLACK_RAD)]
-    return any(_rise_blocked(poses, m, h, ground_z, grasp_w, width_m, gap_m, block, arms) for m, h in ends)
-
-
-STANCE_SLACK_M = 0.03
-"""The steps end within this of the planned stance (the grasp refuses beyond)."""
-STANCE_SLACK_RAD = 0.05
-"""... and turned this much (correct_stance's heading tolerance)."""
-
-
-def _rise_blocked(poses: PosePlanner, mid_xy: np.ndarray, heading: float, ground_z: float, grasp_w: np.ndarray,
-                  width_m: float, gap_m: float, block: Block, arms: np.ndarray) -> bool:
-    planner = stance_planner(poses)
-    q, soles = planner.stance(mid_xy, heading, ground_z)
-    q[7:] = arms
-    q = poses.stand(q, soles, ground_z + poses.nominal_pelvis_m, arms)
-    soles = flat_soles(poses.ik, q)
-    fwd = np.array([math.cos(heading), math.sin(heading)])
-    ahead = float((np.asarray(grasp_w[:2]) - np.asarray(mid_xy)) @ fwd)
-    via = hand_points(np.asarray(grasp_w, dtype=float), heading, width_m, gap_m + 0.03, dz_m=0.08,
-                      ahead_m=-(ahead - RAISE_AHEAD_M))
-    q_via = planner.hold(q, soles, via, heading, np.zeros(2), float(q[2]), UPRIGHT).q
-    try:
-        detour_poses(poses, q, q_via, soles, heading, np.zeros(2), float(q[2]), UPRIGHT, block,
-                     block.height_m + 2 * CLEAR_MARGIN_M, (), True, True)
-    except StanceRefused:
-        return True
-    return False
+def _draw_back(block: Block, p: np.ndarray, fwd: np.ndarray) -> float:
+    """How far back (against fwd) hand point p goes before it rises: DETOUR_BACK_M at least, more
+    (up to DETOUR_BACK_MAX_M) until it and its tip, pointing ahead, are CLEAR_MARGIN_M clear of
+    `block`'s outline."""
+    d = DETOUR_BACK_M
+    while d < DETOUR_BACK_MAX_M and min(block.distance_xy((p - d * fwd)[:2]),
+                                        block.distance_xy((p + (HAND_TIP_M - d) * fwd)[:2])) < 2 * CLEAR_MARGIN_M:
+        d += 0.02
+    return d
 
 
 def raised_pose(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float, dz_m: float,
@@ -813,5 +790,5 @@ def place_heading(support: Block | None, xy: np.ndarray, robot_xy: np.ndarray) -
 
 
 __all__ = ["DEEP", "LEAN", "STAND_LEAN", "UPRIGHT", "Candidate", "StancePlan", "StancePlanner", "StanceRefused", "box_com_shift", "detour_poses", "edge_normal",
-           "face_normals", "grasp_hold_poses", "hand_height", "hands_rise_blocked", "path_meets", "pick_headings", "place_heading", "plan_stance",
+           "face_normals", "grasp_hold_poses", "hand_height", "path_meets", "pick_headings", "place_heading", "plan_stance",
            "raised_pose", "release_hold_poses", "stance_planner"]
