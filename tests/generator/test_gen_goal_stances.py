@@ -231,7 +231,8 @@ def test_with_no_clean_way_around_a_tables_top_the_hands_are_refused_before_they
     q0 = stances.poses.stand(q0, soles, stances.poses.nominal_pelvis_m, ARMS_BACK)
     soles = flat_soles(stances.ik, q0)
     hands = [stances.poses.hand_point(q0, i) for i in range(2)]
-    over = Table("over", (float(hands[0][0]) + 0.25, 0.0), (0.6, 1.0), 0.95, 0.0)  # its near edge behind the hands
+    # its near edge 0.35 m behind the hands: farther than they are drawn back (stances.DETOUR_BACK_MAX_M)
+    over = Table("over", (float(hands[0][0]) + 0.05, 0.0), (0.8, 1.0), 0.95, 0.0)
     assert all(over.contains_xy(h[:2]) and h[2] < over.height_m - 0.1 for h in hands)
     up = tuple(h + np.array([0.0, 0.0, 0.45]) for h in hands)
     (q_up,) = grasp_hold_poses(stances.poses, q0, soles, 0.0, [("via", up, np.zeros(2), q0[2], 0)], "box", "")
