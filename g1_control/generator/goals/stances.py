@@ -186,8 +186,10 @@ TRUNK_EDGE_CLEARANCE_M = 0.15
 """The pelvis stays this far from a top above the legs: the trunk's widest at the top's height
 (pelvis to chest, 0.76-1.2 m standing) is 0.11 m from the pelvis's axis (the G1's collision meshes,
 measured in the nominal pose), plus 4 cm: the steps end within 3 cm of the planned stance (the grasp
-refuses beyond) and the trunk sways ~1 cm. With the 0.18 m rule, bench objects seeds 9-16 refused 11
-of 25 picks from 0.80-0.95 m tables, 4 of them at 0.15-0.18 m."""
+refuses beyond) and the trunk sways ~1 cm. With the 0.18 m rule (and the knee rule), bench objects
+seeds 9-16 refused 12 of 25 picks from 0.80-0.95 m tables before anything moved: 10 on the pelvis (4
+at 0.15-0.18 m; 6 at 0.00-0.10 m, the box turned 31-48 deg to the edge: held square to its faces, no
+stance keeps the trunk off), 2 on the knees."""
 
 
 @dataclass
@@ -626,8 +628,9 @@ DETOUR_BACK_M = 0.06
 """The last way a detour tries draws the hands this far back (against the heading) before they rise:
 hanging (the arms swung back) they are ~5 cm ahead of the pelvis and, raised palms in, their tips
 HAND_TIP_M beyond, so near a high table's edge (the pelvis 0.15-0.18 m from it, TRUNK_EDGE_CLEARANCE_M)
-the tips rose through its top on both other ways ("the hands find no way around", bench objects
-seed 11 trials 0, 6, 9)."""
+the tips rose through its top on both other ways, and a hand hanging under an aslant edge rose into
+it: "the hands find no way around" refused 9 of the 9 picks the trunk's rule let through on bench
+objects seeds 9-16 (physics); with this way 7 got past it (6 picked, 1 set back by the lift check)."""
 DETOUR_BACK_MAX_M = 0.2
 PATH_SAMPLES = 24
 BOX_SINK_M = 0.01
@@ -682,7 +685,7 @@ def detour_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: li
     trial 3). Two ways are tried, by their corners alone, then each solved every DETOUR_SPACING_M
     back from q_b (keeping its IK branch) and on from q_a, then a third so solved, the first whose every blend keeps clear kept, else (strict: StanceRefused, before the hands
     move) the one with the fewest that do not: across below, then straight up or down; straight up
-    (or down) to the higher height, across, straight down; drawn back DETOUR_BACK_M, then as the second."""
+    (or down) to the higher height, across, straight down; drawn back (`_draw_back`), then as the second."""
     if not path_meets(poses, q_a, q_b, heading, block, box_probes, tips):
         return []
     a = [poses.hand_point(q_a, i) for i in range(2)]
