@@ -175,7 +175,21 @@ KNEE_HEIGHT_M = 0.35
 MIN_EDGE_CLEARANCE_M = 0.18
 """The pelvis stays this far from a support whose top is above the knees: issue 17's measured rule
 (box.MIN_EDGE_CLEARANCE_M); closer, the stepping-in knees met 0.53-0.63 m tables and the robot fell
-(g1 bench objects seed 8, measured)."""
+(g1 bench objects seed 8, measured). Not for a top the legs pass under (ABOVE_LEGS_M): there only the
+trunk can meet it (TRUNK_EDGE_CLEARANCE_M)."""
+ABOVE_LEGS_M = 0.02
+"""A table whose top's underside is this much or more above the pelvis (the hold pose's) is above the
+legs: the thighs, knees and shins stay below the pelvis stepping in (the stepping knee rises to
+~0.55 m), so they pass under its top and the knee and pelvis rules above do not apply; the 0.80-0.95 m
+tables (bench objects' "high") have their underside at 0.76-0.91 m, the standing pelvis at 0.756 m."""
+TRUNK_EDGE_CLEARANCE_M = 0.15
+"""The pelvis stays this far from a top above the legs: the trunk's widest at the top's height
+(pelvis to chest, 0.76-1.2 m standing) is 0.11 m from the pelvis's axis (the G1's collision meshes,
+measured in the nominal pose), plus 4 cm: the steps end within 3 cm of the planned stance (the grasp
+refuses beyond) and the trunk sways ~1 cm. With the 0.18 m rule (and the knee rule), bench objects
+seeds 9-16 refused 12 of 25 picks from 0.80-0.95 m tables before anything moved: 10 on the pelvis (4
+at 0.15-0.18 m; 6 at 0.00-0.10 m, the box turned 31-48 deg to the edge: held square to its faces, no
+stance keeps the trunk off), 2 on the knees."""
 
 
 @dataclass
@@ -515,10 +529,11 @@ class StancePlanner:
         pos = {n: ik.data.oMf[f].translation for n, f in self._frames.items()}
         if support is not None and support.height_m > KNEE_HEIGHT_M:
             gap = support.distance_xy(q[:2])
-            if gap < MIN_EDGE_CLEARANCE_M:
-                return (f"the pelvis is {gap:.2f} m from '{support.name}' (stepping in needs "
-                        f">= {MIN_EDGE_CLEARANCE_M:.2f} m)")
-            for side in ("left", "right"):
+            above_legs = support.height_m - TABLE_TOP_THICKNESS_M - float(q[2]) >= ABOVE_LEGS_M
+            need = TRUNK_EDGE_CLEARANCE_M if above_legs else MIN_EDGE_CLEARANCE_M
+            if gap < need:
+                return f"the pelvis is {gap:.2f} m from '{support.name}' (stepping in needs >= {need:.2f} m)"
+            for side in () if above_legs else ("left", "right"):
                 knee_gap = support.distance_xy(pos[f"{side}_knee_link"][:2])
                 if knee_gap < KNEE_EDGE_CLEARANCE_M:
                     return (f"the {side} knee is {knee_gap:.2f} m from under '{support.name}' (stepping in needs "
@@ -609,6 +624,14 @@ HAND_TIP_M = 0.08
 """The rubber hand reaches this far beyond the hand point (the palm's middle) along the hand frame's x."""
 DETOUR_SPACING_M = 0.05
 """A detour's hand points are solved this far apart (the keyframes blend in joint space between)."""
+DETOUR_BACK_M = 0.06
+"""The last way a detour tries draws the hands this far back (against the heading) before they rise:
+hanging (the arms swung back) they are ~5 cm ahead of the pelvis and, raised palms in, their tips
+HAND_TIP_M beyond, so near a high table's edge (the pelvis 0.15-0.18 m from it, TRUNK_EDGE_CLEARANCE_M)
+the tips rose through its top on both other ways, and a hand hanging under an aslant edge rose into
+it: "the hands find no way around" refused 9 of the 9 picks the trunk's rule let through on bench
+objects seeds 9-16 (physics); with this way 7 got past it (6 picked, 1 set back by the lift check)."""
+DETOUR_BACK_MAX_M = 0.2
 PATH_SAMPLES = 24
 BOX_SINK_M = 0.01
 """A held box's bottom counts as in a support's top this far below it."""
@@ -660,21 +683,26 @@ def detour_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: li
     straight move from the arms hanging to above a box on a 0.95 m table swung a hand into the
     table's top from below, the arm caught and the robot fell stepping back (bench objects seed 12,
     trial 3). Two ways are tried, by their corners alone, then each solved every DETOUR_SPACING_M
-    back from q_b (keeping its IK branch) and on from q_a, the first whose every blend keeps clear kept, else (strict: StanceRefused, before the hands
+    back from q_b (keeping its IK branch) and on from q_a, then a third so solved, the first whose every blend keeps clear kept, else (strict: StanceRefused, before the hands
     move) the one with the fewest that do not: across below, then straight up or down; straight up
-    (or down) to the higher height, across, straight down."""
+    (or down) to the higher height, across, straight down; drawn back (`_draw_back`), then as the second."""
     if not path_meets(poses, q_a, q_b, heading, block, box_probes, tips):
         return []
     a = [poses.hand_point(q_a, i) for i in range(2)]
     b = [poses.hand_point(q_b, i) for i in range(2)]
     high = max(a[0][2], a[1][2], b[0][2], b[1][2], clear_z_m)
+    fwd = np.array([math.cos(heading), math.sin(heading), 0.0])
+    drawn = [p - _draw_back(block, p, fwd) * fwd for p in a]
     ways = ([a, [np.array([*p[:2], a[0][2]]) for p in b], b],  # across below, then up (or down)
-            [a, [np.array([*p[:2], high]) for p in a], [np.array([*p[:2], high]) for p in b], b])
+            [a, [np.array([*p[:2], high]) for p in a], [np.array([*p[:2], high]) for p in b], b],
+            # last: drawn back first, then up, across, down (the tips clear of a near edge)
+            [a, drawn, [np.array([*p[:2], high]) for p in drawn], [np.array([*p[:2], high]) for p in b], b])
     best: tuple[int, list[np.ndarray]] | None = None
     # the corners alone first (fewest keyframes), then every DETOUR_SPACING_M, solved from q_b back
     # (keeping its IK branch) or from q_a on
     tries = [(math.inf, ways[0], False), (math.inf, ways[1], False),
-             *((DETOUR_SPACING_M, way, back) for way in ways for back in (True, False))]
+             *((DETOUR_SPACING_M, way, back) for way in ways[:2] for back in (True, False)),
+             *((DETOUR_SPACING_M, ways[2], back) for back in (True, False))]
     for spacing, corners, backward in tries:
         if backward:
             chain = _along(poses, q_b, corners[::-1], soles, heading, shift, pelvis_z, lean, spacing)[:-1][::-1]
@@ -692,6 +720,17 @@ def detour_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: li
         raise StanceRefused(f"the hands find no way around the top of '{block.name}' ({block.height_m:.2f} m): "
                             f"every way tried passes within {CLEAR_MARGIN_M * 100:.0f} cm of it")
     return best[1]
+
+
+def _draw_back(block: Block, p: np.ndarray, fwd: np.ndarray) -> float:
+    """How far back (against fwd) hand point p goes before it rises: DETOUR_BACK_M at least, more
+    (up to DETOUR_BACK_MAX_M) until it and its tip, pointing ahead, are CLEAR_MARGIN_M clear of
+    `block`'s outline."""
+    d = DETOUR_BACK_M
+    while d < DETOUR_BACK_MAX_M and min(block.distance_xy((p - d * fwd)[:2]),
+                                        block.distance_xy((p + (HAND_TIP_M - d) * fwd)[:2])) < 2 * CLEAR_MARGIN_M:
+        d += 0.02
+    return d
 
 
 def raised_pose(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: float, dz_m: float,
