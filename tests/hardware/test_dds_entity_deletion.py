@@ -78,3 +78,41 @@ def test_an_entity_dropped_in_another_thread_is_deleted_only_under_the_entity_lo
     assert dropped.is_set() and ref not in Entity._entities
     with _ENTITY_LOCK:
         del participant
+
+
+def _instance_of_a_sample_through(partition: str) -> int:
+    """Send one LowState_-sized payload robot -> host on fresh links; the instance handle it arrived with."""
+    from cyclonedds._clayer import ddspy_take
+
+    from g1_control.hardware.links.dds import DdsLink
+
+    robot, host = DdsLink("robot", "lo", 1, partition=partition), DdsLink("host", "lo", 1, partition=partition)
+    try:
+        robot.send(b"\x00\x01\x00\x00" + b"\x00" * 1000)
+        for _ in range(200):
+            host._waitset.wait(10_000_000)
+            with host._io_lock:
+                samples = ddspy_take(host._reader._ref, 4)
+            if samples:
+                return int(samples[0][1].instance_handle)
+        raise AssertionError("the sample never arrived")
+    finally:
+        robot.close()
+        host.close()
+
+
+def test_every_keyless_sample_maps_to_the_anchors_instance_which_outlives_every_link():
+    """The binding maps every keyless sample of a domain, whatever its type, to one shared instance (the
+    instance handle of a LowState_ and of a LowCmd_ sample are the same). That instance is the anchor's,
+    made first and kept by a reader that is never taken from, so links made and closed (their types freed)
+    never free it: a sample on links made after the first ones closed arrives on the same instance."""
+    from g1_control.hardware.links.dds import _anchors, domain_participant
+
+    with __import__("g1_control.hardware.links.dds", fromlist=["_ENTITY_LOCK"])._ENTITY_LOCK:
+        participant = domain_participant("lo", 1)
+        del participant
+    _participant, _topic, _writer, reader = _anchors[1]
+    [anchor] = reader.read(N=1)
+    first = _instance_of_a_sample_through(f"anchor-{uuid.uuid4().hex[:8]}")
+    later = _instance_of_a_sample_through(f"anchor-{uuid.uuid4().hex[:8]}")
+    assert first == later == anchor.sample_info.instance_handle
