@@ -812,17 +812,12 @@ class VelocityGait:
 
     def _on_level(self, want: np.ndarray, heading_td: float, level_m: float) -> tuple[np.ndarray, float]:
         """The foothold nearest `want` along the heading (within terrain_level_reach_m) whose whole sole
-        lies on the level `level_m`; the last foothold when there is none."""
+        lies on the level `level_m` (Terrain.snap); the last foothold when there is none."""
         terrain = self.terrain
-        tol, step = terrain.config.level_tolerance_m, terrain.config.shift_step_m
-        direction = np.array([math.cos(heading_td), math.sin(heading_td)])
-        for k in range(int(self.config.terrain_level_reach_m / step) + 1):
-            for sign in ((1.0,) if k == 0 else (1.0, -1.0)):
-                p = want + sign * k * step * direction
-                if terrain.is_level(p, self._landing_yaw):
-                    ground = terrain.sole_height(p, self._landing_yaw)
-                    if abs(ground - level_m) <= tol:
-                        return p, ground
+        xy, ground = terrain.snap(want, self._landing_yaw, heading_td, max_shift_m=self.config.terrain_level_reach_m,
+                                  level_m=level_m)
+        if terrain.fits(xy, self._landing_yaw, level_m):
+            return xy, ground
         return self._foothold.copy(), self._foothold_ground
 
     def _dcm_short_of_stance(self, command_h: np.ndarray, soles_m: np.ndarray, dcm_xy: np.ndarray) -> bool:

@@ -133,13 +133,14 @@ class Terrain:
 
     def snap(self, xy_m: np.ndarray, yaw_rad: float, heading_rad: float,
              forward_only: bool = False, backward_only: bool = False,
-             max_shift_m: float | None = None) -> tuple[np.ndarray, float]:
+             max_shift_m: float | None = None, level_m: float | None = None) -> tuple[np.ndarray, float]:
         """(foothold xy, its height): xy_m moved along heading_rad to the nearest place where the
         sole lies on one level (module docstring); unchanged when it does or none is in reach.
         forward_only / backward_only: only along heading_rad / only against it; max_shift_m: the
-        reach (TerrainConfig.max_shift_m by default)."""
+        reach (TerrainConfig.max_shift_m by default); level_m: only a place on that level (within
+        level_tolerance_m) will do (`fits` tells whether the answer is one)."""
         xy = np.asarray(xy_m, dtype=float)[:2]
-        if self.flat or self.is_level(xy, yaw_rad):
+        if (self.flat and level_m is None) or self.fits(xy, yaw_rad, level_m):
             return xy.copy(), self.sole_height(xy, yaw_rad)
         c = self.config
         direction = np.array([math.cos(heading_rad), math.sin(heading_rad)])
@@ -147,9 +148,15 @@ class Terrain:
         for k in range(1, n + 1):
             for sign in ((1.0,) if forward_only else (-1.0,) if backward_only else (1.0, -1.0)):
                 p = xy + sign * k * c.shift_step_m * direction
-                if self.is_level(p, yaw_rad):
+                if self.fits(p, yaw_rad, level_m):
                     return p, self.sole_height(p, yaw_rad)
         return xy.copy(), self.sole_height(xy, yaw_rad)
+
+    def fits(self, xy_m: np.ndarray, yaw_rad: float, level_m: float | None = None) -> bool:
+        """Whether a sole there lies on one level (is_level), and on `level_m` where given."""
+        if not self.is_level(xy_m, yaw_rad):
+            return False
+        return level_m is None or abs(self.sole_height(xy_m, yaw_rad) - level_m) <= self.config.level_tolerance_m
 
     def level_change_ahead(self, xy_m: np.ndarray, heading_rad: float, distance_m: float, samples: int = 12) -> bool:
         """Whether the height changes on the straight line from xy_m distance_m along heading_rad."""
