@@ -79,6 +79,9 @@ class Terrain:
         gx, gy = np.meshgrid(u * (c.sole_half_length_m + c.edge_margin_m), u[::2] * (c.sole_half_width_m + c.edge_margin_m))
         self._sole_points = np.stack([gx.ravel(), gy.ravel()], axis=1)
         """Points of the sole (with its margin) in sole axes, sampled: its outline and middle."""
+        gx, gy = np.meshgrid(u * c.sole_half_length_m, u[::2] * c.sole_half_width_m)
+        self._bare_sole_points = np.stack([gx.ravel(), gy.ravel()], axis=1)
+        """... and of the sole itself (no margin)."""
         ahead = c.sole_half_length_m + np.linspace(c.edge_margin_m, max(c.riser_gap_m, c.edge_margin_m), 4)
         gx, gy = np.meshgrid(ahead, u[::2] * (c.sole_half_width_m + c.edge_margin_m))
         self._toe_points = np.stack([gx.ravel(), gy.ravel()], axis=1)
@@ -119,6 +122,11 @@ class Terrain:
     def sole_height(self, xy_m: np.ndarray, yaw_rad: float) -> float:
         """The highest point under a sole (with its margin) centred at xy_m, turned yaw_rad."""
         return float(self._sole_heights(xy_m, yaw_rad).max())
+
+    def under_sole(self, xy_m: np.ndarray, yaw_rad: float) -> float:
+        """The highest point under a sole itself (no margin) centred at xy_m, turned yaw_rad: where a
+        foot coming down meets the terrain."""
+        return float(self._sole_heights(xy_m, yaw_rad, self._bare_sole_points).max())
 
     def is_level(self, xy_m: np.ndarray, yaw_rad: float) -> bool:
         """Whether a sole there lies on one level, clear of its edges, of a riser ahead of it and of a
