@@ -460,6 +460,10 @@ def test_a_swing_keeps_the_level_its_foothold_had():
         assert terrain.is_level(out.landing_m[:2], 0.0) and terrain.height(out.landing_m[:2]) == pytest.approx(0.15)
 
 
+WAIT_FOR_CONTACT = GaitConfig(touchdown_height_m=0.02)
+"""The touchdown wait switched on (off by default)."""
+
+
 def _step_up_until_touchdown(cfg, above_m, terrain=None):
     """The right foot on the floor steps up onto a 0.15 m step (the left foot on it already), held
     `above_m` above the landing once the clock's touchdown has come. Returns (the time past the clock's
@@ -495,7 +499,7 @@ def test_on_terrain_a_swing_foot_still_in_the_air_is_not_declared_in_stance():
     """Stepping up, the swing foot 9 cm above the tread at the clock's touchdown (it lagged its
     reference): the step goes on, its reference lowering below the tread, until the foot is within
     touchdown_height_m of the tread, at most touchdown_max_wait_s; the next step starts from then."""
-    cfg = GaitConfig()
+    cfg = WAIT_FOR_CONTACT
     late, lowest, gait = _step_up_until_touchdown(cfg, 0.09)
     assert late == pytest.approx(cfg.touchdown_max_wait_s, abs=0.005)
     assert lowest < 0.15 - 0.5 * cfg.touchdown_descent_mps * cfg.touchdown_max_wait_s
@@ -503,15 +507,16 @@ def test_on_terrain_a_swing_foot_still_in_the_air_is_not_declared_in_stance():
     assert gait._t0 == pytest.approx(gait.touchdowns[-1][0])
     # on the tread (within touchdown_height_m), or with the check off: on the clock
     assert _step_up_until_touchdown(cfg, 0.01)[0] < 0.005
-    off = dataclasses.replace(cfg, touchdown_height_m=math.inf)
-    late, lowest, _ = _step_up_until_touchdown(off, 0.09)
+    # off (inf, the default): on the clock
+    assert GaitConfig().touchdown_height_m == math.inf
+    late, lowest, _ = _step_up_until_touchdown(GaitConfig(), 0.09)
     assert late < 0.005 and lowest == math.inf
 
 
 def test_a_foot_coming_down_onto_the_tread_becomes_the_stance_foot_then():
     """The swing foot 9 cm up at the clock's touchdown, then coming down at 0.6 m/s: the stance
     changes once it is within touchdown_height_m of the tread (0.07 m down: ~0.12 s late)."""
-    cfg = GaitConfig(touchdown_max_wait_s=0.5)
+    cfg = dataclasses.replace(WAIT_FOR_CONTACT, touchdown_max_wait_s=0.5)
     terrain = _step_ahead(1.0)
     gait = VelocityGait(cfg, terrain)
     soles, yaws = _feet()
@@ -535,7 +540,7 @@ def test_a_foot_coming_down_onto_the_tread_becomes_the_stance_foot_then():
 
 def test_on_flat_ground_touchdown_stays_on_the_clock():
     """Without platforms in the scene nothing changes: a foot held up lands on the clock."""
-    gait = VelocityGait()
+    gait = VelocityGait(WAIT_FOR_CONTACT)
     soles, yaws = _feet()
     t = _into_single_support(gait, soles, yaws)
     swing = 1 - gait.stance
@@ -545,3 +550,50 @@ def test_on_flat_ground_touchdown_stays_on_the_clock():
         t += 0.004
         gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
     assert t - clock < 0.005
+
+
+def test_a_step_on_one_level_of_a_terrain_scene_lands_on_the_clock():
+    """A platform in the scene but the step on the floor: a foot held 9 cm up at the clock's
+    touchdown becomes the stance foot then (only a step onto another level waits for contact)."""
+    gait = VelocityGait(WAIT_FOR_CONTACT, _step_ahead(3.0))
+    assert not gait.terrain.flat
+    soles, yaws = _feet()
+    t = _into_single_support(gait, soles, yaws)
+    swing = 1 - gait.stance
+    dcm = soles[gait.stance, :2] + np.array([0.05, 0.03 * (1 if gait.stance == RIGHT else -1)])
+    out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+    clock = gait._t0 + gait.step_T
+    while gait.stance != swing:
+        t += 0.004
+        if t >= clock:
+            soles[swing, 2] = 0.09
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, dcm)
+        out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+        assert out.landing_m[2] == pytest.approx(0.0) or gait.stance == swing
+    assert t - clock < 0.005
+
+
+def test_a_trailing_foot_stepping_down_waits_for_contact_once_over_the_lower_level():
+    """The trailing foot steps down off a 0.15 m step onto the floor beside the stance foot: over the
+    floor by the clock's touchdown but 9 cm above it, it is still a step onto another level (where it
+    lifted from counts, not where it is) and waits for contact."""
+    cfg = WAIT_FOR_CONTACT
+    gait = VelocityGait(cfg, _step_ahead(1.0))  # the step spans x 1.0 .. 2.2
+    soles, yaws = _feet()
+    soles[LEFT] = (2.45, 0.11, 0.0)
+    soles[RIGHT] = (2.05, -0.11, 0.15)
+    t = _into_single_support(gait, soles, yaws)
+    assert gait.stance == LEFT
+    cmd = np.array([0.3, 0.0, 0.0])
+    dcm = soles[LEFT, :2] + np.array([0.02, -0.03])
+    out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+    clock = gait._t0 + gait.step_T
+    while gait.stance == LEFT and t < clock + 0.5:
+        t += 0.004
+        if t >= clock - 0.1:
+            soles[RIGHT] = (*out.landing_m[:2], 0.09)
+        gait.schedule(t, cmd, soles, yaws, dcm)
+        if gait.stance == LEFT:
+            out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+            assert out.landing_m[2] == pytest.approx(0.0)
+    assert t - clock == pytest.approx(cfg.touchdown_max_wait_s, abs=0.005)
