@@ -79,6 +79,9 @@ class Terrain:
         gx, gy = np.meshgrid(u * (c.sole_half_length_m + c.edge_margin_m), u[::2] * (c.sole_half_width_m + c.edge_margin_m))
         self._sole_points = np.stack([gx.ravel(), gy.ravel()], axis=1)
         """Points of the sole (with its margin) in sole axes, sampled: its outline and middle."""
+        gx, gy = np.meshgrid(u * c.sole_half_length_m, u[::2] * c.sole_half_width_m)
+        self._bare_sole_points = np.stack([gx.ravel(), gy.ravel()], axis=1)
+        """... and of the sole itself (no margin)."""
         ahead = c.sole_half_length_m + np.linspace(c.edge_margin_m, max(c.riser_gap_m, c.edge_margin_m), 4)
         gx, gy = np.meshgrid(ahead, u[::2] * (c.sole_half_width_m + c.edge_margin_m))
         self._toe_points = np.stack([gx.ravel(), gy.ravel()], axis=1)
@@ -120,6 +123,11 @@ class Terrain:
         """The highest point under a sole (with its margin) centred at xy_m, turned yaw_rad."""
         return float(self._sole_heights(xy_m, yaw_rad).max())
 
+    def under_sole(self, xy_m: np.ndarray, yaw_rad: float) -> float:
+        """The highest point under a sole itself (no margin) centred at xy_m, turned yaw_rad: where a
+        foot coming down meets the terrain."""
+        return float(self._sole_heights(xy_m, yaw_rad, self._bare_sole_points).max())
+
     def is_level(self, xy_m: np.ndarray, yaw_rad: float) -> bool:
         """Whether a sole there lies on one level, clear of its edges, of a riser ahead of it and of a
         higher level's edge behind it (TerrainConfig.riser_gap_m, drop_gap_m)."""
@@ -133,13 +141,14 @@ class Terrain:
 
     def snap(self, xy_m: np.ndarray, yaw_rad: float, heading_rad: float,
              forward_only: bool = False, backward_only: bool = False,
-             max_shift_m: float | None = None) -> tuple[np.ndarray, float]:
+             max_shift_m: float | None = None, level_m: float | None = None) -> tuple[np.ndarray, float]:
         """(foothold xy, its height): xy_m moved along heading_rad to the nearest place where the
         sole lies on one level (module docstring); unchanged when it does or none is in reach.
         forward_only / backward_only: only along heading_rad / only against it; max_shift_m: the
-        reach (TerrainConfig.max_shift_m by default)."""
+        reach (TerrainConfig.max_shift_m by default); level_m: only a place on that level (within
+        level_tolerance_m) will do (`fits` tells whether the answer is one)."""
         xy = np.asarray(xy_m, dtype=float)[:2]
-        if self.flat or self.is_level(xy, yaw_rad):
+        if (self.flat and level_m is None) or self.fits(xy, yaw_rad, level_m):
             return xy.copy(), self.sole_height(xy, yaw_rad)
         c = self.config
         direction = np.array([math.cos(heading_rad), math.sin(heading_rad)])
@@ -147,9 +156,15 @@ class Terrain:
         for k in range(1, n + 1):
             for sign in ((1.0,) if forward_only else (-1.0,) if backward_only else (1.0, -1.0)):
                 p = xy + sign * k * c.shift_step_m * direction
-                if self.is_level(p, yaw_rad):
+                if self.fits(p, yaw_rad, level_m):
                     return p, self.sole_height(p, yaw_rad)
         return xy.copy(), self.sole_height(xy, yaw_rad)
+
+    def fits(self, xy_m: np.ndarray, yaw_rad: float, level_m: float | None = None) -> bool:
+        """Whether a sole there lies on one level (is_level), and on `level_m` where given."""
+        if not self.is_level(xy_m, yaw_rad):
+            return False
+        return level_m is None or abs(self.sole_height(xy_m, yaw_rad) - level_m) <= self.config.level_tolerance_m
 
     def level_change_ahead(self, xy_m: np.ndarray, heading_rad: float, distance_m: float, samples: int = 12) -> bool:
         """Whether the height changes on the straight line from xy_m distance_m along heading_rad."""

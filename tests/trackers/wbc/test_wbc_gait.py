@@ -1,6 +1,7 @@
 """The velocity gait's pieces without physics: DCM offsets that repeat step after step, swing
 segments that arrive, commands kept within the step limits, named configuration errors."""
 
+import dataclasses
 import itertools
 import math
 
@@ -303,6 +304,11 @@ def test_a_dcm_far_off_its_plan_in_the_double_support_lifts_the_swing_foot_at_on
     ({"after_push_steps": 1.5}, "after_push_steps must be an integer >= 0; got 1.5"),
     ({"early_lift_dcm_error_m": 0.0}, r"early_lift_dcm_error_m must be > 0 \(inf: never\); got 0.0"),
     ({"early_lift_dcm_error_m": math.nan}, "early_lift_dcm_error_m must be > 0"),
+    ({"touchdown_height_m": 0.0}, r"touchdown_height_m must be > 0 \(inf: on the clock\); got 0.0"),
+    ({"touchdown_height_m": math.nan}, "touchdown_height_m must be > 0"),
+    ({"touchdown_max_wait_s": -0.1}, "touchdown_max_wait_s must be a finite number >= 0; got -0.1"),
+    ({"touchdown_max_wait_s": math.inf}, "touchdown_max_wait_s must be a finite number >= 0"),
+    ({"touchdown_descent_mps": math.nan}, "touchdown_descent_mps must be a finite number >= 0"),
 ])
 def test_bad_gait_config_is_refused(kwargs, text):
     with pytest.raises(WbcConfigError, match=text):
@@ -452,3 +458,142 @@ def test_a_swing_keeps_the_level_its_foothold_had():
         out = gait.update(t, 0.004, soles, yaws, soles[LEFT, :2] + np.array([ahead, -0.05]), OMEGA)
         assert out.landing_m[2] == pytest.approx(0.15), ahead
         assert terrain.is_level(out.landing_m[:2], 0.0) and terrain.height(out.landing_m[:2]) == pytest.approx(0.15)
+
+
+WAIT_FOR_CONTACT = GaitConfig(touchdown_height_m=0.02)
+"""The touchdown wait switched on (off by default)."""
+
+
+def _step_up_until_touchdown(cfg, above_m, terrain=None):
+    """The right foot on the floor steps up onto a 0.15 m step (the left foot on it already), held
+    `above_m` above the landing once the clock's touchdown has come. Returns (the time past the clock's
+    touchdown when the right foot became the stance foot (inf: not within 0.5 s), the lowest swing
+    reference height asked after the clock's touchdown (inf: none), the gait)."""
+    terrain = _step_ahead(1.0) if terrain is None else terrain
+    gait = VelocityGait(cfg, terrain)
+    soles, yaws = _feet()
+    soles[LEFT] = (1.25, 0.11, 0.15)
+    soles[RIGHT] = (0.85, -0.11, 0.0)
+    t = _into_single_support(gait, soles, yaws)
+    assert gait.stance == LEFT and not gait.targets.contacts[RIGHT]
+    cmd = np.array([0.3, 0.0, 0.0])
+    dcm = soles[LEFT, :2] + np.array([0.02, -0.03])
+    out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+    clock = gait._t0 + gait.step_T
+    lowest = math.inf
+    while t < clock + 0.5:
+        t += 0.004
+        if t >= clock:
+            soles[RIGHT] = (*out.landing_m[:2], out.landing_m[2] + above_m)
+        gait.schedule(t, cmd, soles, yaws, dcm)
+        if gait.stance == RIGHT:
+            return t - clock, lowest, gait
+        out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+        assert out.swing_foot == RIGHT and out.landing_m[2] == pytest.approx(0.15)
+        if t >= clock:
+            lowest = min(lowest, float(out.swing_pos_m[2]))
+    return math.inf, lowest, gait
+
+
+def test_on_terrain_a_swing_foot_still_in_the_air_is_not_declared_in_stance():
+    """Stepping up, the swing foot 9 cm above the tread at the clock's touchdown (it lagged its
+    reference): the step goes on, its reference lowering below the tread, until the foot is within
+    touchdown_height_m of the tread, at most touchdown_max_wait_s; the next step starts from then."""
+    cfg = WAIT_FOR_CONTACT
+    late, lowest, gait = _step_up_until_touchdown(cfg, 0.09)
+    assert late == pytest.approx(cfg.touchdown_max_wait_s, abs=0.005)
+    assert lowest < 0.15 - 0.5 * cfg.touchdown_descent_mps * cfg.touchdown_max_wait_s
+    # the double support after it starts at the late touchdown, not at the clock's
+    assert gait._t0 == pytest.approx(gait.touchdowns[-1][0])
+    # on the tread (within touchdown_height_m), or with the check off: on the clock
+    assert _step_up_until_touchdown(cfg, 0.01)[0] < 0.005
+    # off (inf, the default): on the clock
+    assert GaitConfig().touchdown_height_m == math.inf
+    late, lowest, _ = _step_up_until_touchdown(GaitConfig(), 0.09)
+    assert late < 0.005 and lowest == math.inf
+
+
+def test_a_foot_coming_down_onto_the_tread_becomes_the_stance_foot_then():
+    """The swing foot 9 cm up at the clock's touchdown, then coming down at 0.6 m/s: the stance
+    changes once it is within touchdown_height_m of the tread (0.07 m down: ~0.12 s late)."""
+    cfg = dataclasses.replace(WAIT_FOR_CONTACT, touchdown_max_wait_s=0.5)
+    terrain = _step_ahead(1.0)
+    gait = VelocityGait(cfg, terrain)
+    soles, yaws = _feet()
+    soles[LEFT] = (1.25, 0.11, 0.15)
+    soles[RIGHT] = (0.85, -0.11, 0.0)
+    t = _into_single_support(gait, soles, yaws)
+    cmd = np.array([0.3, 0.0, 0.0])
+    dcm = soles[LEFT, :2] + np.array([0.02, -0.03])
+    out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+    clock = gait._t0 + gait.step_T
+    while gait.stance == LEFT:
+        t += 0.004
+        if t >= clock:
+            soles[RIGHT] = (*out.landing_m[:2], 0.15 + max(0.09 - 0.6 * (t - clock), 0.0))
+        gait.schedule(t, cmd, soles, yaws, dcm)
+        out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+        assert t < clock + 0.5
+    assert soles[RIGHT, 2] - 0.15 <= cfg.touchdown_height_m + 1e-9
+    assert t - clock == pytest.approx((0.09 - cfg.touchdown_height_m) / 0.6, abs=0.01)
+
+
+def test_on_flat_ground_touchdown_stays_on_the_clock():
+    """Without platforms in the scene nothing changes: a foot held up lands on the clock."""
+    gait = VelocityGait(WAIT_FOR_CONTACT)
+    soles, yaws = _feet()
+    t = _into_single_support(gait, soles, yaws)
+    swing = 1 - gait.stance
+    clock = gait._t0 + gait.step_T
+    soles[swing, 2] = 0.09
+    while gait.stance != swing:
+        t += 0.004
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+    assert t - clock < 0.005
+
+
+def test_a_step_on_one_level_of_a_terrain_scene_lands_on_the_clock():
+    """A platform in the scene but the step on the floor: a foot held 9 cm up at the clock's
+    touchdown becomes the stance foot then (only a step onto another level waits for contact)."""
+    gait = VelocityGait(WAIT_FOR_CONTACT, _step_ahead(3.0))
+    assert not gait.terrain.flat
+    soles, yaws = _feet()
+    t = _into_single_support(gait, soles, yaws)
+    swing = 1 - gait.stance
+    dcm = soles[gait.stance, :2] + np.array([0.05, 0.03 * (1 if gait.stance == RIGHT else -1)])
+    out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+    clock = gait._t0 + gait.step_T
+    while gait.stance != swing:
+        t += 0.004
+        if t >= clock:
+            soles[swing, 2] = 0.09
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, dcm)
+        out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+        assert out.landing_m[2] == pytest.approx(0.0) or gait.stance == swing
+    assert t - clock < 0.005
+
+
+def test_a_trailing_foot_stepping_down_waits_for_contact_once_over_the_lower_level():
+    """The trailing foot steps down off a 0.15 m step onto the floor beside the stance foot: over the
+    floor by the clock's touchdown but 9 cm above it, it is still a step onto another level (where it
+    lifted from counts, not where it is) and waits for contact."""
+    cfg = WAIT_FOR_CONTACT
+    gait = VelocityGait(cfg, _step_ahead(1.0))  # the step spans x 1.0 .. 2.2
+    soles, yaws = _feet()
+    soles[LEFT] = (2.45, 0.11, 0.0)
+    soles[RIGHT] = (2.05, -0.11, 0.15)
+    t = _into_single_support(gait, soles, yaws)
+    assert gait.stance == LEFT
+    cmd = np.array([0.3, 0.0, 0.0])
+    dcm = soles[LEFT, :2] + np.array([0.02, -0.03])
+    out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+    clock = gait._t0 + gait.step_T
+    while gait.stance == LEFT and t < clock + 0.5:
+        t += 0.004
+        if t >= clock - 0.1:
+            soles[RIGHT] = (*out.landing_m[:2], 0.09)
+        gait.schedule(t, cmd, soles, yaws, dcm)
+        if gait.stance == LEFT:
+            out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+            assert out.landing_m[2] == pytest.approx(0.0)
+    assert t - clock == pytest.approx(cfg.touchdown_max_wait_s, abs=0.005)

@@ -48,6 +48,40 @@ def test_a_sole_across_an_edge_is_snapped_onto_one_tread_along_the_heading():
     assert xy == pytest.approx([1.6, 0.0]) and h == pytest.approx(0.30)
 
 
+def test_a_foothold_snapped_onto_a_given_level():
+    """level_m: only a place on that level will do (the gait's trailing foot onto the stance foot's
+    tread); the nearest one along the heading, within the reach; none in reach: unchanged, and `fits`
+    says it is not one."""
+    t = stairs()
+    c = t.config
+    # on the first tread, asked for the first tread: left alone; asked for the second: forward onto it
+    xy, h = t.snap(np.array([1.2, 0.0]), 0.0, 0.0, level_m=0.15)
+    assert xy == pytest.approx([1.2, 0.0]) and h == pytest.approx(0.15)
+    xy, h = t.snap(np.array([1.2, 0.0]), 0.0, 0.0, max_shift_m=0.45, level_m=0.30)
+    assert h == pytest.approx(0.30) and t.fits(xy, 0.0, 0.30)
+    assert xy[0] - c.sole_half_length_m - c.edge_margin_m >= 1.4 - 1e-9
+    # on the second tread, asked for the first: back, whole sole on it
+    xy, h = t.snap(np.array([1.6, 0.0]), 0.0, 0.0, max_shift_m=0.45, level_m=0.15)
+    assert h == pytest.approx(0.15) and t.fits(xy, 0.0, 0.15) and xy[0] < 1.4
+    # the floor out of reach: unchanged, not a fit
+    xy, h = t.snap(np.array([1.6, 0.0]), 0.0, 0.0, max_shift_m=0.1, level_m=0.0)
+    assert xy == pytest.approx([1.6, 0.0]) and not t.fits(xy, 0.0, 0.0)
+    # without level_m, `fits` is is_level
+    assert t.fits(np.array([1.6, 0.0]), 0.0) and not t.fits(np.array([1.02, 0.0]), 0.0)
+
+
+def test_under_a_sole_is_the_highest_point_under_the_sole_itself():
+    """Where a foot coming down meets the terrain: the sole's own outline, not its margin."""
+    t = stairs()
+    c = t.config
+    # the toe over the first tread's edge: it meets the tread
+    assert t.under_sole(np.array([1.0 - c.sole_half_length_m + 0.01, 0.0]), 0.0) == pytest.approx(0.15)
+    # the toe short of the edge by less than the margin: the floor (sole_height, with the margin, reads the tread)
+    xy = np.array([1.0 - c.sole_half_length_m - 0.01, 0.0])
+    assert t.under_sole(xy, 0.0) == 0.0 and t.sole_height(xy, 0.0) == pytest.approx(0.15)
+    assert Terrain().under_sole(np.array([3.0, 1.0]), 0.3) == 0.0
+
+
 def test_a_riser_close_ahead_of_the_toe_is_not_level_but_an_edge_behind_the_heel_going_down_is():
     t = stairs()
     c = t.config
