@@ -30,10 +30,12 @@ marked (GaitTargets.recovery) until it lands; the tracker then holds the swing f
 harder (WbcConfig.recovery_swing_weight), so the QP steps rather than swinging the leg back. One the
 DCM's error made (GaitConfig.pushed_dcm_error_m: GaitTargets.pushed) may land wider
 (recovery_max_width_m), and the tracker holds the CoM lower in it (WbcConfig.recovery_com_lower_m).
-Options, off by default (they save pushes but break random velocity timelines, whose command
-changes make pushed steps too): the CoM held lower in the step after a pushed one too
+Options, off by default: the CoM held lower in the step after a pushed one too
 (GaitConfig.after_push_steps, GaitTargets.after_push), and the swing foot lifted at once when the
-DCM strays in a double support (GaitConfig.early_lift_dcm_error_m).
+DCM strays in a double support (GaitConfig.early_lift_dcm_error_m). The DCM's error alone does not
+tell a push (turning and slowing down put it as far off its plan), so they act only after a push
+told by what the pendulum cannot explain (GaitConfig.push_detect_m: the DCM running away from where
+the pendulum under the asked CoP takes it; a command change moves the plan, not the DCM).
 
 Swing feet: the horizontal path and the yaw are re-planned each tick as a minimum-jerk segment
 from the reference's current position, velocity and acceleration to the (moving) landing point,
@@ -172,7 +174,12 @@ class GaitConfig:
     (ankle over-speed) 3 s after its push (measured, one machine). Off (0) by default: the random
     velocity timelines have pushed steps without a push (the DCM 0.25-0.48 m off its plan turning or
     slowing down, as off as in the bench's pushes), and with 1 random_s1 and random_s6 of `--only
-    wbc/random` fell (10/10 with 0); a push needs telling from a command change first."""
+    wbc/random` fell (10/10 with 0) on stop 36's code. Since stop 37 it acts only after a told push
+    (push_detect_m): on c91c490 the ungated options fired in random_s1, s6 and s7 (no fall there any
+    more) and the gated ones in none of random_s0-19 (the runs bit-identical to the defaults'); the
+    bench's pushes with both options, gated: 12/20 (front_1, back_0, left_3, right_3 survive; front_3,
+    a survivor without them, then trips: a second push told 1.3 s after the first, while it staggers,
+    lowers the step after it) (measured, one machine)."""
     early_lift_dcm_error_m: float = math.inf
     """In a step's double support, the DCM this far off its plan lifts the swing foot at once (its
     double support ends, the single support keeps its length, inf: never): pushed late in a swing, the
@@ -183,14 +190,17 @@ class GaitConfig:
     load needs moving onto the other foot). Off (inf) by default, with after_push_steps."""
     push_detect_m: float = 0.1
     """A push is told from a command change (or from the DCM drifting off its plan turning hard) by what
-    the pendulum cannot explain: each tick the measured DCM is compared with where the previous one would
-    have run under the CoP the gait asked (xi' = p + (xi - p) e^{w dt}); the differences, summed with a
-    push_detect_tau_s memory, staying this far (m) from zero for push_detect_hold_s is a push (a command
-    change moves the plan, not the DCM). after_push_steps and early_lift_dcm_error_m act only within
-    push_memory_s of one; 0: they act on the DCM's error alone (as before). The bench's pushes (150 N for
-    0.2 s walking 0.5 m/s, 20 phases and sides) sum to 0.107-0.19 m held 80 ms, 0.12-0.2 s after the push
-    starts, before the first step they touch; the 10 random velocity timelines of `g1 bench locomotion`
-    (30 s each), with their pushed steps turning and slowing down, at most 0.091 m (measured, tau 0.2 s)."""
+    the pendulum cannot explain: each walking tick the measured DCM is compared with where the last one
+    would have run under the CoP the gait asked (xi' = p + (xi - p) e^{w dt}); the differences, summed
+    with a push_detect_tau_s memory, staying this far (m) from zero for push_detect_hold_s tell a push (a
+    command change moves the plan, not the DCM). after_push_steps and early_lift_dcm_error_m act only
+    within push_memory_s of a told push; 0: on the DCM's error alone (as before stop 37); inf: never.
+    Measured on c91c490 (tau 0.2 s, held 80 ms; GaitTargets.push_drift_m): the bench's 20 pushes (150 N
+    for 0.2 s walking 0.5 m/s) reach levels held 80 ms of 0.107-0.19 m, told 0.12-0.36 s after the push starts and before the first
+    step the options touch; the 10 random velocity timelines of `g1 bench locomotion` (30 s each, their
+    pushed steps turning and slowing down included) at most 0.091 m, and walking before the pushes
+    0.048 m. Unmodelled motion of the robot's own counts too: staggering after a push, front_3 was told a
+    second push 1.3 s after the first."""
     push_detect_tau_s: float = 0.2
     push_detect_hold_s: float = 0.08
     push_memory_s: float = 1.0
