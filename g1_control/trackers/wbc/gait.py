@@ -175,11 +175,13 @@ class GaitConfig:
     velocity timelines have pushed steps without a push (the DCM 0.25-0.48 m off its plan turning or
     slowing down, as off as in the bench's pushes), and with 1 random_s1 and random_s6 of `--only
     wbc/random` fell (10/10 with 0) on stop 36's code. Since stop 37 it acts only after a told push
-    (push_detect_m): on c91c490 the ungated options fired in random_s1, s6 and s7 (no fall there any
-    more) and the gated ones in none of random_s0-19 (the runs bit-identical to the defaults'); the
-    bench's pushes with both options, gated: 12/20 (front_1, back_0, left_3, right_3 survive; front_3,
-    a survivor without them, then trips: a second push told 1.3 s after the first, while it staggers,
-    lowers the step after it) (measured, one machine)."""
+    (push_detect_m). On c91c490 with both options (1, 0.2): ungated, they fired in random_s1, s6 and s7
+    (no fall there now); gated, in none of random_s0-9 and s11-18 (before push_detect_max_rate_mps) and
+    s20-29 (with it; those runs bit-identical to the defaults'), and with it in none of s10 and s19 (uncapped, both were
+    told pushes they did not have and s19 fell at 8.6 s); the bench's pushes 9 -> 12/20 (front_1,
+    back_0, left_3, right_3 survive; front_3, a survivor without them, trips: a second push told 1.3 s
+    after the first, while it staggers, lowers the step after it); unseen, 150 N at phases shifted by 0.1
+    stride, 10 -> 11/20 (before the rate cap; measured, one machine). Off by default for front_3."""
     early_lift_dcm_error_m: float = math.inf
     """In a step's double support, the DCM this far off its plan lifts the swing foot at once (its
     double support ends, the single support keeps its length, inf: never): pushed late in a swing, the
