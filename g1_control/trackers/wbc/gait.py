@@ -181,7 +181,7 @@ class GaitConfig:
     told pushes they did not have and s19 fell at 8.6 s); the bench's pushes 9 -> 12/20 (front_1,
     back_0, left_3, right_3 survive; front_3, a survivor without them, trips: a second push told 1.3 s
     after the first, while it staggers, lowers the step after it); unseen, 150 N at phases shifted by 0.1
-    stride, 10 -> 11/20 (before the rate cap; measured, one machine). Off by default for front_3."""
+    stride, 10 -> 11/20 (with and without the rate cap; measured, one machine). Off by default for front_3."""
     early_lift_dcm_error_m: float = math.inf
     """In a step's double support, the DCM this far off its plan lifts the swing foot at once (its
     double support ends, the single support keeps its length, inf: never): pushed late in a swing, the
