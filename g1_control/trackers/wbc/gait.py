@@ -30,10 +30,12 @@ marked (GaitTargets.recovery) until it lands; the tracker then holds the swing f
 harder (WbcConfig.recovery_swing_weight), so the QP steps rather than swinging the leg back. One the
 DCM's error made (GaitConfig.pushed_dcm_error_m: GaitTargets.pushed) may land wider
 (recovery_max_width_m), and the tracker holds the CoM lower in it (WbcConfig.recovery_com_lower_m).
-Options, off by default (they save pushes but break random velocity timelines, whose command
-changes make pushed steps too): the CoM held lower in the step after a pushed one too
+Options, off by default: the CoM held lower in the step after a pushed one too
 (GaitConfig.after_push_steps, GaitTargets.after_push), and the swing foot lifted at once when the
-DCM strays in a double support (GaitConfig.early_lift_dcm_error_m).
+DCM strays in a double support (GaitConfig.early_lift_dcm_error_m). The DCM's error alone does not
+tell a push (turning and slowing down put it as far off its plan), so they act only after a push
+told by what the pendulum cannot explain (GaitConfig.push_detect_m: the DCM running away from where
+the pendulum under the asked CoP takes it; a command change moves the plan, not the DCM).
 
 Swing feet: the horizontal path and the yaw are re-planned each tick as a minimum-jerk segment
 from the reference's current position, velocity and acceleration to the (moving) landing point,
@@ -172,7 +174,14 @@ class GaitConfig:
     (ankle over-speed) 3 s after its push (measured, one machine). Off (0) by default: the random
     velocity timelines have pushed steps without a push (the DCM 0.25-0.48 m off its plan turning or
     slowing down, as off as in the bench's pushes), and with 1 random_s1 and random_s6 of `--only
-    wbc/random` fell (10/10 with 0); a push needs telling from a command change first."""
+    wbc/random` fell (10/10 with 0) on stop 36's code. Since stop 37 it acts only after a told push
+    (push_detect_m). On c91c490 with both options (1, 0.2): ungated, they fired in random_s1, s6 and s7
+    (no fall there now); gated, in none of random_s0-9 and s11-18 (before push_detect_max_rate_mps) and
+    s20-29 (with it; those runs bit-identical to the defaults'), and with it in none of s10 and s19 (uncapped, both were
+    told pushes they did not have and s19 fell at 8.6 s); the bench's pushes 9 -> 12/20 (front_1,
+    back_0, left_3, right_3 survive; front_3, a survivor without them, trips: a second push told 1.3 s
+    after the first, while it staggers, lowers the step after it); unseen, 150 N at phases shifted by 0.1
+    stride, 10 -> 11/20 (with and without the rate cap; measured, one machine). Off by default for front_3."""
     early_lift_dcm_error_m: float = math.inf
     """In a step's double support, the DCM this far off its plan lifts the swing foot at once (its
     double support ends, the single support keeps its length, inf: never): pushed late in a swing, the
@@ -181,6 +190,27 @@ class GaitConfig:
     0.1 12/20, 0.15 and 0.2 13/20 (right_3 survives), alone (after_push_steps 0) 9/20, the same nine
     (measured, one machine). Never sooner than fast_double_support_s into the double support (the
     load needs moving onto the other foot). Off (inf) by default, with after_push_steps."""
+    push_detect_m: float = 0.1
+    """A push is told from a command change (or from the DCM drifting off its plan turning hard) by what
+    the pendulum cannot explain: each walking tick the measured DCM is compared with where the last one
+    would have run under the CoP the gait asked (xi' = p + (xi - p) e^{w dt}); the differences, summed
+    with a push_detect_tau_s memory, staying this far (m) from zero for push_detect_hold_s tell a push (a
+    command change moves the plan, not the DCM). after_push_steps and early_lift_dcm_error_m act only
+    within push_memory_s of a told push; 0: on the DCM's error alone (as before stop 37); inf: never.
+    Measured on c91c490 (tau 0.2 s, held 80 ms; GaitTargets.push_drift_m): the bench's 20 pushes (150 N
+    for 0.2 s walking 0.5 m/s) reach levels held 80 ms of 0.107-0.19 m, told 0.12-0.36 s after the push starts and before the first
+    step the options touch; the 10 random velocity timelines of `g1 bench locomotion` (30 s each, their
+    pushed steps turning and slowing down included) at most 0.091 m, and walking before the pushes
+    0.048 m. Unmodelled motion of the robot's own counts too: staggering after a push, front_3 was told a
+    second push 1.3 s after the first."""
+    push_detect_tau_s: float = 0.2
+    push_detect_hold_s: float = 0.08
+    push_detect_max_rate_mps: float = 2.0
+    """Each tick's departure from the pendulum counts at most this fast: a push moves the DCM by about
+    F / (m w) per second (150 N on the robot's 35 kg: ~1.1 m/s); faster jumps came and went within
+    0.06 s (the estimate's, walking 0.6-0.7 m/s: unseen random_s10 and s19 told pushes without one and
+    s19 fell with the options; at 2 m/s neither does, every bench push is still told)."""
+    push_memory_s: float = 1.0
     speed_feedback_gain: float = 0.3
     """Per stride, this fraction of the error between the command and the stride's speed (from the
     feet's measured touchdowns) is added to the speed the steps are planned for: the pendulum model
@@ -293,6 +323,14 @@ class GaitConfig:
         if not self.early_lift_dcm_error_m > 0:  # inf: never
             raise WbcConfigError(f"GaitConfig.early_lift_dcm_error_m must be > 0 (inf: never); got "
                                  f"{self.early_lift_dcm_error_m}")
+        if not self.push_detect_m >= 0:  # inf: never a push
+            raise WbcConfigError(f"GaitConfig.push_detect_m must be >= 0 (0: no check, inf: never); got "
+                                 f"{self.push_detect_m}")
+        for name in ("push_detect_tau_s", "push_detect_hold_s", "push_memory_s", "push_detect_max_rate_mps"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value >= 0) or (name in ("push_detect_tau_s", "push_detect_max_rate_mps") and value == 0):
+                raise WbcConfigError(f"GaitConfig.{name} must be a finite number "
+                                     f"{'> 0' if name in ('push_detect_tau_s', 'push_detect_max_rate_mps') else '>= 0'}; got {value}")
         if not self.max_width_m <= self.fast_max_width_m:
             raise WbcConfigError(f"GaitConfig needs max_width_m <= fast_max_width_m; got {self.max_width_m}, "
                                  f"{self.fast_max_width_m}")
@@ -345,6 +383,10 @@ class GaitTargets:
     the tracker keeps the CoM lowered."""
     dcm_error_m: float = 0.0
     """How far the DCM is from its nominal plan this tick (walking; 0 otherwise)."""
+    push_drift_m: float = 0.0
+    """How far the DCM has run beyond what the pendulum explains (GaitConfig.push_detect_m; walking)."""
+    push_seen: bool = False
+    """A push was told (GaitConfig.push_detect_m) within GaitConfig.push_memory_s."""
 
 
 def nominal_dcm_offset(cfg: GaitConfig, stance: int, v_h: np.ndarray, omega: float, wz: float = 0.0) -> np.ndarray:
@@ -583,6 +625,13 @@ class VelocityGait:
         """The _t0 of a step after a pushed one (GaitConfig.after_push_steps; nan: none) ..."""
         self._after_push_left = 0
         self._dcm_error_at = math.nan
+        self._drift = np.zeros(2)
+        """The DCM's runs beyond the pendulum's prediction, summed with push_detect_tau_s's memory (m)."""
+        self._drift_xi: np.ndarray | None = None
+        """The DCM at the last walking tick (None: the last tick did not walk)."""
+        self._drift_over_since = math.nan
+        self._push_seen_t = -math.inf
+        """When a push was last told (GaitConfig.push_detect_m)."""
         """The _t0 of the step GaitTargets.dcm_error_m was last measured in (nan: none)."""
         """... and how many such steps are left, that one included."""
         self.command_h = np.zeros(3)
@@ -641,6 +690,7 @@ class VelocityGait:
                 self._correct_speed(t_s, 1 - self.stance, soles_m[1 - self.stance, :2])
                 self.steps += 1
                 pushed, after = self._pushed_at == self._t0, self._after_push_at == self._t0
+                pushed = pushed and self._push_recent(t_s)
                 self.stance = 1 - self.stance
                 self._t0 += self.step_T
                 if pushed or after:
@@ -654,7 +704,7 @@ class VelocityGait:
                     self._dcm_from = np.array(dcm_xy, dtype=float)
             elif (not self._swinging and self._dcm_error_at == self._t0 and not self._in_swing(t_s)
                   and t_s - self._t0 >= cfg.fast_double_support_s
-                  and self.targets.dcm_error_m > cfg.early_lift_dcm_error_m):
+                  and self.targets.dcm_error_m > cfg.early_lift_dcm_error_m and self._push_recent(t_s)):
                 # pushed in the double support: the swing foot lifts now
                 t_in = t_s - self._t0
                 self.step_T -= self.active.double_support_s - t_in
@@ -879,6 +929,36 @@ class VelocityGait:
         above = float(soles_m[f, 2]) - self.terrain.under_sole(soles_m[f, :2], float(sole_yaws[f]))
         return above > cfg.touchdown_height_m
 
+    def _push_recent(self, t_s: float) -> bool:
+        """Whether a push was told within GaitConfig.push_memory_s (always, with push_detect_m 0)."""
+        cfg = self.config
+        return cfg.push_detect_m == 0 or t_s - self._push_seen_t <= cfg.push_memory_s
+
+    def _track_drift(self, t_s: float, dt_s: float, dcm_xy: np.ndarray, omega: float) -> None:
+        """GaitConfig.push_detect_m: the DCM against the pendulum's prediction from the last walking tick
+        under the CoP asked then (self.targets.cop_xy_m, before this tick's)."""
+        cfg, out = self.config, self.targets
+        walking = self.mode == "walk"
+        if walking and self._drift_xi is not None and dt_s > 0:
+            p = out.cop_xy_m
+            predicted = p + (self._drift_xi - p) * math.exp(omega * dt_s)
+            self._drift *= math.exp(-dt_s / cfg.push_detect_tau_s)
+            departure = dcm_xy - predicted
+            size, most = float(np.hypot(*departure)), cfg.push_detect_max_rate_mps * dt_s
+            self._drift += departure if size <= most else departure * (most / size)
+        else:
+            self._drift *= math.exp(-dt_s / cfg.push_detect_tau_s) if dt_s > 0 else 1.0
+        self._drift_xi = np.array(dcm_xy, dtype=float) if walking else None
+        out.push_drift_m = float(np.hypot(*self._drift))
+        if out.push_drift_m > cfg.push_detect_m:
+            if math.isnan(self._drift_over_since):
+                self._drift_over_since = t_s
+            if t_s - self._drift_over_since >= cfg.push_detect_hold_s - 1e-9:
+                self._push_seen_t = t_s
+        else:
+            self._drift_over_since = math.nan
+        out.push_seen = self._push_recent(t_s)
+
     def _in_swing(self, t_s: float) -> bool:
         return t_s - self._t0 >= self.active.double_support_s
 
@@ -918,6 +998,7 @@ class VelocityGait:
         """The CoP, heading and swing-foot targets for this tick (call schedule() first; the
         command walked is schedule()'s, rate limited)."""
         cfg, out = self.active, self.targets
+        self._track_drift(t_s, dt_s, dcm_xy, omega)
         command_h = self.command_h.copy()
         command_h[:2] += self.speed_correction_h
         out.heading_rad = self.heading

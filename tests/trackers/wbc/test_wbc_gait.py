@@ -247,9 +247,10 @@ def _to_touchdown(gait, t, soles, yaws):
 @pytest.mark.parametrize("steps", [1, 0])
 def test_the_step_after_a_pushed_step_is_held_like_it(steps):
     """GaitConfig.after_push_steps: the step after a pushed step (double support included) is an
-    after-push step (the tracker keeps the CoM lowered); the step after that is a plain step again."""
+    after-push step (the tracker keeps the CoM lowered); the step after that is a plain step again.
+    (push_detect_m 0: on the DCM's error alone, whether or not a push was told.)"""
     soles, yaws = _feet()
-    gait = VelocityGait(GaitConfig(after_push_steps=steps))
+    gait = VelocityGait(GaitConfig(after_push_steps=steps, push_detect_m=0.0))
     t = _into_single_support(gait, soles, yaws)
     out = gait.update(t, 0.004, soles, yaws, soles[LEFT, :2] + np.array([0.05, -1.0]), OMEGA)
     assert out.pushed and not out.after_push
@@ -268,7 +269,7 @@ def test_a_dcm_far_off_its_plan_in_the_double_support_lifts_the_swing_foot_at_on
     fast_double_support_s of it has passed (the load moves onto the other foot first); the single
     support keeps its length, so the step lands that much sooner."""
     soles, yaws = _feet()
-    gait = VelocityGait(GaitConfig(early_lift_dcm_error_m=threshold))
+    gait = VelocityGait(GaitConfig(early_lift_dcm_error_m=threshold, push_detect_m=0.0))
     cfg = gait.config
     t = _to_touchdown(gait, _into_single_support(gait, soles, yaws), soles, yaws)
     step_before = gait.step_T
@@ -292,6 +293,94 @@ def test_a_dcm_far_off_its_plan_in_the_double_support_lifts_the_swing_foot_at_on
         assert lifted_at is None and gait.step_T == step_before
 
 
+def _pendulum_walk(gait, seconds, push=None, command=(0.3, 0.0, 0.0)):
+    """Ticks of a walk where the DCM moves as the pendulum does under the CoP the gait asks (the feet
+    land where the gait sends them); push: (from s, to s, DCM velocity m/s) added on top, as a force
+    on the body does. Per tick: (t, targets' push_drift_m, push_seen, pushed, after_push)."""
+    soles, yaws = _feet()
+    t, dt, xi = 0.0, 0.004, np.zeros(2)
+    rows = []
+    while t < seconds:
+        c = np.array(command(t) if callable(command) else command)
+        gait.schedule(t, c, soles, yaws, xi)
+        out = gait.update(t, dt, soles, yaws, xi, OMEGA)
+        if out.swing_foot >= 0:
+            soles[out.swing_foot, :2] = out.swing_pos_m[:2]
+        p = out.cop_xy_m.copy()
+        xi = p + (xi - p) * math.exp(OMEGA * dt)
+        for start, end, vel in ([] if push is None else [push] if np.isscalar(push[0]) else push):
+            if start <= t < end:
+                xi = xi + np.asarray(vel) * dt
+        rows.append((t, out.push_drift_m, out.push_seen, out.pushed, out.after_push))
+        t += dt
+    return np.array(rows, dtype=float)
+
+
+def _reversal(t):
+    """Walking forward 0.5 m/s, then backwards and turning hard from 2 s: the plan moves, not the DCM."""
+    return (0.5, 0.0, 0.0) if t < 2.0 else (-0.3, 0.0, 0.8)
+
+
+@pytest.mark.parametrize("command", [(0.3, 0.0, 0.0), _reversal])
+def test_a_push_is_told_from_what_the_pendulum_explains(command):
+    """GaitConfig.push_detect_m: the DCM moving as the pendulum does under the CoP the gait asks (a
+    command changing included) is never a push; 1.1 m/s more for 0.2 s (150 N on the robot's 35 kg at
+    w ~ 3.9/s) is one, told by its end, remembered push_memory_s."""
+    cfg = GaitConfig()
+    quiet = _pendulum_walk(VelocityGait(), 4.0, command=command)
+    assert quiet[:, 1].max() < 1e-6 and not quiet[:, 2].any()
+    rows = _pendulum_walk(VelocityGait(), 4.0, push=(2.0, 2.2, (0.0, -1.1)), command=command)
+    t, drift, seen = rows[:, 0], rows[:, 1], rows[:, 2] > 0
+    assert not seen[t < 2.0].any() and drift[t < 2.0].max() < 1e-6
+    first = t[seen][0]
+    assert 2.0 + cfg.push_detect_hold_s < first < 2.22
+    assert drift.max() > cfg.push_detect_m
+    assert seen[(t >= first) & (t <= first + cfg.push_memory_s - 0.01)].all()
+    assert not seen[t > first + cfg.push_memory_s + 0.3].any()  # the drift decays with the memory
+
+
+@pytest.mark.parametrize("max_rate", [2.0, 1e9])
+def test_a_dcm_estimate_that_jumps_out_and_back_is_no_push(max_rate):
+    """GaitConfig.push_detect_max_rate_mps: the DCM estimate jumping 0.24 m at 4 m/s and back within
+    0.16 s (as walking 0.6-0.7 m/s in random timelines, without a push) is not told a push; uncapped it is."""
+    glitch = [(2.0, 2.06, (4.0, 0.0)), (2.1, 2.16, (-4.0, 0.0))]
+    rows = _pendulum_walk(VelocityGait(GaitConfig(push_detect_max_rate_mps=max_rate)), 3.0, push=glitch)
+    assert rows[:, 2].any() == (max_rate > 100)
+
+
+@pytest.mark.parametrize("pushed", [True, False])
+def test_after_push_steps_follow_a_told_push_only(pushed):
+    """After a told push, after_push_steps holds the next step low; a DCM as far off its plan without a
+    push told (the error put there at once: nothing the pendulum's drift shows) does not."""
+    gait = VelocityGait(GaitConfig(after_push_steps=1))
+    if pushed:
+        rows = _pendulum_walk(gait, 4.0, push=(2.0, 2.2, (0.0, -1.1)))
+        assert rows[:, 3].any() and rows[:, 4].any()
+        assert rows[rows[:, 4] > 0, 0].min() > 2.0
+    else:
+        soles, yaws = _feet()
+        t = _into_single_support(gait, soles, yaws)
+        out = gait.update(t, 0.004, soles, yaws, soles[LEFT, :2] + np.array([0.05, -1.0]), OMEGA)
+        assert out.pushed and not out.push_seen
+        t = _to_touchdown(gait, t, soles, yaws)
+        out = gait.update(t, 0.004, soles, yaws, soles[RIGHT, :2] + np.array([0.05, 0.03]), OMEGA)
+        assert not out.after_push
+
+
+def test_the_early_lift_waits_for_a_told_push():
+    """early_lift_dcm_error_m with the push check (the default): a DCM off its plan in the double
+    support without a push told keeps the double support."""
+    soles, yaws = _feet()
+    gait = VelocityGait(GaitConfig(early_lift_dcm_error_m=0.2))
+    cfg = gait.config
+    t = _to_touchdown(gait, _into_single_support(gait, soles, yaws), soles, yaws)
+    while t - gait._t0 < cfg.double_support_s - 0.008:
+        t += 0.004
+        out = gait.update(t, 0.004, soles, yaws, soles[RIGHT, :2] + np.array([0.4, 0.0]), OMEGA)
+        assert out.dcm_error_m > 0.2 and not out.push_seen
+        assert gait.schedule(t + 0.004, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2)).all()
+
+
 @pytest.mark.parametrize("kwargs, text", [
     ({"single_support_s": 0.0}, "single_support_s must be a finite number > 0"),
     ({"min_width_m": 0.3}, "min_width_m <= step_width_m <= max_width_m"),
@@ -309,6 +398,13 @@ def test_a_dcm_far_off_its_plan_in_the_double_support_lifts_the_swing_foot_at_on
     ({"touchdown_max_wait_s": -0.1}, "touchdown_max_wait_s must be a finite number >= 0; got -0.1"),
     ({"touchdown_max_wait_s": math.inf}, "touchdown_max_wait_s must be a finite number >= 0"),
     ({"touchdown_descent_mps": math.nan}, "touchdown_descent_mps must be a finite number >= 0"),
+
+    ({"push_detect_m": -0.1}, r"push_detect_m must be >= 0 \(0: no check, inf: never\); got -0.1"),
+    ({"push_detect_m": math.nan}, "push_detect_m must be >= 0"),
+    ({"push_detect_tau_s": 0.0}, "push_detect_tau_s must be a finite number > 0; got 0.0"),
+    ({"push_detect_hold_s": -1.0}, "push_detect_hold_s must be a finite number >= 0; got -1.0"),
+    ({"push_memory_s": math.inf}, "push_memory_s must be a finite number >= 0; got inf"),
+    ({"push_detect_max_rate_mps": 0.0}, "push_detect_max_rate_mps must be a finite number > 0; got 0.0"),
 ])
 def test_bad_gait_config_is_refused(kwargs, text):
     with pytest.raises(WbcConfigError, match=text):

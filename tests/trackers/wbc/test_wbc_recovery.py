@@ -15,8 +15,9 @@ that saves some of them is taken away in turn (so a test goes red without it):
   WbcConfig.swing_max_accel_mps2   the swing foot's re-planned reference acceleration capped (uncapped:
                                    right_0 fell, ankle pitch over-speed; left_2 and back_2 trip too,
                                    left_2 after the settling time).
-Two options, off by default (they break random velocity timelines, gait.py), are shown to save pushes
-that fall without them:
+Two options, off by default (they save pushes but front_3 then trips; they act only after a push told
+by GaitConfig.push_detect_m, so the random velocity timelines' pushed steps leave them be, gait.py),
+are shown to save pushes that fall without them:
   GaitConfig.after_push_steps 1    the step after a pushed step keeps the CoM lowered (front_1 survives;
                                    it falls with the defaults);
   GaitConfig.early_lift_dcm_error_m  with it, the DCM 0.2 m off its plan in a double support lifts the
