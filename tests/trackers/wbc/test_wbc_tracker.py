@@ -69,7 +69,9 @@ def test_reference_without_any_contact_is_refused():
                                           ({"walking_heading_lag_steps": -1.0}, "walking_heading_lag_steps"),
                                           ({"walking_heading_lag_full_speed_mps": 0.0},
                                            "walking_heading_lag_full_speed_mps must be a finite number > 0"),
-                                          ({"terrain_com_brake_mps2": -1.0}, "terrain_com_brake_mps2")])
+                                          ({"terrain_com_brake_mps2": -1.0}, "terrain_com_brake_mps2"),
+                                          ({"command_latency_s": float("inf")},
+                                           "command_latency_s must be a finite number >= 0")])
 def test_bad_config_is_refused(kwargs, text):
     with pytest.raises(WbcConfigError, match=text):
         WbcConfig(**kwargs)
