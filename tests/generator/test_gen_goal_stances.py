@@ -276,6 +276,17 @@ def test_a_heavy_box_near_a_high_tables_edge_is_held_with_the_trunk_clear_of_its
                          stances.collision(q, SEED11_0_BOX, center, _lowered(SEED11_0_TABLE, 0.72)) or "")
 
 
+
+def test_a_mid_height_top_above_a_squatting_pelvis_still_keeps_the_legs_rules(stances):
+    """The legs pass under a top only if it is above the standing pelvis too: the seed 11 trial 0 pose with
+    its pelvis lowered to a squat's 0.58 m, at a 0.67 m table (its underside 5 cm above that pelvis), is
+    judged by the 0.18 m rule of stepping in (bench objects 29.9: such a squat stance fell stepping in)."""
+    center, plan = _plan_pick(stances, SEED11_0_TABLE, SEED11_0_BOX)
+    q = plan.chosen.poses[0].copy()
+    q[2] = 0.58
+    assert re.search(r"the pelvis is 0\.1\d m from 'table_a' \(stepping in needs >= 0\.18 m\)",
+                     stances.collision(q, SEED11_0_BOX, center, _lowered(SEED11_0_TABLE, 0.67)) or "")
+
 def test_the_knees_may_come_under_a_top_above_the_legs(stances):
     center, plan = _plan_pick(stances, SEED11_9_TABLE, SEED11_9_BOX)
     q = plan.chosen.poses[0]

@@ -182,6 +182,11 @@ ABOVE_LEGS_M = 0.02
 legs: the thighs, knees and shins stay below the pelvis stepping in (the stepping knee rises to
 ~0.55 m), so they pass under its top and the knee and pelvis rules above do not apply; the 0.80-0.95 m
 tables (bench objects' "high") have their underside at 0.76-0.91 m, the standing pelvis at 0.756 m."""
+STANDING_PELVIS_M = 0.756
+"""The G1's pelvis height standing (nominal pose). The legs pass under a top only if its underside is
+ABOVE_LEGS_M above this too, not just above a squatting hold pose's pelvis: the robot walks in upright,
+and a squat brings the knees forward under a mid-height top (bench objects 29.9: a 0.67 m table, a
+squat stance near it allowed by the hold pose's 0.55-0.60 m pelvis, fell stepping in; measured)."""
 TRUNK_EDGE_CLEARANCE_M = 0.15
 """The pelvis stays this far from a top above the legs: the trunk's widest at the top's height
 (pelvis to chest, 0.76-1.2 m standing) is 0.11 m from the pelvis's axis (the G1's collision meshes,
@@ -529,7 +534,8 @@ class StancePlanner:
         pos = {n: ik.data.oMf[f].translation for n, f in self._frames.items()}
         if support is not None and support.height_m > KNEE_HEIGHT_M:
             gap = support.distance_xy(q[:2])
-            above_legs = support.height_m - TABLE_TOP_THICKNESS_M - float(q[2]) >= ABOVE_LEGS_M
+            underside = support.height_m - TABLE_TOP_THICKNESS_M
+            above_legs = underside - max(float(q[2]), STANDING_PELVIS_M) >= ABOVE_LEGS_M
             need = TRUNK_EDGE_CLEARANCE_M if above_legs else MIN_EDGE_CLEARANCE_M
             if gap < need:
                 return f"the pelvis is {gap:.2f} m from '{support.name}' (stepping in needs >= {need:.2f} m)"
