@@ -40,7 +40,6 @@ def import_cyclonedds():
             f"the DDS transport needs the cyclonedds 0.10.x Python binding ({exc}); "
             "install it with scripts/install_cyclonedds.sh"
         ) from None
-    _guard_entity_deletion()
 
 
 def cyclone_config(interface: str) -> str:
@@ -69,10 +68,7 @@ def domain_participant(interface: str, domain_id: int):
     check_interface(interface)
     if not 0 <= int(domain_id) <= 232:
         raise TransportError(f"DDS domain id must be 0..232; got {domain_id} (the robot uses 0, simulation 1)")
-    # Under the entity lock first, always in that order: a deletion waiting for the entity lock inside
-    # _domains_lock (the garbage collector running in Domain()) must not meet a holder of the entity lock
-    # waiting for _domains_lock.
-    with _ENTITY_LOCK, _domains_lock:
+    with _domains_lock:
         if domain_id in _domains:
             bound, _ = _domains[domain_id]
             if bound != interface:
@@ -82,43 +78,14 @@ def domain_participant(interface: str, domain_id: int):
                 )
         else:
             _domains[domain_id] = (interface, Domain(domain_id, cyclone_config(interface)))
-        return DomainParticipant(domain_id)
+    return DomainParticipant(domain_id)
 
 
-
-
-_ENTITY_LOCK = threading.RLock()
+_ENTITY_LOCK = threading.Lock()
 """Held by every link's send/take and close, process-wide: Cyclone DDS (0.10) delivers a write to
 the readers of the same process inline, and deleting a link's entities while another link's
 thread writes on the same domain segfaulted the process (seen in the test suite under load: an
-emulator's state write while a host link closed). Uncontended it costs well under a microsecond.
-Reentrant: an entity whose Python object dies while its thread holds the lock (a close, or the
-cyclic garbage collector running inside a send) deletes itself under it (_guard_entity_deletion)."""
-
-
-def _guard_entity_deletion() -> None:
-    """Make every Cyclone entity's deletion take _ENTITY_LOCK, process-wide.
-
-    The binding deletes an entity (dds_delete, through ctypes, which lets other threads run) when
-    its Python object dies: at once when the last reference goes, or whenever the cyclic garbage
-    collector runs, in whichever thread allocates at that moment, for objects in a reference cycle
-    (the binding's BuiltinDataReader holds a ReadCondition that holds it back). Our owners delete
-    their entities under the lock in close(); this covers what dies elsewhere (an owner dropped
-    without close(), a test's own entity), so no deletion ever runs beside another thread's write."""
-    from cyclonedds.core import Entity, WaitSet
-
-    lock = _ENTITY_LOCK  # held here: module globals may be gone when a late __del__ runs at exit
-    for cls in (Entity, WaitSet):
-        original = cls.__dict__["__del__"]
-        if getattr(original, "_under_entity_lock", False):
-            continue
-
-        def guarded(self, _original=original) -> None:
-            with lock:
-                _original(self)
-
-        guarded._under_entity_lock = True  # type: ignore[attr-defined]
-        cls.__del__ = guarded  # type: ignore[method-assign]
+emulator's state write while a host link closed). Uncontended it costs well under a microsecond."""
 
 
 _open_links: weakref.WeakSet[DdsLink] = weakref.WeakSet()
@@ -179,7 +146,7 @@ class DdsEntities:
     def closed(self) -> bool:
         return self._closed
 
-    def lock(self) -> threading.RLock:
+    def lock(self) -> threading.Lock:
         """The lock to hold while the owner makes its entities (`with entities.lock(): ...`)."""
         return _ENTITY_LOCK
 
@@ -331,11 +298,7 @@ class DdsLink(Link):
                 if self._closed:
                     return []
                 waitset = self._waitset
-            try:
-                waitset.wait(int(timeout_s * 1e9))
-            finally:
-                with self._io_lock:  # a close() meanwhile left this the last reference: delete it under the lock
-                    del waitset
+            waitset.wait(int(timeout_s * 1e9))
             samples = self._take_now()
             if isinstance(samples, int):
                 return []
@@ -351,23 +314,16 @@ class DdsLink(Link):
         from cyclonedds.core import InstanceState
         from cyclonedds.qos import Policy
 
-        with self._io_lock:  # made and deleted under the process-wide lock, like the link's own entities
+        with self._peer_lock:
             if self._closed:  # a reader thread's last look after the link closed (at exit: _close_links_at_exit)
                 return dict.fromkeys(self._topics, 0)
             if self._publications is None:
                 self._publications = BuiltinDataReader(self._participant, BuiltinTopicDcpsPublication)
-        # Read under _peer_lock only, not the process-wide lock: the binding builds a Python object per
-        # discovery sample inside take() (QoS, type identifiers), milliseconds while a deploy starts, and the
-        # link's 500 Hz sender must not wait for that (held under the entity lock, a deploy over DDS with
-        # perception topics tripped on deadline overruns, measured). close() deletes it under _peer_lock too.
-        with self._peer_lock:
-            if self._closed or self._publications is None:
-                return dict.fromkeys(self._topics, 0)
-            return self._update_writers(self._publications.take(N=256), InstanceState, Policy)
+            return self._update_writers(InstanceState, Policy)
 
-    def _update_writers(self, samples, InstanceState, Policy) -> dict[str, int]:
+    def _update_writers(self, InstanceState, Policy) -> dict[str, int]:
         ours = {self.partition or ""}
-        for sample in samples:
+        for sample in self._publications.take(N=256):
             info = sample.sample_info
             handle = info.instance_handle
             if info.instance_state != InstanceState.Alive or not info.valid_data:
@@ -398,12 +354,5 @@ class DdsLink(Link):
             _open_links.discard(self)
             self._waitset.detach(self._condition)
             del self._writer, self._reader, self._condition, self._waitset
-        with self._peer_lock:  # not while peer_writers() reads discovery; never inside the entity lock
-            publications, participant = self._publications, self._participant
-            self._publications = self._participant = None
-        with self._io_lock:
-            if publications is not None:
-                # The binding's built-in reader and its ReadCondition hold each other: break the cycle so
-                # both go now, under the lock, not later in whichever thread the garbage collector runs.
-                publications._next_condition = None
-            del publications, participant
+            with self._peer_lock:  # not while peer_writers() reads discovery
+                del self._participant, self._publications
