@@ -15,6 +15,7 @@ and printed report: g1_control/report/results.py):
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import signal
 import time
@@ -28,6 +29,7 @@ from g1_control.interfaces import InputDevice
 from g1_control.launch.builder import build_loop, make_sim_backend, timeline_of
 from g1_control.launch.schema import LaunchFile
 from g1_control.loop.control_loop import ControlLoop, first_fault
+from g1_control.loop.priority import frozen_heap
 from g1_control.report.overlay import overlay_lines
 from g1_control.report.results import RunResult, run_result, summary_dict
 from g1_control.report.run_folder import RunFolder, interrupt_on_signals
@@ -124,8 +126,12 @@ def _run_loop(launch: LaunchFile, sim: MujocoBackend, loop: ControlLoop, segment
             over = program.ended_s is not None and loop.now_s() - program.ended_s >= PROGRAM_END_HOLD_S
             return over or (viewer_closed is not None and viewer_closed())
     interrupted: KeyboardInterrupt | None = None
+    # On the wall clock, no full collection of the caller's heap inside the loop (loop/priority.py): in a
+    # long-lived process (a test session's, a notebook's) one takes 50 ms or more, and the state goes stale.
+    heap = frozen_heap() if loop.scheduler.wallclock else contextlib.nullcontext()
     try:
-        loop.scheduler.run(round(duration * loop.rates.lowlevel_hz), stop=stop, progress=on_tick)
+        with heap:
+            loop.scheduler.run(round(duration * loop.rates.lowlevel_hz), stop=stop, progress=on_tick)
     except KeyboardInterrupt as exc:
         if folder is None:
             raise

@@ -233,3 +233,31 @@ def test_the_default_safety_filter_carries_the_loops_tilt_limit():
     given = SafetyFilter(SafetyConfig(max_tilt_rad=0.9))
     loop = ControlLoop(StandInRobot(), Still(), VelocityReferenceGenerator(), IKStage(), Hold(), safety=given)
     assert loop.falls.max_tilt_rad == 0.9
+
+
+def test_a_simulator_paced_by_the_wall_clock_steps_the_ticks_a_stall_skipped():
+    """A simulator (lockstep backend) run on the wall clock: one tick stalls 80 ms (the scheduler skips
+    the periods it lost). The world went on meanwhile: the simulator steps the skipped ticks too, so the
+    state's time stays the loop's and the stale-state check (50 ms) sees no stale state. Before, every
+    skipped tick aged the state for good, and a paced sim run (sim_ros2.yaml) damped after ~25 of them."""
+
+    class Clock:
+        def __init__(self):
+            self.t, self.stalled = 0.0, False
+
+        def __call__(self):
+            if not self.stalled and self.t > 0.2:
+                self.stalled, self.t = True, self.t + 0.08
+            return self.t
+
+        def sleep(self, s):
+            self.t += s
+
+    clock = Clock()
+    loop, robot, _records = _loop(StandInRobot(lockstep=True), wallclock=True,
+                                  safety=SafetyFilter(SafetyConfig(stale_state_s=0.05)))
+    loop.scheduler.clock, loop.scheduler.sleep = clock, clock.sleep
+    loop.run(0.5)
+    assert clock.stalled and loop.scheduler.skipped_ticks >= 39  # 80 ms of 2 ms ticks
+    assert robot.t_s == pytest.approx(loop.time_s, abs=0.0021), "the simulator kept the loop's time"
+    assert not loop.faulted, loop.events
