@@ -4,7 +4,9 @@ partitions (concurrent runs on this host never see each other), emulated robots 
 from __future__ import annotations
 
 import os
+import re
 import uuid
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -129,10 +131,35 @@ def standing_state(**changes):
     return state
 
 
+HOST_TIMING_TRIP = re.compile(r"-> damping: (deadline_overruns|stale_state): ")
+"""A deploy that damped because this host could not keep its loop's rate or deliver states in time."""
+TIMING_ATTEMPTS = 3
+
+
 def deploy_to_the_end(partition: str, launch: Path, json_path: Path, out: Path, emulator_flags=(), deploy_flags=(),
                       waits=((r"control -> damping: control time over", 240), (r"^loop: ", 30))):
     """`g1 sim-robot` (flags) and `g1 deploy LAUNCH --yes` as two processes, the deploy waited through `waits`
-    (pattern, seconds) to its exit; (the deploy process, the emulator's wire report). Both are ended either way."""
+    (pattern, seconds) to its exit; (the deploy process, the emulator's wire report). Both are ended either way.
+
+    The controller and the emulated robot share this host's cores (two, shared with other work): a deploy
+    that damps on missed deadlines or a stale state (a timing trip, HOST_TIMING_TRIP) is run again, in a new
+    partition, up to TIMING_ATTEMPTS runs in all, each retry a warning in the test report that names the
+    trip. Any other failure fails at once; a deploy that trips on timing every time fails."""
+    for attempt in range(1, TIMING_ATTEMPTS + 1):
+        name = partition if attempt == 1 else f"{partition}-r{attempt}"
+        try:
+            return _deploy_once(name, launch, json_path, out, emulator_flags, deploy_flags, waits)
+        except AssertionError as exc:
+            trip = HOST_TIMING_TRIP.search(str(exc))
+            if trip is None or attempt == TIMING_ATTEMPTS:
+                raise
+            line = next(t for t in str(exc).splitlines() if HOST_TIMING_TRIP.search(t))
+            warnings.warn(f"{launch.name}: the deploy damped on this host's timing (attempt {attempt} of "
+                          f"{TIMING_ATTEMPTS}), run again: {line.strip()}", stacklevel=2)
+    raise AssertionError("unreachable")
+
+
+def _deploy_once(partition, launch, json_path, out, emulator_flags, deploy_flags, waits):
     from test_deploy_sim2sim import Emulator
 
     from g1_control.tools.soak import G1Process
