@@ -133,7 +133,20 @@ def standing_state(**changes):
 
 HOST_TIMING_TRIP = re.compile(r"-> damping: (deadline_overruns|stale_state): ")
 """A deploy that damped because this host could not keep its loop's rate or deliver states in time."""
+STALLED_LOOP = re.compile(r"(?:^|\s)loop: .*; ([1-9][0-9]*) ticks skipped after stalls\)")
+"""The deploy's loop line when this host stalled it for whole periods (the scheduler skipped ticks)."""
 TIMING_ATTEMPTS = 3
+
+
+def _host_timing(failure: str) -> str | None:
+    """Why a failed deploy is this host's timing (the lines that say so), or None."""
+    lines = failure.splitlines()
+    trip = next((t.strip() for t in lines if HOST_TIMING_TRIP.search(t)), None)
+    if trip is not None:
+        return trip
+    damped = next((t.strip() for t in lines if re.search(r"control -> damping: (?!control time over)", t)), None)
+    stalled = next((t.strip() for t in lines if STALLED_LOOP.search(t.strip())), None)
+    return f"{damped} after a stalled loop ({stalled})" if damped and stalled else None
 
 
 def deploy_to_the_end(partition: str, launch: Path, json_path: Path, out: Path, emulator_flags=(), deploy_flags=(),
@@ -141,21 +154,21 @@ def deploy_to_the_end(partition: str, launch: Path, json_path: Path, out: Path, 
     """`g1 sim-robot` (flags) and `g1 deploy LAUNCH --yes` as two processes, the deploy waited through `waits`
     (pattern, seconds) to its exit; (the deploy process, the emulator's wire report). Both are ended either way.
 
-    The controller and the emulated robot share this host's cores (two, shared with other work): a deploy
-    that damps on missed deadlines or a stale state (a timing trip, HOST_TIMING_TRIP) is run again, in a new
-    partition, up to TIMING_ATTEMPTS runs in all, each retry a warning in the test report that names the
-    trip. Any other failure fails at once; a deploy that trips on timing every time fails."""
+    The controller and the emulated robot share this host's cores (two, shared with other work). A deploy that
+    damps on this host's timing is run again, in a new partition, up to TIMING_ATTEMPTS runs in all, each
+    retry a warning in the test report naming why: a timing trip (missed deadlines, a stale state), or any
+    trip in control after the host stalled the loop for whole periods (its ticks skipped: a walk that fell
+    after a 24 ms stall). Any other failure fails at once; a deploy that fails on timing every time fails."""
     for attempt in range(1, TIMING_ATTEMPTS + 1):
         name = partition if attempt == 1 else f"{partition}-r{attempt}"
         try:
             return _deploy_once(name, launch, json_path, out, emulator_flags, deploy_flags, waits)
         except AssertionError as exc:
-            trip = HOST_TIMING_TRIP.search(str(exc))
-            if trip is None or attempt == TIMING_ATTEMPTS:
+            why = _host_timing(str(exc))
+            if why is None or attempt == TIMING_ATTEMPTS:
                 raise
-            line = next(t for t in str(exc).splitlines() if HOST_TIMING_TRIP.search(t))
-            warnings.warn(f"{launch.name}: the deploy damped on this host's timing (attempt {attempt} of "
-                          f"{TIMING_ATTEMPTS}), run again: {line.strip()}", stacklevel=2)
+            warnings.warn(f"{launch.name}: the deploy failed on this host's timing (attempt {attempt} of "
+                          f"{TIMING_ATTEMPTS}), run again: {why}", stacklevel=2)
     raise AssertionError("unreachable")
 
 
