@@ -28,6 +28,11 @@ MAX_LOOPBACK_PARTICIPANTS = 32
 
 _domains: dict[int, tuple[str, object]] = {}
 _domains_lock = threading.Lock()
+_anchors: dict[int, tuple[Any, ...]] = {}
+"""Per domain, the entities of _anchor_keyless_instance (kept for the life of the process)."""
+
+ANCHOR_TOPIC = "g1_control/keyless_instance_anchor"
+"""The process-local topic of _anchor_keyless_instance (its own partition: no other process matches it)."""
 
 
 def import_cyclonedds():
@@ -78,7 +83,46 @@ def domain_participant(interface: str, domain_id: int):
                 )
         else:
             _domains[domain_id] = (interface, Domain(domain_id, cyclone_config(interface)))
+            _anchors[domain_id] = _anchor_keyless_instance(domain_id)
     return DomainParticipant(domain_id)
+
+
+def _anchor_keyless_instance(domain_id: int) -> tuple[Any, ...]:
+    """Write the domain's first keyless sample from a topic that lives as long as the process, and keep it.
+
+    Why (the CI segfaults of stops 27-36, read from a core file: dds_write -> ddsi_tkmap_find -> a freed
+    instance): Cyclone maps every sample's key to an instance in one table per domain (the "tkmap"), shared
+    by all topics. The Python binding (0.10.x, clayer/pysertype.c) gives every keyless sample the same hash
+    and calls any two keyless samples equal, whatever their types, so all our topics (LowCmd_, LowState_, the
+    motion service's, the hands', ROS 2's: all keyless) share one instance. That instance keeps the first
+    sample that made it, and that sample points at its topic type without holding it; the binding's key
+    comparison reads the type's `keyless` flag through that pointer. Once that type's topics are all deleted
+    (a motion-service client closed while the robot link streams, tests making and closing links), the
+    flag is read from freed memory: a lookup can then miss the instance and make a second one, and the
+    table's removal, which removes the first entry that compares equal, can take out the wrong one, leaving
+    a freed instance in the table for the next write to crash on.
+    So the first keyless sample of each domain is this anchor's, its type is held by a topic that is never
+    deleted, and a reader of this process keeps the sample (never taken), so the shared instance is never
+    freed and its type pointer stays valid. The anchor's participant, writer and reader live in a partition
+    of their own; discovery announces them, nothing else matches them."""
+    from cyclonedds.domain import DomainParticipant
+    from cyclonedds.pub import DataWriter, Publisher
+    from cyclonedds.qos import Policy, Qos
+    from cyclonedds.sub import DataReader, Subscriber
+    from cyclonedds.topic import Topic
+
+    from g1_control.hardware.links.anchor_idl import InstanceAnchor_ as anchor_type
+    participant = DomainParticipant(domain_id)
+    topic = Topic(participant, ANCHOR_TOPIC, anchor_type)
+    group = Qos(Policy.Partition([f"g1_control_anchor_{threading.get_native_id()}_{id(participant):x}"]))
+    qos = Qos(Policy.Reliability.Reliable(1_000_000_000), Policy.History.KeepLast(1),
+              Policy.Durability.TransientLocal)
+    writer = DataWriter(Publisher(participant, qos=group), topic, qos=qos)
+    reader = DataReader(Subscriber(participant, qos=group), topic, qos=qos)
+    writer.write(anchor_type(1))
+    if len(reader.read(N=1)) != 1:
+        raise TransportError(f"DDS domain {domain_id}: the keyless-instance anchor was not delivered in-process")
+    return participant, topic, writer, reader
 
 
 _ENTITY_LOCK = threading.Lock()
