@@ -166,8 +166,12 @@ class ControlLoop:
             Stage("log", r.tracker_hz, self._log),
         ]
         self.scheduler = Scheduler(r.lowlevel_hz, stages, wallclock=wallclock)
-        self._skipped_stepped = 0
-        """The scheduler's skipped ticks the simulator has stepped (_lowlevel)."""
+        if backend.lockstep:
+            # A simulator paced by the wall clock steps the ticks a stall made the scheduler skip, when it
+            # skips them, with the command the drivers hold: the world does not wait for a late controller,
+            # and the next state is current (else every skipped tick would age the state for good, until
+            # the stale-state check damps a robot that was never stale).
+            self.scheduler.on_skip = self._lowlevel_ticks
         # The latest generator and retargeter outputs (None before their first tick: within a tick the
         # stages run in the order listed above, so each is set before the next stage reads it).
         self._kin_ref: KinematicReference | None = None
@@ -337,13 +341,7 @@ class ControlLoop:
 
     def _lowlevel(self) -> None:
         if self.backend.lockstep:
-            # A simulator paced by the wall clock steps the ticks a stall made the scheduler skip too: the
-            # world does not wait for a late controller (the drivers hold the last command meanwhile),
-            # and the state's time keeps up with the loop's (else every skipped tick would age the state
-            # for good, until the stale-state check damps a robot that was never stale).
-            skipped = self.scheduler.skipped_ticks - self._skipped_stepped
-            self._skipped_stepped += skipped
-            self.backend.step_ticks(self.motor_command, self.scheduler.dt_s, 1 + skipped)  # write_command, then step
+            self.backend.step_ticks(self.motor_command, self.scheduler.dt_s, 1)  # write_command, then step
         else:
             self.backend.write_command(self.motor_command)
 

@@ -96,6 +96,8 @@ class Scheduler:
         """Ticks that finished more than a whole tick period late (the next tick's deadline passed too)."""
         self.skipped_ticks = 0
         """Wall-clock ticks not run: the whole periods a late tick overran (tick_index moves past them)."""
+        self.on_skip: Callable[[int], None] | None = None
+        """Called with the number of ticks skipped, when a late tick skips them (a simulator steps them)."""
         self._late_since_take = 0.0
         self._late_since_log = 0.0
         self._t0: float | None = None
@@ -151,6 +153,8 @@ class Scheduler:
                     lost = int(late // self.dt_s)
                     self.tick_index += lost
                     self.skipped_ticks += lost
+                    if self.on_skip is not None:
+                        self.on_skip(lost)
                 self._late_since_take = max(self._late_since_take, late)
                 self._late_since_log = max(self._late_since_log, late)
             else:
