@@ -487,6 +487,7 @@ def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTr
     late = loop.scheduler.lateness.summary()
     report.loop = {"deadline_misses": loop.scheduler.deadline_misses, "ticks": loop.scheduler.tick_index,
                    "tick_p99_us": loop.scheduler.report()["tick"]["p99_us"],
+                   "stages_us": loop.scheduler.report(),
                    "lateness_p99_ms": late["p99_us"] / 1000, "lateness_max_ms": loop.scheduler.max_lateness_s * 1000,
                    "misses_over_period": loop.scheduler.misses_over_period,
                    "skipped_ticks": loop.scheduler.skipped_ticks,

@@ -13,7 +13,8 @@ from deploy_test_helpers import ROOT, deploy_to_the_end, write_launch
 # Not marked `timing` (not run a second time under .ci/run's busy load): with both cores spun by the load
 # generator, the WBC's 250 Hz loop over DDS runs 10 % of its ticks more than 2 ms late (CI at 8d9c271: 196
 # misses in 2036 ticks, p99 3.2 ms, damped at 25 overruns/s); it passes unloaded (every CI pass of stop 32).
-# A faster WBC tick is the fix (issue 23).
+# A faster WBC tick is the fix (issue 23). sim2sim_wbc.yaml runs the WBC at 100 Hz since stop 39: at 250 Hz
+# it failed here even unloaded (3 of 5 runs, every attempt).
 
 SIM2SIM_WBC = ROOT / "launch" / "sim2sim_wbc.yaml"
 

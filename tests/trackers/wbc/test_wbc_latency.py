@@ -35,6 +35,31 @@ def test_the_targets_lead_by_one_tick_plus_the_expected_latency():
         np.testing.assert_allclose(q, state.q_rad + (state.dq_radps + 0.5 * ddq * ahead) * ahead, atol=1e-9)
 
 
+def test_after_a_stalled_tick_the_targets_still_lead_by_one_nominal_tick():
+    """A wall-clock loop that stalled (the next state 40 ms after the last, four 100 Hz ticks): the next
+    command still arrives one tick later, so the targets lead by one tick, not by the stall. Leading by
+    the time since the last state, the held command threw the legs after host stalls (joint-overspeed
+    trips in the WBC's DDS walk at 100 Hz, tests/deploy/test_deploy_wbc_walk.py)."""
+    config = WbcConfig(rate_hz=100.0)
+    backend = MujocoBackend()
+    state = backend.reset()
+    tracker = WholeBodyTracker(config)
+    tracker.reset(state)
+    reference = JointReference(q_rad=g1.DEFAULT_Q_RAD.copy())
+    tracker.act(reference, state)
+    stalled = backend.reset()
+    stalled.t_s = state.t_s + 0.04
+    stalled.dq_radps[:] = np.linspace(-0.5, 0.5, stalled.dq_radps.size)
+    command = tracker.act(reference, stalled)
+    assert tracker.diagnostics.solution is not None
+    ddq = tracker.diagnostics.solution.ddq[6:]
+    assert np.abs(ddq).max() > 0.1  # the lead shows
+    ahead = 1.0 / config.rate_hz
+    np.testing.assert_allclose(command.dq_radps, stalled.dq_radps + ddq * ahead, atol=1e-9)
+    np.testing.assert_allclose(command.q_rad, stalled.q_rad + (stalled.dq_radps + 0.5 * ddq * ahead) * ahead,
+                               atol=1e-9)
+
+
 def test_off_by_default():
     """Off (the targets one tick ahead): on the nominal robot, which has no latency, 12 ms hurt (WbcConfig)."""
     assert WbcConfig().command_latency_s == 0.0
