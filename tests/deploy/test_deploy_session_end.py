@@ -281,7 +281,7 @@ def test_the_loops_figures_in_the_report_are_the_schedulers_after_host_stalls(tm
     run = _run(tmp_path, clock)
     s, loop = run.control.loop.scheduler, run.report.loop
     assert loop == {"deadline_misses": s.deadline_misses, "ticks": s.tick_index,
-                    "tick_p99_us": s.report()["tick"]["p99_us"],
+                    "tick_p99_us": s.report()["tick"]["p99_us"], "stages_us": s.report(),
                     "lateness_p99_ms": pytest.approx(5.0),
                     "lateness_max_ms": pytest.approx(70.0), "misses_over_period": 2, "skipped_ticks": 5,
                     "clamped_commands": run.control.safety.clamps.commands}
