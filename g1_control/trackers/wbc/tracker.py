@@ -390,7 +390,7 @@ class WholeBodyTracker(Tracker):
         sol = self._solve(tasks, stance, load, state.dq_radps, dt, state.q_rad)
         if sol is None:
             return self._command if self.diagnostics.solution is not None else self._hold(state)
-        return self._motor_command(sol, state)
+        return self._motor_command(sol, state, dt)
 
     def _walking(self, reference: JointReference, state: RobotState) -> bool:
         """Whether this tick walks by the gait: footsteps "velocity" and a reference that is not a
@@ -713,16 +713,18 @@ class WholeBodyTracker(Tracker):
         diag.solution = sol
         return sol
 
-    def _motor_command(self, sol: IdSolution, state: RobotState) -> MotorCommand:
+    def _motor_command(self, sol: IdSolution, state: RobotState, dt: float) -> MotorCommand:
         """Step 6: feedforward torque plus q/dq targets one tick (and the expected command latency,
-        WbcConfig.command_latency_s) ahead along the QP's accelerations. One tick is the nominal period
-        (1 / rate_hz), the time until the next command, not the time since the last state: after a stall
-        of the wall-clock loop (20-40 ms on a shared host) they were that far ahead and the held command
-        threw the legs: the WBC's DDS walk at 100 Hz damped on joint overspeed (knees at 20-29 rad/s) in
-        at least 5 of 13 deploys here, in none of 4 after."""
+        WbcConfig.command_latency_s) ahead along the QP's accelerations. One tick is the time since the
+        last state while that is within half a period of the nominal one (1 / rate_hz; the wall clock's
+        jitter), else the nominal period: after a stall of the wall-clock loop (20-40 ms on a shared host)
+        the next command still comes one tick later. Leading by the stall, the held command threw the
+        legs: the WBC's DDS walk at 100 Hz damped on joint overspeed (knees at 20-29 rad/s) in at least 5
+        of 13 deploys here."""
         out = self._command
         ddq = sol.ddq[6:]
-        ahead = 1.0 / self.config.rate_hz + self.config.command_latency_s
+        nominal = 1.0 / self.config.rate_hz
+        ahead = (dt if dt < 1.5 * nominal else nominal) + self.config.command_latency_s
         out.tau_nm[:] = sol.tau_nm
         out.dq_radps[:] = state.dq_radps + ddq * ahead
         out.q_rad[:] = state.q_rad + (state.dq_radps + 0.5 * ddq * ahead) * ahead
