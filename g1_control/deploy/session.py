@@ -484,10 +484,9 @@ def _fill_report(report: DeployReport, log_arrays: dict, loop, tracker: DeployTr
     if isinstance(program, ProgramInput):
         report.control["program"] = {"steps": [record_dict(r) for r in program.records],
                                      "finished": program.done and not program.runner.stopped}
-    late = loop.scheduler.lateness.summary()
+    late, stages = loop.scheduler.lateness.summary(), loop.scheduler.report()
     report.loop = {"deadline_misses": loop.scheduler.deadline_misses, "ticks": loop.scheduler.tick_index,
-                   "tick_p99_us": loop.scheduler.report()["tick"]["p99_us"],
-                   "stages_us": loop.scheduler.report(),
+                   "tick_p99_us": stages["tick"]["p99_us"], "stages_us": stages,
                    "lateness_p99_ms": late["p99_us"] / 1000, "lateness_max_ms": loop.scheduler.max_lateness_s * 1000,
                    "misses_over_period": loop.scheduler.misses_over_period,
                    "skipped_ticks": loop.scheduler.skipped_ticks,
