@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, TypedDict
 
 from g1_control.errors import NetworkInterfaceError, TransportError
 from g1_control.hardware.links.network import AUTO, LOOPBACK, ROBOT_SUBNET, check_interface, robot_interface
-from g1_control.launch.schema import BackendConfig
+from g1_control.launch.schema import BackendConfig, LaunchFile
 from g1_control.robot import g1
 
 if TYPE_CHECKING:
@@ -31,6 +31,7 @@ class _HostOptions(TypedDict):
     expected_mode_machine: int
     connect_timeout_s: float
     damping_kd: float
+    command_ttl_s: float | None
 
 
 def expected_mode_machine(config: BackendConfig) -> int:
@@ -87,13 +88,22 @@ def _serial_ports() -> list[str]:
     return sorted(str(p) for pattern in ("ttyUSB*", "ttyACM*") for p in Path("/dev").glob(pattern))
 
 
+def command_ttl_s(launch: LaunchFile) -> float | None:
+    """How long a motor command lasts on the robot link before its hold form takes over:
+    safety.command_hold_ticks tracker ticks (None where it is 0: never)."""
+    ticks = launch.safety.command_hold_ticks
+    return ticks / launch.rates.tracker_hz if ticks > 0 else None
+
+
 def open_robot_backend(config: BackendConfig, *, damping_kd: float = 2.0,
-                       release_motion_service: bool | None = None) -> LinkBackend:
-    """The host side of the robot link `config` describes (a LinkBackend; threads running, silent)."""
+                       release_motion_service: bool | None = None,
+                       command_ttl_s: float | None = None) -> LinkBackend:
+    """The host side of the robot link `config` describes (a LinkBackend; threads running, silent).
+    command_ttl_s: see LinkBackend (the deploy passes command_ttl_s(launch))."""
     common: _HostOptions = {
         "command_rate_hz": config.command_rate_hz, "mode_pr": config.mode_pr,
         "expected_mode_machine": expected_mode_machine(config), "connect_timeout_s": config.connect_timeout_s,
-        "damping_kd": damping_kd}
+        "damping_kd": damping_kd, "command_ttl_s": command_ttl_s}
     if config.type == "unitree_dds":
         from g1_control.hardware.dds_backend import UnitreeDDSBackend
 

@@ -193,10 +193,11 @@ def deploy(path: Path, options: DeployOptions, say: Callable[[str], None] = _say
     say(f"scheduling: {scheduling}")
     try:
         if pf.check_interface(launch):
-            from g1_control.deploy.backends import open_robot_backend
+            from g1_control.deploy.backends import command_ttl_s, open_robot_backend
 
             try:
-                backend = open_robot_backend(launch.backend, damping_kd=launch.safety.damping_kd)
+                backend = open_robot_backend(launch.backend, damping_kd=launch.safety.damping_kd,
+                                             command_ttl_s=command_ttl_s(launch))
             except G1ControlError as exc:
                 pf.record("interface", FAIL, str(exc), overridable=False)
         if backend is not None:
@@ -568,6 +569,10 @@ def _print_summary(report: DeployReport, say) -> None:
     say(f"lowcmd sent {link['commands_sent']} ({link['command_rate_hz']:.0f} Hz, p99 period "
         f"{link['command_period_p99_s'] * 1000:.2f} ms at the sender); lowstate received {link['states_received']}, "
         f"{link['bad_crc']} bad CRC, {link['malformed']} malformed")
+    if link.get("holds"):
+        say(f"lowcmd hold form: {link['holds']} time(s) the loop stalled past the command's "
+            f"{link['command_ttl_s'] * 1000:.0f} ms life; {link['commands_held']} messages held the pose without "
+            "feedforward torque or velocity targets")
     v = report.control.get("velocity_est_mean") if report.control else None
     if v is not None:
         c = report.control["command_mean"]

@@ -65,6 +65,25 @@ class LinkStats:
     """Writers of the state topic known to discovery (None where the link has no discovery)."""
     command_writers: int | None = None
     """Other writers of the command topic known to discovery (None where the link has no discovery)."""
+    command_ttl_s: float | None = None
+    """A command older than this is resent in its hold form (None: the latest command, as it is, forever)."""
+    holds: int = 0
+    """How many times a command outlived command_ttl_s and its hold form took over (host stalls)."""
+    commands_held: int = 0
+    """LowCmd_ messages sent in the hold form."""
+
+
+@dataclass
+class _Hold:
+    """The hold form of the latest command (no feedforward torque, zero velocity target), encoded by the
+    writer thread the first time it is needed (the control thread pays nothing for it)."""
+
+    command: MotorCommand
+    mode_machine: int
+    since_s: float
+    """When the command it holds was written (time.monotonic())."""
+    payload: bytes | None = None
+    sent: int = 0
 
 
 class LinkBackend(Backend):
@@ -80,16 +99,22 @@ class LinkBackend(Backend):
 
     def __init__(self, link: Link, *, command_rate_hz: float = 500.0, mode_pr: int = 0,
                  expected_mode_machine: int | None = None, connect_timeout_s: float = 2.0,
-                 close_damping_s: float = 0.2, damping_kd: float = 2.0, simulator: SimulatorProfile | None = None):
+                 close_damping_s: float = 0.2, damping_kd: float = 2.0, simulator: SimulatorProfile | None = None,
+                 command_ttl_s: float | None = None):
         """simulator: one of Unitree's simulators (hardware/unitree/simulators.py), whose LowState_
-        leaves fields unset that a robot fills: those are filled in here (needs expected_mode_machine)."""
+        leaves fields unset that a robot fills: those are filled in here (needs expected_mode_machine).
+        command_ttl_s: a command not renewed within this time is resent in its hold form (module
+        docstring); None: resent as it is until the next one."""
         if link.side != "host":
             raise ValueError("LinkBackend needs the host side of a link")
         if not command_rate_hz > 0:
             raise ValueError(f"command_rate_hz must be positive; got {command_rate_hz}")
         if mode_pr not in (0, 1):
             raise ValueError(f"mode_pr must be 0 or 1; got {mode_pr}")
+        if command_ttl_s is not None and not command_ttl_s > 0:
+            raise ValueError(f"command_ttl_s must be positive (or None); got {command_ttl_s}")
         self.link = link
+        self.command_ttl_s = command_ttl_s
         self.command_period_s = 1.0 / command_rate_hz
         self.mode_pr = mode_pr
         self.expected_mode_machine = expected_mode_machine
@@ -100,6 +125,10 @@ class LinkBackend(Backend):
         self._state: RobotState | None = None
         self._state_event = threading.Event()
         self._payload: bytes | None = None
+        self._hold: _Hold | None = None
+        """The latest command's hold form while it differs from the command (else None)."""
+        self._holds = 0
+        self._held_sends = 0
         self._bad_crc = 0
         self._malformed = 0
         self._received = 0
@@ -151,10 +180,15 @@ class LinkBackend(Backend):
             if np.shape(getattr(command, name)) != (g1.NUM_JOINTS,):
                 raise InvalidCommandError(
                     f"MotorCommand.{name} has shape {np.shape(getattr(command, name))}; expected ({g1.NUM_JOINTS},)")
-        msg = motor_command_to_lowcmd(command, mode_machine=self._command_mode_machine(state), mode_pr=self.mode_pr)
-        payload = self.link.encode(msg)
+        mode_machine = self._command_mode_machine(state)
+        payload = self.link.encode(motor_command_to_lowcmd(command, mode_machine=mode_machine, mode_pr=self.mode_pr))
+        hold = None
+        if self.command_ttl_s is not None and (command.tau_nm.any() or command.dq_radps.any()):
+            hold = _Hold(MotorCommand(q_rad=command.q_rad.copy(), kp=command.kp.copy(), kd=command.kd.copy(),
+                                      enable=command.enable.copy()), mode_machine, time.monotonic())
         with self._lock:
             self._payload = payload
+            self._hold = hold
 
     def damp(self) -> None:
         """Switch the stream to damping (kp 0, kd > 0) at once; needs a known mode_machine."""
@@ -167,6 +201,7 @@ class LinkBackend(Backend):
         payload = self.link.encode(msg)
         with self._lock:
             self._payload = payload
+            self._hold = None  # damping is its own hold form
 
     def _command_mode_machine(self, state: RobotState) -> int:
         """The accepted mode_machine, else the expected one, else (before any reset) the robot's."""
@@ -242,6 +277,7 @@ class LinkBackend(Backend):
             sends = np.array(self._send_times)
             last = self._state.t_s if self._state is not None else float("nan")
             bad_crc, malformed, received = self._bad_crc, self._malformed, self._received
+            holds, held = self._holds, self._held_sends
         senders, state_writers, command_writers = self.peers()
         recent = sends[sends >= now - 1.0] if sends.size else sends
         periods = np.diff(sends) if sends.size > 1 else np.array([float("nan")])
@@ -251,6 +287,7 @@ class LinkBackend(Backend):
             state_rate_hz=float(len(state_times)), command_rate_hz=float(recent.size),
             command_period_p99_s=float(np.percentile(periods, 99)), last_state_age_s=now - last,
             state_senders=senders, state_writers=state_writers, command_writers=command_writers,
+            command_ttl_s=self.command_ttl_s, holds=holds, commands_held=held,
         )
 
     # -- threads ---------------------------------------------------------------------------------
@@ -301,7 +338,9 @@ class LinkBackend(Backend):
         next_t = time.monotonic()
         while not self._stop.is_set():
             with self._lock:
-                payload = self._payload
+                payload, hold = self._payload, self._hold
+            if hold is not None and time.monotonic() - hold.since_s > (self.command_ttl_s or 0.0):
+                payload = self._hold_payload(hold)
             if payload is not None:
                 self.link.send(payload)
                 with self._lock:
@@ -312,6 +351,21 @@ class LinkBackend(Backend):
                 self._stop.wait(delay)
             elif delay < -0.1:
                 next_t = time.monotonic()  # fell far behind (host stalled): restart the schedule
+
+    def _hold_payload(self, hold: _Hold) -> bytes | None:
+        """The hold form's message (encoded once, counted); the newest payload instead if a new command
+        (or damping) replaced the held one while it was encoded."""
+        if hold.payload is None:
+            hold.payload = self.link.encode(motor_command_to_lowcmd(hold.command, mode_machine=hold.mode_machine,
+                                                                    mode_pr=self.mode_pr))
+        with self._lock:
+            if self._hold is not hold:
+                return self._payload
+            if hold.sent == 0:
+                self._holds += 1
+            hold.sent += 1
+            self._held_sends += 1
+            return hold.payload
 
     def _no_state_message(self, timeout_s: float | None) -> str:
         waited = f" within {timeout_s:.1f} s" if timeout_s is not None else " yet"

@@ -58,6 +58,14 @@ class SafetyConfig:
     to this many tracker ticks in a row (3: 60 ms at 50 Hz); the next failure in a row damps. 0: damp
     on the first failure. A whole number."""
 
+    command_hold_ticks: float = 3.0
+    """On a robot link, a motor command not renewed within this many tracker ticks (a stalled host) is
+    resent in its hold form: the same position targets and gains, no feedforward torque, zero velocity
+    target (hardware/link_backend.py). The whole-body controller's torque and velocity targets are
+    meant for one tick; held through a 120 ms stall they threw a shoulder to 47 rad/s. 0: never (the
+    last command streams as it is until a trip damps); otherwise at least 1.5 (a tick may come half a
+    period late)."""
+
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
@@ -75,6 +83,10 @@ class SafetyConfig:
         if int(self.ik_hold_ticks) != self.ik_hold_ticks:
             raise SafetyConfigError(f"SafetyConfig.ik_hold_ticks is {self.ik_hold_ticks}; it must be a whole number "
                                     ">= 0 (tracker ticks)")
+        if 0 < self.command_hold_ticks < 1.5:
+            raise SafetyConfigError(f"SafetyConfig.command_hold_ticks is {self.command_hold_ticks}; it must be 0 (never "
+                                    "hold) or at least 1.5 tracker ticks (a tick may come half a period late, and a "
+                                    "command must last until the next one)")
         if self.max_tilt_rad >= math.pi:
             raise SafetyConfigError(f"SafetyConfig.max_tilt_rad is {self.max_tilt_rad}; it must be below pi "
                                     f"({math.pi:.4f} rad): no tilt exceeds pi, so the tilt trip could never fire")

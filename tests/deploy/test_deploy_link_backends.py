@@ -8,7 +8,7 @@ import os
 import uuid
 
 import pytest
-from deploy_test_helpers import write_launch
+from deploy_test_helpers import ROOT, write_launch
 
 from g1_control.deploy.backends import check_link_endpoint, open_robot_backend
 from g1_control.deploy.session import DeployOptions, deploy
@@ -59,6 +59,8 @@ def test_deploy_over_can_runs_preflight_and_the_state_machine(tmp_path, can_robo
     last = endpoint.last_command
     assert float(last.motor_kp_nm_per_rad.max()) == 0.0 and float(last.motor_kd_nms_per_rad[0]) > 0.0
     assert endpoint.counters.bad_crc == 0 and endpoint.counters.commands_applied > 100
+    # A command lives safety.command_hold_ticks (3) tracker ticks on the link before its hold form takes over.
+    assert report.link["command_ttl_s"] == pytest.approx(3 / 50)
 
 
 def test_missing_socketcan_interface_and_serial_port_are_refused(tmp_path):
@@ -89,3 +91,12 @@ def test_serial_backend_opens_on_a_pty(tmp_path):
     finally:
         tty_end.close()
         master_end.close()
+
+
+def test_a_commands_life_on_the_link_is_safety_command_hold_ticks_tracker_ticks():
+    from g1_control.deploy.backends import command_ttl_s
+
+    assert command_ttl_s(load_launch(ROOT / "launch/sim2sim_wbc.yaml")) == pytest.approx(3 / 100)  # the WBC at 100 Hz
+    assert command_ttl_s(load_launch(ROOT / "launch/robot.yaml")) == pytest.approx(3 / 50)
+    assert command_ttl_s(load_launch(ROOT / "launch/sim2sim_wbc.yaml", ["safety.command_hold_ticks=5"])) == pytest.approx(0.05)
+    assert command_ttl_s(load_launch(ROOT / "launch/sim2sim_wbc.yaml", ["safety.command_hold_ticks=0"])) is None

@@ -88,6 +88,8 @@ class StandInLink(Backend):
         """From this time on, no state arrives (read_state raises, as LinkBackend does)."""
         self.refuses_at: float | None = None
         """From this time on, write_command raises (the link refuses the command, as LinkBackend does)."""
+        self.holds = (0, 0)
+        """(times a command outlived its life, hold-form messages sent), as LinkBackend counts them."""
 
     def reset(self) -> RobotState:
         return self.read_state()
@@ -118,7 +120,7 @@ class StandInLink(Backend):
     def stats(self) -> LinkStats:
         return LinkStats(commands_sent=len(self.sent), states_received=self.tick, bad_crc=0, malformed=0,
                          bad_frames=0, state_rate_hz=50.0, command_rate_hz=500.0, command_period_p99_s=0.002,
-                         last_state_age_s=0.0)
+                         last_state_age_s=0.0, command_ttl_s=0.06, holds=self.holds[0], commands_held=self.holds[1])
 
     def streams_damping(self) -> bool:
         s = self.streaming
@@ -237,6 +239,7 @@ def test_a_run_to_the_end_of_its_control_time_ends_planned_in_damping_and_is_rep
                                          "detail": "control time over (5.0 s, launch duration_s)", "trips": True,
                                          "planned": True}]
     assert run.report.link == dataclasses.asdict(run.link.stats())
+    assert not any("hold form" in line for line in run.lines), "no command was held: nothing is said about it"
     summary = run.summary()
     assert (summary["status"], summary["end_reason"]) == ("completed", run.report.end_reason)
     assert summary["transitions"] == json.loads(json.dumps(run.report.transitions))
@@ -289,6 +292,13 @@ def test_the_loops_figures_in_the_report_are_the_schedulers_after_host_stalls(tm
     assert "while_planning" not in loop
     assert run.lines[-1].startswith("loop: 450 ticks, 11 deadline misses (worst 70.0 ms late, p99 5.0 ms; 5 ticks "
                                     "skipped after stalls)")
+
+
+def test_commands_the_link_held_through_stalls_are_reported_and_said(tmp_path, clock):
+    run = _run(tmp_path, clock, prepare=lambda control, link: setattr(link, "holds", (2, 37)))
+    assert (run.report.link["holds"], run.report.link["commands_held"]) == (2, 37)
+    assert ("lowcmd hold form: 2 time(s) the loop stalled past the command's 60 ms life; 37 messages held the pose "
+            "without feedforward torque or velocity targets") in run.lines
 
 
 def test_lateness_while_plans_were_made_is_reported_for_the_generators_plan_windows(tmp_path, clock):

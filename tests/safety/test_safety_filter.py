@@ -158,6 +158,9 @@ def test_tilt_of_known_rotations():
                                 "exceeds pi, so the tilt trip could never fire"),
     ({"max_motor_temperature_c": 120.5}, "max_motor_temperature_c is 120.5 °C; it may be at most the motors' rating, "
                                          "120 °C (a hotter threshold trips only after the damage)"),
+    ({"command_hold_ticks": 1.0}, "command_hold_ticks is 1.0; it must be 0 (never hold) or at least 1.5 tracker ticks "
+                                  "(a tick may come half a period late, and a command must last until the next one)"),
+    ({"command_hold_ticks": -3.0}, "command_hold_ticks is -3.0; it must not be negative"),
 ])
 def test_bad_config_is_refused_by_name(kwargs, text):
     with pytest.raises(SafetyConfigError) as info:
@@ -171,3 +174,5 @@ def test_the_tilt_and_temperature_bounds_are_inclusive_where_a_trip_can_still_fi
     upside_down = np.array([0.0, 1.0, 0.0, 0.0])
     assert SafetyFilter(SafetyConfig(max_tilt_rad=below_pi)).check(_state(imu_quat_wxyz=upside_down), 0.0) is False
     SafetyConfig(max_motor_temperature_c=g1.MOTOR_MAX_TEMPERATURE_C)
+    SafetyConfig(command_hold_ticks=1.5)
+    SafetyConfig(command_hold_ticks=0)  # never hold
