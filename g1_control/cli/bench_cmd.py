@@ -43,6 +43,10 @@ BENCHMARKS = {
                "WBC walking into stairs (3 x 0.15 m up, landing, down) and a 0.20 m platform found in the scene, seeded "
                "approach angles/offsets: top reached, across, falls (ground truth); --seed first seed, --trials count, "
                "--only stairs|platform|step; exits 1 on a fall"),
+    "stall": ("g1_control.tools.bench_stall:main",
+              "the host stalls the WBC's loop 40-200 ms at --trials seeded instants of a walk (29- and 23-DoF): the "
+              "last command resent as it is vs its hold form after its life (safety.command_hold_ticks); falls, trips, "
+              "peak joint speed (ground truth)"),
     "envelope": ("g1_control.tools.bench_envelope:main",
                  "the walking tracker's achievable velocity per axis and style; --write ships it as the command limits"),
 }
@@ -64,12 +68,14 @@ def register(subparsers) -> None:
     parser.add_argument("--seconds", type=float, default=20.0, help="simulated/measured duration (default 20)")
     parser.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
     parser.add_argument("--only", metavar="PREFIXES", help="execution/envelope/locomotion: only rows (styles, controller/case) starting with these "
-                        "comma-separated prefixes; program: instruction numbers (1,5)")
+                        "comma-separated prefixes; program: instruction numbers (1,5); stall: g1_29dof or g1_23dof")
     parser.add_argument("--seed", type=int, default=0, help="execution: the suite's seed (push timing; default 0); "
-                        "robust: the first draw's seed; stairs: the first seed of the draws; objects: the scenes' seed")
+                        "robust: the first draw's seed; stairs: the first seed of the draws; objects: the scenes' seed; "
+                        "stall: the instants' seed")
     parser.add_argument("--draws", type=int, default=10, help="robust: how many seeded randomised robots (default 10)")
     parser.add_argument("--trials", type=int, default=None,
-                        help="stairs: seeded draws per course (default 5); objects: drawn scenes (default 10)")
+                        help="stairs: seeded draws per course (default 5); objects: drawn scenes (default 10); stall: "
+                        "instants per stall length (default 8)")
     parser.add_argument("--video", metavar="DIR", help="execution: a video per behaviour into DIR")
     parser.add_argument("--trace", metavar="DIR", help="stairs: a CSV per trial into DIR (every 0.02 s: soles, "
                         "swing reference, DCM, CoP, CoM height, fastest joint)")
