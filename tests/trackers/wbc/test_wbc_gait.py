@@ -397,6 +397,7 @@ def test_the_early_lift_waits_for_a_told_push():
     ({"touchdown_height_m": math.nan}, "touchdown_height_m must be > 0"),
     ({"touchdown_max_wait_s": -0.1}, "touchdown_max_wait_s must be a finite number >= 0; got -0.1"),
     ({"touchdown_max_wait_s": math.inf}, "touchdown_max_wait_s must be a finite number >= 0"),
+    ({"terrain_side_follow_reach_m": -0.05}, "terrain_side_follow_reach_m must be a finite number >= 0; got -0.05"),
     ({"touchdown_descent_mps": math.nan}, "touchdown_descent_mps must be a finite number >= 0"),
 
     ({"push_detect_m": -0.1}, r"push_detect_m must be >= 0 \(0: no check, inf: never\); got -0.1"),
@@ -693,3 +694,39 @@ def test_a_trailing_foot_stepping_down_waits_for_contact_once_over_the_lower_lev
             out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
             assert out.landing_m[2] == pytest.approx(0.0)
     assert t - clock == pytest.approx(cfg.touchdown_max_wait_s, abs=0.005)
+
+
+def _oblique_stairs_landings(cfg):
+    """`g1 bench stairs` seed 100's stairs (turned 16.7 deg, offset 0.06 m), the left foot on the floor
+    before them: the first landing the DCM asks snaps onto the first tread; a tick later the DCM has run
+    10 cm further right (and ahead). Returns the two landings relative to the left sole, and the terrain."""
+    from g1_control.tools.bench_stairs import course_scene
+    from g1_control.trackers.wbc.terrain import Terrain
+
+    terrain = Terrain.of_scene(course_scene("stairs", math.radians(16.7), 0.06)[0])
+    gait = VelocityGait(cfg, terrain)
+    soles, yaws = _feet()
+    soles[:, 0] = 0.96
+    t = _into_single_support(gait, soles, yaws)
+    assert gait.stance == LEFT
+    first = gait.update(t, 0.004, soles, yaws, soles[LEFT, :2] + np.array([0.03, -0.04]), OMEGA).landing_m.copy()
+    t += 0.004
+    gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+    later = gait.update(t, 0.004, soles, yaws, soles[LEFT, :2] + np.array([0.15, -0.10]), OMEGA).landing_m.copy()
+    return first - soles[LEFT], later - soles[LEFT], later[:2], terrain
+
+
+def test_a_landing_kept_on_its_tread_follows_the_dcm_sideways_with_terrain_side_follow_reach():
+    """A step whose landing snapped onto a tread keeps that tread; with terrain_side_follow_reach_m (off
+    by default) not its first sideways place: the DCM running further sideways moves the foothold
+    sideways too, still whole on the tread (kept where it was, the first step up of seed 100's stairs
+    landed with the DCM 8.6 cm outside the foot, and the robot fell sideways off it in its next single
+    support)."""
+    first, later, xy, terrain = _oblique_stairs_landings(GaitConfig(terrain_side_follow_reach_m=0.1))
+    assert first[2] == pytest.approx(0.15) and later[2] == pytest.approx(0.15)
+    assert later[1] < first[1] - 0.15  # followed the DCM sideways (to the step width limit)
+    assert terrain.is_level(xy, 0.0) and terrain.height(xy) == pytest.approx(0.15)
+    # by default the foothold stays where it first snapped, sideways too
+    kept_first, kept, _, _ = _oblique_stairs_landings(GaitConfig())
+    assert kept_first[:2] == pytest.approx(first[:2], abs=1e-9)
+    assert kept[:2] == pytest.approx(kept_first[:2], abs=1e-9)
