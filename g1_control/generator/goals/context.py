@@ -80,6 +80,14 @@ class GoalConfig:
     force_ramp_s: float = 0.4
     backup_m: float = 0.3
     """Steps back from a table before turning with a box."""
+    carry_over_check: bool = True
+    """A box carried to a table: the carry's plan is checked from the planned hand points less the
+    measured sag of the hands (joint angles and IMU, handling.hands_sag_m) and, where the box's bottom
+    would pass less than BOX_OVER_TOP_M over the top, walked with the pelvis kept at the raise's
+    height, the box raised further, or refused (handling.carry). Off: only the standing raise before
+    the carry checks (it ended 3 cm short at the arms' reach, the carry's walking pelvis took the
+    hands 2 cm lower, the hands sagged 1 cm: the box dragged 0.5-1 cm over a 0.92 m table and the
+    robot fell, bench objects seed 19, trial 8)."""
     carry: SteppingConfig = field(default_factory=lambda: SteppingConfig(
         max_advance_m=0.10, max_turn_rad=0.18, single_support_s=0.6, double_support_s=0.25))
     steps: SteppingConfig = field(default_factory=lambda: SteppingConfig(

@@ -10,7 +10,7 @@ down (`ctx.box_positions`).
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Generator, Iterator
 from dataclasses import replace
 
 import numpy as np
@@ -37,6 +37,7 @@ from g1_control.generator.goals.stances import (
     release_hold_poses,
 )
 from g1_control.generator.goals.stepping import (
+    STRAIGHT_KNEE_GUARD_M,
     Footstep,
     Stance,
     SteppingConfig,
@@ -333,8 +334,10 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
         off = ctx.offset()
         # carry: the hand forces turn with the robot, so plan them per heading: held constant in
         # the robot's frame (the squeeze across it, the weight down)
-        yield from carry(ctx, approach.mid_xy + off, approach.heading, posture, weight, carry_shift)
-        yield from correct_stance(ctx, approach.mid_xy, approach.heading, cfg.carry, posture=posture,
+        # (a carry over a table may walk taller or raise the box further: the corrections do the same)
+        posture, step_cfg = yield from carry(ctx, approach.mid_xy + off, approach.heading, posture, weight,
+                                             carry_shift, over=support)
+        yield from correct_stance(ctx, approach.mid_xy, approach.heading, step_cfg, posture=posture,
                                   forces=hand_forces(approach.heading, squeeze, weight),
                                   com_shift=ctx.poses.com_offset_m + carry_shift)
     q0 = ctx.hold_q()
@@ -411,17 +414,62 @@ def raise_over(ctx: GoalContext, support: Block, posture: np.ndarray, carry_shif
     BOX_OVER_TOP_M above the top, else refuse (the box stays held). Carried at the pick's height, the
     box came into a 0.90 m table's side on the last steps of the carry and the robot fell (bench
     objects seed 7, trial 0)."""
+    q0 = ctx.hold_q()
+    hands_z = min(float(ctx.poses.hand_point(q0, i)[2]) for i in range(2))
+    need = hands_over_m(ctx, support)
+    if hands_z >= need:
+        return
+    yield from _raise_by(ctx, support, need - hands_z, carry_shift, need)
+
+
+def hands_over_m(ctx: GoalContext, support: Block) -> float:
+    """How high the hand points go for the held box's bottom to be BOX_OVER_TOP_M over `support`."""
+    held = ctx.held
+    assert held is not None
+    return support.height_m + BOX_OVER_TOP_M + held.hand_dz_m + held.box.size[2] / 2
+
+
+def hands_sag_m(ctx: GoalContext) -> float:
+    """How far the measured hands sit below the reference's now (mean of the two; negative: above),
+    each over its own soles: the joint angles and the IMU's tilt, robot-side knowledge (the held
+    box's weight bends the arms and the body under the tracker)."""
+    s = ctx.state
+    assert s is not None
+    q_plan = ctx.hold_q()
+    q_meas = q_plan.copy()
+    q_meas[7:] = s.q_rad
+    w, x, y, z = s.imu_quat_wxyz
+    q_meas[3:7] = [x, y, z, w]
+
+    def over_soles(q: np.ndarray) -> float:
+        floor = min(float(p[2]) for p, _ in flat_soles(ctx.ik, q))
+        return float(np.mean([ctx.poses.hand_point(q, i)[2] for i in range(2)])) - floor
+
+    return over_soles(q_plan) - over_soles(q_meas)
+
+
+def lowest_hands_m(poses: PosePlanner, traj, every_s: float = 0.1) -> float:
+    """The lowest hand point along a whole-body trajectory (sampled every `every_s`)."""
+    low = math.inf
+    for tk in np.arange(0.0, traj.duration_s + 1e-9, every_s):
+        j = traj.sample(float(tk))
+        w, x, y, z = j.root_quat_wxyz
+        q = np.concatenate([j.root_pos_w_m, [x, y, z, w], j.q_rad])
+        low = min(low, *(float(poses.hand_point(q, i)[2]) for i in range(2)))
+    return low
+
+
+def _raise_by(ctx: GoalContext, support: Block, dz_m: float, carry_shift: np.ndarray, need: float,
+              strict: bool = True) -> Iterator[None]:
+    """Raise the held box's hands dz_m (standing still), else refuse (the box stays held); not
+    `strict`: as far as they go (refused only for the CoM)."""
     held = ctx.held
     assert held is not None
     q0 = ctx.hold_q()
     soles = flat_soles(ctx.ik, q0)
-    hands_z = min(float(ctx.poses.hand_point(q0, i)[2]) for i in range(2))
-    need = support.height_m + BOX_OVER_TOP_M + held.hand_dz_m + held.box.size[2] / 2
-    if hands_z >= need:
-        return
     heading = stance_heading(soles)
-    up = yield from ctx.compute("raise", raised_pose, q0, soles, heading, need - hands_z, carry_shift, float(q0[2]))
-    if up.residual_m > 0.03 or up.com_error_m > 0.03:
+    up = yield from ctx.compute("raise", raised_pose, q0, soles, heading, dz_m, carry_shift, float(q0[2]))
+    if (strict and up.residual_m > 0.03) or up.com_error_m > 0.03:
         raise GoalFailed(f"box '{held.box.name}' cannot be held above '{support.name}' ({support.height_m:.2f} m): "
                          f"the hands get only within {up.residual_m * 100:.1f} cm of {need:.2f} m up "
                          f"(CoM {up.com_error_m * 100:.1f} cm off)")
@@ -432,26 +480,76 @@ def raise_over(ctx: GoalContext, support: Block, posture: np.ndarray, carry_shif
                                            hand_forces=lambda _t: forces))
 
 
+CARRY_CLEAR_M = 0.03
+"""A box carried to a table (GoalConfig.carry_over_check) goes with its bottom at least this far over
+the top along the whole carry's plan, less the measured sag of the hands, else the place refuses
+before walking (the box stays held). A box 0.5-1 cm over a 0.92 m table dragged on it and the robot
+fell (bench objects seed 19, trial 8); BOX_OVER_TOP_M is what is asked, this is what is accepted."""
+
+
 def carry(ctx: GoalContext, mid_xy: np.ndarray, heading: float, posture: np.ndarray, weight: float,
-          com_shift: np.ndarray) -> Iterator[None]:
+          com_shift: np.ndarray, over: Block | None = None
+          ) -> Generator[None, None, tuple[np.ndarray, SteppingConfig]]:
     """Footsteps to a stance with the box held: back up from the table, turn, walk, turn; the
-    hand forces follow the robot's heading along the way."""
+    hand forces follow the robot's heading along the way.
+
+    Carried to a table (`over`, with GoalConfig.carry_over_check): the plan's lowest hand points
+    less the measured sag (hands_sag_m) must hold the box's bottom BOX_OVER_TOP_M over the top
+    (hands_over_m). Short of that (the carry walks with the pelvis at SteppingConfig
+    pelvis_above_ground_m, 2 cm below the stand the box was raised in, and the raise may end up to
+    3 cm short at the arms' reach), the carry is planned again with the pelvis kept where the raise
+    left it (no higher than the nominal stand + STRAIGHT_KNEE_GUARD_M); still short, the box is raised
+    as far as the arms go, standing, and planned once more; still less than CARRY_CLEAR_M over the
+    top, the place refuses. Returns the upper-body posture and the stepping settings carried with
+    (the corrections after the carry use the same)."""
+    cfg = ctx.config
+    step_cfg = cfg.carry
+    plan = yield from _carry_plan(ctx, mid_xy, heading, posture, com_shift, step_cfg)
+    if over is not None and ctx.held is not None and cfg.carry_over_check:
+        need = hands_over_m(ctx, over)
+        sag = max(0.0, hands_sag_m(ctx))
+        low = lowest_hands_m(ctx.poses, plan.trajectory) - sag
+        for attempt in ("pelvis", "raise"):
+            if low >= need - 0.005:
+                break
+            if attempt == "raise":
+                yield from _raise_by(ctx, over, need - low, com_shift, need, strict=False)
+                posture = ctx.hold_q()[7:].copy()
+            q0 = ctx.hold_q()
+            floor = min(float(p[2]) for p, _ in flat_soles(ctx.ik, q0))
+            kept = min(float(q0[2]) - floor, ctx.poses.nominal_pelvis_m + STRAIGHT_KNEE_GUARD_M)
+            step_cfg = replace(cfg.carry, pelvis_above_ground_m=max(cfg.carry.pelvis_above_ground_m, kept))
+            plan = yield from _carry_plan(ctx, mid_xy, heading, posture, com_shift, step_cfg)
+            was, low = low, lowest_hands_m(ctx.poses, plan.trajectory) - sag
+            ctx.note(f"carry over '{over.name}': the hands {was:.3f} m -> {low:.3f} m ({attempt}; "
+                     f"{need:.3f} m asked, sag {sag * 100:.1f} cm)")
+        clear = low - (need - BOX_OVER_TOP_M)
+        if clear < CARRY_CLEAR_M:
+            raise GoalFailed(f"box '{ctx.held.box.name}' cannot be carried over '{over.name}' "
+                             f"({over.height_m:.2f} m): its bottom would pass {clear * 100:.1f} cm over the top "
+                             f"(at least {CARRY_CLEAR_M * 100:.0f} cm; the hands sag {sag * 100:.1f} cm)")
+    ctx.last_steps = plan
+    yield from ctx.run(plan.trajectory)
+    return posture, step_cfg
+
+
+def _carry_plan(ctx: GoalContext, mid_xy: np.ndarray, heading: float, posture: np.ndarray,
+                com_shift: np.ndarray, step_cfg: SteppingConfig) -> Generator[None, None, SteppingPlan]:
     cfg = ctx.config
     q0 = ctx.hold_q()
     stance = Stance.of(ctx.ik, q0)
     back = stance.mid_xy - cfg.backup_m * np.array([math.cos(stance.heading), math.sin(stance.heading)])
     ground = ctx.scene.ground_height
-    steps = walk_steps(stance, back, stance.heading, cfg.carry, lambda xy: ground(xy), backward_max_m=1.0)
+    steps = walk_steps(stance, back, stance.heading, step_cfg, lambda xy: ground(xy), backward_max_m=1.0)
     for st in steps:
         stance = stance.apply(st)
-    steps += walk_steps(stance, mid_xy, heading, cfg.carry, lambda xy: ground(xy), then=steps)
+    steps += walk_steps(stance, mid_xy, heading, step_cfg, lambda xy: ground(xy), then=steps)
     held = ctx.held  # the box's squeeze (squeeze_for) and weight on the hands; none held: no forces
     squeeze, load = (held.squeeze_n, held.box.mass_kg * GRAVITY) if held is not None else (0.0, 0.0)
-    plan = yield from ctx.compute("carry", carry_plan, q0, steps, cfg.carry, posture, ctx.poses.com_offset_m + com_shift,
+    plan = yield from ctx.compute("carry", carry_plan, q0, steps, step_cfg, posture, ctx.poses.com_offset_m + com_shift,
                                   squeeze, load)
     ctx.last_steps = plan
-    traj = plan.trajectory
     if plan.sole_error_m > 0.03:
         raise GoalFailed(f"carry: the footsteps are out of the legs' reach (plan off by "
                          f"{plan.sole_error_m * 100:.0f} cm)")
-    yield from ctx.run(traj)
+    return plan
