@@ -827,10 +827,20 @@ class VelocityGait:
         out[:2] *= cfg.terrain_speed_mps / speed
         return out
 
+    def _walks(self, command_h: np.ndarray) -> bool:
+        """The command walked still moves the robot (any axis above GaitConfig.moving_speed): the speed
+        correction applies. Stopping (the command walked down to zero), it does not: from a combined walk
+        (random timeline s8 of `g1 bench locomotion`) the correction wound up to -0.28 m/s against the
+        capture steps' own motion while the command was zero, kept the robot stepping and threw it
+        (an ankle over-speed trip 1.4 s after the stop)."""
+        return any(abs(c) > self.config.moving_speed for c in command_h.tolist())
+
     def _correct_speed(self, t_s: float, foot: int, landed_xy: np.ndarray) -> None:
         """A foot has landed: compare the stride since its last touchdown with the command walked."""
         cfg = self.config
-        if np.isfinite(self._td_t[foot]):
+        if not self._walks(self.command_h):
+            self.speed_correction_h[:] = 0.0  # stopping: nothing to correct (a kept one walked the robot on)
+        elif np.isfinite(self._td_t[foot]):
             dt = t_s - self._td_t[foot]
             v_w = (landed_xy - self._td_pos[foot]) / dt
             v_h = _rot2(self.heading - 0.5 * dt * float(self.command_h[2])).T @ v_w
@@ -1040,7 +1050,8 @@ class VelocityGait:
         cfg, out = self.active, self.targets
         self._track_drift(t_s, dt_s, dcm_xy, omega)
         command_h = self.command_h.copy()
-        command_h[:2] += self.speed_correction_h
+        if self._walks(command_h):
+            command_h[:2] += self.speed_correction_h
         out.heading_rad = self.heading
         out.yaw_rate_radps = 0.0 if self.mode == "stand" else float(command_h[2])
         out.swing_foot = -1

@@ -730,3 +730,38 @@ def test_a_landing_kept_on_its_tread_follows_the_dcm_sideways_with_terrain_side_
     kept_first, kept, _, _ = _oblique_stairs_landings(GaitConfig())
     assert kept_first[:2] == pytest.approx(first[:2], abs=1e-9)
     assert kept[:2] == pytest.approx(kept_first[:2], abs=1e-9)
+
+
+@pytest.mark.parametrize("walked", [0.0, 0.3])
+def test_the_speed_correction_applies_while_walking_and_not_once_the_command_walked_is_zero(walked):
+    """Stopping (the command walked down to zero) the gait plans the stop as it is, without the speed
+    correction: random timeline s8 of `g1 bench locomotion` stopped from a combined walk with the correction
+    at (-0.28, -0.14) m/s, kept stepping and was thrown. Walking, the correction moves the landing."""
+    soles, yaws = _feet()
+    landings = []
+    for correction in ((0.0, 0.0), (-0.28, -0.14)):
+        gait = VelocityGait()
+        t = _into_single_support(gait, soles, yaws)
+        gait.command_h[:] = (walked, 0.0, 0.0)
+        gait.speed_correction_h[:] = correction
+        landings.append(gait.update(t, 0.004, soles, yaws, soles[LEFT, :2] + np.array([0.02, -0.03]),
+                                    OMEGA).landing_m.copy())
+    moved = float(np.linalg.norm(landings[1][:2] - landings[0][:2]))
+    if walked:
+        assert moved > 0.05, "walking, the correction moves the landing"
+    else:
+        assert moved == 0.0, "stopping, the landing is the stop's own"
+
+
+def test_a_touchdown_while_stopping_clears_the_speed_correction():
+    gait = VelocityGait()
+    soles, yaws = _feet()
+    t = _into_single_support(gait, soles, yaws)
+    gait.speed_correction_h[:] = (-0.28, -0.14)
+    gait.command_h[:] = 0.0
+    n = gait.steps
+    while gait.steps < n + 1:  # a touchdown with the command walked at zero
+        t += 0.004
+        gait.schedule(t, np.zeros(3), soles, yaws, soles.mean(axis=0)[:2])
+        assert t < 5.0
+    assert not gait.speed_correction_h.any(), "nothing wound up from the stopping steps"
