@@ -470,6 +470,12 @@ class MotorCommand:
         return MotorCommand(self.q_rad.copy(), self.dq_radps.copy(), self.kp.copy(),
                             self.kd.copy(), self.tau_nm.copy(), self.enable.copy())
 
+    def hold_form(self) -> MotorCommand:
+        """This command as a PD hold of its targets (a copy): the same q targets, gains and enables, no
+        feedforward torque, a velocity target of zero (what a robot link resends once the command's
+        life is up: hardware/link_backend.py)."""
+        return MotorCommand(q_rad=self.q_rad.copy(), kp=self.kp.copy(), kd=self.kd.copy(), enable=self.enable.copy())
+
     def is_finite(self) -> bool:
         """No NaN or inf in any field. (One sum per field: this runs every tick. A sum that overflows
         to inf also reads as non-finite, which is the safe side for values near 1e308.)"""

@@ -184,8 +184,7 @@ class LinkBackend(Backend):
         payload = self.link.encode(motor_command_to_lowcmd(command, mode_machine=mode_machine, mode_pr=self.mode_pr))
         hold = None
         if self.command_ttl_s is not None and (command.tau_nm.any() or command.dq_radps.any()):
-            hold = _Hold(MotorCommand(q_rad=command.q_rad.copy(), kp=command.kp.copy(), kd=command.kd.copy(),
-                                      enable=command.enable.copy()), mode_machine, time.monotonic())
+            hold = _Hold(command.hold_form(), mode_machine, time.monotonic())
         with self._lock:
             self._payload = payload
             self._hold = hold

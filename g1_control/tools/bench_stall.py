@@ -70,12 +70,8 @@ def _launch(variant: str):
 
 
 def hold_form(command):
-    """The link's hold form of `command` (hardware/link_backend.py): same q targets and gains, no
-    feedforward torque, zero velocity target."""
-    from g1_control.types import MotorCommand
-
-    return MotorCommand(q_rad=command.q_rad.copy(), kp=command.kp.copy(), kd=command.kd.copy(),
-                        enable=command.enable.copy())
+    """The link's hold form of `command` (MotorCommand.hold_form, as hardware/link_backend.py sends it)."""
+    return command.hold_form()
 
 
 def run_trial(variant: str, stall_s: float, at_s: float, mode: str) -> StallTrial:

@@ -677,7 +677,7 @@ class VelocityGait:
         cfg = self.config
         dt = 0.0 if self._last_t is None else t_s - self._last_t
         self._last_t = t_s
-        moving = any(abs(c) > cfg.moving_speed for c in command_h.tolist())
+        moving = self._walks(command_h)
         walked = self.command_h
         if self.mode == "walk":
             step = np.asarray(cfg.max_accel) * dt
