@@ -454,9 +454,14 @@ class RobotEmulator:
     @staticmethod
     def _report_randomization(out: dict, physics: Backend) -> None:
         """The simulated robot's randomisation (sim/randomize.py) as drawn and as its model holds it."""
+        if getattr(physics, "draw", None) is None:
+            # Not a randomised MuJoCo robot. Importing MuJoCo here (a mock robot's first report) held the
+            # interpreter for tens of ms while the link thread waited: the fault suite's first damping
+            # frame was stamped 17-70 ms late (later ones 1-3 ms).
+            return
         from g1_control.sim.mujoco_backend import MujocoBackend
 
-        if not isinstance(physics, MujocoBackend) or physics.draw is None:
+        if not isinstance(physics, MujocoBackend):
             return
         m = physics.model
         robot = m.body(g1.BASE_BODY).id
