@@ -20,7 +20,7 @@ TESTS = REPO / "tests"
 PACKAGE = REPO / "g1_control"
 
 WHOLE_PACKAGE_TESTS = {"test_layers.py", "test_tests_mirror_packages.py", "test_packaging_wheel.py",
-                       "test_package_docs.py"}
+                       "test_package_docs.py", "test_timing_reruns.py"}
 """Root test files about g1_control as a whole rather than one module."""
 OTHER_FOLDERS = {"examples": REPO / "examples"}
 """Test folders for folders of the repository that are not packages of g1_control."""
