@@ -153,6 +153,8 @@ def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
     from g1_control.trackers.layer import WBC_MIN_PELVIS_HEIGHT_M, TrackingLayer
 
     config = GoalConfig()
+    # A plan pauses through a stall past the command's life on the robot link (3 tracker ticks where the hold is off).
+    config.plan_pause_after_s = max(launch.safety.command_hold_ticks, 3) / launch.rates.tracker_hz
     # wall clock (a robot, a viewer): plans are made beside the loop; lockstep: inline (deterministic)
     config.plan_in_background = launch.backend.mode == "wallclock" or launch.backend.type != "mujoco"
     if isinstance(tracker, TrackingLayer):  # the walking policy's own height range (its envelope)

@@ -461,7 +461,7 @@ class RobotEmulator:
             return
         from g1_control.sim.mujoco_backend import MujocoBackend
 
-        if not isinstance(physics, MujocoBackend):
+        if not isinstance(physics, MujocoBackend) or physics.draw is None:
             return
         m = physics.model
         robot = m.body(g1.BASE_BODY).id

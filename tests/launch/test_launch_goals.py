@@ -56,3 +56,14 @@ def test_a_scene_error_names_the_key():
     # YAML reads a key `on` as true: the field is called stands_on, and the error says what is allowed
     with pytest.raises(LaunchFileError, match="allowed: name, xy_m, stands_on"):
         parse_launch(_launch([], scene=yaml.safe_load("boxes: [{name: box, on: floor, xy_m: [1.9, 0.0]}]")))
+
+
+@pytest.mark.parametrize("overrides, after_s", [([], 0.03), (["rates.tracker_hz=200", "rates.lowlevel_hz=200"], 0.015),
+                                                (["safety.command_hold_ticks=5"], 0.05),
+                                                (["safety.command_hold_ticks=0"], 0.03)])
+def test_a_plan_pauses_after_the_robot_links_command_life(overrides, after_s):
+    """GoalConfig.plan_pause_after_s from the launch file: max(command_hold_ticks, 3) tracker ticks."""
+    from g1_control.launch.builder import make_generator
+
+    launch = load_launch(LAUNCH_DIR / "sim2sim_step.yaml", overrides=overrides)
+    assert make_generator(launch).config.plan_pause_after_s == pytest.approx(after_s)

@@ -104,6 +104,15 @@ class GoalConfig:
     0.16 m from the edge), and the walking policy turning in place there put a sole centre 4 cm
     from the edge and the shin on the platform's top edge (measured: program 20 of g1 bench
     program, a fall). The walking policy knows nothing of the platform."""
+    plan_pause_after_s: float = 0.03
+    """A whole-body plan stops where it is when the loop stalls: of a gap longer than this between two
+    ticks' states (a stalled host), only this much plays; the rest is added to the plan's start. The robot
+    link holds the pose after a command's life (safety.command_hold_ticks: 30 ms at 100 Hz), so a plan that
+    played on through a 120 ms stall resumed 90 ms ahead of a robot that had stood still: mid step-up, a
+    swing foot expected on the platform and the support switched to it (measured: 3 falls in 8 seeded
+    runs of sim2sim_step's timeline with four 120 ms stalls each). 0 plays plans on the state's clock.
+    A launch file's loop sets it to the robot link's command life: max(safety.command_hold_ticks, 3) tracker
+    ticks (launch/builder.py), so a slower tracker's ticks never count as stalls."""
     sight_wait_s: float = 2.0
     """A step goal whose platform the scene does not hold waits this long, standing (nothing moves), for
     perception to see it (a 10 Hz perception with dropouts: a few frames), then refuses, naming it."""
@@ -181,6 +190,9 @@ class GoalContext:
         self.step_back = (0.0, 0.0)
         self.t = 0.0
         self.state: RobotState | None = None
+        self.stalls = 0
+        self.stalled_s = 0.0
+        """Stalls that paused a plan (GoalConfig.plan_pause_after_s) and the plan time they held back."""
 
     def note(self, text: str) -> None:
         self.log.append((self.t, text))

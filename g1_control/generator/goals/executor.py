@@ -160,6 +160,7 @@ class GoalGenerator(Generator):
     # -- the tick ---------------------------------------------------------------------------------
     def update(self, command: Command, state: RobotState) -> KinematicReference:
         ctx = self.ctx
+        self._pause_plan_for_a_stall(state.t_s)
         ctx.state, self._command, ctx.t = self._located(state), command, state.t_s
         for goal in command.tasks:
             if goal.goal_id not in self._seen:
@@ -177,6 +178,21 @@ class GoalGenerator(Generator):
             except StopIteration:
                 self._coro = None
         return self._reference(command, state)
+
+    def _pause_plan_for_a_stall(self, t_s: float) -> None:
+        """GoalConfig.plan_pause_after_s: the part of a stall past it moves the running plan's start (and
+        an arm overlay's) on by as much, so the plan resumes where the robot was held."""
+        ctx, after = self.ctx, self.config.plan_pause_after_s
+        gap = t_s - ctx.t
+        if after <= 0 or ctx.state is None or gap <= after or ctx.phase != PHASE_WHOLE_BODY or ctx.plan is None:
+            return
+        excess = gap - after
+        ctx.plan_t0 += excess
+        if ctx.overlay is not None:
+            ctx.overlay = (ctx.overlay[0], ctx.overlay[1] + excess)
+        ctx.stalls += 1
+        ctx.stalled_s += excess
+        ctx.note(f"the loop stalled {gap * 1000:.0f} ms: the plan paused {excess * 1000:.0f} ms of it")
 
     def _located(self, state: RobotState) -> RobotState:
         if self.estimate is None:
