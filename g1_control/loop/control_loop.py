@@ -168,10 +168,10 @@ class ControlLoop:
         self.scheduler = Scheduler(r.lowlevel_hz, stages, wallclock=wallclock)
         if backend.lockstep:
             # A simulator paced by the wall clock steps the ticks a stall made the scheduler skip, when it
-            # skips them, with the command the drivers hold: the world does not wait for a late controller,
+            # skips them, fed as the robot link would (_skipped_ticks): the world does not wait for a late controller,
             # and the next state is current (else every skipped tick would age the state for good, until
             # the stale-state check damps a robot that was never stale).
-            self.scheduler.on_skip = self._lowlevel_ticks
+            self.scheduler.on_skip = self._skipped_ticks
         # The latest generator and retargeter outputs (None before their first tick: within a tick the
         # stages run in the order listed above, so each is set before the next stage reads it).
         self._kin_ref: KinematicReference | None = None
@@ -348,6 +348,19 @@ class ControlLoop:
     def _lowlevel_ticks(self, n: int) -> None:
         """n low-level ticks in a row with nothing else due (lockstep; see loop/scheduler.py)."""
         self.backend.step_ticks(self.motor_command, self.scheduler.dt_s, n)
+
+    def _skipped_ticks(self, n: int) -> None:
+        """The n ticks a stall made a wall-clock simulator skip, fed as the robot link feeds the motors:
+        the last command for its life (safety.command_hold_ticks tracker ticks), then its hold form
+        (MotorCommand.hold_form: no feedforward torque, no velocity target; hardware/link_backend.py)."""
+        command, dt = self.motor_command, self.scheduler.dt_s
+        ticks = self.safety.config.command_hold_ticks
+        life = round(ticks * self.rates.lowlevel_hz / self.rates.tracker_hz) if ticks > 0 else n
+        if n <= life or not (command.tau_nm.any() or command.dq_radps.any()):
+            self.backend.step_ticks(command, dt, n)
+            return
+        self.backend.step_ticks(command, dt, life)
+        self.backend.step_ticks(command.hold_form(), dt, n - life)
 
     def _log(self) -> None:
         log = self.log

@@ -261,3 +261,63 @@ def test_a_simulator_paced_by_the_wall_clock_steps_the_ticks_a_stall_skipped():
     assert clock.stalled and loop.scheduler.skipped_ticks >= 39  # 80 ms of 2 ms ticks
     assert robot.t_s == pytest.approx(loop.time_s, abs=0.0021), "the simulator kept the loop's time"
     assert not loop.faulted, loop.events
+
+
+def test_a_wall_clock_simulator_feeds_a_stall_as_the_robot_link_does():
+    """The ticks a stall skipped get the last command for its life (safety.command_hold_ticks tracker
+    ticks: 3 at 50 Hz, 60 ms of 2 ms ticks), then its hold form (no feedforward torque, no velocity
+    target), as hardware/link_backend.py resends it; with the hold off, the command throughout."""
+
+    class Pushing(Hold):
+        def act(self, reference, state) -> MotorCommand:
+            command = super().act(reference, state)
+            command.tau_nm[:] = 1.0
+            command.dq_radps[:] = 0.5
+            return command
+
+    class Recording(StandInRobot):
+        def __init__(self):
+            super().__init__(lockstep=True)
+            self.written: list[MotorCommand] = []
+
+        def write_command(self, command: MotorCommand) -> None:
+            super().write_command(command)
+            self.written.append(command)
+
+    class Clock:
+        def __init__(self):
+            self.t, self.stalled = 0.0, False
+
+        def __call__(self):
+            if not self.stalled and self.t > 0.2:
+                self.stalled, self.t = True, self.t + 0.08
+            return self.t
+
+        def sleep(self, s):
+            self.t += s
+
+    for hold_ticks, life in ((3.0, 30), (0.0, None)):
+        robot, clock = Recording(), Clock()
+        loop = ControlLoop(robot, Still(), VelocityReferenceGenerator(), IKStage(), Pushing(), wallclock=True,
+                           safety=SafetyFilter(SafetyConfig(command_hold_ticks=hold_ticks)))
+        loop.reset()
+        loop.scheduler.clock, loop.scheduler.sleep = clock, clock.sleep
+        calls = []
+        skipped = loop._skipped_ticks
+
+        def spy(n, skipped=skipped):
+            first = len(robot.written)
+            skipped(n)
+            calls.append(robot.written[first:])
+
+        loop.scheduler.on_skip = spy
+        loop.run(0.3)
+        assert len(calls) == 1 and len(calls[0]) >= 39, [len(c) for c in calls]
+        fed = calls[0]
+        pushing = [c.tau_nm.any() or c.dq_radps.any() for c in fed]
+        if life is None:
+            assert all(pushing)
+        else:
+            assert pushing == [True] * life + [False] * (len(fed) - life)
+            np.testing.assert_array_equal(fed[-1].q_rad, fed[0].q_rad)
+            np.testing.assert_array_equal(fed[-1].kp, fed[0].kp)

@@ -508,7 +508,7 @@ def carry(ctx: GoalContext, mid_xy: np.ndarray, heading: float, posture: np.ndar
     if over is not None and ctx.held is not None and cfg.carry_over_check:
         need = hands_over_m(ctx, over)
         sag = max(0.0, hands_sag_m(ctx))
-        low = lowest_hands_m(ctx.poses, plan.trajectory) - sag
+        low = (yield from ctx.compute("carry check", lowest_hands_m, plan.trajectory)) - sag
         for attempt in ("pelvis", "raise"):
             if low >= need - 0.005:
                 break
@@ -520,7 +520,7 @@ def carry(ctx: GoalContext, mid_xy: np.ndarray, heading: float, posture: np.ndar
             kept = min(float(q0[2]) - floor, ctx.poses.nominal_pelvis_m + STRAIGHT_KNEE_GUARD_M)
             step_cfg = replace(cfg.carry, pelvis_above_ground_m=max(cfg.carry.pelvis_above_ground_m, kept))
             plan = yield from _carry_plan(ctx, mid_xy, heading, posture, com_shift, step_cfg)
-            was, low = low, lowest_hands_m(ctx.poses, plan.trajectory) - sag
+            was, low = low, (yield from ctx.compute("carry check", lowest_hands_m, plan.trajectory)) - sag
             ctx.note(f"carry over '{over.name}': the hands {was:.3f} m -> {low:.3f} m ({attempt}; "
                      f"{need:.3f} m asked, sag {sag * 100:.1f} cm)")
         clear = low - (need - BOX_OVER_TOP_M)

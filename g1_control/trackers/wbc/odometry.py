@@ -37,11 +37,22 @@ class BaseOdometry:
         self._anchored[:] = True
 
     def update(self, dt_s: float, base_linvel_w_mps: np.ndarray, sole_offsets_w_m: np.ndarray,
-               stance: np.ndarray, ground_height: Callable[[np.ndarray], float] | None = None) -> np.ndarray:
+               stance: np.ndarray, ground_height: Callable[[np.ndarray], float] | None = None,
+               stalled: bool = False) -> np.ndarray:
         """Advance by dt_s; sole_offsets_w_m: (2, 3) sole positions minus base position, world axes.
-        ground_height: the map's height (m) at an xy (None: the anchor keeps the estimate's height)."""
+        ground_height: the map's height (m) at an xy (None: the anchor keeps the estimate's height).
+        stalled: dt_s spans a stalled loop (several ticks): the velocity times dt_s is not where the
+        base went, so the estimate is first corrected to the feet that stood before this tick, and a
+        foot touching down now is anchored from the corrected estimate. (After a 120 ms stall the
+        velocity left the base 1 cm low, a foot landing then was anchored there, and once the other foot
+        lifted the base read 2 cm low: the swing foot's touchdown on a step came 2 cm above the tread,
+        a fall; measured: sim2sim_step's timeline in lockstep, a stall at a touchdown.)"""
         p = self.base_pos_w_m
         p += base_linvel_w_mps * dt_s
+        standing = np.asarray(stance, dtype=bool) & self._anchored
+        if stalled and standing.any():
+            kin = (self.anchors_w_m[standing] - sole_offsets_w_m[standing]).mean(axis=0)
+            p += dt_s / (self.correction_tau_s + dt_s) * (kin - p)
         kin, n = np.zeros(3), 0
         for i in range(2):
             if not stance[i]:

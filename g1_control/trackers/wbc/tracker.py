@@ -55,6 +55,10 @@ from g1_control.trackers.wbc.tasks import (
 from g1_control.trackers.wbc.terrain import Terrain
 from g1_control.types import PHASE_WHOLE_BODY, JointReference, MotorCommand, RobotState
 
+STALLED_TICKS = 2.5
+"""A gap between two ticks' states longer than this many tracker periods is a stalled loop (the
+odometry then corrects to the standing feet before anchoring a landing one: odometry.py)."""
+
 
 @dataclass(frozen=True)
 class WbcConfig:
@@ -468,7 +472,8 @@ class WholeBodyTracker(Tracker):
         base_prev = q[:3].copy()
         terrain = self.gait.terrain if self.gait is not None and not self.gait.terrain.flat else None
         base = self.odometry.update(dt, est.base_linvel_w_mps, offsets, stance,
-                                    None if terrain is None else terrain.height)
+                                    None if terrain is None else terrain.height,
+                                    stalled=dt > STALLED_TICKS / self.config.rate_hz)
         shift = base - base_prev
         q[:3] = base
         self._sole_pos = sole_pos_before + shift

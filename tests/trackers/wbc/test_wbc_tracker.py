@@ -123,3 +123,29 @@ def test_on_steps_a_rising_com_that_reaches_its_height_stops_within_2_cm():
     # rising from rest a tread below, it starts no harder than terrain_com_accel_mps2
     assert terrain_com_height_accel(0.15, 0.0, cfg.com_height, cfg.terrain_com_accel_mps2,
                                     cfg.terrain_com_brake_mps2) == cfg.terrain_com_accel_mps2
+
+
+def test_the_odometry_is_told_of_a_stalled_loop_by_the_gap_between_states():
+    """A gap longer than STALLED_TICKS tracker periods between two ticks' states is a stall to the
+    odometry (it corrects to the standing feet before anchoring a landing one); a late tick is not."""
+    from g1_control.trackers.wbc.tracker import STALLED_TICKS
+
+    backend = MujocoBackend()
+    state = backend.reset()
+    tracker = WholeBodyTracker()
+    tracker.reset(state)
+    seen = []
+    update = tracker.odometry.update
+
+    def spy(*args, stalled=False, **kwargs):
+        seen.append(stalled)
+        return update(*args, stalled=stalled, **kwargs)
+
+    tracker.odometry.update = spy
+    period = 1.0 / tracker.config.rate_hz
+    traj = R.stand(1.0)
+    t = 0.0
+    for gap in (period, period, 2.0 * period, (STALLED_TICKS + 0.5) * period, 13 * period, period):
+        t += gap
+        tracker.act(traj.sample(t), dataclasses.replace(state, t_s=t))
+    assert seen == [False, False, False, True, True, False], seen
