@@ -302,10 +302,9 @@ def test_a_wall_clock_simulator_feeds_a_stall_as_the_robot_link_does():
                            safety=SafetyFilter(SafetyConfig(command_hold_ticks=hold_ticks)))
         loop.reset()
         loop.scheduler.clock, loop.scheduler.sleep = clock, clock.sleep
-        calls = []
-        skipped = loop._skipped_ticks
+        calls: list[list[MotorCommand]] = []
 
-        def spy(n, skipped=skipped):
+        def spy(n, skipped=loop._skipped_ticks, robot=robot, calls=calls):
             first = len(robot.written)
             skipped(n)
             calls.append(robot.written[first:])
