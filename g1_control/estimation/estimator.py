@@ -26,6 +26,10 @@ SOLE_OFFSET_M = np.array([0.035, 0.0, -0.035])
 class EstimatorConfig:
     kinematic_gain_tau_s: float = 0.1
     """Time constant pulling the integrated velocity to the kinematic one."""
+    max_predict_s: float = 0.05
+    """Longer between two states (a stalled loop), the velocity is the kinematic one: one accelerometer
+    sample times a stall's length is not the velocity change over it (a landing foot's impact read at
+    the stall's end turns into metres per second)."""
     stance_height_scale_m: float = 0.003
     """Soft stance weighting: the foot lower by this much gets 73 % of the weight; sharp, because blending in the swing foot biases the speed low."""
 
@@ -110,7 +114,7 @@ class StateEstimator:
         rot = quat_to_rot_rows(quat)
         dt = 0.0 if self._last_t is None else max(0.0, state.t_s - self._last_t)
         self._last_t = state.t_s
-        if dt == 0.0:
+        if dt == 0.0 or dt > self.config.max_predict_s:
             linvel = v_kin
         else:
             acc = state.imu_acc_mps2.tolist()

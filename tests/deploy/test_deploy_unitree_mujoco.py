@@ -72,7 +72,9 @@ def test_with_the_profile_the_preflight_passes_and_its_table_names_the_simulator
                                                  "nothing is released")
     stream = _reason(report, "state_stream")
     rate = float(stream.split(" Hz")[0])
-    assert 150 <= rate <= 230, stream  # the simulator's 200 Hz, accepted below the robot's 400
+    # the simulator's 200 Hz, accepted below the robot's 400 (over the 0.3 s window a loaded host's catch-up
+    # burst read 240 Hz: CI's timing pass, stop 41)
+    assert 150 <= rate < 400, stream
     assert ("backend.simulator unitree_mujoco (200 Hz, robot needs 400): crc 0 accepted unchecked, tick 0 counted "
             "by the host, mode_machine 0 read as 5") in stream
     assert _reason(report, "variant") == ("mode_machine 5 (g1_29dof, 29 DoF) (left 0 by unitree_mujoco: the launch "
