@@ -235,25 +235,28 @@ def test_the_default_safety_filter_carries_the_loops_tilt_limit():
     assert loop.falls.max_tilt_rad == 0.9
 
 
+class StallingClock:
+    """A wall clock for the scheduler that jumps 80 ms once, past 0.2 s (a stalled host)."""
+
+    def __init__(self):
+        self.t, self.stalled = 0.0, False
+
+    def __call__(self):
+        if not self.stalled and self.t > 0.2:
+            self.stalled, self.t = True, self.t + 0.08
+        return self.t
+
+    def sleep(self, s):
+        self.t += s
+
+
 def test_a_simulator_paced_by_the_wall_clock_steps_the_ticks_a_stall_skipped():
     """A simulator (lockstep backend) run on the wall clock: one tick stalls 80 ms (the scheduler skips
     the periods it lost). The world went on meanwhile: the simulator steps the skipped ticks too, so the
     state's time stays the loop's and the stale-state check (50 ms) sees no stale state. Before, every
     skipped tick aged the state for good, and a paced sim run (sim_ros2.yaml) damped after ~25 of them."""
 
-    class Clock:
-        def __init__(self):
-            self.t, self.stalled = 0.0, False
-
-        def __call__(self):
-            if not self.stalled and self.t > 0.2:
-                self.stalled, self.t = True, self.t + 0.08
-            return self.t
-
-        def sleep(self, s):
-            self.t += s
-
-    clock = Clock()
+    clock = StallingClock()
     loop, robot, _records = _loop(StandInRobot(lockstep=True), wallclock=True,
                                   safety=SafetyFilter(SafetyConfig(stale_state_s=0.05)))
     loop.scheduler.clock, loop.scheduler.sleep = clock, clock.sleep
@@ -284,20 +287,8 @@ def test_a_wall_clock_simulator_feeds_a_stall_as_the_robot_link_does():
             super().write_command(command)
             self.written.append(command)
 
-    class Clock:
-        def __init__(self):
-            self.t, self.stalled = 0.0, False
-
-        def __call__(self):
-            if not self.stalled and self.t > 0.2:
-                self.stalled, self.t = True, self.t + 0.08
-            return self.t
-
-        def sleep(self, s):
-            self.t += s
-
     for hold_ticks, life in ((3.0, 30), (0.0, None)):
-        robot, clock = Recording(), Clock()
+        robot, clock = Recording(), StallingClock()
         loop = ControlLoop(robot, Still(), VelocityReferenceGenerator(), IKStage(), Pushing(), wallclock=True,
                            safety=SafetyFilter(SafetyConfig(command_hold_ticks=hold_ticks)))
         loop.reset()

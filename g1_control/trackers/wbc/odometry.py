@@ -49,10 +49,11 @@ class BaseOdometry:
         a fall; measured: sim2sim_step's timeline in lockstep, a stall at a touchdown.)"""
         p = self.base_pos_w_m
         p += base_linvel_w_mps * dt_s
-        standing = np.asarray(stance, dtype=bool) & self._anchored
-        if stalled and standing.any():
-            kin = (self.anchors_w_m[standing] - sole_offsets_w_m[standing]).mean(axis=0)
-            p += dt_s / (self.correction_tau_s + dt_s) * (kin - p)
+        if stalled:
+            standing = np.asarray(stance, dtype=bool) & self._anchored
+            if standing.any():
+                kin = (self.anchors_w_m[standing] - sole_offsets_w_m[standing]).mean(axis=0)
+                p += dt_s / (self.correction_tau_s + dt_s) * (kin - p)
         kin, n = np.zeros(3), 0
         for i in range(2):
             if not stance[i]:
