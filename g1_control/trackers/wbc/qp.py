@@ -85,6 +85,16 @@ class QpConfig:
     tick, so the bound stays within what the torques can do."""
     eps_abs: float = 1e-5
     max_iter: int = 200
+    contact_change_mu_in: float | None = 1e-2
+    """On a tick whose contact rows change (a foot lands or lifts, a load ramps in or out), the solver's
+    inequality proximal parameter is reset to this value (and the equality one to proxsuite's default,
+    1e-3) before the warm-started solve; None carries them over from the last solve. Carried over, they
+    had shrunk to 1e-6..1e-8 on the steady ticks before, and on the changed problem proxsuite stopped
+    after 2-32 iterations with PRIMAL_INFEASIBLE though the same problem solved cold in 9-14: 20 of the
+    1500 ticks of `g1 bench wbc`'s walk, every touchdown and some ramp ticks, each then re-solved relaxed
+    (full load, no contact damping) from a fresh solver. Reset there, the recorded problems of that walk
+    and of a 0.8 m/s one solved with no such exit and with a third to a half lower p99 solve time
+    (measured by replaying the recorded problem sequence, /tmp/s42/replay.py)."""
 
 
 @dataclass
@@ -115,6 +125,9 @@ class InverseDynamicsQP:
         self.position_max = np.asarray(g1.Q_MAX_RAD, dtype=float) - margin
         if not np.all(self.position_min < self.position_max):
             raise WbcConfigError(f"QpConfig.position_limit_margin_rad {margin} leaves a joint no range")
+        mu = self.config.contact_change_mu_in
+        if mu is not None and not (np.isfinite(mu) and 0 < mu <= 1):
+            raise WbcConfigError(f"QpConfig.contact_change_mu_in must be None or a number in (0, 1]; got {mu}")
         for name in ("position_limit_brake_radps2", "position_limit_max_brake_radps2", "position_limit_zone_rad"):
             value = getattr(self.config, name)
             if not (np.isfinite(value) and value > 0):
@@ -158,7 +171,15 @@ class InverseDynamicsQP:
                                     np.tile([c.force_regularisation] * 3 + [c.moment_regularisation] * 3, 2)])
         self._qp: Any = None
         """The proxsuite dense QP (untyped), warm-started between solves; None before the first."""
+        feet = slice(nv - 6, nv - 6 + 2 * ROWS_PER_FOOT)
+        self._feet_rows = feet
+        self._feet_bounds = np.full((2, 2 * ROWS_PER_FOOT), np.nan)
+        """The feet's rows of l and u at the last solve (a change resets the proximal parameters)."""
         self.solves = 0
+        self.contact_resets = 0
+        """Solves whose proximal parameters were reset for changed contact rows (contact_change_mu_in)."""
+        self.cold_retries = 0
+        """Warm-started solves that did not solve and were solved again from a fresh solver."""
 
     def reset(self) -> None:
         """Forget the warm start (the next solve starts cold)."""
@@ -287,29 +308,51 @@ class InverseDynamicsQP:
         self._pos_hi[(d_max > zone) | self._pos_free] = _FREE
         self._pos_lo[(d_min > zone) | self._pos_free] = -_FREE
 
+    def _solve_cold(self) -> None:
+        self._qp = self._new_solver()
+        self._qp.solve()
+        # Only now: proxsuite 0.8 segfaults when asked to warm-start before any result exists.
+        self._qp.settings.initial_guess = self._proxsuite.proxqp.InitialGuess.WARM_START_WITH_PREVIOUS_RESULT
+
+    def _solved(self) -> bool:
+        return "SOLVED" in self._qp.results.info.status.name and bool(np.isfinite(self._qp.results.x).all())
+
     def _solve(self, model: WbcModel, stance: np.ndarray) -> IdSolution:
         nv = self.nv
         M, h, Jc = model.mass_matrix, model.bias, model.contact_jac_local
         H, g, A, b, C, l, u = self.H, self.g, self.A, self.b, self.C, self.l, self.u
         t0 = time.perf_counter()
+        feet = self._feet_rows
+        changed = not (np.array_equal(self._feet_bounds[0], l[feet]) and np.array_equal(self._feet_bounds[1], u[feet]))
+        self._feet_bounds[0], self._feet_bounds[1] = l[feet], u[feet]
+        iterations = 0
         if self._qp is None:
-            self._qp = self._new_solver()
-            self._qp.solve()
-            # Only now: proxsuite 0.8 segfaults when asked to warm-start before any result exists.
-            self._qp.settings.initial_guess = self._proxsuite.proxqp.InitialGuess.WARM_START_WITH_PREVIOUS_RESULT
+            self._solve_cold()
         else:
-            self._qp.update(H, g, A, b, C, l, u)
+            mu = self.config.contact_change_mu_in
+            if changed and mu is not None:
+                self._qp.update(H, g, A, b, C, l, u, mu_in=mu, mu_eq=self._qp.settings.default_mu_eq)
+                self.contact_resets += 1
+            else:
+                self._qp.update(H, g, A, b, C, l, u)
             self._qp.solve()
+            if not self._solved():
+                # a warm start's exit (PRIMAL_INFEASIBLE on a feasible problem, seen from shrunk proximal
+                # parameters) is not the problem's: the same problem once more from a fresh solver
+                iterations = int(self._qp.results.info.iter)
+                self.cold_retries += 1
+                self._solve_cold()
         elapsed = time.perf_counter() - t0
         self.solves += 1
         info = self._qp.results.info
         status = info.status.name
         x = self._qp.results.x
-        if not np.isfinite(x).all() or "SOLVED" not in status:
+        iterations += int(info.iter)
+        if not self._solved():
             self._qp = None  # do not warm-start from a failed solve
-            raise WbcSolveError(f"inverse-dynamics QP not solved: status {status} after {info.iter} iterations "
+            raise WbcSolveError(f"inverse-dynamics QP not solved: status {status} after {iterations} iterations "
                                 f"(stance {stance.tolist()})")
         ddq = x[:nv].copy()
         wrenches = x[nv:].reshape(2, 6).copy()
         tau = M[6:] @ ddq + h[6:] - Jc[:, 6:].T @ x[nv:]
-        return IdSolution(ddq, wrenches, tau, int(info.iter), elapsed, status)
+        return IdSolution(ddq, wrenches, tau, iterations, elapsed, status)

@@ -186,6 +186,9 @@ def test_position_limit_settings_are_checked(model):
         InverseDynamicsQP(model.nv, QpConfig(position_limit_margin_rad=0.3))
     with pytest.raises(WbcConfigError, match="position_limit_brake_radps2"):
         InverseDynamicsQP(model.nv, QpConfig(position_limit_brake_radps2=0.0))
+    for bad in (0.0, -1e-3, 2.0, float("nan")):
+        with pytest.raises(WbcConfigError, match="contact_change_mu_in"):
+            InverseDynamicsQP(model.nv, QpConfig(contact_change_mu_in=bad))
 
 
 def test_only_the_chosen_joints_are_position_bounded(model):

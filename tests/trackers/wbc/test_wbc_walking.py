@@ -8,6 +8,7 @@ from g1_control.robot import g1
 from g1_control.rotations import yaw_of
 from g1_control.sim.mujoco_backend import MujocoBackend
 from g1_control.trackers.wbc.gait import step_duration_for
+from g1_control.trackers.wbc.qp import QpConfig
 from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
 from g1_control.types import JointReference
 
@@ -49,6 +50,25 @@ def test_walks_forward_at_the_commanded_speed_without_falling():
     assert abs(yaw[b] - yaw[a]) < 0.1
     assert tracker.gait is not None and tracker.gait.steps >= 12
     assert tracker.diagnostics.unsolved_ticks == 0
+
+
+def test_touchdowns_solve_the_problem_asked_not_a_relaxed_one():
+    """A foot landing changes its contact rows; the solver, warm-started with the proximal parameters the
+    steady ticks before shrank, used to exit PRIMAL_INFEASIBLE on those feasible problems and the tick
+    was re-solved relaxed (full load, no contact damping). With the parameters reset on a contact change
+    (QpConfig.contact_change_mu_in) no touchdown needs a retry; without it each false exit is re-solved,
+    as asked, from a fresh solver: neither walk takes the relaxed path."""
+    tracker, trace = walk((0.4, 0.0, 0.0), 3.0)
+    assert trace[-1, 0] > 2.9 and tracker.gait is not None and tracker.gait.steps >= 4
+    assert tracker.qp.contact_resets >= 2 * tracker.gait.steps
+    assert tracker.qp.cold_retries == 0
+    assert tracker.diagnostics.solve_failures == 0
+    carried, trace = walk((0.4, 0.0, 0.0), 3.0,
+                          config=WbcConfig(footsteps="velocity", qp=QpConfig(contact_change_mu_in=None)))
+    assert trace[-1, 0] > 2.9
+    assert carried.qp.contact_resets == 0
+    assert carried.qp.cold_retries >= 2, "the walk with carried-over parameters no longer exits early: test moot"
+    assert carried.diagnostics.solve_failures == 0
 
 
 def whole_strides_velocity(tracker, trace: np.ndarray, command_xy, t_from_s: float) -> np.ndarray:
