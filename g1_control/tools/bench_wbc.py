@@ -161,7 +161,8 @@ def main(args) -> int:
     iters = np.array([r[4] for r in records])
     print(f"  QP iterations p50/p99/max: {np.percentile(iters, 50):.0f}/{np.percentile(iters, 99):.0f}/{iters.max()} "
           f"(independent of machine load); ticks relaxed/unsolved: {tracker.diagnostics.solve_failures}/"
-          f"{tracker.diagnostics.unsolved_ticks}")
+          f"{tracker.diagnostics.unsolved_ticks}; warm starts reset for a contact change: {tracker.qp.contact_resets}, "
+          f"retried cold: {tracker.qp.cold_retries}")
     load1, _, _ = os.getloadavg()
     print(f"  1-minute load average during the run: {load1:.1f} on {os.cpu_count()} cores "
           "(p99 figures above 1 ms on a loaded machine are preemption, not solver work)")
@@ -173,5 +174,7 @@ def main(args) -> int:
             "qp_p50_us": qp50, "qp_p99_us": qp99, "qp_cold_p50_us": cold50, "qp_cold_p99_us": cold99,
             "rnea_crba_p50_us": dyn50, "rnea_crba_p99_us": dyn99, "act_p50_us": act50, "act_p99_us": act99,
             "qp_iterations_p50": float(np.percentile(iters, 50)), "qp_iterations_p99": float(np.percentile(iters, 99)),
+            "ticks_relaxed": tracker.diagnostics.solve_failures, "ticks_unsolved": tracker.diagnostics.unsolved_ticks,
+            "qp_contact_resets": tracker.qp.contact_resets, "qp_cold_retries": tracker.qp.cold_retries,
             "load_average_1min": load1, "loop_wall_s": walk.wall_s, "real_time_factor": rtf, "physics_only_wall_s": physics}, indent=2))
     return 1 if walk.fall else 0
