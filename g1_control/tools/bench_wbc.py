@@ -14,7 +14,11 @@ Figures:
     model-based controller computes per tick), and the same QPs (every 8th tick's) solved cold
     by a fresh solver (setup included, as a controller without warm start would pay);
   - real-time factor of the whole loop with the WBC at 250 Hz, against stepping the same MuJoCo
-    model alone for the same simulated time.
+    model alone for the same simulated time;
+  - the warm starts: the walk's first REPLAY_TICKS problems solved again, in order, by a solver as
+    shipped (proximal parameters reset when a foot's contact rows change, QpConfig.contact_change_mu_in)
+    and by one that carries them over (until stop 42), alternately, best of REPLAY_ROUNDS: the warm
+    starts that exited unsolved (each then solved cold), iterations and solve time.
 """
 
 from __future__ import annotations
@@ -36,6 +40,9 @@ PROBLEM_STRIDE = 8
 """Every 8th tick's QP is kept for the cold-solve baseline."""
 WALK_SPEED_MPS = 0.3
 STEADY_FROM_S = 3.0
+REPLAY_TICKS = 1500
+"""The walk's first problems kept for the warm-start replay (each ~56 kB)."""
+REPLAY_ROUNDS = 3
 
 
 @dataclass
@@ -78,6 +85,35 @@ def _pct(samples_s) -> tuple[float, float]:
     return float(p50), float(p99)
 
 
+def replay_warm_starts(sequence, config, nv: int) -> dict[str, dict[str, Any]]:
+    """The problems of `sequence` (H, g, A, b, C, l, u per tick) solved in order by the controller's QP
+    as configured ("shipped") and with the proximal parameters carried over ("carried_over"),
+    alternately for REPLAY_ROUNDS rounds: the best time per problem, the iterations and cold retries of
+    the first round."""
+    from dataclasses import replace
+
+    from g1_control.trackers.wbc.qp import InverseDynamicsQP
+
+    configs = {"shipped": config, "carried_over": replace(config, contact_change_mu_in=None)}
+    out: dict[str, dict[str, Any]] = {}
+    for round_ in range(REPLAY_ROUNDS):
+        for name, cfg in configs.items():
+            qp = InverseDynamicsQP(nv, cfg)
+            mats = (qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u)
+            times, iterations = [], []
+            for problem in sequence:
+                for dst, src in zip(mats, problem):
+                    dst[...] = src
+                _, iters, seconds = qp.solve_problem()
+                times.append(seconds * 1e6)
+                iterations.append(iters)
+            if round_ == 0:
+                out[name] = {"solve_us": np.array(times), "iterations": iterations, "cold_retries": qp.cold_retries}
+            else:
+                np.minimum(out[name]["solve_us"], times, out=out[name]["solve_us"])
+    return out
+
+
 def main(args) -> int:
     import pinocchio as pin
 
@@ -90,24 +126,29 @@ def main(args) -> int:
 
     records, problems = [], []
 
+    act_samples: list[float] = []
+    sequence: list[tuple[np.ndarray, ...]] = []
+
     class Recording(tracker_module.WholeBodyTracker):
         def act(self, reference, state):
+            t0 = time.perf_counter()
             out = super().act(reference, state)
+            act_samples.append(time.perf_counter() - t0)  # the recording below is not the controller's
             sol = self.diagnostics.solution
             assert sol is not None  # None only before the first solved QP
             records.append((self._q.copy(), self._v.copy(), sol.solve_time_s, self._prev_stance.copy(),
                             sol.iterations))
+            qp = self.qp
             if len(records) % PROBLEM_STRIDE == 0:
-                qp = self.qp
                 problems.append(tuple(m.copy() for m in (qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u)))
+            if len(sequence) < REPLAY_TICKS:
+                sequence.append(tuple(m.copy() for m in (qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u)))
             return out
 
     # build_loop makes the WBC tracker by its name in tracker_module: record through a subclass.
     with mock.patch.object(tracker_module, "WholeBodyTracker", Recording):
         walk, loop = velocity_walk(WALK_SPEED_MPS, duration, DEFAULT_TRACKER_HZ)
     tracker = loop.tracker
-    act_times = loop.scheduler.times["tracker"]
-    act_samples = act_times.samples[: min(act_times.count, act_times.capacity)]
     qp_samples = [r[2] for r in records]
 
     # Baseline 1: RNEA + CRBA on the visited states.
@@ -136,6 +177,8 @@ def main(args) -> int:
         cold.solve()
         cold_samples.append(time.perf_counter() - t0)
 
+    replayed = replay_warm_starts(sequence, tracker.config.qp, tracker.qp.nv)
+    sequence.clear()
     physics = physics_only_seconds(walk.sim_s, 0.002)
     qp50, qp99 = _pct(qp_samples)
     act50, act99 = _pct(act_samples)
@@ -163,6 +206,15 @@ def main(args) -> int:
           f"(independent of machine load); ticks relaxed/unsolved: {tracker.diagnostics.solve_failures}/"
           f"{tracker.diagnostics.unsolved_ticks}; warm starts reset for a contact change: {tracker.qp.contact_resets}, "
           f"retried cold: {tracker.qp.cold_retries}")
+    ship, carry = replayed["shipped"], replayed["carried_over"]
+    print(f"  warm starts, the walk's first {len(ship['solve_us'])} problems solved again in order (best of {REPLAY_ROUNDS}):")
+    for name, r in (("as shipped: reset on contact changes", ship), ("carried over (until stop 42)", carry)):
+        p50, p99 = np.percentile(r["solve_us"], [50, 99])
+        print(f"    {name:<38} solve p50 {p50:7.1f} us p99 {p99:7.1f} us, iterations p99 "
+              f"{np.percentile(r['iterations'], 99):.0f} max {max(r['iterations'])}, warm starts unsolved (then solved cold) "
+              f"{r['cold_retries']}")
+    ratio = np.percentile(ship["solve_us"], 99) / np.percentile(carry["solve_us"], 99)
+    print(f"    shipped/carried-over solve p99 {ratio:.2f}x")
     load1, _, _ = os.getloadavg()
     print(f"  1-minute load average during the run: {load1:.1f} on {os.cpu_count()} cores "
           "(p99 figures above 1 ms on a loaded machine are preemption, not solver work)")
@@ -176,5 +228,10 @@ def main(args) -> int:
             "qp_iterations_p50": float(np.percentile(iters, 50)), "qp_iterations_p99": float(np.percentile(iters, 99)),
             "ticks_relaxed": tracker.diagnostics.solve_failures, "ticks_unsolved": tracker.diagnostics.unsolved_ticks,
             "qp_contact_resets": tracker.qp.contact_resets, "qp_cold_retries": tracker.qp.cold_retries,
+            "replay": {name: {"problems": len(r["solve_us"]), "cold_retries": r["cold_retries"],
+                              "solve_p50_us": float(np.percentile(r["solve_us"], 50)),
+                              "solve_p99_us": float(np.percentile(r["solve_us"], 99)),
+                              "iterations_p99": float(np.percentile(r["iterations"], 99)),
+                              "iterations_max": int(max(r["iterations"]))} for name, r in replayed.items()},
             "load_average_1min": load1, "loop_wall_s": walk.wall_s, "real_time_factor": rtf, "physics_only_wall_s": physics}, indent=2))
     return 1 if walk.fall else 0

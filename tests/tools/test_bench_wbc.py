@@ -18,3 +18,9 @@ def test_a_short_run_walks_and_reports_its_solver_counts(tmp_path, capsys):
     assert report["ticks_relaxed"] == 0 and report["ticks_unsolved"] == 0
     assert report["qp_contact_resets"] > 0 and report["qp_cold_retries"] == 0
     assert report["act_p99_us"] >= report["act_p50_us"] > 0
+    # the replay: the same problems, in order, solved as shipped and with the warm starts' parameters carried
+    # over; carried over, the touchdowns' warm starts exit unsolved (as every touchdown's did until stop 42)
+    shipped, carried = report["replay"]["shipped"], report["replay"]["carried_over"]
+    assert shipped["problems"] == carried["problems"] == 1000
+    assert shipped["cold_retries"] == 0 and carried["cold_retries"] >= 4
+    assert "warm starts, the walk's first 1000 problems solved again" in text

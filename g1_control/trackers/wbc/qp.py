@@ -93,8 +93,9 @@ class QpConfig:
     after 2-32 iterations with PRIMAL_INFEASIBLE though the same problem solved cold in 9-14: 20 of the
     1500 ticks of `g1 bench wbc`'s walk, every touchdown and some ramp ticks, each then re-solved relaxed
     (full load, no contact damping) from a fresh solver. Reset there, the recorded problems of that walk
-    and of a 0.8 m/s one solved with no such exit and with a third to a half lower p99 solve time
-    (measured by replaying the recorded problem sequence, /tmp/s42/replay.py)."""
+    and of a 0.8 m/s one solved with no such exit and with a third to a half lower p99 solve time; mu_in
+    reset on every tick (1e-3) cost a quarter more at p50, reset only here (1e-2 or 1e-3) nothing
+    (measured by solving a recorded walk's problems again in order, as `g1 bench wbc` does)."""
 
 
 @dataclass
@@ -317,9 +318,10 @@ class InverseDynamicsQP:
     def _solved(self) -> bool:
         return "SOLVED" in self._qp.results.info.status.name and bool(np.isfinite(self._qp.results.x).all())
 
-    def _solve(self, model: WbcModel, stance: np.ndarray) -> IdSolution:
-        nv = self.nv
-        M, h, Jc = model.mass_matrix, model.bias, model.contact_jac_local
+    def solve_problem(self) -> tuple[bool, int, float]:
+        """Solve the problem now in H, g, A, b, C, l, u as a tick does (warm-started, the proximal
+        parameters reset when the feet's rows changed, a failed warm start retried cold): (solved,
+        iterations, seconds). `g1 bench wbc` replays a walk's problems through it."""
         H, g, A, b, C, l, u = self.H, self.g, self.A, self.b, self.C, self.l, self.u
         t0 = time.perf_counter()
         feet = self._feet_rows
@@ -344,11 +346,17 @@ class InverseDynamicsQP:
                 self._solve_cold()
         elapsed = time.perf_counter() - t0
         self.solves += 1
-        info = self._qp.results.info
-        status = info.status.name
+        solved = self._solved()
+        iterations += int(self._qp.results.info.iter)
+        return solved, iterations, elapsed
+
+    def _solve(self, model: WbcModel, stance: np.ndarray) -> IdSolution:
+        nv = self.nv
+        M, h, Jc = model.mass_matrix, model.bias, model.contact_jac_local
+        solved, iterations, elapsed = self.solve_problem()
+        status = self._qp.results.info.status.name
         x = self._qp.results.x
-        iterations += int(info.iter)
-        if not self._solved():
+        if not solved:
             self._qp = None  # do not warm-start from a failed solve
             raise WbcSolveError(f"inverse-dynamics QP not solved: status {status} after {iterations} iterations "
                                 f"(stance {stance.tolist()})")
