@@ -60,6 +60,7 @@ def walk_to(ctx: GoalContext, approach: Approach, *, out_m: float) -> Iterator[N
     goal_xy = approach.pelvis_xy() - out_m * fwd
     t0 = ctx.t
     settled_since: float | None = None
+    arrived = False
     while True:
         s, pos_w = ctx.world_pose()
         if ctx.t - t0 > cfg.walk_timeout_s:
@@ -70,14 +71,19 @@ def walk_to(ctx: GoalContext, approach: Approach, *, out_m: float) -> Iterator[N
         yaw_err = float(wrap_angle(approach.heading - yaw))
         c, sn = math.cos(yaw), math.sin(yaw)
         d_h = np.array([c * d[0] + sn * d[1], -sn * d[0] + c * d[1]])
-        if dist <= cfg.approach_tolerance_m and abs(yaw_err) <= cfg.approach_heading_tolerance_rad:
+        arrived = arrived or (dist <= cfg.approach_tolerance_m and abs(yaw_err) <= cfg.approach_heading_tolerance_rad)
+        if arrived:
+            # stand until settled, then judge the distance again (GoalConfig.approach_settled_tolerance_m)
             ctx.walk[:] = 0.0
             speed = float(np.hypot(*s.base_linvel_w_mps[:2])) if s.base_linvel_w_mps is not None else 0.0
             settled_since = ctx.t if settled_since is None or speed > cfg.settle_speed_mps else settled_since
             if ctx.t - settled_since >= cfg.settle_s:
-                return
-            yield
-            continue
+                if dist <= cfg.approach_settled_tolerance_m and abs(yaw_err) <= cfg.approach_heading_tolerance_rad:
+                    return
+                arrived = False  # it drifted off: walk again
+            else:
+                yield
+                continue
         settled_since = None
         if dist > 0.5:
             bearing_err = float(wrap_angle(math.atan2(d[1], d[0]) - yaw))

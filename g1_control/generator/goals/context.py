@@ -61,6 +61,12 @@ class GoalConfig:
     the rest (the policy stops within ~5-10 cm; footsteps are exact)."""
     approach_tolerance_m: float = 0.08
     approach_heading_tolerance_rad: float = 0.12
+    approach_settled_tolerance_m: float = 0.16
+    """Once within approach_tolerance_m the walk stops and the robot stands until settled; only then is the
+    distance judged again, against this: a stop coasts on (the whole-body controller's gait, stopping
+    from 0.15 m/s sideways, carried the pelvis ~0.1 m on, measured), and judged while coasting the
+    approach walked back and forth past its stance for the whole pick segment (launch/sim_wbc_carry.yaml,
+    stop 42). The work stance's own steps (step_to) take the rest."""
     settle_s: float = 1.0
     """Standing still this long (speed below settle_speed_mps) before a hand-over."""
     settle_speed_mps: float = 0.05
