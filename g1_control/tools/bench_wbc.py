@@ -15,10 +15,11 @@ Figures:
     by a fresh solver (setup included, as a controller without warm start would pay);
   - real-time factor of the whole loop with the WBC at 250 Hz, against stepping the same MuJoCo
     model alone for the same simulated time;
-  - the warm starts: the walk's first REPLAY_TICKS problems solved again, in order, by a solver as
-    shipped (proximal parameters reset when a foot's contact rows change, QpConfig.contact_change_mu_in)
-    and by one that carries them over (until stop 42), alternately, best of REPLAY_ROUNDS: the warm
-    starts that exited unsolved (each then solved cold), iterations and solve time.
+  - the warm starts: the walk's first REPLAY_TICKS problems solved again, in order, by a solver that
+    carries its proximal parameters over (the default) and by one that resets them when a foot's contact
+    rows change (QpConfig.contact_change_mu_in = RESET_MU_IN, off by default), alternately, best of
+    REPLAY_ROUNDS: the warm starts that exited unsolved (carried over: then solved cold next tick, as the
+    tracker's retry starts a fresh solver), iterations and solve time.
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ STEADY_FROM_S = 3.0
 REPLAY_TICKS = 1500
 """The walk's first problems kept for the warm-start replay (each ~56 kB)."""
 REPLAY_ROUNDS = 3
+RESET_MU_IN = 1e-2
 
 
 @dataclass
@@ -87,14 +89,15 @@ def _pct(samples_s) -> tuple[float, float]:
 
 def replay_warm_starts(sequence, config, nv: int) -> dict[str, dict[str, Any]]:
     """The problems of `sequence` (H, g, A, b, C, l, u per tick) solved in order by the controller's QP
-    as configured ("shipped") and with the proximal parameters carried over ("carried_over"),
-    alternately for REPLAY_ROUNDS rounds: the best time per problem, the iterations and cold retries of
-    the first round."""
+    with the proximal parameters carried over ("carried_over") and reset on contact changes ("reset"),
+    alternately for REPLAY_ROUNDS rounds: the best time per problem, the iterations and the warm starts
+    that exited unsolved in the first round."""
     from dataclasses import replace
 
     from g1_control.trackers.wbc.qp import InverseDynamicsQP
 
-    configs = {"shipped": config, "carried_over": replace(config, contact_change_mu_in=None)}
+    configs = {"carried_over": replace(config, contact_change_mu_in=None),
+               "reset": replace(config, contact_change_mu_in=RESET_MU_IN)}
     out: dict[str, dict[str, Any]] = {}
     for round_ in range(REPLAY_ROUNDS):
         for name, cfg in configs.items():
@@ -104,11 +107,13 @@ def replay_warm_starts(sequence, config, nv: int) -> dict[str, dict[str, Any]]:
             for problem in sequence:
                 for dst, src in zip(mats, problem):
                     dst[...] = src
-                _, iters, seconds = qp.solve_problem()
+                solved, iters, seconds = qp.solve_problem()
+                if not solved:
+                    qp.reset()  # as the tracker does: the next solve starts cold
                 times.append(seconds * 1e6)
                 iterations.append(iters)
             if round_ == 0:
-                out[name] = {"solve_us": np.array(times), "iterations": iterations, "cold_retries": qp.cold_retries}
+                out[name] = {"solve_us": np.array(times), "iterations": iterations, "warm_exits": qp.warm_exits}
             else:
                 np.minimum(out[name]["solve_us"], times, out=out[name]["solve_us"])
     return out
@@ -204,17 +209,17 @@ def main(args) -> int:
     iters = np.array([r[4] for r in records])
     print(f"  QP iterations p50/p99/max: {np.percentile(iters, 50):.0f}/{np.percentile(iters, 99):.0f}/{iters.max()} "
           f"(independent of machine load); ticks relaxed/unsolved: {tracker.diagnostics.solve_failures}/"
-          f"{tracker.diagnostics.unsolved_ticks}; warm starts reset for a contact change: {tracker.qp.contact_resets}, "
-          f"retried cold: {tracker.qp.cold_retries}")
-    ship, carry = replayed["shipped"], replayed["carried_over"]
-    print(f"  warm starts, the walk's first {len(ship['solve_us'])} problems solved again in order (best of {REPLAY_ROUNDS}):")
-    for name, r in (("as shipped: reset on contact changes", ship), ("carried over (until stop 42)", carry)):
+          f"{tracker.diagnostics.unsolved_ticks}; warm starts unsolved: {tracker.qp.warm_exits}, reset for a contact "
+          f"change: {tracker.qp.contact_resets}, retried cold: {tracker.qp.cold_retries}")
+    carry, reset = replayed["carried_over"], replayed["reset"]
+    print(f"  warm starts, the walk's first {len(carry['solve_us'])} problems solved again in order (best of {REPLAY_ROUNDS}):")
+    for name, r in (("carried over (the default)", carry), (f"reset to {RESET_MU_IN:g} on contact changes", reset)):
         p50, p99 = np.percentile(r["solve_us"], [50, 99])
         print(f"    {name:<38} solve p50 {p50:7.1f} us p99 {p99:7.1f} us, iterations p99 "
-              f"{np.percentile(r['iterations'], 99):.0f} max {max(r['iterations'])}, warm starts unsolved (then solved cold) "
-              f"{r['cold_retries']}")
-    ratio = np.percentile(ship["solve_us"], 99) / np.percentile(carry["solve_us"], 99)
-    print(f"    shipped/carried-over solve p99 {ratio:.2f}x")
+              f"{np.percentile(r['iterations'], 99):.0f} max {max(r['iterations'])}, warm starts unsolved "
+              f"{r['warm_exits']}")
+    ratio = np.percentile(reset["solve_us"], 99) / np.percentile(carry["solve_us"], 99)
+    print(f"    reset/carried-over solve p99 {ratio:.2f}x")
     load1, _, _ = os.getloadavg()
     print(f"  1-minute load average during the run: {load1:.1f} on {os.cpu_count()} cores "
           "(p99 figures above 1 ms on a loaded machine are preemption, not solver work)")
@@ -227,8 +232,9 @@ def main(args) -> int:
             "rnea_crba_p50_us": dyn50, "rnea_crba_p99_us": dyn99, "act_p50_us": act50, "act_p99_us": act99,
             "qp_iterations_p50": float(np.percentile(iters, 50)), "qp_iterations_p99": float(np.percentile(iters, 99)),
             "ticks_relaxed": tracker.diagnostics.solve_failures, "ticks_unsolved": tracker.diagnostics.unsolved_ticks,
-            "qp_contact_resets": tracker.qp.contact_resets, "qp_cold_retries": tracker.qp.cold_retries,
-            "replay": {name: {"problems": len(r["solve_us"]), "cold_retries": r["cold_retries"],
+            "qp_warm_exits": tracker.qp.warm_exits, "qp_contact_resets": tracker.qp.contact_resets,
+            "qp_cold_retries": tracker.qp.cold_retries,
+            "replay": {name: {"problems": len(r["solve_us"]), "warm_exits": r["warm_exits"],
                               "solve_p50_us": float(np.percentile(r["solve_us"], 50)),
                               "solve_p99_us": float(np.percentile(r["solve_us"], 99)),
                               "iterations_p99": float(np.percentile(r["iterations"], 99)),

@@ -85,17 +85,21 @@ class QpConfig:
     tick, so the bound stays within what the torques can do."""
     eps_abs: float = 1e-5
     max_iter: int = 200
-    contact_change_mu_in: float | None = 1e-2
-    """On a tick whose contact rows change (a foot lands or lifts, a load ramps in or out), the solver's
-    inequality proximal parameter is reset to this value (and the equality one to proxsuite's default,
-    1e-3) before the warm-started solve; None carries them over from the last solve. Carried over, they
-    had shrunk to 1e-6..1e-8 on the steady ticks before, and on the changed problem proxsuite stopped
-    after 2-32 iterations with PRIMAL_INFEASIBLE though the same problem solved cold in 9-14: 20 of the
-    1500 ticks of `g1 bench wbc`'s walk, every touchdown and some ramp ticks, each then re-solved relaxed
-    (full load, no contact damping) from a fresh solver. Reset there, the recorded problems of that walk
-    and of a 0.8 m/s one solved with no such exit and with a third to a half lower p99 solve time; mu_in
-    reset on every tick (1e-3) cost a quarter more at p50, reset only here (1e-2 or 1e-3) nothing
-    (measured by solving a recorded walk's problems again in order, as `g1 bench wbc` does)."""
+    contact_change_mu_in: float | None = None
+    """Off (None): the solver's proximal parameters carry over from the last solve, and a solve that does
+    not succeed goes to the tracker's relaxed retry. Set (1e-2 measured best): on a tick whose contact rows
+    change (a foot lands or lifts, a load ramps in or out) the inequality proximal parameter is reset to it
+    (the equality one to proxsuite's default, 1e-3) before the warm-started solve, and a warm start that
+    still fails is solved again from a fresh solver before the relaxed retry.
+    Why it exists: carried over, the parameters shrink to 1e-6..1e-8 on steady ticks, and on the changed
+    problem proxsuite stops after 2-32 iterations with PRIMAL_INFEASIBLE though the same problem solves
+    cold in 9-14: 20 of the 1500 ticks of `g1 bench wbc`'s walk, every touchdown and some ramp ticks, each
+    then re-solved relaxed (full load, no contact damping). Set, that walk has no false exit, and its
+    problems solve with half the p99 time (`g1 bench wbc` replays them both ways).
+    Why it is off (stop 42): solving touchdowns as asked changes the walk. Lockstep it was as good or
+    better (pushes 10/20 against 9/20, random timelines s10-49 0/40 falls, stairs a wash), but the 23-DoF
+    G1 walked over DDS (tests/deploy/test_deploy_wbc_walk.py, 1.6 m forward) drifted 0.36-0.56 m sideways
+    in 3 of 14 runs here, against at most 0.19 m in 9 runs without it."""
 
 
 @dataclass
@@ -180,7 +184,9 @@ class InverseDynamicsQP:
         self.contact_resets = 0
         """Solves whose proximal parameters were reset for changed contact rows (contact_change_mu_in)."""
         self.cold_retries = 0
-        """Warm-started solves that did not solve and were solved again from a fresh solver."""
+        """Warm-started solves that did not solve and were solved again from a fresh solver (contact_change_mu_in set)."""
+        self.warm_exits = 0
+        """Warm-started solves that did not solve (retried cold, or else raised to the tracker's relaxed retry)."""
 
     def reset(self) -> None:
         """Forget the warm start (the next solve starts cold)."""
@@ -319,9 +325,10 @@ class InverseDynamicsQP:
         return "SOLVED" in self._qp.results.info.status.name and bool(np.isfinite(self._qp.results.x).all())
 
     def solve_problem(self) -> tuple[bool, int, float]:
-        """Solve the problem now in H, g, A, b, C, l, u as a tick does (warm-started, the proximal
-        parameters reset when the feet's rows changed, a failed warm start retried cold): (solved,
-        iterations, seconds). `g1 bench wbc` replays a walk's problems through it."""
+        """Solve the problem now in H, g, A, b, C, l, u as a tick does (warm-started; with
+        contact_change_mu_in, the proximal parameters reset when the feet's rows changed and a failed warm
+        start retried cold): (solved, iterations, seconds). `g1 bench wbc` replays a walk's problems
+        through it."""
         H, g, A, b, C, l, u = self.H, self.g, self.A, self.b, self.C, self.l, self.u
         t0 = time.perf_counter()
         feet = self._feet_rows
@@ -339,6 +346,8 @@ class InverseDynamicsQP:
                 self._qp.update(H, g, A, b, C, l, u)
             self._qp.solve()
             if not self._solved():
+                self.warm_exits += 1
+            if not self._solved() and mu is not None:
                 # a warm start's exit (PRIMAL_INFEASIBLE on a feasible problem, seen from shrunk proximal
                 # parameters) is not the problem's: the same problem once more from a fresh solver
                 iterations = int(self._qp.results.info.iter)

@@ -1,17 +1,17 @@
 """Pushed while walking, the whole-body controller's recovery steps keep it up: pushes of `g1 bench
 locomotion`'s grid (150 N for 0.2 s on the pelvis, walking 0.5 m/s) in lockstep MuJoCo through the
 one loop builder, judged from the simulator (pelvis height, no fall, no safety trip). Chaotic near its
-limits, the controller survives only some of the grid (10 of 20); these are survived, and each part
+limits, the controller survives only some of the grid (9 of 20); these are survived, and each part
 that saves some of them is taken away in turn (so a test goes red without it):
   WbcConfig.recovery_com_lower_m   the CoM held 0.08 m lower in a pushed recovery step (without:
-                                   front_2 and back_0 fell);
+                                   front_2 and front_3 fell);
   GaitConfig.recovery_max_width_m  a recovery step may land 0.6 m wide (at the plain 0.45 m: left_1
                                    fell within the settling time);
   WbcConfig.recovery_swing_weight  the swing foot held harder in a recovery step (at its plain walking
-                                   weight the QP swings the leg back instead of stepping: front_3
-                                   fell);
-  GaitConfig.min_swing_s 0.15      a recovery step made sooner may swing only 0.15 s (0.2: left_1
-                                   fell);
+                                   weight the QP swings the leg back instead of stepping: front_3 and
+                                   left_2 fell);
+  GaitConfig.min_swing_s 0.15      a recovery step made sooner may swing only 0.15 s (0.2: back_2
+                                   and left_1 fell);
   WbcConfig.swing_max_accel_mps2   the swing foot's re-planned reference acceleration capped (uncapped:
                                    right_0 fell, ankle pitch over-speed; left_2 and back_2 trip too,
                                    left_2 after the settling time).
@@ -34,11 +34,8 @@ from g1_control.trackers.wbc.gait import GaitConfig
 
 UPRIGHT_PELVIS_M = 0.6
 """Ground-truth pelvis height the robot stays above (it walks at ~0.68 m; a fall ends at 0.4)."""
-SURVIVED = ("push_front_0", "push_front_2", "push_front_3", "push_front_4", "push_back_0", "push_left_2",
-            "push_right_0", "push_right_4")
-"""Until stop 42 the knock-outs below saved more of these (without the recovery swing weight left_2 fell too,
-with min_swing_s 0.2 back_2 too, without the lower CoM front_3 rather than back_0) and back_0 fell by default:
-the QP then solved every touchdown relaxed (qp.py, QpConfig.contact_change_mu_in)."""
+SURVIVED = ("push_front_0", "push_front_2", "push_front_3", "push_front_4", "push_left_2", "push_right_0",
+            "push_right_4")
 
 
 def run_push(name: str):
@@ -64,15 +61,15 @@ def test_recovery_steps_survive_a_push(name):
     assert row.min_pelvis_m > UPRIGHT_PELVIS_M
 
 
-def test_without_the_recovery_swing_weight_front_3_fell(monkeypatch):
+def test_without_the_recovery_swing_weight_front_3_and_left_2_fell(monkeypatch):
     without(monkeypatch, recovery_swing_weight=wbc_tracker.WbcConfig().swing_foot.weight)
-    assert_fell(["push_front_3"])
+    assert_fell(["push_front_3", "push_left_2"])
 
 
-def test_with_a_longer_minimum_swing_left_1_fell(monkeypatch):
-    assert run_push("push_left_1").pushes_survived == 1
+def test_with_a_longer_minimum_swing_back_2_and_left_1_fell(monkeypatch):
+    assert run_push("push_back_2").pushes_survived == run_push("push_left_1").pushes_survived == 1
     without(monkeypatch, gait=GaitConfig(min_swing_s=0.2))
-    assert_fell(["push_left_1"])
+    assert_fell(["push_back_2", "push_left_1"])
 
 
 def test_with_the_swing_acceleration_uncapped_right_0_fell(monkeypatch):
@@ -80,9 +77,9 @@ def test_with_the_swing_acceleration_uncapped_right_0_fell(monkeypatch):
     assert_fell(["push_right_0"])
 
 
-def test_without_the_lower_com_in_recovery_steps_front_2_and_back_0_fell(monkeypatch):
+def test_without_the_lower_com_in_recovery_steps_front_2_and_front_3_fell(monkeypatch):
     without(monkeypatch, recovery_com_lower_m=0.0)
-    assert_fell(["push_front_2", "push_back_0"])
+    assert_fell(["push_front_2", "push_front_3"])
 
 
 def test_with_recovery_steps_no_wider_than_plain_steps_left_1_fell(monkeypatch):
