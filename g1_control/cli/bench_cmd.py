@@ -15,7 +15,7 @@ BENCHMARKS = {
     "teleop": ("g1_control.tools.bench_teleop:main", "input event -> Command latency p50/p99 per device vs bare os.read"),
     "transport": ("g1_control.tools.bench_transport:main", "robot link: CRC, LowCmd/LowState encode/decode, safety filter (us/call)"),
     "ik": ("g1_control.tools.bench_ik:main", "IK retargeter: online solve p50/p99, offline frames/s per core"),
-    "wbc": ("g1_control.tools.bench_wbc:main", "whole-body QP solve p50/p99 per tick vs RNEA+CRBA and cold solves; warm starts as shipped vs carried over; loop real-time factor"),
+    "wbc": ("g1_control.tools.bench_wbc:main", "whole-body QP solve p50/p99 per tick vs RNEA+CRBA and cold solves; warm starts carried over vs reset on contact changes; loop real-time factor"),
     "generator": ("g1_control.tools.bench_generator:main",
                   "in-betweening L2P/L2Q/NPSS vs interpolation + motion matching; replan p50/p99; frames/s; 10-min rollout"),
     "execution": ("g1_control.tools.bench_execution:main",

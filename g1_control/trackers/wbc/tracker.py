@@ -723,10 +723,11 @@ class WholeBodyTracker(Tracker):
             sol = self.qp.solve(self.dyn, tasks, stance, load, joint_velocity_radps=dq_radps, dt_s=dt,
                                 joint_position_rad=q_rad)
         except WbcSolveError:
-            # A problem the QP itself found infeasible (a failed warm start is retried cold inside
-            # qp.solve first: until stop 42 every touchdown came here through such false exits,
-            # QpConfig.contact_change_mu_in). Retry with the contacts allowed their full load and no
-            # velocity damping, then also without joint speed bounds; failing that, keep the last command.
+            # The QP did not solve. With QpConfig.contact_change_mu_in off (the default) nearly every
+            # touchdown comes here through a false PRIMAL_INFEASIBLE exit of the warm start (the same
+            # problem solves cold; see there); set, a failed warm start is retried cold inside
+            # qp.solve first. Retry with the contacts allowed their full load and no velocity
+            # damping, then also without joint speed bounds; failing that, keep the last command.
             diag.solve_failures += 1
             try:
                 sol = self.qp.resolve(self.dyn, stance, np.ones(2), contact_damping_per_s=0.0,
