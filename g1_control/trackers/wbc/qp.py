@@ -176,8 +176,7 @@ class InverseDynamicsQP:
                                     np.tile([c.force_regularisation] * 3 + [c.moment_regularisation] * 3, 2)])
         self._qp: Any = None
         """The proxsuite dense QP (untyped), warm-started between solves; None before the first."""
-        feet = slice(nv - 6, nv - 6 + 2 * ROWS_PER_FOOT)
-        self._feet_rows = feet
+        self._feet_rows = slice(nv - 6, nv - 6 + 2 * ROWS_PER_FOOT)
         self._feet_bounds = np.full((2, 2 * ROWS_PER_FOOT), np.nan)
         """The feet's rows of l and u at the last solve (a change resets the proximal parameters)."""
         self.solves = 0
@@ -331,31 +330,35 @@ class InverseDynamicsQP:
         through it."""
         H, g, A, b, C, l, u = self.H, self.g, self.A, self.b, self.C, self.l, self.u
         t0 = time.perf_counter()
-        feet = self._feet_rows
-        changed = not (np.array_equal(self._feet_bounds[0], l[feet]) and np.array_equal(self._feet_bounds[1], u[feet]))
-        self._feet_bounds[0], self._feet_bounds[1] = l[feet], u[feet]
+        mu = self.config.contact_change_mu_in
+        changed = False
+        if mu is not None:  # off (the default), nothing below is looked at in the hot loop
+            feet = self._feet_rows
+            changed = not (np.array_equal(self._feet_bounds[0], l[feet]) and np.array_equal(self._feet_bounds[1], u[feet]))
+            self._feet_bounds[0], self._feet_bounds[1] = l[feet], u[feet]
         iterations = 0
         if self._qp is None:
             self._solve_cold()
+            solved = self._solved()
         else:
-            mu = self.config.contact_change_mu_in
-            if changed and mu is not None:
+            if changed:
                 self._qp.update(H, g, A, b, C, l, u, mu_in=mu, mu_eq=self._qp.settings.default_mu_eq)
                 self.contact_resets += 1
             else:
                 self._qp.update(H, g, A, b, C, l, u)
             self._qp.solve()
-            if not self._solved():
+            solved = self._solved()
+            if not solved:
                 self.warm_exits += 1
-            if not self._solved() and mu is not None:
-                # a warm start's exit (PRIMAL_INFEASIBLE on a feasible problem, seen from shrunk proximal
-                # parameters) is not the problem's: the same problem once more from a fresh solver
-                iterations = int(self._qp.results.info.iter)
-                self.cold_retries += 1
-                self._solve_cold()
+                if mu is not None:
+                    # a warm start's exit (PRIMAL_INFEASIBLE on a feasible problem, seen from shrunk proximal
+                    # parameters) is not the problem's: the same problem once more from a fresh solver
+                    iterations = int(self._qp.results.info.iter)
+                    self.cold_retries += 1
+                    self._solve_cold()
+                    solved = self._solved()
         elapsed = time.perf_counter() - t0
         self.solves += 1
-        solved = self._solved()
         iterations += int(self._qp.results.info.iter)
         return solved, iterations, elapsed
 
