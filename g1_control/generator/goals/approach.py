@@ -78,7 +78,7 @@ def walk_to(ctx: GoalContext, approach: Approach, *, out_m: float) -> Iterator[N
             speed = float(np.hypot(*s.base_linvel_w_mps[:2])) if s.base_linvel_w_mps is not None else 0.0
             settled_since = ctx.t if settled_since is None or speed > cfg.settle_speed_mps else settled_since
             if ctx.t - settled_since >= cfg.settle_s:
-                if dist <= cfg.approach_settled_tolerance_m and abs(yaw_err) <= cfg.approach_heading_tolerance_rad:
+                if dist <= cfg.approach_settled_tolerance_m and abs(yaw_err) <= cfg.approach_settled_heading_tolerance_rad:
                     return
                 arrived = False  # it drifted off: walk again
             else:

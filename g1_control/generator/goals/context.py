@@ -67,6 +67,12 @@ class GoalConfig:
     from 0.15 m/s sideways, carried the pelvis ~0.1 m on, measured), and judged while coasting the
     approach walked back and forth past its stance for the whole pick segment (launch/sim_wbc_carry.yaml,
     stop 42). The work stance's own steps (step_to) take the rest."""
+    approach_settled_heading_tolerance_rad: float = 0.25
+    """... and the heading against this. The walking policy stops turning once within
+    approach_heading_tolerance_rad and, standing, sways its heading by ~0.01 rad: judged settled against
+    that tolerance again, the approach stood at 0.12 +- 0.005 rad off for the whole walk timeout, a tick of
+    small turn command between each second of standing (`g1 bench objects --seed 61` trials 3, 6, 9 and
+    seed 62 trial 6: 4 of 30 picks failed "did not reach the stance"). The work stance's steps turn the rest."""
     settle_s: float = 1.0
     """Standing still this long (speed below settle_speed_mps) before a hand-over."""
     settle_speed_mps: float = 0.05
