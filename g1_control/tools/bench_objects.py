@@ -17,6 +17,8 @@ a pick and a place goal. Judged from the simulator's ground truth only (not the 
   dropped   it sank > 5 cm relative to the hands between the lift and the release (the place's, or
             the set-back of a pick whose box did not come up with the hands)
   fell      the pelvis went below 0.30 m (a squat stays above ~0.40 m) or the loop's fall monitor
+            tripped; reported with the stage it fell in (the running goal's kind and its walk or
+            whole-body plan: approach, pick, raise, carry, place, ...)
 A refused goal (the planner said no before moving) counts as a failure; its reason is listed.
 
     g1 bench objects --seed 3 --trials 20 [--jobs 2] [--json out.json]
@@ -234,10 +236,13 @@ def judge(drawn: dict, a: dict[str, np.ndarray], info: dict, messages: dict, pel
     upright = tilt <= UPRIGHT_DEG
     refusals = [f"{i.get('kind')}: {messages.get(g)}" for g, i in info.items() if i.get("status") == "failed"]
     success = lifted and held and placed and upright and not dropped and not fell
+    # where a fall happened: the stage (walk, or the whole-body plan's name) of the goal that was running
+    running = [i for i in info.values() if i.get("end_s") is None] or list(info.values())[-1:]
+    fell_in = f"{running[-1].get('kind')}: {running[-1].get('stage', 'start')}" if fell and running else ""
     return {**extra, "source": drawn["source"], "target": drawn["target"], "mass_kg": drawn["mass_kg"],
             "weight": "heavy" if drawn["mass_kg"] >= HEAVY_KG else "light", "size_m": drawn["size_m"],
             "box_yaw_deg": drawn["box_yaw_deg"], "lifted": lifted, "held": held, "placed": placed,
-            "upright": upright, "dropped": dropped, "fell": fell, "success": success,
+            "upright": upright, "dropped": dropped, "fell": fell, "fell_in": fell_in, "success": success,
             "place_error_xy_m": err_xy, "place_error_z_m": err_z, "tilt_deg": tilt, "pelvis_min_m": pelvis_min_m,
             "refused": refusals, "pick_status": pick.get("status"), "place_status": place.get("status")}
 
@@ -247,7 +252,8 @@ def _why(r: dict) -> str:
         return f"ok ({r['place_error_xy_m'] * 100:.1f} cm)"
     if r["refused"]:
         return "refused: " + " | ".join(r["refused"])
-    parts = [name for name, bad in (("fell", r["fell"]), ("not lifted", not r["lifted"]),
+    fell = f"fell ({r['fell_in']})" if r.get("fell_in") else "fell"
+    parts = [name for name, bad in ((fell, r["fell"]), ("not lifted", not r["lifted"]),
                                     ("not held", r["lifted"] and not r["held"]), ("dropped", r["dropped"]),
                                     ("not placed", not r["placed"]), ("tilted", not r["upright"])) if bad]
     return ", ".join(parts) + f" (box {r['place_error_xy_m'] * 100:.0f} cm from target, z {r['place_error_z_m'] * 100:+.0f} cm)"

@@ -7,6 +7,7 @@ import numpy as np
 
 from g1_control.tools.bench_objects import (
     HEIGHT_BUCKETS_M,
+    _why,
     draw_scene,
     height_bucket,
     judge,
@@ -113,3 +114,16 @@ def test_refusals_are_counted_per_bucket_by_reason_numbers_aside():
     assert refusal_table(rows) == {
         "from floor": {"pick: waist_pitch_joint needs # N m to hold still (its limit # N m)": 2},
         "to floor": {"place: from the stance the carry ended in, the hands get only within # cm of where the box goes": 1}}
+
+
+def test_a_fall_is_reported_with_the_stage_it_happened_in():
+    """The goal running when the robot fell, and what it was doing (its walk, or its whole-body plan's
+    name: GoalContext.run and walk_to record it as the goal's "stage")."""
+    arrays = _arrays([0.15, 0.3, 0.3, 0.2], [0.3, 0.3, 0.3, 0.2], [2.0, 1.0])
+    info = {"g0": {"kind": "pick", "status": "reached", "end_s": 0.3, "stage": "pick"},
+            "g1": {"kind": "place", "stage": "carry"}}
+    r = judge(DRAWN, arrays, info, {}, 0.25, False, index=0)
+    assert r["fell"] and r["fell_in"] == "place: carry"
+    assert "fell (place: carry)" in _why(r)
+    standing = judge(DRAWN, arrays, info, {}, 0.7, False, index=0)
+    assert not standing["fell"] and standing["fell_in"] == "" and "fell" not in _why(standing)

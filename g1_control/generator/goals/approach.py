@@ -59,6 +59,7 @@ def walk_to(ctx: GoalContext, approach: Approach, *, out_m: float) -> Iterator[N
     fwd = np.array([math.cos(approach.heading), math.sin(approach.heading)])
     goal_xy = approach.pelvis_xy() - out_m * fwd
     t0 = ctx.t
+    ctx.info["stage"] = "walk"
     settled_since: float | None = None
     arrived = False
     while True:

@@ -276,6 +276,7 @@ class GoalContext:
     # -- plans --------------------------------------------------------------------------------------
     def run(self, traj: WholeBodyTrajectory, keep: bool = False) -> Iterator[None]:
         self.plan, self.plan_t0 = traj, self.t
+        self.info["stage"] = traj.name  # what the goal is doing (g1 bench objects names a fall's stage)
         self.overlay = None
         self.keep = keep
         self.phase = PHASE_WHOLE_BODY
