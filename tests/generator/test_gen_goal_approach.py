@@ -28,6 +28,7 @@ class ScriptedRobot:
     def __init__(self, start_x: float, end_x: float, goal_xy: np.ndarray, config: GoalConfig):
         self.x, self.end_x, self.goal_xy = start_x, end_x, goal_xy
         self.config = config
+        self.info: dict = {}
         self.walk = np.zeros(3)
         self.t = 0.0
         self.vx = 0.0
@@ -82,6 +83,7 @@ class SwayingRobot:
 
     def __init__(self, goal_xy: np.ndarray, heading: float, error, config: GoalConfig):
         self.goal_xy, self.heading, self.error, self.config = goal_xy, heading, error, config
+        self.info: dict = {}
         self.walk = np.zeros(3)
         self.t = 0.0
         self.commands: list[tuple[float, np.ndarray]] = []
