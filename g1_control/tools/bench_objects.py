@@ -237,8 +237,10 @@ def judge(drawn: dict, a: dict[str, np.ndarray], info: dict, messages: dict, pel
     refusals = [f"{i.get('kind')}: {messages.get(g)}" for g, i in info.items() if i.get("status") == "failed"]
     success = lifted and held and placed and upright and not dropped and not fell
     # where a fall happened: the stage (walk, or the whole-body plan's name) of the goal that was running
-    running = [i for i in info.values() if i.get("end_s") is None] or list(info.values())[-1:]
-    fell_in = f"{running[-1].get('kind')}: {running[-1].get('stage', 'start')}" if fell and running else ""
+    running = [i for i in info.values() if i.get("end_s") is None]
+    fell_in = ""
+    if fell:
+        fell_in = f"{running[-1].get('kind')}: {running[-1].get('stage', 'start')}" if running else "no goal running"
     return {**extra, "source": drawn["source"], "target": drawn["target"], "mass_kg": drawn["mass_kg"],
             "weight": "heavy" if drawn["mass_kg"] >= HEAVY_KG else "light", "size_m": drawn["size_m"],
             "box_yaw_deg": drawn["box_yaw_deg"], "lifted": lifted, "held": held, "placed": placed,

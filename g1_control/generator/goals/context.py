@@ -276,7 +276,8 @@ class GoalContext:
     # -- plans --------------------------------------------------------------------------------------
     def run(self, traj: WholeBodyTrajectory, keep: bool = False) -> Iterator[None]:
         self.plan, self.plan_t0 = traj, self.t
-        self.info["stage"] = traj.name  # what the goal is doing (g1 bench objects names a fall's stage)
+        if self.goal is not None:  # what the goal is doing (g1 bench objects names a fall's stage); idle
+            self.info["stage"] = traj.name  # plans after a goal leave its record as it ended
         self.overlay = None
         self.keep = keep
         self.phase = PHASE_WHOLE_BODY

@@ -99,7 +99,10 @@ class QpConfig:
     Why it is off (stop 42): solving touchdowns as asked changes the walk. Lockstep it was as good or
     better (pushes 10/20 against 9/20, random timelines s10-49 0/40 falls, stairs a wash), but the 23-DoF
     G1 walked over DDS (tests/deploy/test_deploy_wbc_walk.py, 1.6 m forward) drifted 0.36-0.56 m sideways
-    in 3 of 14 runs here, against at most 0.19 m in 9 runs without it."""
+    in 3 of 14 runs here, against at most 0.19 m in 9 runs without it. Stop 43 traced it (49 more runs): the
+    drift is the gait's, a sideways stepping that saturates at max_width_m / min_width_m and never meets the
+    stop's side-by-side rule; it comes off too (lockstep randomised robots: 2/30 off, 4/30 on) but more often
+    over DDS with the reset (7/44 against 0/27, p ~ 0.03). The gait's stop rule is the thing to fix first."""
 
 
 @dataclass
