@@ -34,7 +34,7 @@ import math
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING, Literal, cast
 
 import numpy as np
 
@@ -50,6 +50,8 @@ CONTROLLERS: dict[str, tuple[str, str, float]] = {
     "fastsac": ("policy", "holosoma_loco_fastsac", 50.0),
 }
 """name -> (tracker.type, tracker.policy, tracker rate Hz)."""
+VariantName = Literal["g1_23dof", "g1_29dof", "g1_29dof_locked_waist"]
+"""backend.expected_variant's values."""
 POLICY_GAIT_PERIOD_S = 1.0
 LOG_DIGEST_FIELDS = ("t_s", "base_pos_m", "base_quat_wxyz", "velocity_true", "q_rad", "q_target_rad", "tau_nm")
 """The per-tick log fields Row.log_sha256 covers: the simulator's ground truth and what was commanded."""
@@ -176,8 +178,11 @@ def wbc_stride_s(tracker, command: tuple[float, float, float]) -> float:
     return 2 * step_duration_for(gait.config, gait.feasible(np.array(command, dtype=float))[:2])
 
 
-def case_launch(controller: str, case: Case, walk_s: float, randomize: RandomizeConfig | None = None):
-    """The launch of one row; `randomize`: on a randomised robot (g1_control/sim/randomize.py)."""
+def case_launch(controller: str, case: Case, walk_s: float, randomize: RandomizeConfig | None = None,
+                variant: VariantName | None = None):
+    """The launch of one row; `randomize`: on a randomised robot (g1_control/sim/randomize.py);
+    `variant`: the robot the simulator builds and the controller models (g1.VARIANTS; None: the launch
+    default, the 29-DoF G1)."""
     from g1_control.launch.schema import LaunchFile
 
     kind, policy, hz = CONTROLLERS[controller]
@@ -198,18 +203,20 @@ def case_launch(controller: str, case: Case, walk_s: float, randomize: Randomize
     launch.limits.max_vy_mps = max(launch.limits.max_vy_mps, abs(vy))
     launch.limits.max_wz_radps = max(launch.limits.max_wz_radps, abs(wz))
     launch.backend.randomize = randomize
+    if variant is not None:
+        launch.backend.expected_variant = variant
     launch.validate("locomotion")
     launch.output.video, launch.output.plot, launch.viewer = False, False, False
     return launch
 
 
 def run_case(controller: str, case: Case, walk_s: float, states: list | None = None,
-             randomize: RandomizeConfig | None = None) -> Row:
+             randomize: RandomizeConfig | None = None, variant: VariantName | None = None) -> Row:
     """One row. `states`: gets (q, v) samples of the run appended (the RNEA + CRBA baseline);
-    `randomize`: on a randomised robot."""
+    `randomize`: on a randomised robot; `variant`: on that robot variant (case_launch)."""
     from g1_control.launch.builder import build_loop
 
-    loop = build_loop(case_launch(controller, case, walk_s, randomize))
+    loop = build_loop(case_launch(controller, case, walk_s, randomize, variant))
     loop.reset()
     tracker = loop.tracker
     cpu: list[int] = []

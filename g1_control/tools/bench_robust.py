@@ -6,13 +6,16 @@ For each of --draws seeded draws (seeds --seed, --seed+1, ...), every controller
 robot:
   wbc/forward_0.6   the model-based whole-body controller (tracker.type wbc, 250 Hz): 1 s standing,
                     then 0.6 m/s forward for --seconds;
+  wbc23/forward_0.6 the same on the 23-DoF G1 (backend.expected_variant g1_23dof: the simulator builds
+                    it and the controller models it), the robot `g1 deploy` runs the WBC on;
   ppo/forward_0.6   holosoma's ppo walking policy (tracker.type policy, 50 Hz), the same timeline;
   layer/step        launch/sim_step.yaml (the walking policy walks to a 0.15 m platform, the WBC steps
                     up, stands, steps down; tracker.type layer): done when both feet are on the
                     platform at the end of step_up and on the floor at the end of step_down.
 Figures from the simulator's ground truth: achieved (vx, vy, wz) in the heading frame over whole gait
 cycles after 3 s of walking (bench_locomotion.steady_velocity), fell (the loop's fall monitor),
-lowest pelvis height. The nominal robot's rows run first in the same run, as the baseline.
+lowest pelvis height. The nominal robot's rows run first in the same run, as the baseline. The
+summary names each draw a row fell on, with its foot friction and command latency.
 Exits 1 when any row fell (or a step was not completed).
 
     g1 bench robust                               # 10 draws, forward rows + step (~30 min)
@@ -27,13 +30,20 @@ import math
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from g1_control.sim.randomize import RandomizeConfig
+from g1_control.sim.randomize import RandomizeConfig, draw
+
+if TYPE_CHECKING:
+    from g1_control.tools.bench_locomotion import VariantName
 
 FORWARD_MPS = 0.6
-CONTROLLERS = ("wbc", "ppo")
+CONTROLLERS = ("wbc", "wbc23", "ppo")
+ROW_KINDS: dict[str, tuple[str, VariantName | None]] = {"wbc": ("wbc", None), "wbc23": ("wbc", "g1_23dof"),
+                                                        "ppo": ("ppo", None)}
+"""row name -> (bench_locomotion controller, robot variant; None: the 29-DoF G1)."""
 STEP_LAUNCH = "sim_step.yaml"
 
 
@@ -64,12 +74,20 @@ def _randomize(seed: int | None) -> RandomizeConfig | None:
     return None if seed is None else RandomizeConfig(seed=seed)
 
 
-def forward_row(controller: str, seed: int | None, walk_s: float) -> RobustRow:
+def draw_friction_latency(seed: int) -> tuple[float, float]:
+    """(foot friction, command latency s) of draw `seed` (drawn before anything that depends on the
+    robot's bodies, so every variant's draw has them)."""
+    d = draw(RandomizeConfig(seed=seed), (), 0)
+    return d.foot_friction, d.latency_s
+
+
+def forward_row(name: str, seed: int | None, walk_s: float) -> RobustRow:
     from g1_control.tools.bench_locomotion import Case, run_case
 
+    controller, variant = ROW_KINDS[name]
     case = Case(f"forward_{FORWARD_MPS}", (FORWARD_MPS, 0.0, 0.0))
-    locomotion = run_case(controller, case, walk_s, randomize=_randomize(seed))
-    row = RobustRow(controller, case.name, seed, draw=locomotion.backend, command_vx_mps=FORWARD_MPS)
+    locomotion = run_case(controller, case, walk_s, randomize=_randomize(seed), variant=variant)
+    row = RobustRow(name, case.name, seed, draw=locomotion.backend, command_vx_mps=FORWARD_MPS)
     row.achieved, row.fell, row.fall = locomotion.achieved, locomotion.fell, locomotion.fall
     row.min_pelvis_m, row.sim_s, row.wall_s = locomotion.min_pelvis_m, locomotion.sim_s, locomotion.wall_s
     return row
@@ -151,6 +169,11 @@ def summary(rows: list[RobustRow]) -> list[str]:
         steps = [r for r in randomized if r.step_done is not None]
         if steps:
             line += f"; step up and down done {sum(bool(r.step_done) for r in steps)}/{len(steps)}"
+        failed = [r.seed for r in randomized if r.failed and r.seed is not None]
+        if failed:
+            line += "; failed on " + ", ".join(
+                f"s{seed} (friction {f:.2f}, latency {1000 * lat:.1f} ms)"
+                for seed in failed for f, lat in [draw_friction_latency(seed)])
         out.append(line)
     return out
 

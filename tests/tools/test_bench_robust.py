@@ -33,8 +33,39 @@ def test_the_summary_counts_falls_and_speeds_of_randomised_draws_only():
     assert lines[0].startswith("  wbc: 1 falls in 2 randomised draws; achieved vx 0.500 m/s mean (0.500..0.500) "
                                "for 0.6 commanded = 83 %; nominal robot 0.610 m/s")
     assert lines[1].startswith("  ppo: 0 falls in 1 randomised draws")
-    assert lines[2].endswith("step up and down done 1/2")
+    assert "step up and down done 1/2; failed on s1 (friction " in lines[2]
     assert [r.failed for r in rows] == [False, False, True, False, False, True]
+
+
+def test_the_summary_names_the_draws_a_row_failed_on_with_their_friction_and_latency():
+    friction, latency = B.draw_friction_latency(25)
+    assert 0.5 <= friction <= 1.2 and 0.005 <= latency <= 0.015
+    # the draw's own values, whatever the variant's bodies (they are drawn first)
+    from g1_control.sim.randomize import RandomizeConfig, draw
+    full = draw(RandomizeConfig(seed=25), tuple(f"b{i}" for i in range(30)), 29)
+    assert (full.foot_friction, full.latency_s) == (friction, latency)
+    lines = B.summary([_row("wbc23", None, 0.6), _row("wbc23", 25, fell=True), _row("wbc23", 26, 0.55)])
+    assert lines == [f"  wbc23: 1 falls in 2 randomised draws; achieved vx 0.550 m/s mean (0.550..0.550) for 0.6 "
+                     f"commanded = 92 %; nominal robot 0.600 m/s; failed on s25 (friction {friction:.2f}, "
+                     f"latency {1000 * latency:.1f} ms)"]
+
+
+def test_the_wbc23_row_walks_the_23_dof_robot_the_controller_models(monkeypatch):
+    from g1_control.launch import builder
+
+    built = []
+
+    def spy(launch, *args, **kwargs):
+        loop = builder_build(launch, *args, **kwargs)
+        built.append((launch.backend.expected_variant, loop.backend.model.nu, loop.tracker.dyn.dynamics_model.nv - 6))
+        return loop
+
+    builder_build = builder.build_loop
+    monkeypatch.setattr(builder, "build_loop", spy)
+    (row,) = B.run_rows([None], walk_s=4.0, only=["wbc23"], echo=lambda line: None)
+    assert built == [("g1_23dof", 23, 23)]
+    assert row.controller == "wbc23" and not row.fell and row.min_pelvis_m > 0.55
+    assert 0.4 < row.achieved[0] < 0.75, row  # commanded 0.6, ground truth
 
 
 @pytest.mark.parametrize(("fell", "code"), [(False, 0), (True, 1)])
