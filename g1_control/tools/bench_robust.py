@@ -6,8 +6,8 @@ For each of --draws seeded draws (seeds --seed, --seed+1, ...), every controller
 robot:
   wbc/forward_0.6   the model-based whole-body controller (tracker.type wbc, 250 Hz): 1 s standing,
                     then 0.6 m/s forward for --seconds;
-  wbc23/forward_0.6 the same on the 23-DoF G1 (backend.expected_variant g1_23dof: the simulator builds
-                    it and the controller models it), the robot `g1 deploy` runs the WBC on;
+  wbc23/forward_0.6 the same on the 23-DoF G1, the base model (backend.expected_variant g1_23dof: the
+                    simulator builds it and the controller models it; `--only wbc` runs both rows);
   ppo/forward_0.6   holosoma's ppo walking policy (tracker.type policy, 50 Hz), the same timeline;
   layer/step        launch/sim_step.yaml (the walking policy walks to a 0.15 m platform, the WBC steps
                     up, stands, steps down; tracker.type layer): done when both feet are on the
