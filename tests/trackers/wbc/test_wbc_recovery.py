@@ -22,9 +22,7 @@ are shown to save pushes that fall without them:
                                    it falls with the defaults);
   GaitConfig.early_lift_dcm_error_m  with it, the DCM 0.2 m off its plan in a double support lifts the
                                    swing foot at once (right_3 survives; with after_push_steps alone it
-                                   falls).
-The part-by-part tests ran at foot friction 0.7 (tracker.foot_friction, the default until stop 44)
-and still do (PREMISE_FRICTION); the survived pushes run at the default."""
+                                   falls)."""
 
 import functools
 
@@ -38,24 +36,6 @@ UPRIGHT_PELVIS_M = 0.6
 """Ground-truth pelvis height the robot stays above (it walks at ~0.68 m; a fall ends at 0.4)."""
 SURVIVED = ("push_front_0", "push_front_2", "push_front_3", "push_front_4", "push_left_2", "push_right_0",
             "push_right_4")
-
-
-PREMISE_FRICTION = 0.7
-"""The foot friction the WBC plans within in the part-by-part tests: they were measured at 0.7. At the
-default 0.6 some of their pushes survive without the part (front_3 and left_2 without the recovery swing
-weight, back_2 and left_1 with the longer minimum swing; measured), so what each part saves is shown at 0.7."""
-
-
-@pytest.fixture
-def at_premise_friction(monkeypatch):
-    make = bench.case_launch
-
-    def case_launch(*args, **kwargs):
-        launch = make(*args, **kwargs)
-        launch.tracker.foot_friction = PREMISE_FRICTION
-        return launch
-
-    monkeypatch.setattr(bench, "case_launch", case_launch)
 
 
 def run_push(name: str):
@@ -81,32 +61,27 @@ def test_recovery_steps_survive_a_push(name):
     assert row.min_pelvis_m > UPRIGHT_PELVIS_M
 
 
-@pytest.mark.usefixtures("at_premise_friction")
 def test_without_the_recovery_swing_weight_front_3_and_left_2_fell(monkeypatch):
     without(monkeypatch, recovery_swing_weight=wbc_tracker.WbcConfig().swing_foot.weight)
     assert_fell(["push_front_3", "push_left_2"])
 
 
-@pytest.mark.usefixtures("at_premise_friction")
 def test_with_a_longer_minimum_swing_back_2_and_left_1_fell(monkeypatch):
     assert run_push("push_back_2").pushes_survived == run_push("push_left_1").pushes_survived == 1
     without(monkeypatch, gait=GaitConfig(min_swing_s=0.2))
     assert_fell(["push_back_2", "push_left_1"])
 
 
-@pytest.mark.usefixtures("at_premise_friction")
 def test_with_the_swing_acceleration_uncapped_right_0_fell(monkeypatch):
     without(monkeypatch, swing_max_accel_mps2=1e9)
     assert_fell(["push_right_0"])
 
 
-@pytest.mark.usefixtures("at_premise_friction")
 def test_without_the_lower_com_in_recovery_steps_front_2_and_front_3_fell(monkeypatch):
     without(monkeypatch, recovery_com_lower_m=0.0)
     assert_fell(["push_front_2", "push_front_3"])
 
 
-@pytest.mark.usefixtures("at_premise_friction")
 def test_with_recovery_steps_no_wider_than_plain_steps_left_1_fell(monkeypatch):
     assert run_push("push_left_1").pushes_survived == 1
     without(monkeypatch, gait=GaitConfig(recovery_max_width_m=GaitConfig().max_width_m))
@@ -116,7 +91,6 @@ def test_with_recovery_steps_no_wider_than_plain_steps_left_1_fell(monkeypatch):
 PUSH_OPTIONS = {"after_push_steps": 1, "early_lift_dcm_error_m": 0.2}
 
 
-@pytest.mark.usefixtures("at_premise_friction")
 def test_with_the_step_after_a_push_held_low_front_1_survives(monkeypatch):
     assert_fell(["push_front_1"])
     without(monkeypatch, gait=GaitConfig(**PUSH_OPTIONS))
@@ -124,7 +98,6 @@ def test_with_the_step_after_a_push_held_low_front_1_survives(monkeypatch):
     assert row.pushes_survived == 1 and not row.fell and not row.trip, row.trip
 
 
-@pytest.mark.usefixtures("at_premise_friction")
 def test_with_the_early_lift_too_right_3_survives(monkeypatch):
     without(monkeypatch, gait=GaitConfig(**{**PUSH_OPTIONS, "early_lift_dcm_error_m": float("inf")}))
     assert_fell(["push_right_3"])
