@@ -30,6 +30,13 @@ walked; draws 0, 1 with floor friction 1.0 still fell), and on the nominal robot
 forward 1.0 m/s (0.7: 0.844 m/s), walked sideways 0.4 m/s at 0.270 (0.7: 0.401), survived 1 of 20
 pushes (0.7: 2) and fell in tests/trackers/wbc/test_wbc_sim.py's 0.3 m/s walk; it did walk 9 of 10
 random timelines (0.7: 6). `g1 bench locomotion --only wbc/...`, one run each, same machine.
+Measured again at stop 44 (`g1 bench robust --only wbc --seed S --draws N`, 20 s at 0.6 m/s; wbc23
+is the 23-DoF G1), falls on draws 20-49: 0.7: wbc 9, wbc23 12; 0.6: 7, 6; 0.5: 4, 7; nominal walking
+within 1.6 % at each, the push grid 9/20 at 0.7 and 11/20 at 0.6 and 0.5. Not shipped: at 0.5 the
+scripted 0.3 m/s plan walk (test_wbc_sim.py) and a 0.15 m step (test_wbc_steps.py, seed 3) fell; at
+0.6 the DDS platform step (tests/deploy/test_deploy_platform_perception.py) fell at 23-24 s, after
+loop stalls, in 4 attempts (2 in a CI rehearsal, 2 of 3 in a run under load) and failed one more run;
+at 0.7 it passed 2 runs of 2 under the same load.
 A floor known to grip better or worse is set per launch file (tracker.foot_friction)."""
 
 
