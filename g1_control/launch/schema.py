@@ -71,7 +71,7 @@ class BackendConfig:
     partition: str | None = None
     release_motion_service: bool = True
     """Release the robot's built-in controller first (false: the operator used the remote's debug mode)."""
-    expected_variant: Literal["g1_23dof", "g1_29dof", "g1_29dof_locked_waist"] = "g1_29dof"
+    expected_variant: g1.VariantName = "g1_29dof"
     hands: Literal["none", "dex3"] = "none"
     """Dex3-1 hands on the robot (g1_29dof only): the generator then plans the fingers too."""
     connect_timeout_s: float = 3.0

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -217,6 +218,8 @@ G1_29DOF_LOCKED_WAIST = Variant(
     "g1_29dof_locked_waist", 6, tuple(i for i in range(NUM_JOINTS) if i not in (13, 14))
 )
 VARIANTS = {v.mode_machine: v for v in (G1_23DOF, G1_29DOF, G1_29DOF_LOCKED_WAIST)}
+VariantName = Literal["g1_23dof", "g1_29dof", "g1_29dof_locked_waist"]
+"""The variants' names (Variant.name), as a launch file's backend.expected_variant and a policy spec spell them."""
 
 
 def variant_named(name: str) -> Variant:

@@ -34,13 +34,14 @@ import math
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Literal, cast
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from g1_control.teleop.scripted import Segment
 
 if TYPE_CHECKING:
+    from g1_control.robot.g1 import VariantName
     from g1_control.sim.mujoco_backend import MujocoBackend
     from g1_control.sim.randomize import RandomizeConfig
 
@@ -50,8 +51,6 @@ CONTROLLERS: dict[str, tuple[str, str, float]] = {
     "fastsac": ("policy", "holosoma_loco_fastsac", 50.0),
 }
 """name -> (tracker.type, tracker.policy, tracker rate Hz)."""
-VariantName = Literal["g1_23dof", "g1_29dof", "g1_29dof_locked_waist"]
-"""backend.expected_variant's values."""
 POLICY_GAIT_PERIOD_S = 1.0
 LOG_DIGEST_FIELDS = ("t_s", "base_pos_m", "base_quat_wxyz", "velocity_true", "q_rad", "q_target_rad", "tau_nm")
 """The per-tick log fields Row.log_sha256 covers: the simulator's ground truth and what was commanded."""

@@ -37,7 +37,7 @@ import numpy as np
 from g1_control.sim.randomize import RandomizeConfig, draw
 
 if TYPE_CHECKING:
-    from g1_control.tools.bench_locomotion import VariantName
+    from g1_control.robot.g1 import VariantName
 
 FORWARD_MPS = 0.6
 CONTROLLERS = ("wbc", "wbc23", "ppo")

@@ -82,7 +82,7 @@ class PolicySpecFile:
     name: str = ""
     kind: Literal["locomotion", "tracking"] = "locomotion"
     rate_hz: float = 50.0
-    variant: Literal["g1_23dof", "g1_29dof", "g1_29dof_locked_waist"] = "g1_29dof"
+    variant: g1.VariantName = "g1_29dof"
     joint_names: Literal["metadata", "robot"] | list[str] = "robot"
     gains: Literal["metadata", "robot"] | GainsSection = "robot"
     default_q: Literal["robot"] | list[float] = "robot"
