@@ -65,13 +65,16 @@ def test_off_by_default():
     assert WbcConfig().command_latency_s == 0.0
 
 
-@pytest.mark.parametrize("seed", [23, 27])
-def test_draws_that_fell_for_the_latency_walk(seed, monkeypatch):
+def test_draws_that_fell_for_the_latency_walk(monkeypatch):
     """Draws 23 and 27 (12 ms latency; with none they walk): forward 0.6 m/s, 4 s of walking. Expecting
-    12 ms they walk; expecting none (the default: targets one tick ahead only) the robot fell (23 at 4.6 s,
-    27 at 4.7 s, measured)."""
-    assert bench_robust.forward_row("wbc", seed, walk_s=4.0).fell
+    12 ms both walk; expecting none (the default: targets one tick ahead only) the robot fell (23 at 4.6 s,
+    27 at 4.7 s, measured). Only one of them needs to fall without: which do moves with the floating-point
+    environment (stop 45, a fresh install with MuJoCo 4.0.0: 27 walked its 4 s, 23 still fell); as both
+    walk with the compensation, a fall without it shows what it does."""
+    without = [bench_robust.forward_row("wbc", seed, walk_s=4.0) for seed in (23, 27)]
+    assert any(row.fell for row in without), [(row.seed, row.min_pelvis_m) for row in without]
     monkeypatch.setattr(wbc_tracker, "WbcConfig", functools.partial(wbc_tracker.WbcConfig, command_latency_s=0.012))
-    row = bench_robust.forward_row("wbc", seed, walk_s=4.0)
-    assert not row.fell and row.min_pelvis_m > 0.6, row.fall
-    assert 0.5 < row.achieved[0] < 0.7
+    for seed in (23, 27):
+        row = bench_robust.forward_row("wbc", seed, walk_s=4.0)
+        assert not row.fell and row.min_pelvis_m > 0.6, (seed, row.fall)
+        assert 0.5 < row.achieved[0] < 0.7
