@@ -1,5 +1,5 @@
-"""With stances.HOLD_TORQUE_SHARE set (off by default: its docstring says why), a pick's lifted pose must
-be one the joints can hold: the stance search refuses, before anything moves, a box whose lift needs
+"""With stances.HOLD_TORQUE_SHARE (1.0 by default; the tests set it), a pick's lifted pose must be one
+the joints can hold: the stance search refuses, before anything moves, a box whose lift needs
 more static torque than the actuators have (the waist pitch, 35 N m, holding a heavy box at arm's
 length), and every pick it keeps lifts within the limits. Scenes are `g1 bench objects` draws (pure
 functions of seed and index)."""

@@ -12,6 +12,7 @@ from itertools import pairwise
 import numpy as np
 import pytest
 
+from g1_control.generator.goals import stances as stances_module
 from g1_control.generator.goals.box import hand_points
 from g1_control.generator.goals.handling import ARMS_BACK
 from g1_control.generator.goals.poses import PosePlanner, flat_soles
@@ -132,15 +133,19 @@ def _knee_gap(stances, q, table):
                for s in ("left", "right"))
 
 
-def test_a_box_on_a_thigh_high_table_is_held_with_the_knees_bent_and_clear_of_its_edge(stances):
+def test_a_box_on_a_thigh_high_table_is_held_with_the_knees_bent_and_clear_of_its_edge(stances, monkeypatch):
     # bench objects seed 8 trial 9: a box on a 0.53 m table; the search kept a 'standing' pose whose
     # pelvis had sunk to 0.54 m with the knees at 1.7 rad under the table's edge, and the robot fell
-    # stepping in; then a leaning squat, and it fell lifting the 3.2 kg box. Light, it is held leaning:
-    # every kept pose with the knees bent and clear of the edge, a standing pelvis at its height
+    # stepping in; then a leaning squat, and it fell lifting the 3.2 kg box. Without the lift's torque
+    # check, 2 kg is held leaning: every kept pose with the knees bent and clear of the edge, a standing
+    # pelvis at its height; with it (the default), the leaning waist cannot lift 2 kg: refused
     table = Table("table_a", (1.416, -0.421), (0.821, 0.951), 0.532, 3.020)
     center = np.array([1.255, -0.242, 0.657])
     box = Box("box", (1.255, -0.242), stands_on="table_a", size_m=(0.293, 0.310, 0.249), mass_kg=2.0, yaw_rad=-1.262)
     headings = pick_headings(box, center[:2], table, np.zeros(2))
+    with pytest.raises(StanceRefused, match=r"2\.0 kg.*no stance can pick it up"):
+        stances.plan(box, center, table, headings, lift_m=0.1, what="pick it up")
+    monkeypatch.setattr(stances_module, "HOLD_TORQUE_SHARE", math.inf)
     plan = stances.plan(box, center, table, headings, lift_m=0.1, what="pick it up")
     standing = plan.pelvis_z_m == pytest.approx(stances.poses.nominal_pelvis_m)
     for q in plan.chosen.poses:
