@@ -5,7 +5,6 @@ draws that fell for it walk (ground truth, lockstep MuJoCo through the one loop 
 import functools
 
 import numpy as np
-import pytest
 
 from g1_control.robot import g1
 from g1_control.sim.mujoco_backend import MujocoBackend
