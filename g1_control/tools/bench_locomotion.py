@@ -333,6 +333,10 @@ def main(args) -> int:
     walk_s = float(args.seconds)
     print(f"g1 bench locomotion: {walk_s:.0f} s per row after 1 s standing; achieved = ground-truth mean over whole "
           f"gait cycles after {STEADY_SKIP_S:.0f} s of walking; act() in thread CPU time")
+    from g1_control.tools.environment import describe, environment
+
+    env = environment()
+    print(describe(env))
     print(HEADER, flush=True)
     cases = [*CASES, *push_cases(walk_s), *random_cases()]
     rows, (base50, base99) = run_table(list(CONTROLLERS), cases, walk_s, only,
@@ -354,7 +358,7 @@ def main(args) -> int:
     if falls:
         print(f"FELL: {', '.join(falls)}")
     if args.json:
-        Path(args.json).write_text(json.dumps({"walk_s": walk_s, "steady_skip_s": STEADY_SKIP_S,
+        Path(args.json).write_text(json.dumps({"walk_s": walk_s, "steady_skip_s": STEADY_SKIP_S, "environment": env,
                                                "rnea_crba_cpu_p50_us": base50, "rnea_crba_cpu_p99_us": base99,
                                                "rows": [asdict(r) for r in rows]}, indent=2))
     return 1 if falls else 0

@@ -301,7 +301,10 @@ def refusal_table(results: list[dict]) -> dict[str, dict[str, int]]:
 def main(args) -> int:
     n, seed = int(args.trials if args.trials is not None else 10), int(args.seed)
     from g1_control.fanout import fan_out
+    from g1_control.tools.environment import describe, environment
 
+    env = environment()
+    print(describe(env), flush=True)
     t0 = time.perf_counter()
     results: list[dict] = []
     for r in fan_out(_trial, [(seed, i) for i in range(n)], jobs=args.jobs, ray=args.ray):
@@ -324,7 +327,7 @@ def main(args) -> int:
             for reason, count in counts.items():
                 print(f"  {bucket:11s} {count:3d}  {reason}")
     if args.json:
-        Path(args.json).write_text(json.dumps({"seed": seed, "trials": n, "table": table, "reasons": reasons,
+        Path(args.json).write_text(json.dumps({"seed": seed, "trials": n, "environment": env, "table": table, "reasons": reasons,
                                                "results": results},
                                               indent=1, default=float))
     return 0

@@ -190,6 +190,10 @@ def main(args) -> int:
           f"{1000 * defaults.latency_s[0]:g}..{1000 * defaults.latency_s[1]:g} ms, foot friction "
           f"{defaults.foot_friction[0]:g}..{defaults.foot_friction[1]:g}; nominal robot first. Forward {FORWARD_MPS} m/s for "
           f"{walk_s:.0f} s after 1 s standing; achieved = ground-truth mean over whole gait cycles after 3 s")
+    from g1_control.tools.environment import describe, environment
+
+    env = environment()
+    print(describe(env))
     print(HEADER, flush=True)
     rows = run_rows(seeds, walk_s, only, echo=lambda line: print(line, flush=True))
     for seed in seeds[1:]:
@@ -201,7 +205,7 @@ def main(args) -> int:
     if failed:
         print(f"FELL or step not done: {', '.join(failed)}")
     if args.json:
-        Path(args.json).write_text(json.dumps({"walk_s": walk_s, "forward_mps": FORWARD_MPS, "draws": draws,
+        Path(args.json).write_text(json.dumps({"walk_s": walk_s, "forward_mps": FORWARD_MPS, "draws": draws, "environment": env,
                                                "randomize": asdict(defaults),
                                                "rows": [asdict(r) for r in rows]}, indent=2))
     return 1 if failed else 0
