@@ -435,10 +435,11 @@ class StancePlanner:
                 cand.collision = cand.collision or f"the pelvis ends at {r.q[2]:.2f} m, tilted {r.tilt_rad:.2f} rad"
             held_kg = mass if len(cand.poses) > 1 or lift_m is None else 0.0
             if deep:
-                cand.collision = cand.collision or self.deep_fault(r.q, soles) or \
-                    self.torque_fault(r.q, soles, held_kg)
-            elif math.isfinite(HOLD_TORQUE_SHARE) and lift_m is not None and len(cand.poses) > 1:  # a lifted pose
-                cand.collision = cand.collision or self.torque_fault(r.q, soles, held_kg, HOLD_TORQUE_SHARE)
+                cand.collision = cand.collision or self.deep_fault(r.q, soles)
+            most = DEEP_TORQUE_SHARE if deep else HOLD_TORQUE_SHARE if lift_m is not None and len(cand.poses) > 1 \
+                else math.inf  # a deep squat's every pose; otherwise a pick's lifted pose
+            if math.isfinite(most):
+                cand.collision = cand.collision or self.torque_fault(r.q, soles, held_kg, most)
             if not squat and cand.pelvis_z_m - r.q[2] > STANDING_GIVE_M:
                 cand.collision = cand.collision or (f"standing, the pelvis sinks to {r.q[2] - ground_z:.2f} m "
                                                     "(a squat, tried as one)")
