@@ -160,8 +160,10 @@ class SceneConfig:
     """Give the rubber hands collision boxes (the robot description has none: without them the
     hands pass through objects)."""
     grip_physics: bool = True
-    """Elliptic friction cones with impratio 100 (MuJoCo's defaults let a squeezed box creep out
-    of the hands at ~1 cm/s; see g1_control/sim/scene.py)."""
+    """Elliptic friction cones with impratio 100, in every model the simulator builds, the bare floor
+    included (MuJoCo's defaults let a squeezed box creep out of the hands at ~1 cm/s, and bound a
+    foot's friction by |fx| + |fy| <= mu fz, so stance feet slid on low-friction floors; see
+    g1_control/sim/scene.py and tests/sim/test_sim_floor_friction.py)."""
 
     def validate(self, where: str) -> None:
         names: dict[str, str] = {}

@@ -15,6 +15,9 @@ tests/sim/test_mujoco_motor_law.py holds both to motor_law.py. State comes out a
 reports it (IMU quaternion/gyro/accelerometer at the pelvis, joint q/dq/tau), plus ground truth
 that only a simulator has (base position and velocity), for tests and logs.
 
+Friction is Coulomb's in every scene, the bare floor included (SceneConfig.grip_physics: elliptic
+cones, impratio 100; MuJoCo's defaults let stance feet slide inside the friction they were given).
+
 Randomised robot (MujocoConfig.randomize, g1_control/sim/randomize.py): the compiled model's link
 masses, CoMs, foot friction and torque limits are the draw's; each driver law is scaled by its
 motor's drawn strength and reaches the drivers the drawn latency (in whole physics steps) after
@@ -153,10 +156,14 @@ class MujocoBackend(Backend):
 
     def _compile(self) -> mujoco.MjModel:
         spec = motor_law_scene(self.config.physics_dt_s, self.variant, self.config.hands, self.config.hard_joint_stops)
-        if not self.scene.empty:
-            from g1_control.sim.scene import build_scene
+        from g1_control.sim.scene import build_scene, grip_physics
 
+        if not self.scene.empty:
             build_scene(spec, self.scene)
+        elif self.scene.grip_physics:
+            # The bare floor too: with MuJoCo's default soft friction a stance foot creeps well inside
+            # its friction cone (g1_control/sim/scene.py grip_physics).
+            grip_physics(spec)
         return spec.compile()
 
     # -- Backend ---------------------------------------------------------------------------------

@@ -55,7 +55,11 @@ def grip_physics(spec: mujoco.MjSpec, impratio: float = 100.0) -> None:
     the friction cone. Measured on a 2 kg box pinched between two plates (mu 1: 9.8 N per side is
     the Coulomb limit), drop over 4 s (issue 17 investigation): pyramidal cones at 30 N per side
     41 mm; elliptic cones + impratio 100 at 12-30 N 0.2 mm. It also keeps a stance foot from
-    sliding off a step's edge.
+    sliding off a step's edge, and from sliding on the floor: the defaults' pyramid bounds
+    |fx| + |fy| <= mu fn (a diagonal push slides at 0.71 mu), and on the bare floor, which had them
+    until stop 46, the model-based controller's stance feet slid at 0.1-0.3 m/s on a 0.5 friction
+    floor with |f_t| / f_z ~0.3 (MuJoCo's contact forces; `g1 bench robust` draw 25 fell at 3.5 s).
+    Cost: a physics step ~1.5x the defaults' (walking: 51 against 33 us, measured in one process).
     """
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
     spec.option.impratio = impratio

@@ -3,7 +3,9 @@ turning, against tests/loop/data/walk_reference.npz (written by the code of comm
 the loop-overhead work of issue 11, with this file run as a script; re-recorded for issue 17, whose
 velocity correction waits 1 s before integrating and holds uncommanded axes: with the earlier
 corrector swapped back in, that code still reproduced the da5b7cd run within these tolerances,
-so only the correction changed the walk). Only float rounding may differ:
+so only the correction changed the walk; re-recorded at stop 46, when the bare floor got Coulomb
+friction (g1_control/sim/scene.py grip_physics): with that switched off, the code reproduced the
+previous recording within these tolerances). Only float rounding may differ:
 it grows through the contacts, so the tolerances sit far below anything a behaviour change gives
 (a changed motor-law integration misses them by three orders of magnitude)."""
 

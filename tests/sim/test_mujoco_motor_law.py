@@ -11,19 +11,23 @@ from g1_control.launch.schema import LaunchFile, Segment
 from g1_control.robot import description, g1
 from g1_control.sim.motor_law import motor_torque
 from g1_control.sim.mujoco_backend import MujocoBackend
+from g1_control.sim.scene import grip_physics
 from g1_control.types import MotorCommand
 
 
 class PythonLawBackend(MujocoBackend):
     """The reference: plain motor actuators (ctrl = torque) on the scene as robot/description.py
-    builds it (implicitfast integrator), the torque computed by motor_law.py before every step."""
+    builds it (implicitfast integrator), with the backend's floor friction (elliptic cones, scene.py
+    grip_physics), the torque computed by motor_law.py before every step."""
 
     def __init__(self):
         self._tau = np.zeros(g1.NUM_JOINTS)
         super().__init__()
 
     def _compile(self):
-        return description.mujoco_spec(timestep_s=self.config.physics_dt_s).compile()
+        spec = description.mujoco_spec(timestep_s=self.config.physics_dt_s)
+        grip_physics(spec)
+        return spec.compile()
 
     def write_command(self, command):
         self._command = command

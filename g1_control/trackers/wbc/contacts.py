@@ -37,6 +37,10 @@ scripted 0.3 m/s plan walk (test_wbc_sim.py) and a 0.15 m step (test_wbc_steps.p
 0.6 the DDS platform step (tests/deploy/test_deploy_platform_perception.py) fell at 23-24 s, after
 loop stalls, in 4 attempts (2 in a CI rehearsal, 2 of 3 in a run under load) and failed one more run;
 at 0.7 it passed 2 runs of 2 under the same load.
+All of the above ran on MuJoCo's default friction (soft, pyramidal: stance feet slid well inside their
+friction). On the Coulomb floor of stop 46 (g1_control/sim/scene.py grip_physics), at 0.7, draws 20-49
+fell: wbc 3 (23, 27, 39), wbc23 2 (39, 43), every one a draw with 10-12 ms command latency; on the soft
+floor the same code fell on wbc 8, wbc23 9 of them (measured, one machine).
 A floor known to grip better or worse is set per launch file (tracker.foot_friction)."""
 
 

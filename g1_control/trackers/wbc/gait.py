@@ -30,10 +30,10 @@ marked (GaitTargets.recovery) until it lands; the tracker then holds the swing f
 harder (WbcConfig.recovery_swing_weight), so the QP steps rather than swinging the leg back. One the
 DCM's error made (GaitConfig.pushed_dcm_error_m: GaitTargets.pushed) may land wider
 (recovery_max_width_m), and the tracker holds the CoM lower in it (WbcConfig.recovery_com_lower_m).
-Options, off by default: the CoM held lower in the step after a pushed one too
-(GaitConfig.after_push_steps, GaitTargets.after_push), and the swing foot lifted at once when the
-DCM strays in a double support (GaitConfig.early_lift_dcm_error_m). The DCM's error alone does not
-tell a push (turning and slowing down put it as far off its plan), so they act only after a push
+The CoM is held lower in the step after a pushed one too (GaitConfig.after_push_steps,
+GaitTargets.after_push; on since stop 46), and, an option off by default, the swing foot lifted at
+once when the DCM strays in a double support (GaitConfig.early_lift_dcm_error_m). The DCM's error
+alone does not tell a push (turning and slowing down put it as far off its plan), so they act only after a push
 told by what the pendulum cannot explain (GaitConfig.push_detect_m: the DCM running away from where
 the pendulum under the asked CoP takes it; a command change moves the plan, not the DCM).
 
@@ -163,7 +163,7 @@ class GaitConfig:
     soon as it may, with a 0.02-0.07 s double support after it: 7/20 (with the lowering 11/20, other
     cases); a CoP target up to 0.1 / 0.08 m off the sole in recovery steps (for the trunk's angular
     momentum) 6/20 (measured, one machine)."""
-    after_push_steps: int = 0
+    after_push_steps: int = 1
     """In the steps after a pushed step (GaitTargets.after_push, this many, from the touchdown of the
     pushed step, double support included; 0: none) the tracker keeps the CoM lowered
     (WbcConfig.recovery_com_lower_m). Pushed from behind, the capture step caught the DCM, then the
@@ -181,7 +181,12 @@ class GaitConfig:
     told pushes they did not have and s19 fell at 8.6 s); the bench's pushes 9 -> 12/20 (front_1,
     back_0, left_3, right_3 survive; front_3, a survivor without them, trips: a second push told 1.3 s
     after the first, while it staggers, lowers the step after it); unseen, 150 N at phases shifted by 0.1
-    stride, 10 -> 11/20 (with and without the rate cap; measured, one machine). Off by default for front_3."""
+    stride, 10 -> 11/20 (with and without the rate cap; measured, one machine). Off by default for front_3
+    until stop 46. On (1) since, when the bare floor got Coulomb friction (g1_control/sim/scene.py
+    grip_physics): there the grid is 9/20 with 0 and 12/20 with 1 (front_1, front_3 and right_3 survive;
+    front_3 falls with 0), 150 N at phases shifted by 0.1 stride 9 -> 11/20; the random timelines
+    10/10 either way, and `g1 bench locomotion --only wbc`'s walking rows within 2 % with it (measured,
+    one machine; tests/trackers/wbc/test_wbc_recovery.py)."""
     early_lift_dcm_error_m: float = math.inf
     """In a step's double support, the DCM this far off its plan lifts the swing foot at once (its
     double support ends, the single support keeps its length, inf: never): pushed late in a swing, the
@@ -189,7 +194,8 @@ class GaitConfig:
     while the DCM ran off. `g1 bench locomotion --only wbc/push` (with after_push_steps 1): inf 12/20,
     0.1 12/20, 0.15 and 0.2 13/20 (right_3 survives), alone (after_push_steps 0) 9/20, the same nine
     (measured, one machine). Never sooner than fast_double_support_s into the double support (the
-    load needs moving onto the other foot). Off (inf) by default, with after_push_steps."""
+    load needs moving onto the other foot). Off (inf) by default: on the Coulomb floor of stop 46 it
+    saves no push of the grid (12/20 with 0.2 and without, 11 and 11 shifted by 0.1 stride; measured)."""
     push_detect_m: float = 0.1
     """A push is told from a command change (or from the DCM drifting off its plan turning hard) by what
     the pendulum cannot explain: each walking tick the measured DCM is compared with where the last one

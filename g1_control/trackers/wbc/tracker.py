@@ -109,7 +109,10 @@ class WbcConfig:
     test_wbc_recovery.py's "fell without X" pushes no longer fall without X (a stronger recovery, but
     the tests' premise re-found), and the random timelines, stairs and objects were not run with it.
     A pure 16-24 ms latency on the otherwise nominal robot was not helped (lockstep 6 s walks; 24 ms
-    fell either way, measured)."""
+    fell either way, measured). On the Coulomb floor of stop 46 (g1_control/sim/scene.py grip_physics;
+    GaitConfig.after_push_steps 0), `g1 bench robust`'s draws 20-49 (20 s each) fell: 0: wbc 3, wbc23 2;
+    0.006: wbc 1 (42), wbc23 2 (39, 46); 0.010: wbc 0, wbc23 3 (23, 25, 26); the nominal robot walked at
+    each (measured, one machine). Still off by default."""
     qp: QpConfig = field(default_factory=QpConfig)
     footsteps: Literal["plan", "velocity"] = "plan"
     """plan: the feet follow the reference's contact schedule and poses (a scripted or goal plan);
@@ -179,7 +182,10 @@ class WbcConfig:
     made plain walking fall; 1000 in recovery steps made the random timelines worse (measured).
     Scaling the pelvis's and torso's orientation weights in recovery steps (to let the trunk lean)
     did not help: x0.1, x0.3, x0.5 and x2 each survived 1/20 of the push grid (front_4; 2/20 unscaled,
-    measured), so the trunk's orientation task is not what kicks the leg."""
+    measured), so the trunk's orientation task is not what kicks the leg. Measured on MuJoCo's default
+    (soft, pyramidal) friction; on the Coulomb floor of stop 46 (g1_control/sim/scene.py grip_physics) it
+    saves no push of `g1 bench locomotion`'s grid (12/20 at 300 and at the plain weight; 120 N: 10 at
+    300, 11 plain), so no test shows it there (tests/trackers/wbc/test_wbc_recovery.py)."""
     recovery_com_lower_m: float = 0.08
     """In a pushed recovery step (the gait's GaitTargets.pushed, GaitConfig.pushed_dcm_error_m), the CoM
     is held this much lower still: the bent stance leg lets the swing foot reach further, and it holds

@@ -7,7 +7,7 @@ import pytest
 from g1_control.robot import g1
 from g1_control.rotations import yaw_of
 from g1_control.sim.mujoco_backend import MujocoBackend
-from g1_control.trackers.wbc.gait import step_duration_for
+from g1_control.trackers.wbc.gait import GaitConfig, step_duration_for
 from g1_control.trackers.wbc.qp import QpConfig
 from g1_control.trackers.wbc.tracker import WbcConfig, WholeBodyTracker
 from g1_control.types import JointReference
@@ -16,7 +16,9 @@ FALL_HEIGHT_M = 0.6
 """Pelvis height (ground truth) the robot never goes below while walking (it walks at ~0.72 m)."""
 
 
-def walk(command, seconds, start_s=0.5, pelvis_height_m=None, fall_height_m=FALL_HEIGHT_M, config=None):
+def walk(command, seconds, start_s=0.5, pelvis_height_m=None, fall_height_m=FALL_HEIGHT_M, config=None,
+         corrections=None):
+    """corrections: a list that gets the gait's speed correction (heading frame) after every tick."""
     backend = MujocoBackend()
     state = backend.reset()
     tracker = WholeBodyTracker(config or WbcConfig(footsteps="velocity"))
@@ -31,6 +33,8 @@ def walk(command, seconds, start_s=0.5, pelvis_height_m=None, fall_height_m=FALL
         backend.write_command(tracker.act(ref, state))
         backend.step(0.004)
         trace.append((state.t_s, *state.base_pos_w_m, yaw_of(state.imu_quat_wxyz)))
+        if corrections is not None and tracker.gait is not None:
+            corrections.append(tracker.gait.speed_correction_h.copy())
         if state.base_pos_w_m[2] < fall_height_m:
             break
     return tracker, np.array(trace)
@@ -113,13 +117,22 @@ def test_walking_while_turning_needs_no_sideways_correction():
     """0.6 m/s forward turning 0.5 rad/s: with the nominal DCM offsets planned along the turn
     (GaitConfig.plan_turn) the strides the feet walk (measured) match the command sideways, so the
     gait's sideways speed correction stays small; planned as if straight it saturated near 0.1 m/s
-    and the widened steps ended in an ankle/knee over-speed fall (issue 23, bench wbc/combined)."""
-    tracker, trace = walk((0.6, 0.0, 0.5), 5.2)
-    assert trace[-1, 0] > 5.1, f"fell at {trace[-1, 0]:.2f} s"
-    assert tracker.gait is not None
-    correction = tracker.gait.speed_correction_h
-    assert abs(correction[1]) < 0.05, f"sideways correction {correction[1]:+.3f} m/s"
-    assert tracker.diagnostics.unsolved_ticks == 0
+    and the widened steps ended in an ankle/knee over-speed fall (issue 23, bench wbc/combined). Since
+    the bare floor grips as Coulomb friction does (stop 46) it no longer falls planned as if straight,
+    and the correction is judged over the walk, not at its last tick (on: mean 0.017, at most 0.056 m/s
+    over 2-5.2 s; planned straight: mean 0.088, at most 0.133; measured)."""
+    mean = {}
+    for plan_turn in (True, False):
+        corrections: list[np.ndarray] = []
+        config = WbcConfig(footsteps="velocity", gait=GaitConfig(plan_turn=plan_turn))
+        tracker, trace = walk((0.6, 0.0, 0.5), 5.2, config=config, corrections=corrections)
+        assert trace[-1, 0] > 5.1, f"fell at {trace[-1, 0]:.2f} s"
+        sideways = np.abs(np.array(corrections)[trace[:, 0] >= 2.0, 1])
+        mean[plan_turn] = sideways.mean()
+        if plan_turn:
+            assert sideways.mean() < 0.04 and sideways.max() < 0.08, (sideways.mean(), sideways.max())
+            assert tracker.diagnostics.unsolved_ticks == 0
+    assert mean[False] > 2 * mean[True], mean
 
 
 def test_a_reference_through_the_ik_does_not_throw_the_walk():
