@@ -92,8 +92,10 @@ def test_reports_taken_while_commands_arrive_never_fail():
     errors: list[Exception] = []
     reports = 0
     try:
-        end = time.monotonic() + 2.0
-        while time.monotonic() < end:
+        # at least 2 s and at least 20 reports: on a loaded machine 2 s gave 9 (a CI rehearsal beside
+        # physics runs), so the count is not left to the machine's speed (60 s at most)
+        start = time.monotonic()
+        while (time.monotonic() - start < 2.0 or reports < 20) and time.monotonic() - start < 60.0:
             try:
                 ep.whole_run_period_stats()
                 ep.command_wire_stats(window_s=1.0)
@@ -103,5 +105,5 @@ def test_reports_taken_while_commands_arrive_never_fail():
     finally:
         stop.set()
         writer.join(timeout=2.0)
-    assert reports > 10
+    assert reports >= 20
     assert not errors, f"{len(errors)} of {reports + len(errors)} reports failed, first: {errors[0]!r}"
