@@ -156,14 +156,9 @@ class MujocoBackend(Backend):
 
     def _compile(self) -> mujoco.MjModel:
         spec = motor_law_scene(self.config.physics_dt_s, self.variant, self.config.hands, self.config.hard_joint_stops)
-        from g1_control.sim.scene import build_scene, grip_physics
+        from g1_control.sim.scene import build_scene
 
-        if not self.scene.empty:
-            build_scene(spec, self.scene)
-        elif self.scene.grip_physics:
-            # The bare floor too: with MuJoCo's default soft friction a stance foot creeps well inside
-            # its friction cone (g1_control/sim/scene.py grip_physics).
-            grip_physics(spec)
+        build_scene(spec, self.scene)  # an empty scene too: its floor's friction (scene.py grip_physics)
         return spec.compile()
 
     # -- Backend ---------------------------------------------------------------------------------

@@ -66,11 +66,12 @@ def grip_physics(spec: mujoco.MjSpec, impratio: float = 100.0) -> None:
 
 
 def build_scene(spec: mujoco.MjSpec, scene: SceneConfig) -> None:
-    """Add the scene's objects to `spec` (robot + floor from description.mujoco_spec)."""
-    if scene.empty:
-        return
+    """Add the scene's objects to `spec` (robot + floor from description.mujoco_spec), and its friction
+    physics, an empty scene's (the bare floor) too."""
     if scene.grip_physics:
         grip_physics(spec)
+    if scene.empty:
+        return
     if scene.hand_collision and spec.body(HAND_BODIES[0]) is not None:  # Dex3 hands collide with their own meshes
         add_hand_collision(spec)
     world = spec.worldbody
