@@ -538,6 +538,35 @@ def test_a_trailing_foot_comes_onto_the_stance_foot_level_not_past_it():
     assert terrain.is_level(out.landing_m[:2], 0.0) and terrain.height(out.landing_m[:2]) == pytest.approx(0.15)
 
 
+@pytest.mark.parametrize("plan", [True, False])
+def test_a_step_onto_a_tread_is_planned_as_the_long_step_from_its_double_support(plan):
+    """GaitConfig.terrain_plan_long_steps: the stance foot just landed short of a riser, its double
+    support under way: the next step goes onto the tread, so it already has its long single support,
+    and the DCM's plan is that step's (the DCM over the stance sole's centre, where a 0.8 s step wants
+    it at lift-off); without, the plan is a 0.42 s step's, 4-5 cm inside the stance sole."""
+    terrain = _two_treads()
+    gait = VelocityGait(GaitConfig(terrain_plan_long_steps=plan), terrain)
+    soles, yaws = _feet()
+    soles[:, 0] = 0.6
+    t = _into_single_support(gait, soles, yaws)
+    soles[RIGHT, 0] = 0.775  # lands with its toe a riser gap short of the first tread
+    t = _to_touchdown(gait, t, soles, yaws)
+    assert gait.stance == RIGHT
+    dcm = soles[RIGHT, :2].copy()
+    for _ in range(3):
+        t += 0.004
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, dcm)
+        out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+    assert not gait._swinging and out.landing_m[2] == pytest.approx(0.15)
+    cfg = gait.config
+    if plan:
+        assert gait.active.single_support_s > cfg.terrain_single_support_s + 0.2
+        assert out.dcm_error_m < 0.02
+    else:
+        assert gait.active.single_support_s == cfg.terrain_single_support_s
+        assert out.dcm_error_m > 0.035
+
+
 def test_a_swing_keeps_the_level_its_foothold_had():
     """Both feet on the first tread, a short step under way: the DCM then running ahead moves the
     landing forward, but not onto the next tread (its swing was planned for this level)."""

