@@ -1174,7 +1174,7 @@ class VelocityGait:
             self._landing_yaw = yaw_s + min(max(dyaw, -lim), lim)
             if not self.terrain.flat:
                 self._on_terrain(u, soles_m[f], heading_td)
-                if not self._swinging and cfg.terrain_plan_long_steps:
+                if not self._swinging and self.config.terrain_plan_long_steps:
                     self._lengthen_for_level(soles_m)
         out.landing_m[:] = self._landing
         out.after_push = bool(self._after_push_at == self._t0)

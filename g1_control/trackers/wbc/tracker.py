@@ -637,20 +637,21 @@ class WholeBodyTracker(Tracker):
             lower += cfg.recovery_com_lower_m
         height = self._com_height_m - lower
         lean = 0.0
-        if reference.pelvis_height_m is not None:
-            # the pelvis held at the height asked (at most the walking height: knees stay bent), by the
-            # CoM's height above the pelvis now (the posture sets it: crouched, the trunk leans and the
-            # pelvis drops further than the CoM)
+        terrain = not self.gait.terrain.flat
+        # stepping up, the pelvis keeps its walking height (WbcConfig.terrain_hold_pelvis_up)
+        step_up = (terrain and cfg.terrain_hold_pelvis_up and gt.swing_foot >= 0
+                   and float(gt.landing_m[2]) > ground_z + self.gait.config.step_change_m)
+        if reference.pelvis_height_m is not None or step_up:
+            # the pelvis held at the height asked (at most the walking height: knees stay bent), or at
+            # the walking height stepping up, by the CoM's height above the pelvis now (the posture sets
+            # it: crouched, the trunk leans and the pelvis drops further than the CoM; a swing leg raised
+            # over a riser lifts the CoM above the pelvis)
             pelvis_z = float(self._q[2])  # after this tick's odometry step, as com
-            pelvis = min(reference.pelvis_height_m, self._pelvis_height_m - lower)
+            pelvis = self._pelvis_height_m - lower
+            if reference.pelvis_height_m is not None:
+                pelvis = min(reference.pelvis_height_m, pelvis)
             height = pelvis + (com[2] - pelvis_z)
             lean = cfg.walking_crouch_lean_per_m * (self._pelvis_height_m - lower - pelvis)
-        terrain = not self.gait.terrain.flat
-        if (terrain and cfg.terrain_hold_pelvis_up and reference.pelvis_height_m is None and gt.swing_foot >= 0
-                and float(gt.landing_m[2]) > ground_z + self.gait.config.step_change_m):
-            # stepping up, the pelvis keeps its height: the CoM's target rises by what the raised swing
-            # leg adds to the CoM's height above the pelvis (WbcConfig.terrain_hold_pelvis_up)
-            height += (com[2] - float(self._q[2])) - (self._com_height_m - self._pelvis_height_m)
         a_com = np.empty(3)
         a_com[:2] = omega**2 * (com_xy - gt.cop_xy_m)
         a_com[2] = h.kp * (ground_z + height - com[2]) - h.kd * com_vel[2]
