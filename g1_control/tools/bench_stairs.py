@@ -11,7 +11,8 @@ the scene says):
 
 Per trial: fell (the pelvis below 0.45 m above the ground under it, a fall the loop saw, or any
 safety trip: a trip counts as a failure), top (both soles on the structure's highest level at
-once), across (both soles back on the floor beyond the structure). Draws: angle uniform in
+once), across (both soles back on the floor beyond the structure); and, of the controller itself,
+its CoP jumps (CopJumps: ticks whose CoP asked moved more than COP_JUMP_M within one contact phase). Draws: angle uniform in
 +-25 deg, offset uniform in +-0.3 m, from numpy's default_rng(seed).
 
     g1 bench stairs --seed 100 --trials 10              # seeds 100..109, both courses
@@ -41,6 +42,33 @@ FALL_PELVIS_M = 0.45
 """Pelvis above the ground under it, below which the robot has fallen (it walks at ~0.70 m)."""
 SOLE_BELOW_ANKLE_M = 0.034
 """The ankle-roll body's origin above the sole, standing (measured in the G1 model)."""
+COP_JUMP_M = 0.03
+"""A CoP asked that moves more than this in one 250 Hz tick (7.5 m/s) within a contact phase jumps:
+the gait's CoP moves a few millimetres a tick; only a change of stance or swing foot moves it further."""
+
+
+class CopJumps:
+    """Counts the controller's ticks whose CoP asked (the gait's target, the tracker's view) moved more
+    than jump_m from the tick before while the contact phase (the gait's mode, stance foot and swing
+    foot) stayed the same. Stop 48 found the CoP asked jumping between the stance sole's two ends every
+    tick through a step onto a tread, and MuJoCo's measured CoP with it (the gait's plan moved with the
+    landing the terrain snapped, and that landing with the CoP: a loop with a gain above 1); the count
+    makes such chatter visible beside the outcomes."""
+
+    def __init__(self, jump_m: float = COP_JUMP_M):
+        self.jump_m = jump_m
+        self.jumps = 0
+        self.ticks = 0
+        self._last: tuple[object, np.ndarray] | None = None
+
+    def update(self, phase: object, cop_xy: np.ndarray) -> None:
+        cop = np.array(cop_xy, dtype=float)[:2]
+        last = self._last
+        if last is not None and last[0] == phase:
+            self.ticks += 1
+            if float(np.hypot(*(cop - last[1]))) > self.jump_m:
+                self.jumps += 1
+        self._last = (phase, cop)
 
 
 def course_scene(course: str, angle_rad: float, offset_m: float) -> tuple[SceneConfig, float, float]:
@@ -76,6 +104,10 @@ class StairsTrial:
     detail: str
     sim_s: float
     wall_s: float
+    cop_jumps: int = 0
+    """Ticks whose CoP asked jumped (CopJumps) ..."""
+    cop_ticks: int = 0
+    """... of the ticks that stayed in their contact phase."""
 
     @property
     def success(self) -> bool:
@@ -143,10 +175,14 @@ def run_course(course: str, seed: int, *, speed_mps: float = 0.3, duration_s: fl
     origin = np.array([NEAR_EDGE_M, offset_m])
     top = across = fell = False
     detail = ""
+    jumps = CopJumps()
+    gait = loop.tracker.gait  # type: ignore[attr-defined]
     t0 = time.perf_counter()
     try:
         while loop.time_s < duration_s - 1e-9:
-            loop.run(0.02)
+            for _ in range(5):  # 0.02 s, a tick (250 Hz) at a time: the same ticks as one run(0.02)
+                loop.run(0.004)
+                jumps.update((gait.mode, gait.stance, gait.targets.swing_foot), gait.targets.cop_xy_m)
             soles = np.array([d.xpos[f] for f in feet])
             soles[:, 2] -= SOLE_BELOW_ANKLE_M
             if trace is not None:
@@ -170,7 +206,8 @@ def run_course(course: str, seed: int, *, speed_mps: float = 0.3, duration_s: fl
     finally:
         wall = time.perf_counter() - t0
         sim.close()
-    return StairsTrial(course, seed, angle_deg, offset_m, fell, top, across, detail, float(loop.time_s), wall)
+    return StairsTrial(course, seed, angle_deg, offset_m, fell, top, across, detail, float(loop.time_s), wall,
+                       jumps.jumps, jumps.ticks)
 
 
 def _write_trace(path: Path, rows: list[list]) -> None:
@@ -194,7 +231,8 @@ def main(args) -> int:
     rows: list[StairsTrial] = []
     print(f"g1 bench stairs: tracker wbc, vx 0.3 m/s, seeds {first}..{first + count - 1}, angle +-{MAX_ANGLE_DEG:.0f} deg, "
           f"offset +-{MAX_OFFSET_M} m (ground truth)")
-    print(f"{'course':9s} {'seed':>4s} {'angle':>7s} {'offset':>7s} {'top':>4s} {'across':>6s} {'fell':>4s}  detail")
+    print(f"{'course':9s} {'seed':>4s} {'angle':>7s} {'offset':>7s} {'top':>4s} {'across':>6s} {'fell':>4s} "
+          f"{'CoP jumps':>9s}  detail")
     for course in courses:
         for seed in range(first, first + count):
             trace: list[list] | None = [] if getattr(args, "trace", None) else None
@@ -203,15 +241,17 @@ def main(args) -> int:
             if trace is not None:
                 _write_trace(Path(args.trace) / f"{course}_{seed}.csv", trace)
             print(f"{r.course:9s} {r.seed:4d} {r.angle_deg:6.1f}° {r.offset_m:6.2f}m {str(r.top)[0]:>4s} "
-                  f"{str(r.across)[0]:>6s} {str(r.fell)[0]:>4s}  {r.detail}  ({r.sim_s:.1f} s sim, {r.wall_s:.0f} s wall)",
+                  f"{str(r.across)[0]:>6s} {str(r.fell)[0]:>4s} {r.cop_jumps:9d}  {r.detail}  ({r.sim_s:.1f} s sim, "
+                  f"{r.wall_s:.0f} s wall)",
                   flush=True)
     for course in courses:
         sel = [r for r in rows if r.course == course]
         print(f"{course}: {sum(r.success for r in sel)}/{len(sel)} up and down, top reached {sum(r.top for r in sel)}/"
-              f"{len(sel)}, falls {sum(r.fell for r in sel)}/{len(sel)}")
+              f"{len(sel)}, falls {sum(r.fell for r in sel)}/{len(sel)}; CoP jumps {sum(r.cop_jumps for r in sel)} in "
+              f"{sum(r.cop_ticks for r in sel)} ticks (> {COP_JUMP_M * 100:.0f} cm in a tick within a contact phase)")
     if args.json:
         Path(args.json).write_text(json.dumps([{**asdict(r), "success": r.success} for r in rows], indent=1))
     return 1 if any(r.fell for r in rows) else 0
 
 
-__all__ = ["COURSES", "TRACE_COLUMNS", "StairsTrial", "course_scene", "draw", "main", "run_course"]
+__all__ = ["COP_JUMP_M", "COURSES", "TRACE_COLUMNS", "CopJumps", "StairsTrial", "course_scene", "draw", "main", "run_course"]

@@ -6,7 +6,15 @@ import math
 import numpy as np
 import pytest
 
-from g1_control.tools.bench_stairs import MAX_ANGLE_DEG, MAX_OFFSET_M, NEAR_EDGE_M, course_scene, draw
+from g1_control.tools.bench_stairs import (
+    COP_JUMP_M,
+    MAX_ANGLE_DEG,
+    MAX_OFFSET_M,
+    NEAR_EDGE_M,
+    CopJumps,
+    course_scene,
+    draw,
+)
 
 
 def test_stairs_go_up_three_treads_to_the_landing_and_down_along_the_turned_axis():
@@ -38,6 +46,23 @@ def test_unknown_course_is_named():
         course_scene("ramp", 0.0, 0.0)
 
 
+def test_cop_jumps_count_ticks_that_jump_within_a_contact_phase_only():
+    jumps = CopJumps()
+    for k in range(50):  # a CoP walking 4 mm a tick across the sole: smooth
+        jumps.update(("walk", 0, 1), np.array([0.004 * k, 0.0]))
+    assert (jumps.jumps, jumps.ticks) == (0, 49)
+    jumps.update(("walk", 1, -1), np.array([0.0, -0.2]))  # the stance changes: moves far, not a jump
+    assert (jumps.jumps, jumps.ticks) == (0, 49)
+    for k in range(10):  # then between the sole's two ends every tick (stop 48's chatter)
+        jumps.update(("walk", 1, -1), np.array([(-1) ** k * 0.05, -0.2]))
+    assert (jumps.jumps, jumps.ticks) == (10, 59)
+    edge = CopJumps()
+    edge.update(0, np.zeros(2))
+    edge.update(0, np.array([COP_JUMP_M * 0.99, 0.0]))
+    edge.update(0, np.array([COP_JUMP_M * 0.99 - COP_JUMP_M * 1.01, 0.0]))
+    assert (edge.jumps, edge.ticks) == (1, 2)
+
+
 def test_a_trial_traces_the_feet_the_gait_and_the_balance_every_50th_of_a_second(tmp_path):
     import csv
 
@@ -46,6 +71,9 @@ def test_a_trial_traces_the_feet_the_gait_and_the_balance_every_50th_of_a_second
     rows: list = []
     trial = run_course("step", 0, duration_s=2.0, trace=rows)
     assert not trial.fell and len(rows) == 100 and all(len(r) == len(TRACE_COLUMNS) for r in rows)
+    # standing, then starting to walk on the floor: every tick counted (250 Hz, less the phase changes)
+    # and the CoP asked never jumps
+    assert trial.cop_jumps == 0 and 480 <= trial.cop_ticks < 500
     col = {name: i for i, name in enumerate(TRACE_COLUMNS)}
     times = np.array([r[col["t_s"]] for r in rows])
     np.testing.assert_allclose(np.diff(times), 0.02, atol=1e-6)
