@@ -567,6 +567,32 @@ def test_a_step_onto_a_tread_is_planned_as_the_long_step_from_its_double_support
         assert out.dcm_error_m > 0.035
 
 
+@pytest.mark.parametrize("speed", [2.0, 0.0])
+def test_on_steps_a_swing_s_landing_moves_no_faster_than_its_limit(speed):
+    """GaitConfig.terrain_landing_speed_mps: a DCM jumping 0.1 m back and forth every tick (as it read in
+    the long steps up, predicted e^{w t_r} further out) moves the landing at most speed * dt a tick on a
+    terrain; unlimited (0), the landing jumps with it."""
+    gait = VelocityGait(GaitConfig(terrain_landing_speed_mps=speed), _step_ahead(2.0))
+    soles, yaws = _feet()
+    t = _into_single_support(gait, soles, yaws)
+    assert gait._swinging
+    last = None
+    moves = []
+    for k in range(20):
+        t += 0.004
+        dcm = soles[gait.stance, :2] + np.array([0.05 + 0.1 * (k % 2), 0.0])
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, dcm)
+        out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+        assert out.swing_foot >= 0
+        if last is not None:
+            moves.append(float(np.hypot(*(out.landing_m[:2] - last))))
+        last = out.landing_m[:2].copy()
+    if speed > 0:
+        assert max(moves) <= speed * 0.004 + 1e-9
+    else:
+        assert max(moves) > 0.05
+
+
 def test_a_swing_keeps_the_level_its_foothold_had():
     """Both feet on the first tread, a short step under way: the DCM then running ahead moves the
     landing forward, but not onto the next tread (its swing was planned for this level)."""
@@ -750,13 +776,15 @@ def test_a_landing_kept_on_its_tread_follows_the_dcm_sideways_with_terrain_side_
     by default) not its first sideways place: the DCM running further sideways moves the foothold
     sideways too, still whole on the tread (kept where it was, the first step up of seed 100's stairs
     landed with the DCM 8.6 cm outside the foot, and the robot fell sideways off it in its next single
-    support)."""
-    first, later, xy, terrain = _oblique_stairs_landings(GaitConfig(terrain_side_follow_reach_m=0.1))
+    support). The landing's speed limit (terrain_landing_speed_mps) is off here: this is where the
+    foothold goes, not how fast."""
+    first, later, xy, terrain = _oblique_stairs_landings(GaitConfig(terrain_side_follow_reach_m=0.1,
+                                                                     terrain_landing_speed_mps=0.0))
     assert first[2] == pytest.approx(0.15) and later[2] == pytest.approx(0.15)
     assert later[1] < first[1] - 0.15  # followed the DCM sideways (to the step width limit)
     assert terrain.is_level(xy, 0.0) and terrain.height(xy) == pytest.approx(0.15)
     # by default the foothold stays where it first snapped, sideways too
-    kept_first, kept, _, _ = _oblique_stairs_landings(GaitConfig())
+    kept_first, kept, _, _ = _oblique_stairs_landings(GaitConfig(terrain_landing_speed_mps=0.0))
     assert kept_first[:2] == pytest.approx(first[:2], abs=1e-9)
     assert kept[:2] == pytest.approx(kept_first[:2], abs=1e-9)
 
