@@ -108,3 +108,14 @@ def test_the_trailing_step_up_holds_the_com_not_the_pelvis(seed, monkeypatch):
     assert dataclasses.replace(GaitConfig()).terrain_landing_speed_mps == 0.0
     trial = run_course("step", seed, duration_s=9.0)
     assert trial.top and not trial.fell, trial
+
+
+def test_a_020_m_platform_is_crossed_with_the_landing_s_speed_limited():
+    """GaitConfig.terrain_landing_speed_mps: seed 100 of `g1 bench stairs --only platform` (0.20 m,
+    approached at 16.7 deg). With the landing unlimited, the trailing foot's landing jumped between the
+    step's limits tick to tick in the long step up and the swing tripped the safety layer (left ankle
+    roll at 34.5 rad/s, limit 30, at 7.2 s; measured, stop 48). Limited, the robot goes up and down."""
+    from g1_control.tools.bench_stairs import run_course
+
+    trial = run_course("platform", 100, duration_s=16.0)
+    assert trial.top and trial.across and not trial.fell, trial
