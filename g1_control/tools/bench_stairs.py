@@ -12,8 +12,8 @@ the scene says):
 Per trial: fell (the pelvis below 0.45 m above the ground under it, a fall the loop saw, or any
 safety trip: a trip counts as a failure), top (both soles on the structure's highest level at
 once), across (both soles back on the floor beyond the structure); and, of the controller itself,
-its CoP jumps (CopJumps: ticks whose CoP asked moved more than COP_JUMP_M within one contact phase). Draws: angle uniform in
-+-25 deg, offset uniform in +-0.3 m, from numpy's default_rng(seed).
+its CoP jumps (CopJumps: ticks whose CoP asked moved more than COP_JUMP_M within one contact phase).
+Draws: angle uniform in +-25 deg, offset uniform in +-0.3 m, from numpy's default_rng(seed).
 
     g1 bench stairs --seed 100 --trials 10              # seeds 100..109, both courses
     g1 bench stairs --only platform --seed 100 --trials 5
@@ -177,11 +177,13 @@ def run_course(course: str, seed: int, *, speed_mps: float = 0.3, duration_s: fl
     detail = ""
     jumps = CopJumps()
     gait = loop.tracker.gait  # type: ignore[attr-defined]
+    tick_s = 1.0 / trial.tracker_hz
+    ticks = round(0.02 / tick_s)
     t0 = time.perf_counter()
     try:
         while loop.time_s < duration_s - 1e-9:
-            for _ in range(5):  # 0.02 s, a tick (250 Hz) at a time: the same ticks as one run(0.02)
-                loop.run(0.004)
+            for _ in range(ticks):  # 0.02 s, a controller tick at a time: the same ticks as one run(0.02)
+                loop.run(tick_s)
                 jumps.update((gait.mode, gait.stance, gait.targets.swing_foot), gait.targets.cop_xy_m)
             soles = np.array([d.xpos[f] for f in feet])
             soles[:, 2] -= SOLE_BELOW_ANKLE_M

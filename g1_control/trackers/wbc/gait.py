@@ -654,9 +654,9 @@ class VelocityGait:
         self._path_top = 0.0
         self._snap_shift = np.zeros(2)
         """How far (xy) the terrain moved this step's landing from where the DCM would put it."""
-        self._landing_prev = np.zeros(2)
-        self._landing_prev_at = math.nan
-        """The landing (xy) the last tick gave, and the _t0 of the step it swung in (nan: none)."""
+        self._swung_at = math.nan
+        """The _t0 of the step the last walking tick swung in (nan: it did not swing); that tick's landing
+        is still in targets.landing_m (terrain_landing_speed_mps limits the move from it)."""
         self._snap_shift_at = math.nan
         """The _t0 of the step _snap_shift belongs to (nan: none)."""
         self._snap_dir = 0
@@ -1199,14 +1199,13 @@ class VelocityGait:
                 if not self._swinging and self.config.terrain_plan_long_steps:
                     self._lengthen_for_level(soles_m)
                 speed = self.config.terrain_landing_speed_mps
-                if speed > 0 and self._swinging and self._landing_prev_at == self._t0:
-                    # the landing moves at most so fast (GaitConfig.terrain_landing_speed_mps)
-                    move = self._landing[:2] - self._landing_prev
+                if speed > 0 and self._swinging and self._swung_at == self._t0:
+                    # the landing moves at most so fast from the last tick's (GaitConfig.terrain_landing_speed_mps)
+                    move = self._landing[:2] - out.landing_m[:2]
                     dist = float(np.hypot(*move))
                     if dist > speed * dt_s:
-                        self._landing[:2] = self._landing_prev + move * (speed * dt_s / dist)
-        self._landing_prev[:] = self._landing[:2]
-        self._landing_prev_at = self._t0 if self._swinging else math.nan
+                        self._landing[:2] = out.landing_m[:2] + move * (speed * dt_s / dist)
+        self._swung_at = self._t0 if self._swinging else math.nan
         out.landing_m[:] = self._landing
         out.after_push = bool(self._after_push_at == self._t0)
         if not self._swinging:
