@@ -12,7 +12,9 @@ the scene says):
 Per trial: fell (the pelvis below 0.45 m above the ground under it, a fall the loop saw, or any
 safety trip: a trip counts as a failure), top (both soles on the structure's highest level at
 once), across (both soles back on the floor beyond the structure); and, of the controller itself,
-its CoP jumps (CopJumps: ticks whose CoP asked moved more than COP_JUMP_M within one contact phase).
+its CoP jumps (CopJumps: ticks whose CoP asked moved more than COP_JUMP_M within one contact phase)
+and the CPU time (thread time) of its act() each tick, per course beside pinocchio RNEA + CRBA on the
+controller's visited states in the same run (the terrain's footholds are searched inside act()).
 Draws: angle uniform in +-25 deg, offset uniform in +-0.3 m, from numpy's default_rng(seed).
 
     g1 bench stairs --seed 100 --trials 10              # seeds 100..109, both courses
@@ -26,7 +28,7 @@ from __future__ import annotations
 import json
 import math
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +36,8 @@ import numpy as np
 from g1_control.scene import Platform, SceneConfig
 
 COURSES = ("stairs", "platform", "step")
+TRACKER_HZ = 250.0
+"""The controller's rate in every trial."""
 NEAR_EDGE_M = 1.0
 MAX_ANGLE_DEG = 25.0
 MAX_OFFSET_M = 0.3
@@ -108,6 +112,10 @@ class StairsTrial:
     """Ticks whose CoP asked jumped (CopJumps) ..."""
     cop_ticks: int = 0
     """... of the ticks that stayed in their contact phase."""
+    act_cpu_us: list[float] = field(default_factory=list, repr=False)
+    """The controller's act() each tick: thread CPU time (us)."""
+    states: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list, repr=False)
+    """(q, v) of the controller every 10th tick: the RNEA + CRBA baseline's inputs."""
 
     @property
     def success(self) -> bool:
@@ -165,7 +173,7 @@ def run_course(course: str, seed: int, *, speed_mps: float = 0.3, duration_s: fl
     scene, top_m, far_m = course_scene(course, math.radians(angle_deg), offset_m)
     trial = Trial(f"stairs_{course}_{seed}", [Segment(1.0, label="stand"),
                                               Segment(duration_s - 1.0, vx_mps=speed_mps, label="walk")],
-                  tracker="wbc", tracker_hz=250.0, scene=scene)
+                  tracker="wbc", tracker_hz=TRACKER_HZ, scene=scene)
     loop = build_loop(trial_launch(trial))
     loop.reset()
     sim = loop.backend
@@ -176,7 +184,21 @@ def run_course(course: str, seed: int, *, speed_mps: float = 0.3, duration_s: fl
     top = across = fell = False
     detail = ""
     jumps = CopJumps()
-    gait = loop.tracker.gait  # type: ignore[attr-defined]
+    tracker = loop.tracker
+    gait = tracker.gait  # type: ignore[attr-defined]
+    act = tracker.act
+    cpu: list[float] = []
+    states: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def timed_act(reference, state):
+        t = time.thread_time_ns()
+        out = act(reference, state)
+        cpu.append((time.thread_time_ns() - t) / 1e3)
+        if len(cpu) % 10 == 0:
+            states.append((tracker._q.copy(), tracker._v.copy()))  # type: ignore[attr-defined]
+        return out
+
+    tracker.act = timed_act  # type: ignore[method-assign]
     tick_s = 1.0 / trial.tracker_hz
     ticks = round(0.02 / tick_s)
     t0 = time.perf_counter()
@@ -209,7 +231,7 @@ def run_course(course: str, seed: int, *, speed_mps: float = 0.3, duration_s: fl
         wall = time.perf_counter() - t0
         sim.close()
     return StairsTrial(course, seed, angle_deg, offset_m, fell, top, across, detail, float(loop.time_s), wall,
-                       jumps.jumps, jumps.ticks)
+                       jumps.jumps, jumps.ticks, cpu, states)
 
 
 def _write_trace(path: Path, rows: list[list]) -> None:
@@ -246,13 +268,27 @@ def main(args) -> int:
                   f"{str(r.across)[0]:>6s} {str(r.fell)[0]:>4s} {r.cop_jumps:9d}  {r.detail}  ({r.sim_s:.1f} s sim, "
                   f"{r.wall_s:.0f} s wall)",
                   flush=True)
+    from g1_control.tools.bench_locomotion import rnea_crba_cpu_us
+
+    base50, _ = rnea_crba_cpu_us([s for r in rows for s in r.states])
+    tick_us = 1e6 / TRACKER_HZ
+    cpu: dict[str, tuple[float, float]] = {}
     for course in courses:
         sel = [r for r in rows if r.course == course]
+        cpu[course] = tuple(float(v) for v in np.percentile([c for r in sel for c in r.act_cpu_us], [50, 99]))  # type: ignore[assignment]
+        p50, p99 = cpu[course]
         print(f"{course}: {sum(r.success for r in sel)}/{len(sel)} up and down, top reached {sum(r.top for r in sel)}/"
               f"{len(sel)}, falls {sum(r.fell for r in sel)}/{len(sel)}; CoP jumps {sum(r.cop_jumps for r in sel)} in "
-              f"{sum(r.cop_ticks for r in sel)} ticks (> {COP_JUMP_M * 100:.0f} cm in a tick within a contact phase)")
+              f"{sum(r.cop_ticks for r in sel)} ticks (> {COP_JUMP_M * 100:.0f} cm in a tick within a contact phase); "
+              f"act() CPU p50 {p50:.0f} us ({p50 / base50:.0f}x RNEA+CRBA), p99 {p99:.0f} us = "
+              f"{p99 / tick_us * 100:.0f} % of the {tick_us / 1e3:.0f} ms tick")
+    print(f"baseline, same run: pinocchio RNEA + CRBA on the controller's visited states: p50 {base50:.1f} us (thread CPU)")
     if args.json:
-        Path(args.json).write_text(json.dumps([{**asdict(r), "success": r.success} for r in rows], indent=1))
+        Path(args.json).write_text(json.dumps(
+            [{**{k: v for k, v in asdict(r).items() if k not in ("act_cpu_us", "states")}, "success": r.success,
+              "act_cpu_p50_us": float(np.percentile(r.act_cpu_us, 50)) if r.act_cpu_us else math.nan,
+              "act_cpu_p99_us": float(np.percentile(r.act_cpu_us, 99)) if r.act_cpu_us else math.nan}
+             for r in rows], indent=1))
     return 1 if any(r.fell for r in rows) else 0
 
 

@@ -74,6 +74,9 @@ def test_a_trial_traces_the_feet_the_gait_and_the_balance_every_50th_of_a_second
     # standing, then starting to walk on the floor: every tick counted (250 Hz, less the phase changes)
     # and the CoP asked never jumps
     assert trial.cop_jumps == 0 and 480 <= trial.cop_ticks < 500
+    # the controller's act() timed every tick (2 s at 250 Hz), its state kept every 10th for the baseline
+    assert len(trial.act_cpu_us) == 500 and all(c > 0 for c in trial.act_cpu_us)
+    assert len(trial.states) == 50 and trial.states[0][0].shape == (36,) and trial.states[0][1].shape == (35,)
     col = {name: i for i, name in enumerate(TRACE_COLUMNS)}
     times = np.array([r[col["t_s"]] for r in rows])
     np.testing.assert_allclose(np.diff(times), 0.02, atol=1e-6)
@@ -87,3 +90,22 @@ def test_a_trial_traces_the_feet_the_gait_and_the_balance_every_50th_of_a_second
     with (tmp_path / "t" / "step_0.csv").open() as f:
         read = list(csv.reader(f))
     assert tuple(read[0]) == TRACE_COLUMNS and len(read) == 101 and read[1][col["mode"]] == "stand"
+
+
+def test_the_bench_reports_the_controller_s_cpu_per_course_beside_rnea_crba(tmp_path, capsys):
+    """`g1 bench stairs`: per course, act()'s thread CPU p50/p99 (and p50 over RNEA + CRBA on the visited
+    states, measured in the same run), and each trial's p50/p99 in --json."""
+    import json
+    from types import SimpleNamespace
+
+    from g1_control.tools.bench_stairs import main
+
+    out = tmp_path / "s.json"
+    code = main(SimpleNamespace(only="step", seed=1, trials=1, json=str(out), trace=None))
+    printed = capsys.readouterr().out
+    trial = json.loads(out.read_text())[0]
+    assert code == (1 if trial["fell"] else 0)
+    line = next(ln for ln in printed.splitlines() if ln.startswith("step: "))
+    assert "act() CPU p50" in line and "x RNEA+CRBA), p99" in line and "% of the 4 ms tick" in line
+    assert "baseline, same run: pinocchio RNEA + CRBA" in printed
+    assert 0 < trial["act_cpu_p50_us"] <= trial["act_cpu_p99_us"] and "states" not in trial and "act_cpu_us" not in trial
