@@ -148,19 +148,41 @@ class Terrain:
         sole lies on one level (module docstring); unchanged when it does or none is in reach.
         forward_only / backward_only: only along heading_rad / only against it; max_shift_m: the
         reach (TerrainConfig.max_shift_m by default); level_m: only a place on that level (within
-        level_tolerance_m) will do (`fits` tells whether the answer is one)."""
+        level_tolerance_m) will do (`fits` tells whether the answer is one). The places are tried
+        nearest first, forward before backward at the same distance (`fits` on each, evaluated for
+        all of them at once: one by one, a search that found nothing cost ~6 ms a tick, measured)."""
         xy = np.asarray(xy_m, dtype=float)[:2]
         if (self.flat and level_m is None) or self.fits(xy, yaw_rad, level_m):
             return xy.copy(), self.sole_height(xy, yaw_rad)
         c = self.config
         direction = np.array([math.cos(heading_rad), math.sin(heading_rad)])
         n = int((c.max_shift_m if max_shift_m is None else max_shift_m) / c.shift_step_m)
-        for k in range(1, n + 1):
-            for sign in ((1.0,) if forward_only else (-1.0,) if backward_only else (1.0, -1.0)):
-                p = xy + sign * k * c.shift_step_m * direction
-                if self.fits(p, yaw_rad, level_m):
-                    return p, self.sole_height(p, yaw_rad)
+        signs = (1.0,) if forward_only else (-1.0,) if backward_only else (1.0, -1.0)
+        shifts = np.array([sign * k * c.shift_step_m for k in range(1, n + 1) for sign in signs])
+        if shifts.size:
+            places = xy + shifts[:, None] * direction
+            ok = np.flatnonzero(self.fits_many(places, yaw_rad, level_m))
+            if ok.size:
+                p = places[ok[0]]
+                return p, self.sole_height(p, yaw_rad)
         return xy.copy(), self.sole_height(xy, yaw_rad)
+
+    def fits_many(self, xy_m: np.ndarray, yaw_rad: float, level_m: float | None = None) -> np.ndarray:
+        """`fits` for each of the places xy_m (n, 2), soles turned yaw_rad alike: (n,) bools."""
+        xy = np.asarray(xy_m, dtype=float).reshape(-1, 2)
+        c, s = math.cos(yaw_rad), math.sin(yaw_rad)
+        rot = np.array([[c, s], [-s, c]])
+        kinds = (self._sole_points, self._toe_points, self._heel_points)
+        pts = np.concatenate([k @ rot for k in kinds])
+        h = self.heights((xy[:, None, :] + pts[None, :, :]).reshape(-1, 2)).reshape(len(xy), -1)
+        n_sole, n_toe = len(self._sole_points), len(self._toe_points)
+        sole, toe, heel = h[:, :n_sole], h[:, n_sole:n_sole + n_toe], h[:, n_sole + n_toe:]
+        tol = self.config.level_tolerance_m
+        top = sole.max(axis=1)
+        ok = (top - sole.min(axis=1) <= tol) & (toe.max(axis=1) <= top + tol) & (heel.max(axis=1) <= top + tol)
+        if level_m is not None:
+            ok &= np.abs(top - level_m) <= tol
+        return ok
 
     def fits(self, xy_m: np.ndarray, yaw_rad: float, level_m: float | None = None) -> bool:
         """Whether a sole there lies on one level (is_level), and on `level_m` where given."""

@@ -70,6 +70,57 @@ def test_a_foothold_snapped_onto_a_given_level():
     assert t.fits(np.array([1.6, 0.0]), 0.0) and not t.fits(np.array([1.02, 0.0]), 0.0)
 
 
+def _turned_stairs() -> Terrain:
+    """Three treads turned 0.3 rad, the top one wide (`g1 bench stairs`' shape)."""
+    return Terrain.of_scene(SceneConfig(platforms=[
+        Platform("a", (1.225, 0.0), (0.45, 1.4), 0.15, yaw_rad=0.3),
+        Platform("b", (1.675, 0.1), (0.45, 1.4), 0.30, yaw_rad=0.3),
+        Platform("c", (2.5, 0.2), (1.2, 1.4), 0.45, yaw_rad=0.3)]))
+
+
+def test_fits_many_is_fits_at_each_place():
+    t = _turned_stairs()
+    rng = np.random.default_rng(5)
+    for level in (None, 0.0, 0.15, 0.30, 0.45):
+        places = rng.uniform([0.5, -1.0], [3.2, 1.0], size=(300, 2))
+        yaw = float(rng.uniform(-0.6, 0.6))
+        assert t.fits_many(places, yaw, level).tolist() == [t.fits(p, yaw, level) for p in places]
+        assert any(t.fits(p, yaw, level) for p in places) and not all(t.fits(p, yaw, level) for p in places)
+
+
+def test_snap_takes_the_nearest_place_that_fits_forward_first():
+    """Terrain.snap against a search one place at a time (`fits`), nearest first and forward before
+    backward at the same distance, on seeded draws of place, yaw, heading, reach, level and direction."""
+    t = _turned_stairs()
+    step = t.config.shift_step_m
+    rng = np.random.default_rng(6)
+    moved = 0
+    for i in range(400):
+        xy = rng.uniform([0.5, -1.0], [3.2, 1.0])
+        yaw, heading = (float(v) for v in rng.uniform(-0.6, 0.6, size=2))
+        forward, backward = i % 5 == 1, i % 5 == 2
+        reach = [None, 0.45, 0.1][i % 3]
+        level = [None, 0.0, 0.15, 0.30][i % 4]
+        got, height = t.snap(xy, yaw, heading, forward_only=forward, backward_only=backward, max_shift_m=reach,
+                             level_m=level)
+        want = xy
+        if not t.fits(xy, yaw, level):
+            n = int((t.config.max_shift_m if reach is None else reach) / step)
+            signs = (1.0,) if forward else (-1.0,) if backward else (1.0, -1.0)
+            direction = np.array([math.cos(heading), math.sin(heading)])
+            want = next((xy + s * k * step * direction for k in range(1, n + 1) for s in signs
+                         if t.fits(xy + s * k * step * direction, yaw, level)), xy)
+        moved += not np.array_equal(want, xy)
+        np.testing.assert_allclose(got, want, atol=1e-12)
+        assert height == pytest.approx(t.sole_height(want, yaw))
+    assert moved > 40
+    # at the same distance both ways (17 steps back onto the floor, 17 on onto the tread): forward
+    xy = np.array([0.972, 0.0])
+    s = stairs()
+    assert s.fits(xy - np.array([17 * step, 0.0]), 0.0) and s.fits(xy + np.array([17 * step, 0.0]), 0.0)
+    assert s.snap(xy, 0.0, 0.0)[0] == pytest.approx([0.972 + 17 * step, 0.0])
+
+
 def test_under_a_sole_is_the_highest_point_under_the_sole_itself():
     """Where a foot coming down meets the terrain: the sole's own outline, not its margin."""
     t = stairs()
