@@ -945,12 +945,12 @@ class VelocityGait:
             # a foot below (or above) the stance foot's level comes onto that level, beside it: never
             # past it onto the next tread (the trailing foot swung from the first tread onto the top,
             # 0.3 m up and 0.8 m on, measured)
-            xy, ground_l = self._on_level(want, heading_td, ground_s)
+            xy, ground_l = self._on_level(want, heading_td, ground_s, u[:2])
         elif self._swinging and self._snap_shift_at == self._t0 and abs(ground_l - self._foothold_ground) > tol:
             # a swing keeps the level its foothold had (its timing and apex were chosen for it at
             # lift-off): a same-level step whose landing moved onto the next tread mid-swing came down
             # on that tread's edge (measured)
-            xy, ground_l = self._on_level(want, heading_td, self._foothold_ground)
+            xy, ground_l = self._on_level(want, heading_td, self._foothold_ground, u[:2])
         shift = float((xy - want) @ forward)
         if self._snap_shift_at != self._t0 or self._snap_dir == 0:
             self._snap_dir = 1 if shift > 1e-9 else -1 if shift < -1e-9 else 0
@@ -979,15 +979,32 @@ class VelocityGait:
             return xy, ground
         return self._foothold.copy(), self._foothold_ground
 
-    def _on_level(self, want: np.ndarray, heading_td: float, level_m: float) -> tuple[np.ndarray, float]:
+    def _on_level(self, want: np.ndarray, heading_td: float, level_m: float,
+                  stance_xy: np.ndarray) -> tuple[np.ndarray, float]:
         """The foothold nearest `want` along the heading (within terrain_level_reach_m) whose whole sole
-        lies on the level `level_m` (Terrain.snap); the last foothold when there is none."""
+        lies on the level `level_m` (Terrain.snap). When there is none: this step's own foothold, once it
+        has one; before that, beside the stance sole on want's side (step_width_m, else min_width_m
+        across the heading) on that level, else the nearest foothold on any level (Terrain.snap), else
+        `want` as it is. Never the last step's foothold, which is where the stance foot stands: a trailing
+        foot whose landing lay off the stairs' side was sent onto the stance sole (`g1 bench stairs` seed
+        100 at 8.59 s, measured)."""
         terrain = self.terrain
-        xy, ground = terrain.snap(want, self._landing_yaw, heading_td, max_shift_m=self.config.terrain_level_reach_m,
-                                  level_m=level_m)
-        if terrain.fits(xy, self._landing_yaw, level_m):
+        yaw = self._landing_yaw
+        xy, ground = terrain.snap(want, yaw, heading_td, max_shift_m=self.config.terrain_level_reach_m, level_m=level_m)
+        if terrain.fits(xy, yaw, level_m):
             return xy, ground
-        return self._foothold.copy(), self._foothold_ground
+        if self._snap_shift_at == self._t0:
+            return self._foothold.copy(), self._foothold_ground
+        across = np.array([-math.sin(heading_td), math.cos(heading_td)])
+        side = 1.0 if float((want - stance_xy) @ across) >= 0.0 else -1.0
+        for width in (self.config.step_width_m, self.config.min_width_m):
+            beside = stance_xy + side * width * across
+            if terrain.fits(beside, yaw, level_m):
+                return beside, terrain.sole_height(beside, yaw)
+        xy, ground = terrain.snap(want, yaw, heading_td)
+        if terrain.fits(xy, yaw):
+            return xy, ground
+        return want.copy(), terrain.sole_height(want, yaw)
 
     def _dcm_short_of_stance(self, command_h: np.ndarray, soles_m: np.ndarray, dcm_xy: np.ndarray) -> bool:
         """Near a step, whether the DCM lies behind the stance sole's centre along the motion (by more than

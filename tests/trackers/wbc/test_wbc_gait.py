@@ -612,6 +612,52 @@ def test_a_swing_keeps_the_level_its_foothold_had():
         assert terrain.is_level(out.landing_m[:2], 0.0) and terrain.height(out.landing_m[:2]) == pytest.approx(0.15)
 
 
+@pytest.mark.parametrize("dcm_out_m, stance_y_m", [(0.015, None), (0.3, None), (0.3, 0.62)])
+def test_a_trailing_foot_asked_off_the_stairs_side_does_not_aim_at_the_stance_sole(dcm_out_m, stance_y_m):
+    """The right foot steps up onto the first tread near its side (y 0.7); the left foot, on the floor
+    beside the stairs' side, trails. The DCM asks it to land where no sole lies whole on the stance
+    foot's level along the heading (as a DCM running out sideways does, `g1 bench stairs` seed 100):
+    straddling the second tread's riser at the tread's side (0.015 m out), or off the stairs' side over
+    the second tread (0.3 m out). The foot then comes onto the tread beside the stance foot, at the step
+    width; with the stance foot at the tread's side (no room beside it), onto the floor off the side,
+    where it was asked. Never where the stance foot stands (the last step's foothold, where it aimed
+    before)."""
+    terrain = _two_treads()
+    gait = VelocityGait(GaitConfig(), terrain)
+    soles, yaws = _feet()
+    soles[LEFT] = (0.8, 0.55, 0.0)
+    soles[RIGHT] = (0.8, 0.33, 0.0)
+    cmd = np.array([0.3, 0.0, 0.0])
+    t = _into_single_support(gait, soles, yaws)
+    assert gait.stance == LEFT
+    # the right foot's step onto the first tread (its foothold there), then its touchdown
+    for _ in range(5):
+        t += 0.004
+        gait.schedule(t, cmd, soles, yaws, soles[LEFT, :2])
+        out = gait.update(t, 0.004, soles, yaws, soles[LEFT, :2] + np.array([0.3, -0.04]), OMEGA)
+    assert out.landing_m[2] == pytest.approx(0.15)
+    soles[RIGHT] = out.landing_m
+    while gait.stance == LEFT:
+        t += 0.004
+        gait.schedule(t, cmd, soles, yaws, soles[RIGHT, :2])
+    assert gait.stance == RIGHT and terrain.height(soles[RIGHT, :2]) == pytest.approx(0.15)
+    if stance_y_m is not None:
+        soles[RIGHT, 1] = stance_y_m
+        assert terrain.fits(soles[RIGHT, :2], 0.0, 0.15)
+    # the left foot's landing, the DCM out to the left
+    t += 0.004
+    gait.schedule(t, cmd, soles, yaws, soles[RIGHT, :2])
+    out = gait.update(t, 0.004, soles, yaws, soles[RIGHT, :2] + np.array([0.0, dcm_out_m]), OMEGA)
+    landing = out.landing_m
+    assert landing[1] - soles[RIGHT, 1] >= gait.config.min_width_m
+    if stance_y_m is None:
+        assert landing[2] == pytest.approx(0.15) and terrain.fits(landing[:2], 0.0, 0.15)
+        assert landing[:2] == pytest.approx(soles[RIGHT, :2] + np.array([0.0, gait.config.step_width_m]))
+    else:
+        assert landing[2] == pytest.approx(0.0) and terrain.fits(landing[:2], 0.0, 0.0)
+        assert landing[1] > 0.7  # off the stairs' side, where it was asked
+
+
 WAIT_FOR_CONTACT = GaitConfig(touchdown_height_m=0.02)
 """The touchdown wait switched on (off by default)."""
 
