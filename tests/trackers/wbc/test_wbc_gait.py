@@ -658,6 +658,41 @@ def test_a_trailing_foot_asked_off_the_stairs_side_does_not_aim_at_the_stance_so
         assert landing[1] > 0.7  # off the stairs' side, where it was asked
 
 
+def test_on_steps_the_cop_sent_is_the_two_tick_mean_of_the_cop_law_s():
+    """GaitConfig.terrain_cop_two_tick_mean: the feet before a riser, the landing the DCM asks snapped
+    onto the tread, the DCM held still: the gait's own loop (the landing predicted from this tick's
+    CoP moves the DCM's plan, and the plan the next tick's CoP) makes the CoP law alternate tick to
+    tick, more than 3 cm at a time (stop 48's chatter). With the mean, what the gait sends is the mean
+    of that same law's last two values within the contact phase (two gaits, one input): it no longer
+    jumps tick to tick."""
+    def run(mean):
+        gait = VelocityGait(GaitConfig(terrain_cop_two_tick_mean=mean), _step_ahead(1.0))
+        soles, yaws = _feet()
+        soles[:, 0] = 0.75
+        t = _into_single_support(gait, soles, yaws)
+        cops, phases, levels = [], [], []
+        for _ in range(150):
+            t += 0.004
+            dcm = soles[gait.stance, :2] + np.array([0.06, 0.0])
+            gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, dcm)
+            out = gait.update(t, 0.004, soles, yaws, dcm, OMEGA)
+            cops.append(out.cop_xy_m.copy())
+            phases.append((gait._t0, gait._swinging))
+            levels.append(out.landing_m[2])
+        return np.array(cops), phases, levels
+
+    law, phases, levels = run(False)
+    sent, phases_on, _ = run(True)
+    assert phases_on == phases and min(levels) == pytest.approx(0.15)  # the landing on the tread throughout
+    same = [k for k in range(1, len(law)) if phases[k] == phases[k - 1]]
+    jumps = [float(np.hypot(*(law[k] - law[k - 1]))) for k in same]
+    assert sum(j > 0.03 for j in jumps) >= 20
+    for k in same:
+        np.testing.assert_allclose(sent[k], 0.5 * (law[k] + law[k - 1]), atol=1e-12)
+    # what is sent jumps only where the law itself moves on (the double support's first ticks)
+    assert sum(float(np.hypot(*(sent[k] - sent[k - 1]))) > 0.03 for k in same) <= 2
+
+
 WAIT_FOR_CONTACT = GaitConfig(touchdown_height_m=0.02)
 """The touchdown wait switched on (off by default)."""
 
