@@ -272,11 +272,9 @@ def main(args) -> int:
 
     base50, _ = rnea_crba_cpu_us([s for r in rows for s in r.states])
     tick_us = 1e6 / TRACKER_HZ
-    cpu: dict[str, tuple[float, float]] = {}
     for course in courses:
         sel = [r for r in rows if r.course == course]
-        cpu[course] = tuple(float(v) for v in np.percentile([c for r in sel for c in r.act_cpu_us], [50, 99]))  # type: ignore[assignment]
-        p50, p99 = cpu[course]
+        p50, p99 = (float(v) for v in np.percentile([c for r in sel for c in r.act_cpu_us], [50, 99]))
         print(f"{course}: {sum(r.success for r in sel)}/{len(sel)} up and down, top reached {sum(r.top for r in sel)}/"
               f"{len(sel)}, falls {sum(r.fell for r in sel)}/{len(sel)}; CoP jumps {sum(r.cop_jumps for r in sel)} in "
               f"{sum(r.cop_ticks for r in sel)} ticks (> {COP_JUMP_M * 100:.0f} cm in a tick within a contact phase); "
