@@ -133,13 +133,7 @@ class Terrain:
     def is_level(self, xy_m: np.ndarray, yaw_rad: float) -> bool:
         """Whether a sole there lies on one level, clear of its edges, of a riser ahead of it and of a
         higher level's edge behind it (TerrainConfig.riser_gap_m, drop_gap_m)."""
-        h = self._sole_heights(xy_m, yaw_rad)
-        tol = self.config.level_tolerance_m
-        if h.max() - h.min() > tol:
-            return False
-        if self._sole_heights(xy_m, yaw_rad, self._toe_points).max() > h.max() + tol:
-            return False
-        return bool(self._sole_heights(xy_m, yaw_rad, self._heel_points).max() <= h.max() + tol)
+        return bool(self.fits_many(np.asarray(xy_m, dtype=float)[:2], yaw_rad)[0])
 
     def snap(self, xy_m: np.ndarray, yaw_rad: float, heading_rad: float,
              forward_only: bool = False, backward_only: bool = False,
@@ -168,7 +162,10 @@ class Terrain:
         return xy.copy(), self.sole_height(xy, yaw_rad)
 
     def fits_many(self, xy_m: np.ndarray, yaw_rad: float, level_m: float | None = None) -> np.ndarray:
-        """`fits` for each of the places xy_m (n, 2), soles turned yaw_rad alike: (n,) bools."""
+        """`fits` for each of the places xy_m (n, 2), soles turned yaw_rad alike: (n,) bools. A sole lies
+        on one level when the heights under it (with its margin) differ by level_tolerance_m at most
+        and none of the points ahead of its toe or behind its heel stands higher than it (a riser
+        ahead, a higher level's edge behind); on `level_m` when its highest point is there."""
         xy = np.asarray(xy_m, dtype=float).reshape(-1, 2)
         c, s = math.cos(yaw_rad), math.sin(yaw_rad)
         rot = np.array([[c, s], [-s, c]])
@@ -186,9 +183,7 @@ class Terrain:
 
     def fits(self, xy_m: np.ndarray, yaw_rad: float, level_m: float | None = None) -> bool:
         """Whether a sole there lies on one level (is_level), and on `level_m` where given."""
-        if not self.is_level(xy_m, yaw_rad):
-            return False
-        return level_m is None or abs(self.sole_height(xy_m, yaw_rad) - level_m) <= self.config.level_tolerance_m
+        return bool(self.fits_many(np.asarray(xy_m, dtype=float)[:2], yaw_rad, level_m)[0])
 
     def level_change_ahead(self, xy_m: np.ndarray, heading_rad: float, distance_m: float, samples: int = 12) -> bool:
         """Whether the height changes on the straight line from xy_m distance_m along heading_rad."""

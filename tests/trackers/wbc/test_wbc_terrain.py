@@ -79,6 +79,7 @@ def _turned_stairs() -> Terrain:
 
 
 def test_fits_many_is_fits_at_each_place():
+    """Many places at once answer as each alone (is_level and fits ask fits_many for one place)."""
     t = _turned_stairs()
     rng = np.random.default_rng(5)
     for level in (None, 0.0, 0.15, 0.30, 0.45):
