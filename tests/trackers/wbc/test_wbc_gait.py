@@ -693,6 +693,31 @@ def test_on_steps_the_cop_sent_is_the_two_tick_mean_of_the_cop_law_s():
     assert sum(float(np.hypot(*(sent[k] - sent[k - 1]))) > 0.03 for k in same) <= 2
 
 
+def test_a_swing_asked_off_the_stairs_side_keeps_its_foothold():
+    """Both feet on the first tread near its right side, the right foot's step under way with its
+    foothold on that tread: the DCM then asking a landing off the stairs' side (no place on the tread
+    along the heading from there), the swing keeps the foothold it had (its level and its place), rather
+    than moving to a new place beside the stance foot mid-swing."""
+    terrain = _two_treads()
+    gait = VelocityGait(GaitConfig(), terrain)
+    soles, yaws = _feet()
+    soles[:, 0] = 1.16
+    soles[:, 2] = 0.15
+    soles[LEFT, 1], soles[RIGHT, 1] = -0.35, -0.57
+    t = _into_single_support(gait, soles, yaws)
+    assert gait.stance == LEFT and gait._swinging
+    landings = []
+    for out_m in (0.0, 0.0, -0.3, -0.3, -0.3, -0.3):
+        t += 0.004
+        gait.schedule(t, np.array([0.3, 0.0, 0.0]), soles, yaws, np.zeros(2))
+        out = gait.update(t, 0.004, soles, yaws, soles[LEFT, :2] + np.array([0.05, out_m]), OMEGA)
+        landings.append(out.landing_m.copy())
+    kept = landings[1]
+    assert kept[2] == pytest.approx(0.15) and terrain.fits(kept[:2], 0.0, 0.15)
+    for landing in landings[2:]:
+        np.testing.assert_allclose(landing, kept, atol=1e-12)
+
+
 WAIT_FOR_CONTACT = GaitConfig(touchdown_height_m=0.02)
 """The touchdown wait switched on (off by default)."""
 
