@@ -218,20 +218,8 @@ def run_case(controller: str, case: Case, walk_s: float, states: list | None = N
     loop = build_loop(case_launch(controller, case, walk_s, randomize, variant))
     loop.reset()
     tracker = loop.tracker
-    cpu: list[int] = []
-    act = tracker.act
-
-    keep = states is not None and controller == "wbc"
-
-    def timed_act(reference, state):
-        t0 = time.thread_time_ns()
-        out = act(reference, state)
-        cpu.append(time.thread_time_ns() - t0)
-        if keep and len(cpu) % 10 == 0:  # the WBC's own (q, v) this tick: the baseline's inputs
-            states.append((tracker._q.copy(), tracker._v.copy()))  # type: ignore[attr-defined, union-attr]
-        return out
-
-    tracker.act = timed_act  # type: ignore[method-assign]
+    cpu: list[float] = []
+    time_act(tracker, cpu, states if controller == "wbc" else None)
     duration = sum(seg.duration_s for seg in case.timeline) if case.timeline else 1.0 + walk_s
     stride = wbc_stride_s(tracker, case.command) if controller == "wbc" else POLICY_GAIT_PERIOD_S
     shifted = tuple((t + case.push_stride_fraction * stride, f) for t, f in case.pushes)
@@ -259,7 +247,7 @@ def run_case(controller: str, case: Case, walk_s: float, states: list | None = N
     trip = next((e for e in loop.events if e.trips and e.kind != "fall"), None)
     row.trip = str(trip) if trip else ""
     row.min_pelvis_m = float(log["base_pos_m"][:, 2].min())
-    samples = np.asarray(cpu, dtype=float) / 1e3
+    samples = np.asarray(cpu, dtype=float)
     row.act_cpu_p50_us, row.act_cpu_p99_us = (float(v) for v in np.percentile(samples, [50, 99]))
     if case.pushes:
         # a safety trip (damping) ends the controller's run as surely as a fall
@@ -274,6 +262,22 @@ def run_case(controller: str, case: Case, walk_s: float, states: list | None = N
         row.error_pct = float(max(errors, key=abs))
         row.off_axis = float(max([abs(achieved[k]) for k, c in enumerate(case.command) if not c], default=0.0))
     return row
+
+
+def time_act(tracker, cpu_us: list[float], states: list | None = None) -> None:
+    """Wrap tracker.act: each call's thread CPU time (us) appended to cpu_us, and, given `states`, the
+    WBC's own (q, v) every 10th call (the RNEA + CRBA baseline's inputs, `rnea_crba_cpu_us`)."""
+    act = tracker.act
+
+    def timed_act(reference, state):
+        t0 = time.thread_time_ns()
+        out = act(reference, state)
+        cpu_us.append((time.thread_time_ns() - t0) / 1e3)
+        if states is not None and len(cpu_us) % 10 == 0:
+            states.append((tracker._q.copy(), tracker._v.copy()))
+        return out
+
+    tracker.act = timed_act
 
 
 def rnea_crba_cpu_us(states: list[tuple[np.ndarray, np.ndarray]]) -> tuple[float, float]:

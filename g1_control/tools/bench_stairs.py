@@ -167,6 +167,7 @@ def run_course(course: str, seed: int, *, speed_mps: float = 0.3, duration_s: fl
 
     from g1_control.launch.builder import build_loop
     from g1_control.teleop.scripted import Segment
+    from g1_control.tools.bench_locomotion import time_act
     from g1_control.tools.physics_trials import Trial, trial_launch
 
     angle_deg, offset_m = draw(seed)
@@ -184,21 +185,10 @@ def run_course(course: str, seed: int, *, speed_mps: float = 0.3, duration_s: fl
     top = across = fell = False
     detail = ""
     jumps = CopJumps()
-    tracker = loop.tracker
-    gait = tracker.gait  # type: ignore[attr-defined]
-    act = tracker.act
+    gait = loop.tracker.gait  # type: ignore[attr-defined]
     cpu: list[float] = []
     states: list[tuple[np.ndarray, np.ndarray]] = []
-
-    def timed_act(reference, state):
-        t = time.thread_time_ns()
-        out = act(reference, state)
-        cpu.append((time.thread_time_ns() - t) / 1e3)
-        if len(cpu) % 10 == 0:
-            states.append((tracker._q.copy(), tracker._v.copy()))  # type: ignore[attr-defined]
-        return out
-
-    tracker.act = timed_act  # type: ignore[method-assign]
+    time_act(loop.tracker, cpu, states)
     tick_s = 1.0 / trial.tracker_hz
     ticks = round(0.02 / tick_s)
     t0 = time.perf_counter()

@@ -670,9 +670,10 @@ class VelocityGait:
         self._path_top = 0.0
         self._snap_shift = np.zeros(2)
         """How far (xy) the terrain moved this step's landing from where the DCM would put it."""
-        self._swung_at = math.nan
-        """The _t0 of the step the last walking tick swung in (nan: it did not swing); that tick's landing
-        is still in targets.landing_m (terrain_landing_speed_mps limits the move from it)."""
+        self._last_phase: tuple[float, bool] = (math.nan, False)
+        """(_t0, swinging) of the last walking tick: within the same phase, that tick's landing is still in
+        targets.landing_m (terrain_landing_speed_mps limits the move from it) and its CoP in _p_last
+        (terrain_cop_two_tick_mean)."""
         self._snap_shift_at = math.nan
         """The _t0 of the step _snap_shift belongs to (nan: none)."""
         self._snap_dir = 0
@@ -705,8 +706,7 @@ class VelocityGait:
         self._after_push_left = 0
         self._dcm_error_at = math.nan
         self._p_last = np.zeros(2)
-        self._p_last_at: tuple[float, bool] = (math.nan, False)
-        """The CoP this gait computed last tick, and (_t0, swinging) of its contact phase."""
+        """The CoP this gait computed last tick."""
         self._drift = np.zeros(2)
         """The DCM's runs beyond the pendulum's prediction, summed with push_detect_tau_s's memory (m)."""
         self._drift_xi: np.ndarray | None = None
@@ -1020,10 +1020,7 @@ class VelocityGait:
             beside = stance_xy + side * width * across
             if terrain.fits(beside, yaw, level_m):
                 return beside, terrain.sole_height(beside, yaw)
-        xy, ground = terrain.snap(want, yaw, heading_td)
-        if terrain.fits(xy, yaw):
-            return xy, ground
-        return want.copy(), terrain.sole_height(want, yaw)
+        return terrain.snap(want, yaw, heading_td)  # want itself when no place in reach fits
 
     def _dcm_short_of_stance(self, command_h: np.ndarray, soles_m: np.ndarray, dcm_xy: np.ndarray) -> bool:
         """Near a step, whether the DCM lies behind the stance sole's centre along the motion (by more than
@@ -1164,6 +1161,8 @@ class VelocityGait:
                 out.landing_m[:] = soles_m[1 - self.stance]
             return out
         # walking
+        same_phase = self._last_phase == (self._t0, self._swinging)
+        self._last_phase = (self._t0, self._swinging)
         s, f = self.stance, 1 - self.stance
         Tds = cfg.double_support_s
         t_in = t_s - self._t0
@@ -1196,14 +1195,13 @@ class VelocityGait:
             d_local[0] = min(max(d_local[0], -cfg.cop_limit_x_m), cfg.cop_limit_x_m)
             d_local[1] = min(max(d_local[1], -cfg.cop_limit_y_m), cfg.cop_limit_y_m)
             p = u[:2] + rs @ d_local
-        if self.config.terrain_cop_two_tick_mean and not self.terrain.flat and self._p_last_at == (self._t0, self._swinging):
+        if self.config.terrain_cop_two_tick_mean and not self.terrain.flat and same_phase:
             # the CoP sent is the mean of this tick's and the last one's, within one contact phase
             # (GaitConfig.terrain_cop_two_tick_mean); the landing below is predicted from this tick's own
             out.cop_xy_m[:] = 0.5 * (p + self._p_last)
         else:
             out.cop_xy_m[:] = p
         self._p_last[:] = p
-        self._p_last_at = (self._t0, self._swinging)
         # where the swing foot lands: the DCM predicted at touchdown less the next stance's offset
         tau = (t_in - Tds) / cfg.single_support_s
         if tau < cfg.freeze_landing_after or not self._swinging:
@@ -1242,13 +1240,12 @@ class VelocityGait:
                 if not self._swinging and self.config.terrain_plan_long_steps:
                     self._lengthen_for_level(soles_m)
                 speed = self.config.terrain_landing_speed_mps
-                if speed > 0 and self._swinging and self._swung_at == self._t0:
+                if speed > 0 and self._swinging and same_phase:
                     # the landing moves at most so fast from the last tick's (GaitConfig.terrain_landing_speed_mps)
                     move = self._landing[:2] - out.landing_m[:2]
                     dist = float(np.hypot(*move))
                     if dist > speed * dt_s:
                         self._landing[:2] = out.landing_m[:2] + move * (speed * dt_s / dist)
-        self._swung_at = self._t0 if self._swinging else math.nan
         out.landing_m[:] = self._landing
         out.after_push = bool(self._after_push_at == self._t0)
         if not self._swinging:
