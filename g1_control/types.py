@@ -327,6 +327,9 @@ class KinematicReference:
 
     hand_q_rad: np.ndarray | None = None
     """Dex3 finger angles (14, generator.skeleton.FINGER_JOINTS order) on a G1 with hands; None otherwise."""
+    grasp_nm: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    """Per hand (left, right): the torque limit (N m) of the force-limited finger grasp the plan asks
+    for (loop/hands.py); 0: no grasp, the fingers follow hand_q_rad (or open)."""
     feasible_plan: JointReference | None = None
     """The tracker's reference when the generator made it feasible by construction (a sampled
     whole-body plan with exact joint velocities and hand forces; the default legs with a style's
@@ -373,12 +376,15 @@ class JointReference:
     """Known forces a held object exerts on the (left, right) hand point, world axes (N): the
     reaction to the squeeze and the object's weight. A whole-body controller puts them in its
     dynamics, so its torques hold the object and its balance accounts for it."""
+    hand_moments_w_nm: np.ndarray = field(default_factory=lambda: np.zeros((2, 3)))
+    """Known moments a held object exerts about the (left, right) hand point, world axes (N m): its
+    weight acting off the hand point (a bottle held in one hand, generator/goals/bottle.py)."""
 
     def copy_from(self, src: JointReference) -> JointReference:
         """Copy every field of `src` into this reference's own arrays (no allocation); returns self."""
         self.t_s = src.t_s
         for name in ("q_rad", "dq_radps", "root_pos_w_m", "root_quat_wxyz", "root_linvel_h_mps",
-                     "root_angvel_h_radps", "contacts", "hand_forces_w_n"):
+                     "root_angvel_h_radps", "contacts", "hand_forces_w_n", "hand_moments_w_nm"):
             getattr(self, name)[:] = getattr(src, name)
         self.upper_body_override = src.upper_body_override
         self.pelvis_height_m = src.pelvis_height_m

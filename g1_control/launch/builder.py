@@ -34,6 +34,7 @@ from g1_control.types import CommandLimits
 if TYPE_CHECKING:
     from g1_control.estimation.localiser import Localiser
     from g1_control.ik.stage import IKStage
+    from g1_control.loop.hands import HandsStage
     from g1_control.sim.mujoco_backend import MujocoBackend
     from g1_control.trackers.wbc.tracker import WbcConfig
 
@@ -65,6 +66,19 @@ def wbc_config(launch: LaunchFile, footsteps: Literal["plan", "velocity"] = "pla
 
     qp = QpConfig(foot=FootGeometry(friction=launch.tracker.foot_friction))
     return WbcConfig(rate_hz=launch.rates.tracker_hz, footsteps=footsteps, qp=qp)
+
+
+def simulated_hands(backend) -> HandsStage | None:
+    """The loop's finger stage for a simulated G1 with Dex3 hands (backend.hands: dex3): the
+    reference's grasps and finger angles through the hands' safety layer on MuJoCo's fingers. None
+    for any other backend: the robot's hands are driven over their own DDS topics (`g1 hands`)."""
+    if not getattr(backend, "hand_sides", ()):  # MujocoBackend's, with Dex3 hands built
+        return None
+    from g1_control.loop.hands import HandsStage
+    from g1_control.safety.hands import GuardedHands
+    from g1_control.sim.mujoco_hands import MujocoHandLink
+
+    return HandsStage(GuardedHands(MujocoHandLink(backend), clock=lambda: backend.time_s))
 
 
 def make_tracker(launch: LaunchFile) -> Tracker:
@@ -260,9 +274,12 @@ def build_loop(launch: LaunchFile, *, backend: Backend | None = None, input_devi
     if localiser is not None:
         generator.steer_by(localiser)
         chain["localiser"] = localiser.describe()
+    hands = simulated_hands(backend)
+    if hands is not None:
+        chain["hands"] = "Dex3-1 (simulated fingers, GuardedHands)"
     loop = ControlLoop(backend, input_device, generator, ik, tracker, r, wallclock=wallclock,
                        safety=safety, log_capacity=capacity, estimator=estimator, localiser=localiser,
-                       falls=FallMonitor(launch.fall, max_tilt_rad=safety.config.max_tilt_rad))
+                       falls=FallMonitor(launch.fall, max_tilt_rad=safety.config.max_tilt_rad), hands=hands)
     chain["input"] = type(input_device).__name__
     chain["backend"] = backend.describe()
     loop.chain = chain

@@ -7,6 +7,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -22,6 +23,9 @@ from g1_control.safety import SafetyConfig, SafetyFilter
 from g1_control.safety.events import SafetyEvent
 from g1_control.safety.fall import Fall, FallMonitor
 from g1_control.types import Button, Command, ExecutionFeedback, JointReference, KinematicReference, RobotState
+
+if TYPE_CHECKING:
+    from g1_control.loop.hands import HandsStage
 
 
 @dataclass
@@ -130,7 +134,7 @@ class ControlLoop:
                  tracker: Tracker, rates: LoopRates | None = None, *, estimator: StateEstimator | None = None,
                  wallclock: bool = False, max_tilt_rad: float = 1.0, log_capacity: int = 0,
                  safety: SafetyFilter | None = None, falls: FallMonitor | None = None,
-                 localiser: Localiser | None = None):
+                 localiser: Localiser | None = None, hands: HandsStage | None = None):
         self.backend, self.input, self.generator = backend, input_device, generator
         self.retargeter, self.tracker = retargeter, tracker
         self.rates = rates or LoopRates()
@@ -138,6 +142,9 @@ class ControlLoop:
         self.localiser = localiser
         """The robot's world pose estimate (estimation/localiser.py), updated after the estimator; None:
         the loop runs none (goals and programs steer by the simulator's ground truth)."""
+        self.hands = hands
+        """The Dex3 fingers' stage (loop/hands.py): the reference's grasps and finger angles through the
+        hands' safety layer; None: a robot without hands (or hands the loop does not drive)."""
         self.safety = safety or SafetyFilter(SafetyConfig(max_tilt_rad=max_tilt_rad))
         self.falls = falls or FallMonitor(max_tilt_rad=self.safety.config.max_tilt_rad)
         self.command = Command()
@@ -162,6 +169,7 @@ class ControlLoop:
             Stage("retargeter", r.tracker_hz, self._retarget),
             Stage("tracker", r.tracker_hz, self._track),
             Stage("safety", r.tracker_hz, self._safety),
+            *([Stage("hands", r.tracker_hz, self._hands)] if hands is not None else []),
             Stage("lowlevel", r.lowlevel_hz, self._lowlevel, batch=self._lowlevel_ticks if backend.lockstep else None),
             Stage("log", r.tracker_hz, self._log),
         ]
@@ -188,6 +196,8 @@ class ControlLoop:
             self.localiser.reset(self.state)
         self.tracker.reset(self.state)
         self.generator.reset(self.state)
+        if self.hands is not None:
+            self.hands.reset()
         return self.state
 
     def run(self, duration_s: float, progress=None) -> int:
@@ -324,6 +334,10 @@ class ControlLoop:
         self.motor_command = self.safety.filter(self._tracker_command, self.state, now)
         if self.falls.fall is None:
             self._check_fall(now)
+
+    def _hands(self) -> None:
+        assert self.hands is not None
+        self.hands.update(self._kin_ref, self.now_s(), self.faulted)
 
     def _check_fall(self, now: float) -> None:
         s = self.state

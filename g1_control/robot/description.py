@@ -28,9 +28,12 @@ HANDS = ("none", "dex3")
 FINGER_STIFFNESS_NM_PER_RAD = 2.0
 FINGER_DAMPING_NMS_PER_RAD = 0.05
 FINGER_ARMATURE_KGM2 = 1e-4
-"""The simulated Dex3's fingers hold the open pose (every finger joint at 0, inside each range) as
-a spring-damper: what the hand's own controller does with its last command. Nothing commands the
-fingers yet (no HandCmd_ path); the hand is there for its mass, its shape and its contacts."""
+"""The simulated Dex3's finger joints: a motor each (actuator named as the joint without "_joint",
+after the body's 29, force limited to the URDF's effort), under the hand's motor law
+tau = kp (q* - q) + kd (dq* - dq) + tau_ff (HandCmd_'s fields; MujocoBackend.write_fingers). Until
+a command arrives each motor holds the open pose (every finger at 0) with kp FINGER_STIFFNESS_NM_PER_RAD:
+what the hand's own controller does with its last command. FINGER_DAMPING_NMS_PER_RAD is the joint's
+own viscous friction, under any command."""
 
 JOINT_STOP_TIMECONST_STEPS = 2
 """A joint's stop (its limit constraint) pulls a joint back from beyond its range with a time
@@ -138,7 +141,7 @@ def mujoco_spec(floor: bool = True, timestep_s: float = 0.005, variant: g1.Varia
     their links are welded to their parents at the joint's zero, as the locked waist and the
     wrist-less forearm of the real robot are. Its actuators are the variant's joints, in g1.JOINT_NAMES
     order (nu = variant.num_dof). hands 'dex3': the G1 with Dex3-1 hands, fingers held open
-    (FINGER_STIFFNESS_NM_PER_RAD), no finger motors; the 29-DoF G1 only. hard_stops: the joints'
+    (FINGER_STIFFNESS_NM_PER_RAD), a motor per finger joint after the body's; the 29-DoF G1 only. hard_stops: the joints'
     stops as JOINT_STOP_TIMECONST_STEPS and JOINT_STOP_SOLIMP say (the emulated robot, `g1 sim-robot`);
     else MuJoCo's default soft limits, which the lockstep simulation and its tuned figures still use."""
     import mujoco
@@ -186,9 +189,22 @@ def mujoco_spec(floor: bool = True, timestep_s: float = 0.005, variant: g1.Varia
         for name in finger_joint_names():
             finger = spec.joint(name)
             finger.armature = FINGER_ARMATURE_KGM2
-            finger.stiffness = [FINGER_STIFFNESS_NM_PER_RAD, 0.0, 0.0]  # linear spring to springref 0: open
             finger.damping = [FINGER_DAMPING_NMS_PER_RAD, 0.0, 0.0]
             finger.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+        from g1_control.robot import dex3
+
+        for side in dex3.SIDES:
+            for name, limit in zip(dex3.joint_names(side), dex3.hand_limits(side).effort_nm, strict=True):
+                # the hand's motor law in the bias (ctrl unused), holding the open pose until commanded
+                motor = spec.add_actuator(name=name.removesuffix("_joint"), target=name)
+                motor.trntype = mujoco.mjtTrn.mjTRN_JOINT
+                motor.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+                motor.gainprm[0] = 0.0
+                motor.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+                motor.biasprm[:3] = [0.0, -FINGER_STIFFNESS_NM_PER_RAD, 0.0]
+                motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+                motor.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+                motor.forcerange = [-float(limit), float(limit)]
 
     # Collisions: robot geoms touch the floor only (contype 0 / conaffinity 1 vs floor 1 / 0), so a
     # fallen robot lies on the floor instead of sinking through it. The URDF importer marks visual

@@ -15,6 +15,11 @@ tests/sim/test_mujoco_motor_law.py holds both to motor_law.py. State comes out a
 reports it (IMU quaternion/gyro/accelerometer at the pelvis, joint q/dq/tau), plus ground truth
 that only a simulator has (base position and velocity), for tests and logs.
 
+Dex3 hands (MujocoConfig.hands 'dex3'): each finger joint has a motor after the body's 29 under
+the hand's own motor law (HandCmd_'s q, dq, kp, kd, tau), written with write_fingers and read with
+read_fingers (the torque is what the motor applied), applied at once (no latency draw); the loop
+drives them through the hands' safety layer (sim/mujoco_hands.py, loop/hands.py).
+
 Friction is Coulomb's in every scene, the bare floor included (SceneConfig.grip_physics: elliptic
 cones, impratio 100; MuJoCo's defaults let stance feet slide inside the friction they were given).
 
@@ -38,10 +43,10 @@ import numpy as np
 
 from g1_control.errors import RobotDescriptionError
 from g1_control.interfaces import Backend
-from g1_control.robot import description, g1
+from g1_control.robot import description, dex3, g1
 from g1_control.scene import SceneConfig
 from g1_control.sim.randomize import RandomizeConfig, RobotDraw, draw
-from g1_control.types import MotorCommand, RobotState
+from g1_control.types import FingerCommand, FingerState, MotorCommand, RobotState
 
 
 def motor_law_scene(physics_dt_s: float, variant: g1.Variant = g1.G1_29DOF, hands: str = "none",
@@ -72,7 +77,8 @@ class MujocoConfig:
     init_height_clearance_m: float = 0.002
     seed: int = 0
     hands: str = "none"
-    """'dex3': the G1 with Dex3-1 hands (fingers held open, robot/description.py; 29-DoF G1 only)."""
+    """'dex3': the G1 with Dex3-1 hands (a motor per finger, holding the open pose until
+    write_fingers commands it; robot/description.py; 29-DoF G1 only)."""
     variant: str = "g1_29dof"
     """Which G1 is built (g1.VARIANTS by name; a launch file's backend.expected_variant): a variant
     without some joints has no such joints and motors in the model, and its state reports them as 0
@@ -141,6 +147,18 @@ class MujocoBackend(Backend):
         self._views = (d.qpos[self._q], d.qvel[self._v], d.actuator_force[:n], d.sensordata[self._quat],
                        d.sensordata[self._gyro], d.sensordata[self._acc], d.qpos[qa:qa + 3], d.qvel[va:va + 3])
         self._temperature = np.full(g1.NUM_JOINTS, float(self.config.motor_temperature_c))
+        # Dex3 fingers (hands 'dex3'): one motor per finger joint after the body's (robot/description.py)
+        self._fingers: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        self._finger_enabled: dict[str, np.ndarray] = {}
+        if self.config.hands == "dex3":
+            for side in dex3.SIDES:
+                fingers = dex3.joint_names(side)
+                self._fingers[side] = (np.array([m.actuator(n.removesuffix("_joint")).id for n in fingers]),
+                                       np.array([m.jnt_qposadr[m.joint(n).id] for n in fingers]),
+                                       np.array([m.jnt_dofadr[m.joint(n).id] for n in fingers]))
+                self._finger_enabled[side] = np.ones(dex3.NUM_MOTORS, dtype=bool)
+        self._finger_hold = {side: m.actuator_biasprm[acts, :3].copy() for side, (acts, _, _) in self._fingers.items()}
+        """Each hand's motor law as compiled (the open pose held), for reset()."""
         self._push_force_w = np.zeros(3)
         self._push_until_s = -1.0
         self._pushing = False
@@ -180,6 +198,9 @@ class MujocoBackend(Backend):
         )
         base[2] += -lowest + self.config.init_height_clearance_m
         self._apply_now(MotorCommand(q_rad=q.copy(), kp=g1.KP_DEFAULT.copy(), kd=g1.KD_DEFAULT.copy()))
+        for side, (acts, _, _) in self._fingers.items():  # the hands hold the open pose again
+            self.model.actuator_biasprm[acts, :3] = self._finger_hold[side]
+            self._finger_enabled[side][:] = True
         self._tick = 0
         self._push_until_s = -1.0
         self._pushing = False
@@ -316,6 +337,45 @@ class MujocoBackend(Backend):
             elif b in ground and a in watched:
                 bodies.add(int(self.model.geom_bodyid[a]))
         return tuple(sorted(self.model.body(i).name for i in bodies)) if bodies else ()
+
+    # -- Dex3 hands (hands 'dex3') ------------------------------------------------------------------
+    @property
+    def hand_sides(self) -> tuple[str, ...]:
+        """The hands this robot has fingers on (('left', 'right') with Dex3 hands, else ())."""
+        return tuple(self._fingers)
+
+    def _hand(self, side: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        dex3.check_side(side)
+        if side not in self._fingers:
+            raise RobotDescriptionError(f"this simulated G1 has no Dex3 hands (backend.hands is "
+                                        f"{self.config.hands!r}); no {side} fingers to command or read")
+        return self._fingers[side]
+
+    def write_fingers(self, side: str, command: FingerCommand) -> None:
+        """One Dex3 hand's command to its simulated motors, the hand's motor law (HandCmd_'s fields,
+        tau = kp (q* - q) + kd (dq* - dq) + tau_ff, each motor force limited to its URDF effort),
+        from the next physics step on; a disabled motor gets no torque. A non-finite command is
+        refused (ValueError) and the motors keep the last law: vetting and damping are the hands'
+        safety layer's (safety/hands.py), as on the robot."""
+        acts = self._hand(side)[0]
+        if not command.is_finite():
+            raise ValueError(f"{side} hand command is not finite; not applied")
+        on = command.enable.astype(float)
+        b = self.model.actuator_biasprm
+        b[acts, 0] = on * (command.kp * command.q_rad + command.kd * command.dq_radps + command.tau_nm)
+        b[acts, 1] = -on * command.kp
+        b[acts, 2] = -on * command.kd
+        self._finger_enabled[side] = command.enable.copy()
+
+    def read_fingers(self, side: str) -> FingerState:
+        """One hand's state as HandState_ reports it: finger angles, speeds, the motors' torque (the
+        force MuJoCo applied, within the effort limit), stamped with the simulated time."""
+        acts, qadr, vadr = self._hand(side)
+        d = self.data
+        return FingerState(q_rad=d.qpos[qadr].copy(), dq_radps=d.qvel[vadr].copy(),
+                           tau_nm=d.actuator_force[acts].copy(),
+                           temperature_c=np.full(dex3.NUM_MOTORS, float(self.config.motor_temperature_c)),
+                           motor_enabled=self._finger_enabled[side].copy(), t_s=float(d.time))
 
     # -- simulation only ----------------------------------------------------------------------------
     def push(self, force_w_n, duration_s: float) -> None:

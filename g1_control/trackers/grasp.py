@@ -10,7 +10,8 @@ only when a new state arrived. A joint whose measured torque (the hand's tau_est
 reaches touch_fraction * limit has touched: it stops closing, and its target is set once to the
 angle where it touched + hold_fraction * limit / kp in the closing direction. As the finger then
 presses in, kp (target - q) only falls, so the squeeze stays below hold_fraction * limit whatever
-the object's stiffness. Touch is declared below the limit because the target keeps moving for the
+the object's stiffness; pushed back open (the object moved by the other fingers, or loaded), the
+target follows the finger to keep that bound, so the finger gives way rather than squeeze harder. Touch is declared below the limit because the target keeps moving for the
 loop's latency after the torque rose (measured on the emulator at 1.5 rad/s, 100 Hz: ~0.13 N m of
 overshoot when joints were stopped only at the limit itself). A joint that reaches its closed
 pose without touching anything stops too. thumb_0 (which swings the thumb across the palm rather
@@ -93,6 +94,12 @@ class ForceLimitedGrasp:
         hold = state.q_rad + self.sign * self.hold_fraction * self.torque_limit_nm / self.kp
         self.target = np.where(touch, hold, self.target)
         self.touched |= touch
+        # a touched finger that the object pushes back open (the other fingers pressing it across the
+        # palm, a lift) gives way: its target follows it, so its squeeze stays at hold_fraction * limit
+        # (held only from the touch angle, a thumb was pushed 0.11 rad open and squeezed 0.73 N m
+        # against a 0.5 N m limit: a bottle in the simulated Dex3, launch/sim_bottle.yaml)
+        pushed = self.touched & (self.sign * (self.target - hold) > 0)
+        self.target = np.where(pushed, hold, self.target)
         moving = self.closing & ~self.touched & ~self.closed
         closed_pose = self.limits.closed_rad
         advanced = self.target + self.sign * self.closing_speed_radps * dt

@@ -87,13 +87,15 @@ def test_the_23dof_robot_stands_under_its_default_pd_for_a_moment():
 
 
 # -- backend.hands: dex3 ---------------------------------------------------------------------------------
-def test_dex3_hands_are_built_with_their_fingers_held_open_and_the_same_29_motors():
+def test_dex3_hands_are_built_with_their_fingers_held_open_and_a_motor_each_after_the_body_s_29():
     from g1_control.robot import description
 
     backend = MujocoBackend(MujocoConfig(hands="dex3"))
     m = backend.model
     fingers = description.finger_joint_names()
-    assert len(fingers) == 14 and m.nu == 29 and m.njnt == 1 + 29 + 14
+    assert len(fingers) == 14 and m.nu == 29 + 14 and m.njnt == 1 + 29 + 14
+    assert [m.actuator(i).name for i in range(29)] == [n.removesuffix("_joint") for n in g1.JOINT_NAMES]
+    assert sorted(m.actuator(i).name for i in range(29, 43)) == sorted(f.removesuffix("_joint") for f in fingers)
     assert np.sum(m.body_mass) == pytest.approx(34.394, abs=1e-3)  # the hand URDF's mass (rubber hands: 33.34)
     assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "left_hand_palm_link") >= 0
     assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "left_rubber_hand") == -1

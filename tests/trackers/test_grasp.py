@@ -153,3 +153,29 @@ def test_a_touching_finger_holds_a_fixed_target_below_the_limit():
 def test_a_limit_beyond_the_motors_is_refused():
     with pytest.raises(ValueError, match=r"torque_limit_nm must be in \(0, 1.4\] N m .*; got 2.0"):
         ForceLimitedGrasp("left", torque_limit_nm=2.0)
+
+
+def test_a_finger_pushed_back_open_after_touching_gives_way_instead_of_squeezing_harder():
+    """Held only from the touch angle, a thumb that the other fingers pushed 0.11 rad open squeezed 0.73 N m
+    against a 0.5 N m limit (a bottle in the simulated Dex3). Pure: states fed by hand."""
+    from g1_control.types import FingerState
+
+    grasp = ForceLimitedGrasp("right", torque_limit_nm=LIMIT_NM)
+    sign = grasp.sign
+    q = np.zeros(dex3.NUM_MOTORS)
+    grasp.act(FingerState(q_rad=q.copy(), t_s=0.0), 0.0)
+    touch = np.where(grasp.closing, sign * grasp.touch_fraction * LIMIT_NM, 0.0)  # every closing joint feels it
+    q_touch = q + sign * 0.3
+    cmd = grasp.act(FingerState(q_rad=q_touch, tau_nm=touch, t_s=0.01), 0.01)
+    assert grasp.touched[grasp.closing].all()
+    squeeze = sign * cmd.kp * (cmd.q_rad - q_touch)
+    assert np.allclose(squeeze[grasp.closing], grasp.hold_fraction * LIMIT_NM)
+    pushed = q_touch - sign * 0.11  # pushed back open
+    cmd = grasp.act(FingerState(q_rad=pushed, tau_nm=touch, t_s=0.02), 0.02)
+    squeeze = sign * cmd.kp * (cmd.q_rad - pushed)
+    assert np.all(squeeze[grasp.closing] <= grasp.hold_fraction * LIMIT_NM + 1e-9), squeeze
+    # pressed further in, the target stays where it was: the squeeze only falls
+    inward = pushed + sign * 0.05
+    cmd = grasp.act(FingerState(q_rad=inward, tau_nm=touch, t_s=0.03), 0.03)
+    squeeze = sign * cmd.kp * (cmd.q_rad - inward)
+    assert np.all(squeeze[grasp.closing] < grasp.hold_fraction * LIMIT_NM - 0.1)
