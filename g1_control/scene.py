@@ -1,4 +1,4 @@
-"""What stands around the robot: tables, platforms (steps) and boxes, in the world frame.
+"""What stands around the robot: tables, platforms (steps), boxes and bottles, in the world frame.
 
 One description serves three readers: the simulator builds it into the MuJoCo model
 (g1_control/sim/scene.py), the goal generator plans against it (where a box is, how high a table
@@ -12,6 +12,7 @@ start frame when the file is read).
       tables:    [{name: table_a, center_xy_m: [2.0, 0.0], size_xy_m: [0.5, 0.8], height_m: 0.7}]
       platforms: [{name: step, center_xy_m: [1.2, 0.0], size_xy_m: [0.6, 1.0], height_m: 0.15}]
       boxes:     [{name: box, stands_on: table_a, xy_m: [1.9, 0.0], size_m: [0.3, 0.3, 0.3], mass_kg: 2.0}]
+      bottles:   [{name: bottle, stands_on: table_a, xy_m: [1.8, 0.2], radius_m: 0.035, height_m: 0.2, mass_kg: 0.4}]
 
 Nothing here imports MuJoCo; numbers are SI (m, kg, rad).
 """
@@ -150,12 +151,41 @@ class Box:
 
 
 @dataclass
+class Bottle:
+    """A free upright cylinder (uniform density: a bottle, a can) resting on the floor or on a
+    table/platform top: what one Dex3 hand picks (generator/goals/bottle.py)."""
+
+    name: str
+    xy_m: tuple[float, float]
+    """Centre of its footprint, world frame."""
+    stands_on: str = FLOOR
+    radius_m: float = 0.035
+    height_m: float = 0.2
+    mass_kg: float = 0.4
+    friction: float = 1.0
+
+    def validate(self, where: str) -> None:
+        _check_name(self.name, where)
+        _finite(self.xy_m, 2, f"{where}.xy_m")
+        if not 0.02 <= self.radius_m <= 0.05:
+            raise LaunchFileError(f"{where}.radius_m: {self.radius_m} m is outside [0.02, 0.05] m (what one Dex3 "
+                                  "hand closes around)")
+        if not 0.08 <= self.height_m <= 0.35:
+            raise LaunchFileError(f"{where}.height_m: {self.height_m} m is outside [0.08, 0.35] m")
+        if not 0.0 < self.mass_kg <= 1.5:
+            raise LaunchFileError(f"{where}.mass_kg: {self.mass_kg} kg is outside (0, 1.5] kg (one hand)")
+        if not 0.05 <= self.friction <= 3.0:
+            raise LaunchFileError(f"{where}.friction: {self.friction} is outside [0.05, 3]")
+
+
+@dataclass
 class SceneConfig:
     """Objects around the robot (module docstring). Empty: the floor only, as before."""
 
     tables: list[Table] = field(default_factory=list)
     platforms: list[Platform] = field(default_factory=list)
     boxes: list[Box] = field(default_factory=list)
+    bottles: list[Bottle] = field(default_factory=list)
     hand_collision: bool = True
     """Give the rubber hands collision boxes (the robot description has none: without them the
     hands pass through objects)."""
@@ -168,7 +198,7 @@ class SceneConfig:
     def validate(self, where: str) -> None:
         names: dict[str, str] = {}
         groups: tuple[tuple[str, list[Any]], ...] = (("tables", self.tables), ("platforms", self.platforms),
-                                                     ("boxes", self.boxes))  # every kind has a .name
+                                                     ("boxes", self.boxes), ("bottles", self.bottles))  # each has a .name
         for kind, items in groups:
             for i, item in enumerate(items):
                 w = f"{where}.{kind}[{i}]"
@@ -181,8 +211,9 @@ class SceneConfig:
                 if b.distance_xy(np.zeros(2)) < ROBOT_CLEARANCE_M:
                     raise LaunchFileError(f"{where}.{kind}[{i}] ({b.name}): closer than {ROBOT_CLEARANCE_M} m to "
                                           "the robot's start at the origin")
-        for i, box in enumerate(self.boxes):
-            w = f"{where}.boxes[{i}]"
+        objects: list[tuple[str, Box | Bottle]] = [(f"{where}.boxes[{i}]", b) for i, b in enumerate(self.boxes)]
+        objects += [(f"{where}.bottles[{i}]", b) for i, b in enumerate(self.bottles)]
+        for w, box in objects:
             if box.stands_on != FLOOR:
                 support = self.block(box.stands_on)
                 if support is None:
@@ -196,7 +227,7 @@ class SceneConfig:
     # -- queries ------------------------------------------------------------------------------
     @property
     def empty(self) -> bool:
-        return not (self.tables or self.platforms or self.boxes)
+        return not (self.tables or self.platforms or self.boxes or self.bottles)
 
     def block_names(self) -> list[str]:
         return [b.name for b in self.tables] + [b.name for b in self.platforms]
@@ -210,8 +241,11 @@ class SceneConfig:
     def box(self, name: str) -> Box | None:
         return next((b for b in self.boxes if b.name == name), None)
 
+    def bottle(self, name: str) -> Bottle | None:
+        return next((b for b in self.bottles if b.name == name), None)
+
     def names(self) -> list[str]:
-        return self.block_names() + [b.name for b in self.boxes]
+        return self.block_names() + [b.name for b in self.boxes] + [b.name for b in self.bottles]
 
     def surface_height(self, name: str) -> float:
         """Top of a table/platform, or 0 for the floor."""
@@ -226,10 +260,14 @@ class SceneConfig:
         """Where the box's centre is at the start (world, m)."""
         return np.array([box.xy_m[0], box.xy_m[1], self.surface_height(box.stands_on) + box.size[2] / 2])
 
+    def bottle_center(self, bottle: Bottle) -> np.ndarray:
+        """Where the bottle's centre is at the start (world, m)."""
+        return np.array([bottle.xy_m[0], bottle.xy_m[1], self.surface_height(bottle.stands_on) + bottle.height_m / 2])
+
     def ground_height(self, xy_w: np.ndarray) -> float:
         """Height of what a foot stands on at xy: a platform's top, else the floor."""
         tops = [p.height_m for p in self.platforms if p.contains_xy(xy_w)]
         return max(tops, default=0.0)
 
 
-__all__ = ["FLOOR", "Block", "Box", "Platform", "SceneConfig", "Table"]
+__all__ = ["FLOOR", "Block", "Bottle", "Box", "Platform", "SceneConfig", "Table"]

@@ -35,6 +35,10 @@ BENCHMARKS = {
     "objects": ("g1_control.tools.bench_objects:main",
                 "pick a box (floor/low/table/high support, 0.15-0.45 m, 0.2-6 kg, any yaw) and put it on another "
                 "support, --trials drawn scenes judged from ground truth; a table per bucket, every refusal's reason"),
+    "bottle": ("g1_control.tools.bench_bottle:main",
+               "a bottle picked with one Dex3 hand (force-limited grasp) and put down upright, --trials drawn scenes "
+               "(table height, bottle size/mass/friction, hand, place) judged from ground truth; peak finger squeeze "
+               "against its limit; exits 1 on a fall"),
     "robust": ("g1_control.tools.bench_robust:main",
                "wbc vs ppo walking 0.6 m/s and the step (sim_step) on --draws seeded randomised robots (link mass, "
                "CoM, motor strength, latency, foot friction): falls, achieved vs commanded from ground truth; exits 1 "
@@ -51,7 +55,7 @@ BENCHMARKS = {
                  "the walking tracker's achievable velocity per axis and style; --write ships it as the command limits"),
 }
 
-FANS_OUT = ("execution", "objects", "program")
+FANS_OUT = ("bottle", "execution", "objects", "program")
 """The benchmarks whose trials fan out over --jobs processes or a --ray cluster (g1_control/fanout.py):
 their per-trial work is a function of the trial's task alone, so the figures do not depend on where it ran."""
 
@@ -70,11 +74,11 @@ def register(subparsers) -> None:
     parser.add_argument("--only", metavar="PREFIXES", help="execution/envelope/locomotion: only rows (styles, controller/case) starting with these "
                         "comma-separated prefixes; program: instruction numbers (1,5); stall: g1_29dof or g1_23dof")
     parser.add_argument("--seed", type=int, default=0, help="execution: the suite's seed (push timing; default 0); "
-                        "robust: the first draw's seed; stairs: the first seed of the draws; objects: the scenes' seed; "
+                        "robust: the first draw's seed; stairs: the first seed of the draws; objects, bottle: the scenes' seed; "
                         "stall: the instants' seed")
     parser.add_argument("--draws", type=int, default=10, help="robust: how many seeded randomised robots (default 10)")
     parser.add_argument("--trials", type=int, default=None,
-                        help="stairs: seeded draws per course (default 5); objects: drawn scenes (default 10); stall: "
+                        help="stairs: seeded draws per course (default 5); objects, bottle: drawn scenes (default 10); stall: "
                         "instants per stall length (default 8)")
     parser.add_argument("--video", metavar="DIR", help="execution: a video per behaviour into DIR")
     parser.add_argument("--trace", metavar="DIR", help="stairs: a CSV per trial into DIR (every 0.02 s: soles, "

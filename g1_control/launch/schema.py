@@ -603,9 +603,16 @@ class LaunchFile:
                 if not self.executes_goals:
                     raise LaunchFileError(f"{where}: goals are executed by tracker.type layer (got "
                                           f"{self.tracker.type}; or wbc with a scene and a generator other than scripted)")
-                if goal.object is not None and sc.box(goal.object) is None:
-                    raise LaunchFileError(f"{where}.object: '{goal.object}' is not a box of the scene; known: "
-                                          f"{', '.join(b.name for b in sc.boxes) or 'none (scene.boxes is empty)'}")
+                if goal.object is not None and sc.box(goal.object) is None and sc.bottle(goal.object) is None:
+                    objects = [b.name for b in sc.boxes] + [b.name for b in sc.bottles]
+                    raise LaunchFileError(f"{where}.object: '{goal.object}' is not a box or bottle of the scene; known: "
+                                          f"{', '.join(objects) or 'none (scene.boxes and scene.bottles are empty)'}")
+                if goal.object is not None and sc.bottle(goal.object) is not None:
+                    if self.backend.hands != "dex3":
+                        raise LaunchFileError(f"{where}: picking bottle '{goal.object}' takes a Dex3 hand "
+                                              f"(backend.hands: dex3; got {self.backend.hands})")
+                    if goal.hand == "both":
+                        raise LaunchFileError(f"{where}.hand: a bottle is picked with one hand (left or right)")
                 # a platform perception may see at run time need not be in the scene (a goal whose platform
                 # is never seen refuses then, before anything moves: generator/goals/platform.py)
                 perceived = self.estimation.perception is not None and goal.kind in ("step_up", "step_down")
@@ -618,8 +625,9 @@ class LaunchFile:
                         what = "a platform" if goal.kind in ("step_up", "step_down") else "a place"
                         raise LaunchFileError(f"{where}.target: '{goal.target}' is not {what} of the scene; known: "
                                               f"{', '.join(known) or 'none'}")
-                if goal.kind in ("pick", "place") and not sc.boxes:
-                    raise LaunchFileError(f"{where}: a {goal.kind} goal needs a box in scene.boxes")
+                if goal.kind in ("pick", "place") and not (sc.boxes or sc.bottles):
+                    raise LaunchFileError(f"{where}: a {goal.kind} goal needs a box in scene.boxes (or a bottle in "
+                                          "scene.bottles)")
                 if goal.kind == "step_up" and not sc.platforms and not perceived:
                     raise LaunchFileError(f"{where}: a step_up goal needs a platform in scene.platforms")
 
@@ -656,10 +664,10 @@ class LaunchFile:
     def executes_goals(self) -> bool:
         """Whether task goals run (the generator inside a GoalGenerator, g1_control/generator/goals/):
         tracker.type layer, or wbc walking by its own gait (a generator other than scripted) in a
-        scene with boxes, where it walks with a held box too. A scene of platforms only leaves the wbc
+        scene with boxes (or bottles), where it walks with a held box too. A scene of platforms only leaves the wbc
         its own gait (it steps onto them from the scene's terrain; step goals on wbc are not wired)."""
         return self.tracker.type == "layer" or (self.tracker.type == "wbc" and self.generator.type != "scripted"
-                                                and bool(self.scene.boxes))
+                                                and bool(self.scene.boxes or self.scene.bottles))
 
     @property
     def total_duration_s(self) -> float:

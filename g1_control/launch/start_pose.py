@@ -10,7 +10,7 @@ floor plan, motion capture's calibration) and say where the robot stands in it:
       tables: [{name: t, center_xy_m: [1.5, 1.5], ...}]      # 2 m ahead of the robot
 
 When the file is read, every position given in the scene's frame is re-expressed in the start
-frame: the tables, platforms and boxes (centres and yaws), the timeline goals' `pos_w_m`, the program's
+frame: the tables, platforms, boxes and bottles (centres and yaws), the timeline goals' `pos_w_m`, the program's
 `input.places`, and an external pose with `frame: scene` (its poses are mapped on arrival, through
 `estimation.external_pose.start_in_scene`). Heights are unchanged. Absent, the start is the scene's
 origin and nothing moves.
@@ -84,6 +84,8 @@ def to_start_frame(data: Any) -> Any:
             move(block, "center_xy_m", "yaw_rad")
     for box in scene.get("boxes") or []:
         move(box, "xy_m", "yaw_rad")
+    for bottle in scene.get("bottles") or []:
+        move(bottle, "xy_m", None)
     source = data.get("input")
     if isinstance(source, dict):
         for segment in source.get("timeline") or []:

@@ -69,6 +69,12 @@ def judge_goal(goal_id: str, info: dict, a: dict[str, np.ndarray]) -> dict:
     if len(t) == 0:
         return out
     kind = info.get("kind")
+    # the object handled: a box (both hands) or a bottle (one hand), its ground truth under its kind's key
+    what = "bottle" if info.get("bottle") else "box"
+    key = f"{what}_{info.get(what)}" if info.get(what) else None
+    if key is not None:
+        out["object_kind"] = what
+    holding = [0, 1] if what == "box" else [{"left": 0, "right": 1}[info.get("hand", "right")]]  # hands it is in
     if kind == "reach" and "hold_s" in info:
         t0, t1 = info["hold_s"]
         rows = (t >= t0) & (t <= t1)
@@ -78,20 +84,20 @@ def judge_goal(goal_id: str, info: dict, a: dict[str, np.ndarray]) -> dict:
             err = np.linalg.norm(a["hands_w_m"][rows][:, hands[0]] - target, axis=1)
             out.update(hand_error_mean_m=float(err.mean()), hand_error_max_m=float(err.max()),
                        within_tolerance=float((err <= REACH_TOLERANCE_M).mean()), hold_samples=int(rows.sum()))
-    elif kind == "pick" and info.get("box") and f"box_{info['box']}" in a:
-        box = a[f"box_{info['box']}"][:, :3]
-        start = np.asarray(info["box_start_w_m"])
+    elif kind == "pick" and key is not None and key in a:
+        box = a[key][:, :3]
+        start = np.asarray(info.get("object_start_w_m", info.get("box_start_w_m")))
         held = t >= info.get("held_from_s", np.inf)
         end = t <= (info.get("end_s") or t[-1])
         rows = held & end
         if rows.any():
             rise = box[rows, 2] - start[2]
-            hands_z = a["hands_w_m"][rows][:, :, 2].mean(axis=1)
+            hands_z = a["hands_w_m"][rows][:, holding, 2].mean(axis=1)
             rel = (box[rows, 2] - hands_z) - (box[rows, 2][0] - hands_z[0])
             out.update(box_rise_m=float(rise.mean()), slip_m=float(max(0.0, -rel.min())),
                        dropped=bool(rise.min() < info.get("lift_m", 0.1) - DROP_M))
-    elif kind == "place" and info.get("box") and f"box_{info['box']}" in a:
-        rows = a[f"box_{info['box']}"]
+    elif kind == "place" and key is not None and key in a:
+        rows = a[key]
         final, target = rows[-1], np.asarray(info["target_w_m"])
         qx, qy = final[4], final[5]
         up = 1.0 - 2.0 * (qx * qx + qy * qy)  # the box's z axis against the world's
@@ -102,7 +108,7 @@ def judge_goal(goal_id: str, info: dict, a: dict[str, np.ndarray]) -> dict:
         if "start_s" in info:
             carried = (t >= info["start_s"]) & (t <= info.get("released_s", t[-1]))
             if carried.any():
-                hands_z = a["hands_w_m"][carried][:, :, 2].mean(axis=1)
+                hands_z = a["hands_w_m"][carried][:, holding, 2].mean(axis=1)
                 rel = rows[carried, 2] - hands_z
                 out["dropped"] = bool(rel.min() < rel[0] - DROP_M)
     elif kind in ("step_up", "step_down"):
@@ -157,11 +163,12 @@ def outcome_line(o: dict) -> str:
     if o.get("kind") == "reach" and "hand_error_mean_m" in o:
         text += (f"; hand within {REACH_TOLERANCE_M * 100:.0f} cm {100 * o['within_tolerance']:.0f} % of the hold, "
                  f"mean error {o['hand_error_mean_m'] * 1000:.0f} mm")
+    what = o.get("object_kind", "box")
     if "box_rise_m" in o:
-        text += f"; box lifted {o['box_rise_m'] * 100:.1f} cm, slip {o['slip_m'] * 1000:.0f} mm" + \
+        text += f"; {what} lifted {o['box_rise_m'] * 100:.1f} cm, slip {o['slip_m'] * 1000:.0f} mm" + \
             (", DROPPED" if o["dropped"] else "")
     if "place_error_xy_m" in o:
-        text += (f"; box {o['place_error_xy_m'] * 100:.1f} cm from where it was to go (z {o['place_error_z_m'] * 100:+.1f} cm, "
+        text += (f"; {what} {o['place_error_xy_m'] * 100:.1f} cm from where it was to go (z {o['place_error_z_m'] * 100:+.1f} cm, "
                  f"tilt {o['box_tilt_deg']:.1f} deg)") + (", DROPPED on the way" if o.get("dropped") else "")
     if "both_feet_on_top_s" in o:
         text += f"; both feet on the platform {o['both_feet_on_top_s']:.1f} s"

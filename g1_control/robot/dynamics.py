@@ -134,6 +134,10 @@ class WbcModel:
         the hands (its weight share, the squeeze's reaction). update() folds them into `bias`
         (bias - J^T f), so the QP's dynamics, torque limits and foot forces account for them and
         its torques push back."""
+        self.hand_moments_w_nm = np.zeros((2, 3))
+        """Known moments on the (left, right) hand frames, world axes: a held object's weight acting
+        off the hand point (a bottle in one Dex3 hand hangs ~5 cm inside the palm). update() folds them
+        into `bias` as bias - J_ang^T m, like hand_forces_w_n."""
         self.hand_masses_kg = np.zeros(2)
         """Point masses moving rigidly with the (left, right) hand frames: a held object's inertia.
         update() adds m J^T J to `mass_matrix` and m J^T (J-dot v) to `bias` (the hand's linear
@@ -224,13 +228,18 @@ class WbcModel:
         m J^T J into the mass matrix, m J^T (J-dot v) into bias) on the 29-DoF coordinates `cols`
         that `m` (the model just computed) has."""
         forces, masses = self.hand_forces_w_n.any(), self.hand_masses_kg.any()
-        if not (forces or masses):
+        moments = self.hand_moments_w_nm.any()
+        if not (forces or masses or moments):
             return
         pin = self._pin
-        jacs = [pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED)[:3] for fid in self.hand_ids]
+        full = [pin.getFrameJacobian(m, d, fid, pin.LOCAL_WORLD_ALIGNED) for fid in self.hand_ids]
+        jacs = [jac[:3] for jac in full]
         if forces:
             for jac, force in zip(jacs, self.hand_forces_w_n):
                 self.bias[cols] -= jac.T @ force
+        if moments:
+            for jac, moment in zip(full, self.hand_moments_w_nm):
+                self.bias[cols] -= jac[3:].T @ moment
         if masses:
             block = np.ix_(cols, cols)
             for fid, jac, mass in zip(self.hand_ids, jacs, self.hand_masses_kg):

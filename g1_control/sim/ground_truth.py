@@ -13,7 +13,8 @@ from g1_control.sim.mujoco_backend import MujocoBackend
 
 
 class GroundTruthRecorder:
-    """sample(t_s) records the hand points (wrist-yaw link + 0.1 m), the sole points and each box's pose."""
+    """sample(t_s) records the hand points (wrist-yaw link + 0.1 m), the sole points and each box's and
+    bottle's pose."""
 
     def __init__(self, sim: MujocoBackend):
         m = sim.model
@@ -21,10 +22,12 @@ class GroundTruthRecorder:
         self.hands = [m.body(n).id for n in g1.HAND_BODIES]
         self.feet = [m.body(n).id for n in g1.FOOT_BODIES]
         self.boxes = [b.name for b in sim.scene.boxes]
+        self.bottles = [b.name for b in sim.scene.bottles]
         self.t: list[float] = []
         self.hand_w: list[np.ndarray] = []
         self.sole_w: list[np.ndarray] = []
         self.box_w: dict[str, list[np.ndarray]] = {b: [] for b in self.boxes}
+        self.bottle_w: dict[str, list[np.ndarray]] = {b: [] for b in self.bottles}
 
     def sample(self, t_s: float) -> None:
         d = self.data
@@ -34,13 +37,19 @@ class GroundTruthRecorder:
         for name in self.boxes:
             pos, quat = self.sim.object_pose(name)
             self.box_w[name].append(np.concatenate([pos, quat]))
+        for name in self.bottles:
+            pos, quat = self.sim.object_pose(name)
+            self.bottle_w[name].append(np.concatenate([pos, quat]))
 
     def arrays(self) -> dict[str, np.ndarray]:
-        """t_s, hands_w_m (n, 2, 3), soles_w_m (n, 2, 3), box_<name> (n, 7: position, quaternion wxyz)."""
+        """t_s, hands_w_m (n, 2, 3), soles_w_m (n, 2, 3), box_<name> and bottle_<name> (n, 7: position,
+        quaternion wxyz)."""
         out = {"t_s": np.array(self.t), "hands_w_m": np.array(self.hand_w).reshape(-1, 2, 3),
                "soles_w_m": np.array(self.sole_w).reshape(-1, 2, 3)}
         for name, rows in self.box_w.items():
             out[f"box_{name}"] = np.array(rows).reshape(-1, 7)
+        for name, rows in self.bottle_w.items():
+            out[f"bottle_{name}"] = np.array(rows).reshape(-1, 7)
         return out
 
 

@@ -30,6 +30,7 @@ HAND_BOX_CENTER_M = np.array([0.066, 0.0145, 0.010])
 HAND_BOX_HALF_M = np.array([0.066, 0.0335, 0.053])
 HAND_BODIES = ("left_rubber_hand", "right_rubber_hand")
 BOX_RGBA = (0.25, 0.7, 0.25, 1.0)
+BOTTLE_RGBA = (0.2, 0.45, 0.85, 1.0)
 """Boxes are green: apart from the robot (grey in MuJoCo, blue in the browser), the brown tables
 and the grey platforms in every video, replay and screenshot (tests look for it)."""
 
@@ -100,6 +101,19 @@ def build_scene(spec: mujoco.MjSpec, scene: SceneConfig) -> None:
         body.add_geom(name=f"{b.name}_geom", type=mujoco.mjtGeom.mjGEOM_BOX, size=(b.size / 2).tolist(),
                       mass=b.mass_kg, contype=OBJECT_COLLISION[0], conaffinity=OBJECT_COLLISION[1], condim=4,
                       friction=[b.friction, 0.01, 0.0001], rgba=list(BOX_RGBA))
+    add_bottles(spec, scene)
+
+
+def add_bottles(spec, scene: SceneConfig) -> None:
+    """The scene's bottles: free upright cylinders, each body named as the bottle (its free joint
+    `<name>_free`, as a box's), colliding with the hands and what they stand on."""
+    for b in scene.bottles:
+        center = scene.bottle_center(b)
+        body = spec.worldbody.add_body(name=b.name, pos=(center + [0.0, 0.0, 0.001]).tolist())
+        body.add_freejoint(name=f"{b.name}_free")
+        body.add_geom(name=f"{b.name}_geom", type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[b.radius_m, b.height_m / 2, 0.0],
+                      mass=b.mass_kg, contype=OBJECT_COLLISION[0], conaffinity=OBJECT_COLLISION[1], condim=4,
+                      friction=[b.friction, 0.01, 0.0001], rgba=list(BOTTLE_RGBA))
 
 
 def free_body_pose(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -108,4 +122,4 @@ def free_body_pose(model: mujoco.MjModel, data: mujoco.MjData, name: str) -> tup
     return data.qpos[adr:adr + 3].copy(), data.qpos[adr + 3:adr + 7].copy()
 
 
-__all__ = ["add_hand_collision", "build_scene", "free_body_pose", "grip_physics"]
+__all__ = ["add_bottles", "add_hand_collision", "build_scene", "free_body_pose", "grip_physics"]

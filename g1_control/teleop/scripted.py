@@ -21,7 +21,7 @@ class GoalEntry:
     kind: Literal["reach", "pick", "place", "step_up", "step_down"]
     hand: Literal["left", "right", "both"] = "right"
     object: str | None = None
-    """pick / place: a box of the scene (none: the nearest box in front / the one held)."""
+    """pick / place: a box or bottle of the scene (none: the nearest box in front / the one held)."""
     target: str | None = None
     """place: a table or platform of the scene; step_up: a platform (none: the nearest in front)."""
     pos_w_m: tuple[float, float, float] | None = None

@@ -195,16 +195,16 @@ G = "<launch>: input.timeline[1].goals[0]"
 
 
 @pytest.mark.parametrize(("goal", "scene", "message"), [
-    ({"kind": "pick", "object": "crate"}, SCENE, f"{G}.object: 'crate' is not a box of the scene; known: box"),
+    ({"kind": "pick", "object": "crate"}, SCENE, f"{G}.object: 'crate' is not a box or bottle of the scene; known: box"),
     ({"kind": "pick", "object": "crate"}, {**SCENE, "boxes": [*SCENE["boxes"], {"name": "box2", "xy_m": [1.0, 1.0]}]},
-     f"{G}.object: 'crate' is not a box of the scene; known: box, box2"),
-    ({"kind": "pick", "object": "crate"}, {}, f"{G}.object: 'crate' is not a box of the scene; known: none "
-                                              "(scene.boxes is empty)"),
+     f"{G}.object: 'crate' is not a box or bottle of the scene; known: box, box2"),
+    ({"kind": "pick", "object": "crate"}, {}, f"{G}.object: 'crate' is not a box or bottle of the scene; known: none "
+                                              "(scene.boxes and scene.bottles are empty)"),
     ({"kind": "place", "target": "shelf"}, SCENE, f"{G}.target: 'shelf' is not a place of the scene; known: table_a, "
                                                   "step, floor"),
     ({"kind": "place", "target": "step"}, {"platforms": SCENE["platforms"]}, f"{G}: a place goal needs a box in "
-                                                                              "scene.boxes"),
-    ({"kind": "pick"}, {}, f"{G}: a pick goal needs a box in scene.boxes"),
+                                                                              "scene.boxes (or a bottle in scene.bottles)"),
+    ({"kind": "pick"}, {}, f"{G}: a pick goal needs a box in scene.boxes (or a bottle in scene.bottles)"),
     ({"kind": "step_up", "target": "table_a"}, SCENE, f"{G}.target: 'table_a' is not a platform of the scene; "
                                                       "known: step"),
     ({"kind": "step_down", "target": "box"}, SCENE, f"{G}.target: 'box' is not a platform of the scene; known: step"),
@@ -215,6 +215,37 @@ G = "<launch>: input.timeline[1].goals[0]"
 ])
 def test_goal_errors_name_the_key_and_what_the_scene_has(goal, scene, message):
     _refused(_goals([goal], scene), message)
+
+
+BOTTLE_SCENE = {"tables": SCENE["tables"], "bottles": [{"name": "bottle", "stands_on": "table_a", "xy_m": [1.9, 0.2]}]}
+
+
+def test_a_bottle_goal_takes_one_dex3_hand_and_names_its_bottle():
+    wbc = {"rates": {"tracker_hz": 250}, "tracker": {"type": "wbc"}, "generator": {"type": "velocity"}}
+    pick = {"kind": "pick", "object": "bottle", "hand": "right"}
+    _refused({**_goals([pick], BOTTLE_SCENE), **wbc},
+             f"{G}: picking bottle 'bottle' takes a Dex3 hand (backend.hands: dex3; got none)")
+    dex3 = {**wbc, "backend": {"type": "mujoco", "hands": "dex3"}}
+    _refused({**_goals([{**pick, "hand": "both"}], BOTTLE_SCENE), **dex3},
+             f"{G}.hand: a bottle is picked with one hand (left or right)")
+    _refused({**_goals([{**pick, "object": "cup"}], BOTTLE_SCENE), **dex3},
+             f"{G}.object: 'cup' is not a box or bottle of the scene; known: bottle")
+    launch = parse_launch({**_goals([pick], BOTTLE_SCENE), **dex3})
+    assert launch.executes_goals and launch.scene.bottle("bottle") is not None
+
+
+@pytest.mark.parametrize(("bottle", "message"), [
+    ({"radius_m": 0.06}, "scene.bottles[0].radius_m: 0.06 m is outside [0.02, 0.05] m (what one Dex3 hand closes around)"),
+    ({"height_m": 0.5}, "scene.bottles[0].height_m: 0.5 m is outside [0.08, 0.35] m"),
+    ({"mass_kg": 2.0}, "scene.bottles[0].mass_kg: 2.0 kg is outside (0, 1.5] kg (one hand)"),
+    ({"stands_on": "shelf"}, "scene.bottles[0].stands_on: 'shelf' is not a table or platform of the scene"),
+    ({"xy_m": [2.6, 0.2]}, "scene.bottles[0].xy_m: [2.6, 0.2] is not over the top of 'table_a'"),
+    ({"name": "table_a"}, "scene.bottles[0].name: 'table_a' is already used by scene.tables[0]"),
+])
+def test_a_bad_bottle_is_refused_naming_its_key(bottle, message):
+    scene = {**BOTTLE_SCENE, "bottles": [{**BOTTLE_SCENE["bottles"][0], **bottle}]}
+    with pytest.raises(LaunchFileError, match="^<launch>: " + re.escape(message)):
+        parse_launch(_with(scene=scene))
 
 
 def test_goals_name_their_tracker_and_reach_any_scene_name():

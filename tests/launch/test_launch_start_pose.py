@@ -47,6 +47,13 @@ def test_positions_given_in_the_rooms_frame_are_read_in_the_robots_start_frame()
     assert ROOM["scene"]["robot_start"] == {"xy_m": [1.5, -0.5], "yaw_rad": math.pi / 2}, "the input is not changed"
 
 
+def test_a_bottle_given_in_the_rooms_frame_is_read_in_the_robots_start_frame():
+    scene = {**ROOM["scene"], "bottles": [{"name": "bottle", "stands_on": "t", "xy_m": [1.6, 1.5]}]}
+    launch = parse_launch({**ROOM, "scene": scene})
+    # (1.6, 1.5) in the room: 2 m ahead of the robot and 0.1 m to its right
+    np.testing.assert_allclose(launch.scene.bottles[0].xy_m, (2.0, -0.1), atol=1e-9)
+
+
 def test_the_robots_start_at_the_rooms_origin_changes_nothing():
     plain = {**ROOM, "scene": {k: v for k, v in ROOM["scene"].items() if k != "robot_start"}}
     assert to_start_frame(plain) is plain

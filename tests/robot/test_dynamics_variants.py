@@ -119,3 +119,20 @@ def test_hand_masses_add_the_loads_inertia_at_the_hands(variant):
     kept = np.concatenate([np.arange(6), 6 + np.array(variant.active_joints)])  # locked rows stay decoupled
     np.testing.assert_allclose((loaded.mass_matrix @ ddq + loaded.bias)[kept], expected[kept], atol=1e-8)
     assert np.abs(loaded.mass_matrix - plain.mass_matrix).max() > 0.1  # the load is felt
+
+
+def test_hand_moments_enter_the_dynamics_as_the_hands_angular_jacobian_transposed():
+    """A held bottle's weight acts off the hand point: its moment m there joins the bias as -J_ang^T m."""
+    import pinocchio as pin
+
+    plain, loaded = WbcModel(), WbcModel()
+    loaded.hand_moments_w_nm[1] = (0.1, -0.2, 0.05)
+    q, dq = _state(g1.G1_29DOF, seed=3)
+    qf = np.concatenate([[0.0, 0.1, 0.76, 0.0, 0.0, 0.0, 1.0], q])
+    v = np.concatenate([[0.1, 0.0, 0.0, 0.0, 0.2, 0.0], dq])
+    plain.update(qf, v)
+    loaded.update(qf, v)
+    data = plain.model.createData()
+    jac = pin.computeFrameJacobian(plain.model, data, qf, plain.hand_ids[1], pin.LOCAL_WORLD_ALIGNED)[3:]
+    np.testing.assert_allclose(loaded.bias, plain.bias - jac.T @ loaded.hand_moments_w_nm[1], atol=1e-9)
+    assert np.abs(loaded.bias - plain.bias)[6 + 22:].max() > 0.01  # the right arm feels it

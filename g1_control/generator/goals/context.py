@@ -15,7 +15,7 @@ import dataclasses
 import time
 from collections.abc import Callable, Generator, Iterator
 from dataclasses import dataclass, field
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
@@ -27,6 +27,9 @@ from g1_control.generator.whole_body import WholeBodyTrajectory
 from g1_control.robot import g1
 from g1_control.scene import Box, Platform, SceneConfig
 from g1_control.types import PHASE_LOCOMOTION, PHASE_WHOLE_BODY, RobotState, TaskGoal
+
+if TYPE_CHECKING:
+    from g1_control.generator.goals.bottle import HeldBottle
 
 ARMS = np.array(g1.ARM_JOINTS)
 T = TypeVar("T")
@@ -135,6 +138,15 @@ class GoalConfig:
     """A velocity command while a box is held walks with it: the tracker walks by its own gait with
     the held upper-body posture and the box's forces on the hands (the whole-body controller with
     footsteps 'velocity'). Off (a walking policy would drop the box), the robot stands holding it."""
+    bottle_grasp_nm: float = 0.5
+    """A bottle's one-hand grasp (goals/bottle.py): each finger motor stops squeezing at this torque
+    (trackers/grasp.py; the Dex3's motors give 1.4-2.45 N m). 0.5 N m at a finger's ~5 cm lever
+    presses ~10 N, five times what holds a 0.4 kg bottle at friction 1 between two sides."""
+    bottle_close_s: float = 1.5
+    """The hand holds still this long while its fingers close on the bottle (or open off it)."""
+    bottle_slide_s: float = 1.0
+    """The hand's moves beside the bottle (in to the grasp, the lift, down to the place, back out)."""
+    bottle_lift_m: float = 0.10
     plan_in_background: bool = False
     """Plan in the planner's own process (planner.py) while the robot holds its current reference
     (wall-clock runs: a carry's footstep plan takes ~1-2 s of CPU, which would stall the loop). Off
@@ -190,6 +202,10 @@ class GoalContext:
         self.walk = np.zeros(3)
         """The walking command (vx, vy, wz) of an approach (approach.walk_to)."""
         self.held: Held | None = None
+        self.held_bottle: HeldBottle | None = None
+        """The bottle in one hand (goals/bottle.py)."""
+        self.grasp_nm = np.zeros(2)
+        """Per hand (left, right): the finger grasp the plan asks for (KinematicReference.grasp_nm)."""
         self.on_platform: str | None = None
         self.scene.platforms[:] = self._listed_platforms
         self.platforms_seen: set[str] = set()

@@ -39,6 +39,7 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from g1_control.generator.goals.approach import enter_whole_body
+from g1_control.generator.goals.bottle import held_wrench, pick_bottle, place_bottle
 from g1_control.generator.goals.box import GRASP_DISTANCE_M
 from g1_control.generator.goals.context import ARMS, GoalConfig, GoalContext, GoalFailed, world_pose_needed
 from g1_control.generator.goals.handling import held_forces, pick, place
@@ -62,8 +63,24 @@ from g1_control.types import (
 )
 
 REACHED, FAILED = "reached", "failed"
+def pick_object(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
+    """A pick: of a bottle with one hand (bottle.py) when `object` names one, else of a box with both."""
+    if goal.object is not None and ctx.scene.bottle(goal.object) is not None:
+        return pick_bottle(ctx, goal)
+    return pick(ctx, goal)
+
+
+def place_object(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
+    """A place: of the bottle in a hand (bottle.py), else of the box held."""
+    if ctx.held_bottle is not None:
+        return place_bottle(ctx, goal)
+    if goal.object is not None and ctx.scene.bottle(goal.object) is not None:
+        raise GoalFailed(f"not holding bottle '{goal.object}'")
+    return place(ctx, goal)
+
+
 SKILLS: dict[str, Callable[[GoalContext, TaskGoal], Iterator[None]]] = {
-    "reach": reach, "pick": pick, "place": place, "step_up": step_up, "step_down": step_down}
+    "reach": reach, "pick": pick_object, "place": place_object, "step_up": step_up, "step_down": step_down}
 """Goal kind -> its skill."""
 HAND_BACK_AFTER = frozenset({"place", "step_down"})
 """Goals after which the robot hands back to the walking policy (unless it stands on a platform)."""
@@ -212,12 +229,21 @@ class GoalGenerator(Generator):
             ctx.see_platform(platform)
 
     def _reference(self, command: Command, state: RobotState) -> KinematicReference:
+        ref = self._plan_reference(command, state)
+        ref.grasp_nm = self.ctx.grasp_nm.copy()  # the fingers' grasps (loop/hands.py), whoever planned the body
+        return ref
+
+    def _plan_reference(self, command: Command, state: RobotState) -> KinematicReference:
         ctx = self.ctx
         if self._carry_q is not None:
             return self._holding_reference(command, state)
         if ctx.phase == PHASE_WHOLE_BODY:
             assert ctx.plan is not None
             j = ctx.plan.sample(ctx.t - ctx.plan_t0, self._joint)
+            if ctx.held_bottle is not None:  # its weight, off the hand point, on the holding hand
+                j.hand_forces_w_n[:], j.hand_moments_w_nm[:] = held_wrench(ctx.held_bottle, ctx.held_bottle.heading_rad)
+            else:
+                j.hand_moments_w_nm[:] = 0.0
             if ctx.overlay is not None:
                 style, t0 = ctx.overlay
                 q_now, q_next = style.pose(ctx.t - t0), style.pose(ctx.t - t0 + 0.01)

@@ -481,6 +481,7 @@ class WholeBodyTracker(Tracker):
         v[3:6] = state.imu_gyro_radps
         v[6:] = state.dq_radps
         dyn.hand_forces_w_n[:] = reference.hand_forces_w_n
+        dyn.hand_moments_w_nm[:] = reference.hand_moments_w_nm
         if self.config.held_load_inertia:
             # the load's weight share at each hand as a mass moving with it
             dyn.hand_masses_kg[:] = np.maximum(0.0, -reference.hand_forces_w_n[:, 2] / cp.GRAVITY_MPS2)

@@ -1,0 +1,271 @@
+"""One-hand pick and place of a bottle (scene.Bottle: an upright cylinder) with a Dex3-1 hand.
+
+pick (TaskGoal kind "pick", object a bottle, hand left or right), from where the robot stands:
+  1. the hand, palm upright and facing the body's midline, fingers along the heading, goes to a
+     pre-grasp point GRASP_APPROACH_M back and out from the grasp;
+  2. it slides in until the bottle sits between the thumb and the two fingers (the grasp centre,
+     GRASP_CENTRE_M from the hand point in the wrist frame, where the closing fingers meet;
+     measured on the hand URDF's finger bodies), at grasp_height_m above the bottle's base;
+  3. the plan asks for a force-limited grasp (KinematicReference.grasp_nm; the loop's hands stage
+     closes each finger until it feels the bottle, never squeezing past the limit) and holds while
+     the fingers close (GoalConfig.bottle_close_s);
+  4. the hand lifts it GoalConfig.bottle_lift_m.
+place (kind "place" while holding a bottle; pos_w_m: where its base goes, on the floor or the top of
+  table/platform `target`): the hand carries it over the point, lowers it until its base is
+  BOTTLE_PLACE_ABOVE_M over the top, opens (grasp_nm 0), and backs out the way it came in; the arms
+  go back to the standing pose.
+Both are refused before anything moves when the hand cannot get there upright within
+BOTTLE_REFUSE_M (the closest pose's error is in the reason), or when the bottle is too short to
+grasp above its support. Standing only: the bottle must be within the hand's reach from where the
+robot stands (nothing walks to it yet).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import numpy as np
+
+from g1_control.generator.goals.approach import enter_whole_body
+from g1_control.generator.goals.context import GoalContext, GoalFailed
+from g1_control.generator.goals.poses import PosePlanner, PoseResult, ReachRefused, Sole, flat_soles, stance_heading
+from g1_control.generator.whole_body import keyframe_trajectory
+from g1_control.robot import g1
+from g1_control.robot.dynamics import HAND_FRAMES
+from g1_control.rotations import rot_z
+from g1_control.scene import FLOOR, Bottle
+from g1_control.types import PHASE_WHOLE_BODY, TaskGoal
+
+GRAVITY_MPS2 = 9.81
+
+GRASP_CENTRE_M = np.array([0.027, 0.048, 0.0])
+"""The right hand's grasp centre from its hand point (robot/dynamics.py HAND_OFFSET_M), wrist-yaw
+frame (x along the fingers, y toward the palm's inside, z up when the palm stands upright); the left
+hand's mirrors it in y. Where the thumb (thumb_2) and the two fingers (index_1, middle_1) close onto
+a 7 cm cylinder: the palm link sits 0.058 m behind the hand point, the cylinder's centre 0.085 m
+along and 0.045 m inside from the palm's origin (g1_29dof_with_hand_rev_1_0.urdf, measured in MuJoCo)."""
+GRASP_APPROACH_M = np.array([-0.07, -0.06, 0.0])
+"""Pre-grasp point from the grasp (right hand, wrist frame; y mirrored for the left): back along the
+fingers and out from the bottle, so the open fingers pass beside it on the way in."""
+MIN_GRASP_ABOVE_M = 0.07
+"""The grasp centre stays this high above the bottle's support: the palm and the middle finger reach
+~0.05 m below it."""
+GRASP_BELOW_TOP_M = 0.03
+"""... and this far below the bottle's top, so the fingers close on it."""
+BOTTLE_PLACE_ABOVE_M = 0.005
+"""The bottle's base is let go this high over the support."""
+BOTTLE_BACK_OFF_M = 0.15
+"""After letting go, the hand backs off this far along the heading (the fingers clear of the table's
+edge) before the arm goes back to its standing pose."""
+BOTTLE_REFUSE_M = 0.015
+"""A hand pose further than this from its point (or tilted more than BOTTLE_REFUSE_RAD) is refused."""
+BOTTLE_REFUSE_RAD = 0.25
+BOTTLE_GOOD_M = 0.005
+"""A pose this close needs no leaning."""
+
+
+@dataclass
+class HeldBottle:
+    bottle: Bottle
+    hand: int
+    """0 left, 1 right."""
+    grasp_above_base_m: float
+    """The grasp centre's height above the bottle's base when it was picked."""
+    heading_rad: float
+    """The palm's heading while it holds the bottle (the plans keep it)."""
+
+
+def held_wrench(held: HeldBottle, heading: float) -> tuple[np.ndarray, np.ndarray]:
+    """((2, 3) forces, (2, 3) moments): the held bottle's weight on the hand point, and its moment
+    there from the grasp centre (palm upright, fingers along `heading`): JointReference.hand_forces_w_n
+    and hand_moments_w_nm, so the whole-body controller carries it. Its weight at the hand point
+    alone, the wrist rolled ~0.2 N m short and the palm tilted 25 deg (launch/sim_bottle.yaml)."""
+    forces, moments = np.zeros((2, 3)), np.zeros((2, 3))
+    weight = np.array([0.0, 0.0, -held.bottle.mass_kg * GRAVITY_MPS2])
+    forces[held.hand] = weight
+    moments[held.hand] = np.cross(rot_z(np.asarray(heading)) @ grasp_offset(held.hand), weight)
+    return forces, moments
+
+
+def grasp_offset(hand: int) -> np.ndarray:
+    """GRASP_CENTRE_M for hand `hand` (0 left, 1 right)."""
+    return GRASP_CENTRE_M * np.array([1.0, 1.0 if hand == 1 else -1.0, 1.0])
+
+
+def approach_offset(hand: int) -> np.ndarray:
+    return GRASP_APPROACH_M * np.array([1.0, 1.0 if hand == 1 else -1.0, 1.0])
+
+
+def grasp_height(bottle: Bottle) -> float:
+    """The grasp centre's height above the bottle's base; ReachRefused for a bottle too short."""
+    top = bottle.height_m - GRASP_BELOW_TOP_M
+    if top < MIN_GRASP_ABOVE_M:
+        raise ReachRefused(f"bottle '{bottle.name}' is {bottle.height_m:.2f} m tall: a Dex3 hand grasps it "
+                           f"{MIN_GRASP_ABOVE_M:.2f} m or more above its support and {GRASP_BELOW_TOP_M:.2f} m "
+                           "below its top")
+    return min(max(bottle.height_m / 2, MIN_GRASP_ABOVE_M), top)
+
+
+def hand_points(hand: int, centre_w: np.ndarray, heading: float) -> tuple[np.ndarray, np.ndarray]:
+    """(pre-grasp, grasp) points of the hand point for a grasp centre at centre_w, the palm turned to heading."""
+    rot = rot_z(np.asarray(heading))
+    grasp = centre_w - rot @ grasp_offset(hand)
+    return grasp + rot @ approach_offset(hand), grasp
+
+
+def upright_hand_pose(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], hand: int, target_w: np.ndarray,
+                      heading: float) -> PoseResult:
+    """The standing pose with hand `hand`'s point at target_w, the palm upright and its fingers along
+    `heading` (a planner job: GoalContext.compute). ReachRefused when no pose gets there."""
+    target_w = np.asarray(target_w, dtype=float)
+    rot = rot_z(np.asarray(heading))
+    frame = HAND_FRAMES[hand]
+    com = poses.com_over(soles)
+    posture = g1.DEFAULT_Q_RAD.copy()
+    arm = np.array(g1.ARM_JOINTS[:7] if hand == 0 else g1.ARM_JOINTS[7:])
+    seeds = [q0, q0.copy()]
+    seeds[1][7 + arm] = g1.DEFAULT_Q_RAD[arm]
+    best: PoseResult | None = None
+    best_tilt = math.inf
+    # the arm alone (pelvis and trunk held), then leaning the trunk in too (PosePlanner.reach's modes)
+    modes = (("arm_only", 5.0, (10.0, 10.0, 10.0)), ("lean", 0.5, (10.0, 1.0, 5.0)))
+    for mode, waist, pelvis_rot in modes:
+        weights = np.full(g1.NUM_JOINTS, 0.002)
+        weights[list(g1.WAIST_JOINTS)] = waist
+        weights[list(g1.ARM_JOINTS)] = 0.02
+        for seed in seeds:
+            q = poses._solve(seed, soles, com, q0[2], heading, posture, hands=[(frame, target_w)], hand_weight=100.0,
+                             hand_rot=[(frame, rot)], hand_rot_weight=10.0, posture_weight=weights,
+                             pelvis_rot_weight=pelvis_rot, pelvis_z_weight=100.0, com_weight=300.0, rounds=8)
+            pos, r = poses.ik.frame_pose(q, frame)
+            res = float(np.linalg.norm(pos - target_w))
+            tilt = float(np.arccos(np.clip((np.trace(rot.T @ r) - 1.0) / 2.0, -1.0, 1.0)))
+            if best is None or res + 0.05 * tilt < best.residual_m + 0.05 * best_tilt:
+                best, best_tilt = PoseResult(q, res, mode), tilt
+        if best is not None and best.residual_m <= BOTTLE_GOOD_M and best_tilt <= BOTTLE_REFUSE_RAD:
+            break
+    assert best is not None
+    if best.residual_m > BOTTLE_REFUSE_M or best_tilt > BOTTLE_REFUSE_RAD:
+        side = ("left", "right")[hand]
+        raise ReachRefused(f"{side} hand: the closest standing pose leaves the hand {best.residual_m * 100:.1f} cm "
+                           f"from the grasp and turned {math.degrees(best_tilt):.0f} deg (limits "
+                           f"{BOTTLE_REFUSE_M * 100:.1f} cm, {math.degrees(BOTTLE_REFUSE_RAD):.0f} deg)")
+    return best
+
+
+def _poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], hand: int, points: list[np.ndarray],
+           heading: float) -> list[PoseResult]:
+    """upright_hand_pose through `points` in turn, each from the one before (one planner job)."""
+    out, q = [], q0
+    for p in points:
+        res = upright_hand_pose(poses, q, soles, hand, p, heading)
+        out.append(res)
+        q = res.q
+    return out
+
+
+def _hand(goal: TaskGoal) -> int:
+    if goal.hand == "both":
+        raise ReachRefused("a bottle is picked with one hand: say left or right")
+    return 0 if goal.hand == "left" else 1
+
+
+def _move_s(ctx: GoalContext, a: np.ndarray, b: np.ndarray) -> float:
+    return ctx.config.move_s * max(1.0, float(np.abs(b[7:] - a[7:]).max()) / 1.5)
+
+
+def pick_bottle(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
+    cfg = ctx.config
+    if ctx.held is not None or ctx.held_bottle is not None:
+        what = ctx.held.box.name if ctx.held is not None else ctx.held_bottle.bottle.name  # type: ignore[union-attr]
+        raise GoalFailed(f"already holding '{what}'")
+    assert goal.object is not None
+    bottle = ctx.scene.bottle(goal.object)
+    if bottle is None:
+        raise GoalFailed(f"'{goal.object}' is not a bottle of the scene")
+    hand = _hand(goal)
+    above = grasp_height(bottle)
+    base_w = ctx.scene.bottle_center(bottle) - np.array([0.0, 0.0, bottle.height_m / 2])
+    if ctx.phase != PHASE_WHOLE_BODY:
+        yield from enter_whole_body(ctx)
+    q0 = ctx.hold_q()
+    soles = flat_soles(ctx.ik, q0)
+    heading = stance_heading(soles)
+    off = np.append(ctx.offset(), 0.0)
+    centre = base_w + off + np.array([0.0, 0.0, above])
+    pre, grasp = hand_points(hand, centre, heading)
+    lift = grasp + np.array([0.0, 0.0, cfg.bottle_lift_m])
+    # first up where the hand is, to the grasp's height: straight to the pre-grasp, the open fingers
+    # (0.15 m ahead of the palm) caught the table's edge (measured)
+    raised = ctx.poses.hand_point(q0, hand)
+    raised[2] = max(raised[2], pre[2])
+    raise_res, pre_res, grasp_res, lift_res = yield from ctx.compute("bottle grasp", _poses, q0, soles, hand,
+                                                                     [raised, pre, grasp, lift], heading)
+    ctx.note(f"pick {bottle.name}: {('left', 'right')[hand]} hand, grasp {above:.2f} m above its base, "
+             f"plan within {max(r.residual_m for r in (pre_res, grasp_res, lift_res)) * 100:.1f} cm")
+    ctx.info.update(bottle=bottle.name, hand=goal.hand, object_start_w_m=(base_w + [0.0, 0.0, bottle.height_m / 2]).tolist(),
+                    lift_m=cfg.bottle_lift_m)
+    t0 = _move_s(ctx, q0, raise_res.q)
+    t1 = t0 + _move_s(ctx, raise_res.q, pre_res.q)
+    t2 = t1 + cfg.bottle_slide_s
+    yield from ctx.run(keyframe_trajectory("bottle_reach", [(0.0, q0), (t0, raise_res.q), (t1, pre_res.q),
+                                                            (t2, grasp_res.q), (t2 + 0.3, grasp_res.q)]), keep=True)
+    ctx.grasp_nm[hand] = cfg.bottle_grasp_nm
+    yield from ctx.run(keyframe_trajectory("bottle_close", [(0.0, grasp_res.q), (cfg.bottle_close_s, grasp_res.q)]),
+                       keep=True)
+    ctx.held_bottle = HeldBottle(bottle, hand, above, heading)
+    ctx.info["held_from_s"] = ctx.t + cfg.bottle_slide_s  # lifted by the end of this move (report/outcomes.py)
+    yield from ctx.run(keyframe_trajectory("bottle_lift", [(0.0, grasp_res.q), (cfg.bottle_slide_s, lift_res.q),
+                                                           (cfg.bottle_slide_s + 0.3, lift_res.q)]), keep=True)
+
+
+def place_bottle(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
+    cfg = ctx.config
+    held = ctx.held_bottle
+    assert held is not None
+    if goal.object is not None and goal.object != held.bottle.name:
+        raise GoalFailed(f"holding '{held.bottle.name}', not '{goal.object}'")
+    if goal.pos_w_m is None:
+        raise GoalFailed(f"placing '{held.bottle.name}' needs a point (pos_w_m): where its base goes")
+    point = np.asarray(goal.pos_w_m, dtype=float)
+    if goal.target is not None and goal.target != FLOOR:
+        support = ctx.scene.block(goal.target)
+        if support is None:
+            raise ReachRefused(f"'{goal.target}' is not a table or platform of the scene")
+        top = support.height_m
+    else:
+        top = ctx.scene.ground_height(point[:2])
+    q0 = ctx.hold_q()
+    soles = flat_soles(ctx.ik, q0)
+    heading = stance_heading(soles)
+    off = np.append(ctx.offset(), 0.0)
+    hand = held.hand
+    centre = np.array([point[0], point[1], top + BOTTLE_PLACE_ABOVE_M + held.grasp_above_base_m]) + off
+    out, down = hand_points(hand, centre, heading)
+    over = down + np.array([0.0, 0.0, cfg.bottle_lift_m])
+    back = out - rot_z(np.asarray(heading)) @ np.array([BOTTLE_BACK_OFF_M, 0.0, 0.0])
+    over_res, down_res, out_res, back_res = yield from ctx.compute("bottle place", _poses, q0, soles, hand,
+                                                                   [over, down, out, back], heading)
+    target_w = np.array([point[0], point[1], top + held.bottle.height_m / 2])  # where its centre is to rest
+    ctx.info.update(bottle=held.bottle.name, hand=("left", "right")[hand], target_w_m=target_w.tolist())
+    t1 = _move_s(ctx, q0, over_res.q)
+    t2 = t1 + cfg.bottle_slide_s
+    yield from ctx.run(keyframe_trajectory("bottle_over", [(0.0, q0), (t1, over_res.q), (t2, down_res.q),
+                                                           (t2 + 0.3, down_res.q)]), keep=True)
+    ctx.grasp_nm[hand] = 0.0
+    ctx.held_bottle = None
+    ctx.info["released_s"] = ctx.t
+    yield from ctx.run(keyframe_trajectory("bottle_release", [(0.0, down_res.q), (cfg.bottle_close_s, down_res.q)]),
+                       keep=True)
+    home = back_res.q.copy()
+    home[7 + np.array(g1.ARM_JOINTS)] = g1.DEFAULT_Q_RAD[list(g1.ARM_JOINTS)]
+    t3 = cfg.bottle_slide_s
+    t4 = t3 + _move_s(ctx, out_res.q, back_res.q)
+    yield from ctx.run(keyframe_trajectory("bottle_back", [(0.0, down_res.q), (t3, out_res.q), (t4, back_res.q),
+                                                           (t4 + _move_s(ctx, back_res.q, home), home)]), keep=True)
+
+
+__all__ = ["GRASP_CENTRE_M", "HeldBottle", "grasp_height", "hand_points", "pick_bottle", "place_bottle",
+           "upright_hand_pose"]

@@ -1,0 +1,186 @@
+"""`g1 bench bottle`: a bottle picked with one Dex3-1 hand and put down upright, over drawn scenes,
+judged from MuJoCo's ground truth (issue 25: objects beyond boxes; the Dex3 hands in the simulator).
+
+Each trial is one scene drawn from the seed and the trial's index (`draw_scene`, pure): the G1 with
+Dex3 hands stands under the whole-body controller (launch/sim_bottle.yaml's chain) before a table
+0.65-0.85 m high whose near edge is 0.36 m ahead; on it a bottle (radius 0.03-0.04 m, 0.16-0.28 m
+tall, 0.2-0.8 kg, friction 0.6-1.2) 0.10-0.22 m to one side, 0.41-0.48 m ahead; the hand on that side
+picks it (a force-limited grasp, GoalConfig.bottle_grasp_nm) and puts it down 0.08-0.18 m towards
+the middle. Judged from the simulator only (not the goals' status):
+  lifted    the bottle rose >= LIFT_M above where it stood
+  held      it moved with the palm from the lift to the release (its height relative to the palm
+            changed < DROP_M)
+  placed    its base's centre ended within PLACE_TOLERANCE_M (xy) of the target, resting on the top
+            (within REST_TOLERANCE_M) and upright (< UPRIGHT_DEG)
+  squeeze   the grasping hand's closing motors' torque (what the motor applies, MuJoCo's actuator
+            force) while the grasp was asked for: the peak, against the grasp's torque limit
+  fell      the loop's fall monitor or a safety trip
+A refused goal (the planner said no before moving) counts as a failure, with its reason.
+
+    g1 bench bottle --seed 0 --trials 20 [--jobs 2] [--json out.json]
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING, cast
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from g1_control.generator.goals.executor import GoalGenerator
+    from g1_control.sim.mujoco_backend import MujocoBackend
+
+TABLE_HEIGHT_M = (0.65, 0.85)
+TABLE_NEAR_EDGE_M = 0.36
+RADIUS_M = (0.03, 0.04)
+HEIGHT_M = (0.16, 0.28)
+MASS_KG = (0.2, 0.8)
+FRICTION = (0.6, 1.2)
+AHEAD_M = (0.41, 0.48)
+SIDE_M = (0.10, 0.22)
+MOVE_M = (0.08, 0.18)
+LIFT_M = 0.05
+DROP_M = 0.03
+PLACE_TOLERANCE_M = 0.05
+REST_TOLERANCE_M = 0.01
+UPRIGHT_DEG = 10.0
+STAND_S, PICK_S, PLACE_S, SETTLE_S = 2.0, 9.0, 9.0, 1.0
+
+
+def draw_scene(seed: int, index: int) -> dict:
+    """The trial's scene (a pure function of seed and index)."""
+    rng = np.random.default_rng([seed, index])
+    hand = str(rng.choice(["left", "right"]))
+    side = 1.0 if hand == "left" else -1.0
+    height = float(rng.uniform(*TABLE_HEIGHT_M))
+    radius = float(rng.uniform(*RADIUS_M))
+    ahead = float(rng.uniform(max(AHEAD_M[0], TABLE_NEAR_EDGE_M + radius + 0.02), AHEAD_M[1]))
+    xy = (ahead, side * float(rng.uniform(*SIDE_M)))
+    target = (ahead + float(rng.uniform(-0.03, 0.03)), xy[1] - side * float(rng.uniform(*MOVE_M)))
+    return {"seed": seed, "index": index, "hand": hand, "table_height_m": height,
+            "bottle": {"xy_m": xy, "radius_m": radius, "height_m": float(rng.uniform(*HEIGHT_M)),
+                       "mass_kg": float(rng.uniform(*MASS_KG)), "friction": float(rng.uniform(*FRICTION))},
+            "target_xy_m": target}
+
+
+def scene_launch(scene: dict):
+    """The LaunchFile of a drawn scene: launch/sim_bottle.yaml's chain with the scene's table, bottle and goals."""
+    from g1_control.launch.schema import parse_launch
+
+    top = scene["table_height_m"]
+    bottle = {"name": "bottle", "stands_on": "table", **scene["bottle"]}
+    data = {
+        "name": f"bench_bottle_{scene['seed']}_{scene['index']}",
+        "backend": {"type": "mujoco", "mode": "lockstep", "physics_dt_s": 0.002, "hands": "dex3"},
+        "rates": {"lowlevel_hz": 500, "tracker_hz": 250, "input_hz": 100, "estimator_hz": 100},
+        "tracker": {"type": "wbc"}, "generator": {"type": "velocity"},
+        "scene": {"tables": [{"name": "table", "center_xy_m": [TABLE_NEAR_EDGE_M + 0.25, 0.0], "size_xy_m": [0.5, 0.9],
+                              "height_m": top}],
+                  "bottles": [bottle]},
+        "input": {"type": "scripted", "timeline": [
+            {"duration_s": STAND_S, "label": "stand"},
+            {"duration_s": PICK_S, "label": "pick", "goals": [{"kind": "pick", "object": "bottle", "hand": scene["hand"]}]},
+            {"duration_s": PLACE_S + SETTLE_S, "label": "place",
+             "goals": [{"kind": "place", "object": "bottle", "target": "table",
+                        "pos_w_m": [*scene["target_xy_m"], top]}]}]},
+        "output": {"video": False, "plot": False}, "viewer": False,
+    }
+    return parse_launch(data, str(data["name"]))
+
+
+def _tilt_deg(quat_wxyz: np.ndarray) -> float:
+    _, x, y, _ = quat_wxyz
+    return math.degrees(math.acos(min(1.0, max(-1.0, 1.0 - 2.0 * (x * x + y * y)))))
+
+
+def run_trial(task: tuple[int, int]) -> dict:
+    """One drawn scene, run and judged (a plain function of its task, for fan_out)."""
+    from g1_control.launch.builder import build_loop
+    from g1_control.robot import dex3
+
+    seed, index = task
+    scene = draw_scene(seed, index)
+    launch = scene_launch(scene)
+    loop = build_loop(launch)
+    loop.reset()
+    sim = cast("MujocoBackend", loop.backend)
+    gen = cast("GoalGenerator", loop.generator)
+    m, d = sim.model, sim.data
+    hand = scene["hand"]
+    h = dex3.SIDES.index(hand)
+    palm = m.body(f"{hand}_hand_palm_link").id
+    closing = dex3.hand_limits(hand).closing_sign != 0
+    start, _ = sim.object_pose("bottle")
+    top, height = scene["table_height_m"], scene["bottle"]["height_m"]
+    peak_tau, max_z, rel0, rel_dev = 0.0, -math.inf, None, 0.0
+    t0 = time.perf_counter()
+    end = STAND_S + PICK_S + PLACE_S + SETTLE_S
+    while loop.time_s < end - 1e-9 and not loop.fell:
+        loop.run(0.02)
+        pos, _ = sim.object_pose("bottle")
+        max_z = max(max_z, float(pos[2]))
+        ref = loop._kin_ref
+        grasping = ref is not None and float(ref.grasp_nm[h]) > 0
+        if grasping:
+            tau = sim.read_fingers(hand).tau_nm
+            peak_tau = max(peak_tau, float(np.abs(tau[closing]).max()))
+        held = gen.ctx.held_bottle is not None
+        if held and pos[2] > start[2] + 0.01:  # carried: its height against the palm's
+            rel = float(pos[2] - d.xpos[palm][2])
+            rel0 = rel if rel0 is None else rel0
+            rel_dev = max(rel_dev, abs(rel - rel0))
+    pos, quat = sim.object_pose("bottle")
+    wall = time.perf_counter() - t0
+    statuses = dict(gen.goal_status)
+    messages = dict(gen.goal_messages)
+    refused = "; ".join(f"{k}: {v}" for k, v in messages.items())
+    lifted = max_z >= start[2] + LIFT_M
+    base_xy_err = float(np.hypot(*(pos[:2] - np.asarray(scene["target_xy_m"]))))
+    resting = abs(float(pos[2]) - (top + height / 2)) <= REST_TOLERANCE_M
+    tilt = _tilt_deg(quat)
+    placed = lifted and base_xy_err <= PLACE_TOLERANCE_M and resting and tilt < UPRIGHT_DEG
+    trip = next((e for e in loop.events if e.trips), None)
+    limit = float(gen.ctx.config.bottle_grasp_nm)
+    sim.close()
+    return {**scene, "lifted": bool(lifted), "held": bool(lifted and rel_dev < DROP_M), "placed": bool(placed),
+            "place_error_m": base_xy_err, "tilt_deg": tilt, "resting": bool(resting), "rise_m": float(max_z - start[2]),
+            "slip_m": rel_dev, "peak_squeeze_nm": peak_tau, "torque_limit_nm": limit, "fell": bool(loop.fell),
+            "trip": str(trip) if trip else "", "goals": statuses, "refused": refused, "sim_s": float(loop.time_s),
+            "wall_s": wall}
+
+
+def main(args) -> int:
+    from g1_control.fanout import fan_out
+
+    n, seed = int(args.trials if args.trials is not None else 10), int(args.seed)
+    print(f"g1 bench bottle: seed {seed}, {n} drawn scenes (one Dex3 hand, whole-body controller; ground truth)")
+    print(f"{'trial':>5} {'hand':>5} {'table':>6} {'r':>6} {'h':>5} {'kg':>5}  {'lifted':>6} {'held':>5} {'placed':>6} "
+          f"{'err cm':>6} {'tilt':>5} {'squeeze/limit':>13}  detail")
+    rows = []
+    for r in fan_out(run_trial, [(seed, i) for i in range(n)], jobs=getattr(args, "jobs", 1) or 1,
+                     ray=getattr(args, "ray", None)):
+        rows.append(r)
+        b = r["bottle"]
+        detail = "FELL " + r["trip"] if r["fell"] else (r["refused"] or r["trip"])
+        print(f"{r['index']:>5} {r['hand']:>5} {r['table_height_m']:6.2f} {b['radius_m']:6.3f} {b['height_m']:5.2f} "
+              f"{b['mass_kg']:5.2f}  {'yes' if r['lifted'] else 'no':>6} {'yes' if r['held'] else 'no':>5} "
+              f"{'yes' if r['placed'] else 'no':>6} {r['place_error_m'] * 100:6.1f} {r['tilt_deg']:5.1f} "
+              f"{r['peak_squeeze_nm']:6.2f}/{r['torque_limit_nm']:.2f}  {detail[:90]}", flush=True)
+    placed = sum(r["placed"] for r in rows)
+    falls = sum(r["fell"] for r in rows)
+    over = sum(r["peak_squeeze_nm"] > r["torque_limit_nm"] for r in rows)
+    squeezes = [r["peak_squeeze_nm"] for r in rows if r["lifted"]]
+    print(f"bottle: placed {placed}/{n} (within {PLACE_TOLERANCE_M * 100:.0f} cm, upright < {UPRIGHT_DEG:.0f} deg, "
+          f"resting), lifted {sum(r['lifted'] for r in rows)}/{n}, held {sum(r['held'] for r in rows)}/{n}, "
+          f"falls {falls}; peak squeeze over the limit in {over}/{n}"
+          + (f" (peak {max(squeezes):.2f} N m)" if squeezes else ""))
+    if args.json:
+        Path(args.json).write_text(json.dumps({"seed": seed, "trials": rows, "placed": placed, "falls": falls}, indent=1))
+    return 1 if falls else 0
+
+
+__all__ = ["draw_scene", "main", "run_trial", "scene_launch"]
