@@ -277,6 +277,9 @@ def build_loop(launch: LaunchFile, *, backend: Backend | None = None, input_devi
     hands = simulated_hands(backend)
     if hands is not None:
         chain["hands"] = "Dex3-1 (simulated fingers, GuardedHands)"
+    goals = getattr(generator, "ctx", None)
+    if goals is not None:  # a GoalGenerator: its finger grasps reach fingers only through a hands stage
+        goals.fingers_driven = hands is not None
     loop = ControlLoop(backend, input_device, generator, ik, tracker, r, wallclock=wallclock,
                        safety=safety, log_capacity=capacity, estimator=estimator, localiser=localiser,
                        falls=FallMonitor(launch.fall, max_tilt_rad=safety.config.max_tilt_rad), hands=hands)

@@ -611,6 +611,10 @@ class LaunchFile:
                     if self.backend.hands != "dex3":
                         raise LaunchFileError(f"{where}: picking bottle '{goal.object}' takes a Dex3 hand "
                                               f"(backend.hands: dex3; got {self.backend.hands})")
+                    if self.backend.type != "mujoco":
+                        raise LaunchFileError(f"{where}: picking bottle '{goal.object}' needs the simulator for now "
+                                              f"(backend.type mujoco; got {self.backend.type}): on the robot the loop "
+                                              "does not drive the Dex3 fingers yet (`g1 hands grasp` does, alone)")
                     if goal.hand == "both":
                         raise LaunchFileError(f"{where}.hand: a bottle is picked with one hand (left or right)")
                 # a platform perception may see at run time need not be in the scene (a goal whose platform

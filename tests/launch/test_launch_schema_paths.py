@@ -230,6 +230,9 @@ def test_a_bottle_goal_takes_one_dex3_hand_and_names_its_bottle():
              f"{G}.hand: a bottle is picked with one hand (left or right)")
     _refused({**_goals([{**pick, "object": "cup"}], BOTTLE_SCENE), **dex3},
              f"{G}.object: 'cup' is not a box or bottle of the scene; known: bottle")
+    _refused({**_goals([pick], BOTTLE_SCENE), **wbc, "backend": {**DDS, "hands": "dex3"}},
+             f"{G}: picking bottle 'bottle' needs the simulator for now (backend.type mujoco; got unitree_dds): on the "
+             "robot the loop does not drive the Dex3 fingers yet (`g1 hands grasp` does, alone)")
     launch = parse_launch({**_goals([pick], BOTTLE_SCENE), **dex3})
     assert launch.executes_goals and launch.scene.bottle("bottle") is not None
 

@@ -186,6 +186,10 @@ def pick_bottle(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     if bottle is None:
         raise GoalFailed(f"'{goal.object}' is not a bottle of the scene")
     hand = _hand(goal)
+    if not ctx.fingers_driven:
+        raise GoalFailed(f"picking '{bottle.name}' closes a Dex3 hand, and nothing drives the fingers here (the "
+                         "simulated G1 with backend.hands: dex3 has them; on the robot `g1 hands grasp` drives them "
+                         "alone, the loop does not yet)")
     above = grasp_height(bottle)
     base_w = ctx.scene.bottle_center(bottle) - np.array([0.0, 0.0, bottle.height_m / 2])
     if ctx.phase != PHASE_WHOLE_BODY:

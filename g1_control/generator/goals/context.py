@@ -188,6 +188,9 @@ class GoalContext:
         """The current goal's entry of goal_info."""
         self.last_steps: Any = None
         """The last footstep plan (stepping.StepPlan), for inspection."""
+        self.fingers_driven = False
+        """The loop drives the Dex3 fingers (loop/hands.py; launch/builder.py sets it): without, a grasp the
+        plan asks for would close nothing, so a bottle pick refuses."""
         self.planner: PlannerProcess | None = None
         """Where plans are made beside a wall-clock loop (None: inline)."""
         if self.config.plan_in_background:
