@@ -203,6 +203,23 @@ class Retargeter(ABC):
     def solve(self, reference: KinematicReference, q_prev: np.ndarray) -> JointReference: ...
 
 
+class Hands(ABC):
+    """The loop's fingers stage (trackers/hands.py): the reference's grasps and finger angles to the
+    hands, once per tracker tick after the body's safety stage."""
+
+    @property
+    @abstractmethod
+    def tripped(self) -> str | None:
+        """Why the fingers were damped (None: not)."""
+
+    @abstractmethod
+    def reset(self) -> None: ...
+
+    @abstractmethod
+    def update(self, ref: KinematicReference | None, now_s: float, body_faulted: bool) -> None:
+        """Command the fingers from `ref`; damp them (latched) when the body's safety layer has."""
+
+
 class Tracker(ABC):
     @abstractmethod
     def act(self, reference: JointReference, state: RobotState) -> MotorCommand: ...

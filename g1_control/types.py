@@ -329,7 +329,7 @@ class KinematicReference:
     """Dex3 finger angles (14, generator.skeleton.FINGER_JOINTS order) on a G1 with hands; None otherwise."""
     grasp_nm: np.ndarray = field(default_factory=lambda: np.zeros(2))
     """Per hand (left, right): the torque limit (N m) of the force-limited finger grasp the plan asks
-    for (loop/hands.py); 0: no grasp, the fingers follow hand_q_rad (or open)."""
+    for (trackers/hands.py); 0: no grasp, the fingers follow hand_q_rad (or open)."""
     feasible_plan: JointReference | None = None
     """The tracker's reference when the generator made it feasible by construction (a sampled
     whole-body plan with exact joint velocities and hand forces; the default legs with a style's

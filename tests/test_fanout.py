@@ -74,7 +74,7 @@ def test_an_address_where_no_cluster_answers_is_refused_at_once():
 
 def test_the_command_line_says_which_benches_fan_out_and_names_an_unreachable_cluster(capsys):
     assert g1(["bench", "loop", "--jobs", "2"]) == 1
-    assert "g1 bench: error: --jobs/--ray: loop runs in this process; they apply to execution, objects, program" in \
+    assert "g1 bench: error: --jobs/--ray: loop runs in this process; they apply to bottle, execution, objects, program" in \
         capsys.readouterr().err
     port = _closed_port()
     assert g1(["bench", "execution", "--only", "walk.default.vx0.5", "--ray", f"127.0.0.1:{port}"]) == 1

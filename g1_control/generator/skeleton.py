@@ -21,12 +21,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from g1_control.errors import G1ControlError
-from g1_control.robot import g1
+from g1_control.robot import dex3, g1
 
 SIDES = ("left", "right")
-FINGER_JOINTS: tuple[str, ...] = tuple(f"{side}_hand_{f}_joint" for side in SIDES
-                                       for f in ("thumb_0", "thumb_1", "thumb_2", "index_0", "index_1",
-                                                 "middle_0", "middle_1"))
+FINGER_JOINTS: tuple[str, ...] = dex3.REFERENCE_FINGER_JOINTS
+"""The 14 finger slots (robot/dex3.py keeps the order, for the loop's hands stage to read them by name)."""
 NUM_BODY = g1.NUM_JOINTS
 NUM_FINGERS = len(FINGER_JOINTS)
 NUM_SLOTS = NUM_BODY + NUM_FINGERS

@@ -34,8 +34,8 @@ from g1_control.types import CommandLimits
 if TYPE_CHECKING:
     from g1_control.estimation.localiser import Localiser
     from g1_control.ik.stage import IKStage
-    from g1_control.loop.hands import HandsStage
     from g1_control.sim.mujoco_backend import MujocoBackend
+    from g1_control.trackers.hands import HandsStage
     from g1_control.trackers.wbc.tracker import WbcConfig
 
 CHAIN_STAGES = ("generator", "retargeter", "tracker", "rates", "safety")
@@ -74,9 +74,9 @@ def simulated_hands(backend) -> HandsStage | None:
     for any other backend: the robot's hands are driven over their own DDS topics (`g1 hands`)."""
     if not getattr(backend, "hand_sides", ()):  # MujocoBackend's, with Dex3 hands built
         return None
-    from g1_control.loop.hands import HandsStage
     from g1_control.safety.hands import GuardedHands
     from g1_control.sim.mujoco_hands import MujocoHandLink
+    from g1_control.trackers.hands import HandsStage
 
     return HandsStage(GuardedHands(MujocoHandLink(backend), clock=lambda: backend.time_s))
 

@@ -7,14 +7,13 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from g1_control.errors import InvalidCommandError, InvalidStateError, RetargetError
 from g1_control.estimation.estimator import StateEstimator
 from g1_control.estimation.localiser import Localiser
-from g1_control.interfaces import Backend, Generator, InputDevice, Retargeter, Tracker
+from g1_control.interfaces import Backend, Generator, Hands, InputDevice, Retargeter, Tracker
 from g1_control.loop.rates import LoopRates
 from g1_control.loop.scheduler import Scheduler, Stage
 from g1_control.robot import g1
@@ -23,9 +22,6 @@ from g1_control.safety import SafetyConfig, SafetyFilter
 from g1_control.safety.events import SafetyEvent
 from g1_control.safety.fall import Fall, FallMonitor
 from g1_control.types import Button, Command, ExecutionFeedback, JointReference, KinematicReference, RobotState
-
-if TYPE_CHECKING:
-    from g1_control.loop.hands import HandsStage
 
 
 @dataclass
@@ -134,7 +130,7 @@ class ControlLoop:
                  tracker: Tracker, rates: LoopRates | None = None, *, estimator: StateEstimator | None = None,
                  wallclock: bool = False, max_tilt_rad: float = 1.0, log_capacity: int = 0,
                  safety: SafetyFilter | None = None, falls: FallMonitor | None = None,
-                 localiser: Localiser | None = None, hands: HandsStage | None = None):
+                 localiser: Localiser | None = None, hands: Hands | None = None):
         self.backend, self.input, self.generator = backend, input_device, generator
         self.retargeter, self.tracker = retargeter, tracker
         self.rates = rates or LoopRates()
@@ -143,7 +139,7 @@ class ControlLoop:
         """The robot's world pose estimate (estimation/localiser.py), updated after the estimator; None:
         the loop runs none (goals and programs steer by the simulator's ground truth)."""
         self.hands = hands
-        """The Dex3 fingers' stage (loop/hands.py): the reference's grasps and finger angles through the
+        """The Dex3 fingers' stage (trackers/hands.py): the reference's grasps and finger angles through the
         hands' safety layer; None: a robot without hands (or hands the loop does not drive)."""
         self.safety = safety or SafetyFilter(SafetyConfig(max_tilt_rad=max_tilt_rad))
         self.falls = falls or FallMonitor(max_tilt_rad=self.safety.config.max_tilt_rad)

@@ -10,6 +10,7 @@ collision meshes only matter once the robot is down).
 from __future__ import annotations
 
 import functools
+import math
 import sysconfig
 from pathlib import Path
 
@@ -82,6 +83,21 @@ def finger_joint_names() -> tuple[str, ...]:
     root = ET.parse(urdf_path("dex3")).getroot()
     return tuple(j.get("name", "") for j in root.iter("joint")
                  if j.get("type") == "revolute" and "_hand_" in j.get("name", ""))
+
+
+def finger_efforts_nm() -> dict[str, float]:
+    """Each finger joint's effort limit (N m) from the hand URDF, in finger_joint_names() order."""
+    import xml.etree.ElementTree as ET
+
+    found = {j.get("name", ""): j.find("limit") for j in ET.parse(urdf_path("dex3")).getroot().iter("joint")}
+    out = {}
+    for name in finger_joint_names():
+        limit = found.get(name)
+        effort = float(limit.get("effort", "nan")) if limit is not None else math.nan
+        if not math.isfinite(effort) or effort <= 0:
+            raise RobotDescriptionError(f"the hand URDF gives {name} no positive effort limit")
+        out[name] = effort
+    return out
 
 
 def mesh_dir() -> Path:
@@ -191,20 +207,17 @@ def mujoco_spec(floor: bool = True, timestep_s: float = 0.005, variant: g1.Varia
             finger.armature = FINGER_ARMATURE_KGM2
             finger.damping = [FINGER_DAMPING_NMS_PER_RAD, 0.0, 0.0]
             finger.limited = mujoco.mjtLimited.mjLIMITED_TRUE
-        from g1_control.robot import dex3
-
-        for side in dex3.SIDES:
-            for name, limit in zip(dex3.joint_names(side), dex3.hand_limits(side).effort_nm, strict=True):
-                # the hand's motor law in the bias (ctrl unused), holding the open pose until commanded
-                motor = spec.add_actuator(name=name.removesuffix("_joint"), target=name)
-                motor.trntype = mujoco.mjtTrn.mjTRN_JOINT
-                motor.gaintype = mujoco.mjtGain.mjGAIN_FIXED
-                motor.gainprm[0] = 0.0
-                motor.biastype = mujoco.mjtBias.mjBIAS_AFFINE
-                motor.biasprm[:3] = [0.0, -FINGER_STIFFNESS_NM_PER_RAD, 0.0]
-                motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
-                motor.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
-                motor.forcerange = [-float(limit), float(limit)]
+        for name, limit in finger_efforts_nm().items():
+            # the hand's motor law in the bias (ctrl unused), holding the open pose until commanded
+            motor = spec.add_actuator(name=name.removesuffix("_joint"), target=name)
+            motor.trntype = mujoco.mjtTrn.mjTRN_JOINT
+            motor.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+            motor.gainprm[0] = 0.0
+            motor.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+            motor.biasprm[:3] = [0.0, -FINGER_STIFFNESS_NM_PER_RAD, 0.0]
+            motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+            motor.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+            motor.forcerange = [-limit, limit]
 
     # Collisions: robot geoms touch the floor only (contype 0 / conaffinity 1 vs floor 1 / 0), so a
     # fallen robot lies on the floor instead of sinking through it. The URDF importer marks visual

@@ -27,6 +27,12 @@ SIDES: tuple[Side, Side] = ("left", "right")
 FINGERS = ("thumb_0", "thumb_1", "thumb_2", "middle_0", "middle_1", "index_0", "index_1")
 """The 7 motors of one hand, in message order (the URDF's joint order)."""
 NUM_MOTORS = len(FINGERS)
+REFERENCE_FINGER_JOINTS: tuple[str, ...] = tuple(f"{side}_hand_{f}_joint" for side in ("left", "right")
+                                                 for f in ("thumb_0", "thumb_1", "thumb_2", "index_0", "index_1",
+                                                           "middle_0", "middle_1"))
+"""The 14 finger angles of a reference (KinematicReference.hand_q_rad) in the generator skeleton's slot
+order (generator/skeleton.py FINGER_JOINTS is this): left then right, index before middle, unlike the
+motors' order (FINGERS)."""
 HAND_URDF_RELATIVE = "robots/g1_description/urdf/g1_29dof_with_hand_rev_1_0.urdf"
 
 DAMPING_KD = 0.05

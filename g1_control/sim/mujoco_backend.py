@@ -18,7 +18,7 @@ that only a simulator has (base position and velocity), for tests and logs.
 Dex3 hands (MujocoConfig.hands 'dex3'): each finger joint has a motor after the body's 29 under
 the hand's own motor law (HandCmd_'s q, dq, kp, kd, tau), written with write_fingers and read with
 read_fingers (the torque is what the motor applied), applied at once (no latency draw); the loop
-drives them through the hands' safety layer (sim/mujoco_hands.py, loop/hands.py).
+drives them through the hands' safety layer (sim/mujoco_hands.py, trackers/hands.py).
 
 Friction is Coulomb's in every scene, the bare floor included (SceneConfig.grip_physics: elliptic
 cones, impratio 100; MuJoCo's defaults let stance feet slide inside the friction they were given).

@@ -83,9 +83,9 @@ def test_a_robot_without_hands_has_no_fingers_to_command_and_says_so():
 
 
 def _stage(backend):
-    from g1_control.loop.hands import HandsStage
     from g1_control.safety.hands import GuardedHands
     from g1_control.sim.mujoco_hands import MujocoHandLink
+    from g1_control.trackers.hands import HandsStage
 
     return HandsStage(GuardedHands(MujocoHandLink(backend), clock=lambda: backend.time_s))
 

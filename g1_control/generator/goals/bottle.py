@@ -24,12 +24,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from dataclasses import dataclass
 
 import numpy as np
 
 from g1_control.generator.goals.approach import enter_whole_body
-from g1_control.generator.goals.context import GoalContext, GoalFailed
+from g1_control.generator.goals.context import GoalContext, GoalFailed, HeldBottle
 from g1_control.generator.goals.poses import PosePlanner, PoseResult, ReachRefused, Sole, flat_soles, stance_heading
 from g1_control.generator.whole_body import keyframe_trajectory
 from g1_control.robot import g1
@@ -64,17 +63,6 @@ BOTTLE_REFUSE_M = 0.015
 BOTTLE_REFUSE_RAD = 0.25
 BOTTLE_GOOD_M = 0.005
 """A pose this close needs no leaning."""
-
-
-@dataclass
-class HeldBottle:
-    bottle: Bottle
-    hand: int
-    """0 left, 1 right."""
-    grasp_above_base_m: float
-    """The grasp centre's height above the bottle's base when it was picked."""
-    heading_rad: float
-    """The palm's heading while it holds the bottle (the plans keep it)."""
 
 
 def held_wrench(held: HeldBottle, heading: float) -> tuple[np.ndarray, np.ndarray]:
@@ -271,5 +259,5 @@ def place_bottle(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
                                                            (t4 + _move_s(ctx, back_res.q, home), home)]), keep=True)
 
 
-__all__ = ["GRASP_CENTRE_M", "HeldBottle", "grasp_height", "hand_points", "pick_bottle", "place_bottle",
+__all__ = ["GRASP_CENTRE_M", "grasp_height", "hand_points", "pick_bottle", "place_bottle",
            "upright_hand_pose"]

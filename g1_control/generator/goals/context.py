@@ -15,7 +15,7 @@ import dataclasses
 import time
 from collections.abc import Callable, Generator, Iterator
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -25,11 +25,8 @@ from g1_control.generator.goals.stepping import SteppingConfig
 from g1_control.generator.styles import UpperBodyStyle
 from g1_control.generator.whole_body import WholeBodyTrajectory
 from g1_control.robot import g1
-from g1_control.scene import Box, Platform, SceneConfig
+from g1_control.scene import Bottle, Box, Platform, SceneConfig
 from g1_control.types import PHASE_LOCOMOTION, PHASE_WHOLE_BODY, RobotState, TaskGoal
-
-if TYPE_CHECKING:
-    from g1_control.generator.goals.bottle import HeldBottle
 
 ARMS = np.array(g1.ARM_JOINTS)
 T = TypeVar("T")
@@ -166,6 +163,19 @@ class Held:
     """The hands above the box's centre (stances.hand_height at the pick)."""
 
 
+@dataclass
+class HeldBottle:
+    """A bottle in one hand (goals/bottle.py)."""
+
+    bottle: Bottle
+    hand: int
+    """0 left, 1 right."""
+    grasp_above_base_m: float
+    """The grasp centre's height above the bottle's base when it was picked."""
+    heading_rad: float
+    """The palm's heading while it holds the bottle (the plans keep it)."""
+
+
 class GoalContext:
     """The state the goal skills and the executor share (module docstring)."""
 
@@ -189,7 +199,7 @@ class GoalContext:
         self.last_steps: Any = None
         """The last footstep plan (stepping.StepPlan), for inspection."""
         self.fingers_driven = False
-        """The loop drives the Dex3 fingers (loop/hands.py; launch/builder.py sets it): without, a grasp the
+        """The loop drives the Dex3 fingers (trackers/hands.py; launch/builder.py sets it): without, a grasp the
         plan asks for would close nothing, so a bottle pick refuses."""
         self.planner: PlannerProcess | None = None
         """Where plans are made beside a wall-clock loop (None: inline)."""

@@ -230,7 +230,7 @@ class GoalGenerator(Generator):
 
     def _reference(self, command: Command, state: RobotState) -> KinematicReference:
         ref = self._plan_reference(command, state)
-        ref.grasp_nm = self.ctx.grasp_nm.copy()  # the fingers' grasps (loop/hands.py), whoever planned the body
+        ref.grasp_nm = self.ctx.grasp_nm.copy()  # the fingers' grasps (trackers/hands.py), whoever planned the body
         return ref
 
     def _plan_reference(self, command: Command, state: RobotState) -> KinematicReference:

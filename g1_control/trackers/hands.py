@@ -1,4 +1,4 @@
-"""The control loop's fingers: the reference's hands, through the hands' safety layer.
+"""The control loop's fingers (its "hands" stage): the reference's hands, through the hands' safety layer.
 
 Per Dex3-1 hand, every hands tick:
 - the plan asks for a grasp (KinematicReference.grasp_nm[hand] > 0): a ForceLimitedGrasp
@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from g1_control.generator.skeleton import FINGER_JOINTS
+from g1_control.interfaces import Hands
 from g1_control.robot import dex3
 from g1_control.safety.hands import GuardedHands
 from g1_control.trackers.grasp import ForceLimitedGrasp
@@ -30,11 +30,11 @@ FOLLOW_KD = 0.05
 
 
 def _finger_slots(side: dex3.Side) -> np.ndarray:
-    """Indices into hand_q_rad (skeleton.FINGER_JOINTS order) of the hand's motors, in motor order."""
-    return np.array([FINGER_JOINTS.index(name) for name in dex3.joint_names(side)])
+    """Indices into hand_q_rad (dex3.REFERENCE_FINGER_JOINTS order) of the hand's motors, in motor order."""
+    return np.array([dex3.REFERENCE_FINGER_JOINTS.index(name) for name in dex3.joint_names(side)])
 
 
-class HandsStage:
+class HandsStage(Hands):
     def __init__(self, hands: GuardedHands):
         self.hands = hands
         self.sides: tuple[dex3.Side, ...] = tuple(hands.link.sides)
