@@ -2,11 +2,13 @@
 judged from MuJoCo's ground truth (issue 25: objects beyond boxes; the Dex3 hands in the simulator).
 
 Each trial is one scene drawn from the seed and the trial's index (`draw_scene`, pure): the G1 with
-Dex3 hands stands under the whole-body controller (launch/sim_bottle.yaml's chain) before a table
-0.65-0.85 m high whose near edge is 0.36 m ahead; on it a bottle (radius 0.03-0.04 m, 0.16-0.28 m
-tall, 0.2-0.8 kg, friction 0.6-1.2) 0.10-0.22 m to one side, 0.41-0.48 m ahead; the hand on that side
-picks it (a force-limited grasp, GoalConfig.bottle_grasp_nm) and puts it down 0.08-0.18 m towards
-the middle. Judged from the simulator only (not the goals' status):
+Dex3 hands (launch/sim_bottle.yaml's chain: the whole-body controller, its own gait) starts before a
+table 0.65-0.85 m high, 0.5 x 0.9 m, its centre 0.75-1.8 m away within +-25 deg of straight ahead and
+turned +-20 deg more; on it, 0.05-0.12 m in from the side facing the robot and within +-0.2 m of that
+side's middle, a bottle (radius 0.03-0.04 m, 0.16-0.28 m tall, 0.2-0.8 kg, friction 0.6-1.2); the
+left or right hand picks it (walking to it first when it is out of reach, goals/bottle.py; a
+force-limited grasp, GoalConfig.bottle_grasp_nm) and puts it down 0.08-0.18 m across, towards the
+other hand. Judged from the simulator only (not the goals' status):
   lifted    the bottle rose >= LIFT_M above where it stood
   held      it moved with the palm from the lift to the release (its height relative to the palm
             changed < DROP_M)
@@ -35,20 +37,24 @@ if TYPE_CHECKING:
     from g1_control.sim.mujoco_backend import MujocoBackend
 
 TABLE_HEIGHT_M = (0.65, 0.85)
-TABLE_NEAR_EDGE_M = 0.36
+TABLE_SIZE_M = (0.5, 0.9)
+TABLE_DISTANCE_M = (0.75, 1.8)
+TABLE_BEARING_DEG = 25.0
+TABLE_TURN_DEG = 20.0
+INSET_M = (0.05, 0.12)
+"""The bottle's edge this far in from the table's side that faces the robot."""
+ALONG_M = 0.2
 RADIUS_M = (0.03, 0.04)
 HEIGHT_M = (0.16, 0.28)
 MASS_KG = (0.2, 0.8)
 FRICTION = (0.6, 1.2)
-AHEAD_M = (0.41, 0.48)
-SIDE_M = (0.10, 0.22)
 MOVE_M = (0.08, 0.18)
 LIFT_M = 0.05
 DROP_M = 0.03
 PLACE_TOLERANCE_M = 0.05
 REST_TOLERANCE_M = 0.01
 UPRIGHT_DEG = 10.0
-STAND_S, PICK_S, PLACE_S, SETTLE_S = 2.0, 9.0, 9.0, 1.0
+STAND_S, PICK_S, PLACE_S, SETTLE_S = 2.0, 30.0, 12.0, 1.0
 
 
 def draw_scene(seed: int, index: int) -> dict:
@@ -58,13 +64,21 @@ def draw_scene(seed: int, index: int) -> dict:
     side = 1.0 if hand == "left" else -1.0
     height = float(rng.uniform(*TABLE_HEIGHT_M))
     radius = float(rng.uniform(*RADIUS_M))
-    ahead = float(rng.uniform(max(AHEAD_M[0], TABLE_NEAR_EDGE_M + radius + 0.02), AHEAD_M[1]))
-    xy = (ahead, side * float(rng.uniform(*SIDE_M)))
-    target = (ahead + float(rng.uniform(-0.03, 0.03)), xy[1] - side * float(rng.uniform(*MOVE_M)))
+    bearing = math.radians(float(rng.uniform(-TABLE_BEARING_DEG, TABLE_BEARING_DEG)))
+    yaw = bearing + math.radians(float(rng.uniform(-TABLE_TURN_DEG, TABLE_TURN_DEG)))
+    centre = float(rng.uniform(*TABLE_DISTANCE_M)) * np.array([math.cos(bearing), math.sin(bearing)])
+    rot = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
+    # in the table's frame: x from its side facing the robot (-x) inwards, y along that side
+    local = np.array([-TABLE_SIZE_M[0] / 2 + float(rng.uniform(*INSET_M)) + radius, float(rng.uniform(-ALONG_M, ALONG_M))])
+    xy = centre + rot @ local
+    # put down across, towards the other hand (the robot faces the table's x: along its -y for the left hand)
+    move = rot @ np.array([float(rng.uniform(-0.03, 0.03)), -side * float(rng.uniform(*MOVE_M))])
     return {"seed": seed, "index": index, "hand": hand, "table_height_m": height,
-            "bottle": {"xy_m": xy, "radius_m": radius, "height_m": float(rng.uniform(*HEIGHT_M)),
-                       "mass_kg": float(rng.uniform(*MASS_KG)), "friction": float(rng.uniform(*FRICTION))},
-            "target_xy_m": target}
+            "table": {"center_xy_m": [float(centre[0]), float(centre[1])], "yaw_rad": yaw},
+            "bottle": {"xy_m": (float(xy[0]), float(xy[1])), "radius_m": radius,
+                       "height_m": float(rng.uniform(*HEIGHT_M)), "mass_kg": float(rng.uniform(*MASS_KG)),
+                       "friction": float(rng.uniform(*FRICTION))},
+            "target_xy_m": (float(xy[0] + move[0]), float(xy[1] + move[1]))}
 
 
 def scene_launch(scene: dict):
@@ -78,8 +92,7 @@ def scene_launch(scene: dict):
         "backend": {"type": "mujoco", "mode": "lockstep", "physics_dt_s": 0.002, "hands": "dex3"},
         "rates": {"lowlevel_hz": 500, "tracker_hz": 250, "input_hz": 100, "estimator_hz": 100},
         "tracker": {"type": "wbc"}, "generator": {"type": "velocity"},
-        "scene": {"tables": [{"name": "table", "center_xy_m": [TABLE_NEAR_EDGE_M + 0.25, 0.0], "size_xy_m": [0.5, 0.9],
-                              "height_m": top}],
+        "scene": {"tables": [{"name": "table", **scene["table"], "size_xy_m": list(TABLE_SIZE_M), "height_m": top}],
                   "bottles": [bottle]},
         "input": {"type": "scripted", "timeline": [
             {"duration_s": STAND_S, "label": "stand"},

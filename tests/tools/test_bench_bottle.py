@@ -20,12 +20,16 @@ def test_scenes_are_drawn_from_their_ranges_the_same_for_the_same_seed_and_index
         side = 1.0 if s["hand"] == "left" else -1.0
         assert bb.TABLE_HEIGHT_M[0] <= s["table_height_m"] <= bb.TABLE_HEIGHT_M[1]
         assert bb.RADIUS_M[0] <= b["radius_m"] <= bb.RADIUS_M[1] and bb.MASS_KG[0] <= b["mass_kg"] <= bb.MASS_KG[1]
-        assert bb.SIDE_M[0] <= side * b["xy_m"][1] <= bb.SIDE_M[1], "on the picking hand's side"
-        assert b["xy_m"][0] - b["radius_m"] >= bb.TABLE_NEAR_EDGE_M + 0.02, "wholly on the table"
-        moved = side * (b["xy_m"][1] - s["target_xy_m"][1])
-        assert bb.MOVE_M[0] <= moved <= bb.MOVE_M[1], "put down towards the middle"
+        assert bb.TABLE_DISTANCE_M[0] <= np.hypot(*s["table"]["center_xy_m"]) <= bb.TABLE_DISTANCE_M[1]
         launch = bb.scene_launch(s)  # the launch file's own validation accepts every draw
-        assert launch.scene.bottles[0].radius_m == b["radius_m"] and launch.backend.hands == "dex3"
+        table, bottle = launch.scene.tables[0], launch.scene.bottles[0]
+        assert bottle.radius_m == b["radius_m"] and launch.backend.hands == "dex3"
+        # in the table's frame: near the side facing the robot (-x), put down across (y) towards the other hand
+        local, target = table.local_xy(np.array(b["xy_m"])), table.local_xy(np.array(s["target_xy_m"]))
+        inset = local[0] - b["radius_m"] + table.half[0]
+        assert bb.INSET_M[0] - 1e-9 <= inset <= bb.INSET_M[1] + 1e-9 and abs(local[1]) <= bb.ALONG_M
+        assert bb.MOVE_M[0] <= -side * (target[1] - local[1]) <= bb.MOVE_M[1] and abs(target[0] - local[0]) <= 0.03
+        assert table.contains_xy(np.array(s["target_xy_m"]), margin_m=b["radius_m"]), "put down wholly on the top"
     assert np.ptp([s["table_height_m"] for s in scenes]) > 0.1
 
 

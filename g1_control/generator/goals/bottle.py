@@ -1,7 +1,10 @@
 """One-hand pick and place of a bottle (scene.Bottle: an upright cylinder) with a Dex3-1 hand.
 
-pick (TaskGoal kind "pick", object a bottle, hand left or right), from where the robot stands:
-  1. the hand, palm upright and facing the body's midline, fingers along the heading, goes to a
+pick (TaskGoal kind "pick", object a bottle, hand left or right):
+  0. a bottle out of the hand's reach from where the robot stands (REACH_AHEAD_M, REACH_SIDE_M) is
+     walked to: the stance facing its table's nearest side, the bottle STANCE_AHEAD_M ahead and
+     STANCE_SIDE_M to the hand's side (bottle_stance; the walk and the last steps as a box's pick);
+  1. the hand, first up to the grasp's height where it is (the open fingers caught a table's edge), then palm upright and facing the body's midline, fingers along the heading, goes to a
      pre-grasp point GRASP_APPROACH_M back and out from the grasp;
   2. it slides in until the bottle sits between the thumb and the two fingers (the grasp centre,
      GRASP_CENTRE_M from the hand point in the wrist frame, where the closing fingers meet;
@@ -16,8 +19,8 @@ place (kind "place" while holding a bottle; pos_w_m: where its base goes, on the
   go back to the standing pose.
 Both are refused before anything moves when the hand cannot get there upright within
 BOTTLE_REFUSE_M (the closest pose's error is in the reason), or when the bottle is too short to
-grasp above its support. Standing only: the bottle must be within the hand's reach from where the
-robot stands (nothing walks to it yet).
+grasp above its support. The place is made from where the pick left the robot (a point out of the
+hand's reach from there is refused: carrying a bottle while walking is not built).
 """
 
 from __future__ import annotations
@@ -27,13 +30,14 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from g1_control.generator.goals.approach import enter_whole_body
+from g1_control.generator.goals.approach import correct_stance, enter_whole_body, step_to, walk_to
+from g1_control.generator.goals.box import PELVIS_TO_STANCE_MID_M, Approach, _edge_normal
 from g1_control.generator.goals.context import GoalContext, GoalFailed, HeldBottle
 from g1_control.generator.goals.poses import PosePlanner, PoseResult, ReachRefused, Sole, flat_soles, stance_heading
 from g1_control.generator.whole_body import keyframe_trajectory
 from g1_control.robot import g1
 from g1_control.robot.dynamics import HAND_FRAMES
-from g1_control.rotations import rot_z
+from g1_control.rotations import rot_z, yaw_of
 from g1_control.scene import FLOOR, Bottle
 from g1_control.types import PHASE_WHOLE_BODY, TaskGoal
 
@@ -48,6 +52,13 @@ along and 0.045 m inside from the palm's origin (g1_29dof_with_hand_rev_1_0.urdf
 GRASP_APPROACH_M = np.array([-0.07, -0.06, 0.0])
 """Pre-grasp point from the grasp (right hand, wrist frame; y mirrored for the left): back along the
 fingers and out from the bottle, so the open fingers pass beside it on the way in."""
+STANCE_AHEAD_M = 0.43
+STANCE_SIDE_M = 0.16
+"""The stance a bottle is picked from (bottle_stance): the bottle this far ahead of the pelvis and this far
+to the picking hand's side (launch/sim_bottle.yaml's layout)."""
+REACH_AHEAD_M = (0.36, 0.50)
+REACH_SIDE_M = (0.06, 0.26)
+"""A bottle within these of the pelvis (ahead; to the hand's side) is picked from where the robot stands."""
 MIN_GRASP_ABOVE_M = 0.07
 """The grasp centre stays this high above the bottle's support: the palm and the middle finger reach
 ~0.05 m below it."""
@@ -154,6 +165,31 @@ def _poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], hand: int, poi
     return out
 
 
+def bottle_stance(ctx: GoalContext, bottle: Bottle, hand: int) -> Approach | None:
+    """Where to stand to pick `bottle` with `hand`: facing the side of its table nearest to it, the bottle
+    STANCE_AHEAD_M ahead of the pelvis and STANCE_SIDE_M to the hand's side (None: on the floor)."""
+    support = ctx.scene.block(bottle.stands_on) if bottle.stands_on != FLOOR else None
+    if support is None:
+        return None
+    xy = np.asarray(bottle.xy_m, dtype=float)
+    normal, _ = _edge_normal(support, xy)
+    heading = math.atan2(-normal[1], -normal[0])
+    side = 1.0 if hand == 0 else -1.0
+    pelvis = xy - rot_z(np.asarray(heading))[:2, :2] @ np.array([STANCE_AHEAD_M, side * STANCE_SIDE_M])
+    fwd = np.array([math.cos(heading), math.sin(heading)])
+    return Approach(pelvis + PELVIS_TO_STANCE_MID_M * fwd, heading)
+
+
+def _within_reach(ctx: GoalContext, xy_w: np.ndarray, hand: int) -> bool:
+    """Whether a bottle at xy_w lies where the hand grasps it from the stance the robot stands in
+    (REACH_AHEAD_M ahead of the pelvis, REACH_SIDE_M to the hand's side)."""
+    s, pos_w = ctx.world_pose()
+    yaw = yaw_of(s.imu_quat_wxyz)
+    d = rot_z(np.asarray(yaw))[:2, :2].T @ (np.asarray(xy_w) - pos_w[:2])
+    side = 1.0 if hand == 0 else -1.0
+    return bool(REACH_AHEAD_M[0] <= d[0] <= REACH_AHEAD_M[1] and REACH_SIDE_M[0] <= side * d[1] <= REACH_SIDE_M[1])
+
+
 def _hand(goal: TaskGoal) -> int:
     if goal.hand == "both":
         raise ReachRefused("a bottle is picked with one hand: say left or right")
@@ -180,8 +216,19 @@ def pick_bottle(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
                          "alone, the loop does not yet)")
     above = grasp_height(bottle)
     base_w = ctx.scene.bottle_center(bottle) - np.array([0.0, 0.0, bottle.height_m / 2])
+    approach = bottle_stance(ctx, bottle, hand)
+    far = approach is not None and not _within_reach(ctx, base_w[:2], hand)
+    if far:
+        assert approach is not None
+        ctx.note(f"pick {bottle.name}: out of reach from here; walking to the stance beside it")
+        if ctx.phase != PHASE_WHOLE_BODY:
+            yield from walk_to(ctx, approach, out_m=cfg.approach_offset_m)
     if ctx.phase != PHASE_WHOLE_BODY:
         yield from enter_whole_body(ctx)
+    if far:
+        assert approach is not None
+        yield from step_to(ctx, approach.mid_xy + ctx.offset(), approach.heading, cfg.steps, name="approach")
+        yield from correct_stance(ctx, approach.mid_xy, approach.heading, cfg.steps)
     q0 = ctx.hold_q()
     soles = flat_soles(ctx.ik, q0)
     heading = stance_heading(soles)
