@@ -163,7 +163,7 @@ def run_trial(task: tuple[int, int]) -> dict:
             "place_error_m": base_xy_err, "tilt_deg": tilt, "resting": bool(resting), "rise_m": float(max_z - start[2]),
             "slip_m": rel_dev, "peak_squeeze_nm": peak_tau, "torque_limit_nm": limit, "fell": bool(loop.fell),
             "trip": str(trip) if trip else "", "goals": statuses, "refused": refused, "sim_s": float(loop.time_s),
-            "wall_s": wall}
+            "wall_s": wall, "log": [f"{t:.2f} {text}" for t, text in gen.log]}
 
 
 def main(args) -> int:

@@ -45,12 +45,15 @@ def test_main_runs_a_trial_prints_it_and_writes_the_json(tmp_path, capsys):
 
 
 def test_a_bottle_is_picked_with_one_dex3_hand_and_put_down_upright_within_the_squeeze_limit():
-    """g1 bench bottle's trial 1 of seed 1 (the right hand), in full: the whole-body controller, the grasp
-    through the hands' safety layer, the bottle's weight and its moment about the hand point in the
-    controller's dynamics (without the moment the palm tilted 25 deg and the bottle toppled at the
-    release; without the grasp's give-way a thumb squeezed 0.73 N m against the 0.5 N m limit)."""
-    r = bb.run_trial((1, 1))
+    """g1 bench bottle's trial 8 of seed 2 (the right hand), in full: the walk to the bottle, the whole-body
+    controller, the grasp through the hands' safety layer, the bottle's weight and its moment about the
+    hand point in the controller's dynamics (without the moment the palm tilted 25 deg and the bottle
+    toppled at the release; without the grasp's give-way a thumb squeezed 0.73 N m against the 0.5 N m
+    limit), and a sidestep to a place out of the hand's reach (refused 2.7 cm short without it)."""
+    r = bb.run_trial((2, 8))
     assert not r["fell"] and not r["refused"], r
+    assert any("walking to the stance" in line for line in r["log"])
+    assert any("stepping to put it down" in line for line in r["log"])
     assert r["lifted"] and r["held"] and r["rise_m"] > 0.08
     assert r["placed"] and r["place_error_m"] < 0.04 and r["tilt_deg"] < 3.0
     assert 0.3 < r["peak_squeeze_nm"] <= r["torque_limit_nm"]

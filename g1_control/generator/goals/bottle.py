@@ -19,8 +19,9 @@ place (kind "place" while holding a bottle; pos_w_m: where its base goes, on the
   go back to the standing pose.
 Both are refused before anything moves when the hand cannot get there upright within
 BOTTLE_REFUSE_M (the closest pose's error is in the reason), or when the bottle is too short to
-grasp above its support. The place is made from where the pick left the robot (a point out of the
-hand's reach from there is refused: carrying a bottle while walking is not built).
+grasp above its support. The place is made from where the pick left the robot; a point out of the
+hand's reach from there is stepped to sideways (the arm held as it holds the bottle), then planned
+again and refused if still out of reach (carrying a bottle while walking is not built).
 """
 
 from __future__ import annotations
@@ -260,6 +261,21 @@ def pick_bottle(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
                                                            (cfg.bottle_slide_s + 0.3, lift_res.q)]), keep=True)
 
 
+def _place_poses(ctx: GoalContext, held: HeldBottle, point: np.ndarray, top: float):
+    """(q0, over, down, out, back): the place's poses from the stance the robot stands in (ReachRefused
+    when the hand cannot get there upright)."""
+    q0 = ctx.hold_q()
+    soles = flat_soles(ctx.ik, q0)
+    heading = stance_heading(soles)
+    off = np.append(ctx.offset(), 0.0)
+    centre = np.array([point[0], point[1], top + BOTTLE_PLACE_ABOVE_M + held.grasp_above_base_m]) + off
+    out, down = hand_points(held.hand, centre, heading)
+    over = down + np.array([0.0, 0.0, ctx.config.bottle_lift_m])
+    back = out - rot_z(np.asarray(heading)) @ np.array([BOTTLE_BACK_OFF_M, 0.0, 0.0])
+    poses = yield from ctx.compute("bottle place", _poses, q0, soles, held.hand, [over, down, out, back], heading)
+    return (q0, *poses)
+
+
 def place_bottle(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     cfg = ctx.config
     held = ctx.held_bottle
@@ -276,17 +292,20 @@ def place_bottle(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
         top = support.height_m
     else:
         top = ctx.scene.ground_height(point[:2])
-    q0 = ctx.hold_q()
-    soles = flat_soles(ctx.ik, q0)
-    heading = stance_heading(soles)
-    off = np.append(ctx.offset(), 0.0)
     hand = held.hand
-    centre = np.array([point[0], point[1], top + BOTTLE_PLACE_ABOVE_M + held.grasp_above_base_m]) + off
-    out, down = hand_points(hand, centre, heading)
-    over = down + np.array([0.0, 0.0, cfg.bottle_lift_m])
-    back = out - rot_z(np.asarray(heading)) @ np.array([BOTTLE_BACK_OFF_M, 0.0, 0.0])
-    over_res, down_res, out_res, back_res = yield from ctx.compute("bottle place", _poses, q0, soles, hand,
-                                                                   [over, down, out, back], heading)
+    try:
+        q0, over_res, down_res, out_res, back_res = yield from _place_poses(ctx, held, point, top)
+    except ReachRefused as exc:
+        # out of the hand's reach from here: sidestep (the arm held as it holds the bottle) until the point
+        # lies where the pick's stance had the bottle, and plan again (refused if still out of reach)
+        q0 = ctx.hold_q()
+        heading = stance_heading(flat_soles(ctx.ik, q0))
+        side = 1.0 if hand == 0 else -1.0
+        pelvis = point[:2] - rot_z(np.asarray(heading))[:2, :2] @ np.array([STANCE_AHEAD_M, side * STANCE_SIDE_M])
+        mid = pelvis + PELVIS_TO_STANCE_MID_M * np.array([math.cos(heading), math.sin(heading)])
+        ctx.note(f"place {held.bottle.name}: {exc}; stepping to put it down from beside the point")
+        yield from step_to(ctx, mid + ctx.offset(), heading, cfg.steps, posture=q0[7:], name="place steps")
+        q0, over_res, down_res, out_res, back_res = yield from _place_poses(ctx, held, point, top)
     target_w = np.array([point[0], point[1], top + held.bottle.height_m / 2])  # where its centre is to rest
     ctx.info.update(bottle=held.bottle.name, hand=("left", "right")[hand], target_w_m=target_w.tolist())
     t1 = _move_s(ctx, q0, over_res.q)
