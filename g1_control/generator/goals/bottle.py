@@ -32,8 +32,9 @@ from collections.abc import Iterator
 import numpy as np
 
 from g1_control.generator.goals.approach import correct_stance, enter_whole_body, step_to, walk_to
-from g1_control.generator.goals.box import PELVIS_TO_STANCE_MID_M, Approach, _edge_normal
+from g1_control.generator.goals.box import PELVIS_TO_STANCE_MID_M, Approach, edge_normal
 from g1_control.generator.goals.context import GoalContext, GoalFailed, HeldBottle
+from g1_control.generator.goals.handling import GRAVITY
 from g1_control.generator.goals.poses import PosePlanner, PoseResult, ReachRefused, Sole, flat_soles, stance_heading
 from g1_control.generator.whole_body import keyframe_trajectory
 from g1_control.robot import g1
@@ -41,8 +42,6 @@ from g1_control.robot.dynamics import HAND_FRAMES
 from g1_control.rotations import rot_z, yaw_of
 from g1_control.scene import FLOOR, Bottle
 from g1_control.types import PHASE_WHOLE_BODY, TaskGoal
-
-GRAVITY_MPS2 = 9.81
 
 GRASP_CENTRE_M = np.array([0.027, 0.048, 0.0])
 """The right hand's grasp centre from its hand point (robot/dynamics.py HAND_OFFSET_M), wrist-yaw
@@ -83,19 +82,19 @@ def held_wrench(held: HeldBottle, heading: float) -> tuple[np.ndarray, np.ndarra
     and hand_moments_w_nm, so the whole-body controller carries it. Its weight at the hand point
     alone, the wrist rolled ~0.2 N m short and the palm tilted 25 deg (launch/sim_bottle.yaml)."""
     forces, moments = np.zeros((2, 3)), np.zeros((2, 3))
-    weight = np.array([0.0, 0.0, -held.bottle.mass_kg * GRAVITY_MPS2])
+    weight = np.array([0.0, 0.0, -held.bottle.mass_kg * GRAVITY])
     forces[held.hand] = weight
     moments[held.hand] = np.cross(rot_z(np.asarray(heading)) @ grasp_offset(held.hand), weight)
     return forces, moments
 
 
 def grasp_offset(hand: int) -> np.ndarray:
-    """GRASP_CENTRE_M for hand `hand` (0 left, 1 right)."""
-    return GRASP_CENTRE_M * np.array([1.0, 1.0 if hand == 1 else -1.0, 1.0])
+    """GRASP_CENTRE_M for hand `hand` (0 left, 1 right; the right hand's mirrored in y)."""
+    return GRASP_CENTRE_M * np.array([1.0, -_side(hand), 1.0])
 
 
 def approach_offset(hand: int) -> np.ndarray:
-    return GRASP_APPROACH_M * np.array([1.0, 1.0 if hand == 1 else -1.0, 1.0])
+    return GRASP_APPROACH_M * np.array([1.0, -_side(hand), 1.0])
 
 
 def grasp_height(bottle: Bottle) -> float:
@@ -173,12 +172,21 @@ def bottle_stance(ctx: GoalContext, bottle: Bottle, hand: int) -> Approach | Non
     if support is None:
         return None
     xy = np.asarray(bottle.xy_m, dtype=float)
-    normal, _ = _edge_normal(support, xy)
-    heading = math.atan2(-normal[1], -normal[0])
-    side = 1.0 if hand == 0 else -1.0
-    pelvis = xy - rot_z(np.asarray(heading))[:2, :2] @ np.array([STANCE_AHEAD_M, side * STANCE_SIDE_M])
-    fwd = np.array([math.cos(heading), math.sin(heading)])
-    return Approach(pelvis + PELVIS_TO_STANCE_MID_M * fwd, heading)
+    normal, _ = edge_normal(support, xy)
+    return stance_beside(xy, math.atan2(-normal[1], -normal[0]), hand)
+
+
+def stance_beside(xy_w: np.ndarray, heading: float, hand: int) -> Approach:
+    """The stance facing `heading` with xy_w STANCE_AHEAD_M ahead of the pelvis and STANCE_SIDE_M to
+    the side of `hand` (0 left, 1 right): where the hand picks or puts down a bottle at xy_w."""
+    pelvis = np.asarray(xy_w, dtype=float)[:2] - rot_z(np.asarray(heading))[:2, :2] @ np.array(
+        [STANCE_AHEAD_M, _side(hand) * STANCE_SIDE_M])
+    return Approach(pelvis + PELVIS_TO_STANCE_MID_M * np.array([math.cos(heading), math.sin(heading)]), heading)
+
+
+def _side(hand: int) -> float:
+    """+1 for the left hand, -1 for the right: the sign of y (left) on the hand's side."""
+    return 1.0 if hand == 0 else -1.0
 
 
 def _within_reach(ctx: GoalContext, xy_w: np.ndarray, hand: int) -> bool:
@@ -187,8 +195,7 @@ def _within_reach(ctx: GoalContext, xy_w: np.ndarray, hand: int) -> bool:
     s, pos_w = ctx.world_pose()
     yaw = yaw_of(s.imu_quat_wxyz)
     d = rot_z(np.asarray(yaw))[:2, :2].T @ (np.asarray(xy_w) - pos_w[:2])
-    side = 1.0 if hand == 0 else -1.0
-    return bool(REACH_AHEAD_M[0] <= d[0] <= REACH_AHEAD_M[1] and REACH_SIDE_M[0] <= side * d[1] <= REACH_SIDE_M[1])
+    return bool(REACH_AHEAD_M[0] <= d[0] <= REACH_AHEAD_M[1] and REACH_SIDE_M[0] <= _side(hand) * d[1] <= REACH_SIDE_M[1])
 
 
 def _hand(goal: TaskGoal) -> int:
@@ -299,12 +306,10 @@ def place_bottle(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
         # out of the hand's reach from here: sidestep (the arm held as it holds the bottle) until the point
         # lies where the pick's stance had the bottle, and plan again (refused if still out of reach)
         q0 = ctx.hold_q()
-        heading = stance_heading(flat_soles(ctx.ik, q0))
-        side = 1.0 if hand == 0 else -1.0
-        pelvis = point[:2] - rot_z(np.asarray(heading))[:2, :2] @ np.array([STANCE_AHEAD_M, side * STANCE_SIDE_M])
-        mid = pelvis + PELVIS_TO_STANCE_MID_M * np.array([math.cos(heading), math.sin(heading)])
+        stance = stance_beside(point[:2], stance_heading(flat_soles(ctx.ik, q0)), hand)
         ctx.note(f"place {held.bottle.name}: {exc}; stepping to put it down from beside the point")
-        yield from step_to(ctx, mid + ctx.offset(), heading, cfg.steps, posture=q0[7:], name="place steps")
+        yield from step_to(ctx, stance.mid_xy + ctx.offset(), stance.heading, cfg.steps, posture=q0[7:],
+                           name="place steps")
         q0, over_res, down_res, out_res, back_res = yield from _place_poses(ctx, held, point, top)
     target_w = np.array([point[0], point[1], top + held.bottle.height_m / 2])  # where its centre is to rest
     ctx.info.update(bottle=held.bottle.name, hand=("left", "right")[hand], target_w_m=target_w.tolist())

@@ -38,7 +38,7 @@ class Approach:
         return self.mid_xy - PELVIS_TO_STANCE_MID_M * np.array([math.cos(self.heading), math.sin(self.heading)])
 
 
-def _edge_normal(block: Block, xy_w: np.ndarray) -> tuple[np.ndarray, float]:
+def edge_normal(block: Block, xy_w: np.ndarray) -> tuple[np.ndarray, float]:
     """The outward normal (world) of the block's side nearest to a point on its top, and how far
     inside that side the point is."""
     local = block.local_xy(xy_w)
@@ -66,7 +66,7 @@ def pick_approach(scene: SceneConfig, box: Box, box_xy: np.ndarray, robot_xy: np
         return approach_for(box_xy, n)
     block = scene.block(box.stands_on)
     assert block is not None  # SceneConfig.validate checked it
-    normal, inside = _edge_normal(block, box_xy)
+    normal, inside = edge_normal(block, box_xy)
     if GRASP_DISTANCE_M - inside < MIN_EDGE_CLEARANCE_M:
         raise ReachRefused(f"box '{box.name}' is {inside:.2f} m inside the edge of '{block.name}': from that edge "
                            f"the pelvis would be {GRASP_DISTANCE_M - inside:.2f} m from the table (needs "
@@ -88,7 +88,7 @@ def place_target(scene: SceneConfig, box: Box, target: str | None, point_w: np.n
         raise ReachRefused(f"'{target}' is not a table or platform of the scene")
     if point_w is not None:
         xy = np.asarray(point_w[:2], dtype=float)
-        normal, inside = _edge_normal(block, xy)
+        normal, inside = edge_normal(block, xy)
         if GRASP_DISTANCE_M - inside < MIN_EDGE_CLEARANCE_M:
             raise ReachRefused(f"the point is {inside:.2f} m inside the edge of '{target}': out of reach")
     else:
