@@ -72,6 +72,8 @@ edge) before the arm goes back to its standing pose."""
 BOTTLE_REFUSE_M = 0.015
 """A hand pose further than this from its point (or tilted more than BOTTLE_REFUSE_RAD) is refused."""
 BOTTLE_REFUSE_RAD = 0.25
+BOTTLE_CROUCH_M = 0.12
+"""The last of upright_hand_pose's modes lowers the pelvis towards this much below where it stands."""
 BOTTLE_GOOD_M = 0.005
 """A pose this close needs no leaning."""
 
@@ -128,16 +130,18 @@ def upright_hand_pose(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], han
     seeds[1][7 + arm] = g1.DEFAULT_Q_RAD[arm]
     best: PoseResult | None = None
     best_tilt = math.inf
-    # the arm alone (pelvis and trunk held), then leaning the trunk in too (PosePlanner.reach's modes)
-    modes = (("arm_only", 5.0, (10.0, 10.0, 10.0)), ("lean", 0.5, (10.0, 1.0, 5.0)))
-    for mode, waist, pelvis_rot in modes:
+    # the arm alone (pelvis and trunk held), then leaning the trunk in too, then crouching as well (a low
+    # table's short bottle: PosePlanner.reach's modes)
+    modes = (("arm_only", 5.0, (10.0, 10.0, 10.0), q0[2], 100.0), ("lean", 0.5, (10.0, 1.0, 5.0), q0[2], 100.0),
+             ("crouch", 0.5, (10.0, 1.0, 5.0), q0[2] - BOTTLE_CROUCH_M, 1.0))
+    for mode, waist, pelvis_rot, pelvis_z, pelvis_z_weight in modes:
         weights = np.full(g1.NUM_JOINTS, 0.002)
         weights[list(g1.WAIST_JOINTS)] = waist
         weights[list(g1.ARM_JOINTS)] = 0.02
         for seed in seeds:
-            q = poses._solve(seed, soles, com, q0[2], heading, posture, hands=[(frame, target_w)], hand_weight=100.0,
+            q = poses._solve(seed, soles, com, pelvis_z, heading, posture, hands=[(frame, target_w)], hand_weight=100.0,
                              hand_rot=[(frame, rot)], hand_rot_weight=10.0, posture_weight=weights,
-                             pelvis_rot_weight=pelvis_rot, pelvis_z_weight=100.0, com_weight=300.0, rounds=8)
+                             pelvis_rot_weight=pelvis_rot, pelvis_z_weight=pelvis_z_weight, com_weight=300.0, rounds=8)
             pos, r = poses.ik.frame_pose(q, frame)
             res = float(np.linalg.norm(pos - target_w))
             tilt = float(np.arccos(np.clip((np.trace(rot.T @ r) - 1.0) / 2.0, -1.0, 1.0)))
