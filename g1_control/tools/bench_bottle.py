@@ -112,11 +112,15 @@ def _tilt_deg(quat_wxyz: np.ndarray) -> float:
 
 def run_trial(task: tuple[int, int]) -> dict:
     """One drawn scene, run and judged (a plain function of its task, for fan_out)."""
+    seed, index = task
+    return run_scene(draw_scene(seed, index))
+
+
+def run_scene(scene: dict) -> dict:
+    """A scene (draw_scene's form), run and judged."""
     from g1_control.launch.builder import build_loop
     from g1_control.robot import dex3
 
-    seed, index = task
-    scene = draw_scene(seed, index)
     launch = scene_launch(scene)
     loop = build_loop(launch)
     loop.reset()
@@ -196,4 +200,4 @@ def main(args) -> int:
     return 1 if falls else 0
 
 
-__all__ = ["draw_scene", "main", "run_trial", "scene_launch"]
+__all__ = ["draw_scene", "main", "run_scene", "run_trial", "scene_launch"]

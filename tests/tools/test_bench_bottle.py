@@ -45,12 +45,18 @@ def test_main_runs_a_trial_prints_it_and_writes_the_json(tmp_path, capsys):
 
 
 def test_a_bottle_is_picked_with_one_dex3_hand_and_put_down_upright_within_the_squeeze_limit():
-    """g1 bench bottle's trial 8 of seed 2 (the right hand), in full: the walk to the bottle, the whole-body
-    controller, the grasp through the hands' safety layer, the bottle's weight and its moment about the
-    hand point in the controller's dynamics (without the moment the palm tilted 25 deg and the bottle
-    toppled at the release; without the grasp's give-way a thumb squeezed 0.73 N m against the 0.5 N m
-    limit), and a sidestep to a place out of the hand's reach (refused 2.7 cm short without it)."""
-    r = bb.run_trial((2, 8))
+    """g1 bench bottle's trial 8 of seed 2 (the right hand), in full, but put down 0.40 m outward (the draw:
+    0.08-0.18 m the other way): the walk to the bottle, the whole-body controller, the grasp through the
+    hands' safety layer, the bottle's weight and its moment about the hand point in the controller's
+    dynamics (without the moment the palm tilted 25 deg and the bottle toppled at the release; without
+    the grasp's give-way a thumb squeezed 0.73 N m against the 0.5 N m limit), and a sidestep to the
+    place, out of the hand's reach from the pick's stance."""
+    scene = bb.draw_scene(2, 8)
+    table = scene["table"]
+    c, s = np.cos(table["yaw_rad"]), np.sin(table["yaw_rad"])
+    x, y = scene["bottle"]["xy_m"]
+    scene["target_xy_m"] = (x + 0.40 * s, y - 0.40 * c)  # 0.40 m along the table's -y: outward, past the right hand
+    r = bb.run_scene(scene)
     assert not r["fell"] and not r["refused"], r
     assert any("walking to the stance" in line for line in r["log"])
     assert any("stepping to put it down" in line for line in r["log"])
