@@ -65,7 +65,11 @@ class HandsStage(Hands):
             if limit > 0.0:
                 grasp = self.grasps[side]
                 if grasp is None or grasp.torque_limit_nm != limit:
-                    grasp = self.grasps[side] = ForceLimitedGrasp(side, torque_limit_nm=limit)
+                    try:
+                        grasp = self.grasps[side] = ForceLimitedGrasp(side, torque_limit_nm=limit)
+                    except ValueError as exc:  # a limit past the motors' effort: damp, never squeeze
+                        self.hands.trip(f"{side} hand: the plan's grasp is refused: {exc}; the fingers were damped")
+                        return
                 state = self.hands.link.read(side)
                 if state is None:  # no state yet: the safety layer refuses and damps (write below)
                     command = FingerCommand.damping(self.hands.link.damping_kd)

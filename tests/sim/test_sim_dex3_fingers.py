@@ -145,3 +145,14 @@ def test_the_hands_stage_sends_the_plans_finger_angles_by_name():
     q = b.read_fingers("right").q_rad
     assert q[dex3.FINGERS.index("index_0")] > 0.35 and abs(q[dex3.FINGERS.index("middle_0")]) < 0.1, q
     b.close()
+
+
+def test_a_grasp_asked_past_the_motors_effort_damps_the_fingers_with_the_reason(backend):
+    backend.reset()
+    stage = _stage(backend)
+    ref = KinematicReference()
+    ref.grasp_nm[0] = 2.0  # a finger motor gives 1.4 N m
+    stage.update(ref, backend.time_s, body_faulted=False)
+    assert stage.tripped is not None and "left hand: the plan's grasp is refused: torque_limit_nm" in stage.tripped
+    acts = np.array([backend.model.actuator(n.removesuffix("_joint")).id for n in dex3.joint_names("left")])
+    assert np.all(backend.model.actuator_biasprm[acts, 1] == 0.0)

@@ -63,6 +63,8 @@ from g1_control.types import (
 )
 
 REACHED, FAILED = "reached", "failed"
+
+
 def pick_object(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     """A pick: of a bottle with one hand (bottle.py) when `object` names one, else of a box with both."""
     if goal.object is not None and ctx.scene.bottle(goal.object) is not None:
