@@ -10,7 +10,6 @@ collision meshes only matter once the robot is down).
 from __future__ import annotations
 
 import functools
-import math
 import sysconfig
 from pathlib import Path
 
@@ -83,21 +82,6 @@ def finger_joint_names() -> tuple[str, ...]:
     root = ET.parse(urdf_path("dex3")).getroot()
     return tuple(j.get("name", "") for j in root.iter("joint")
                  if j.get("type") == "revolute" and "_hand_" in j.get("name", ""))
-
-
-def finger_efforts_nm() -> dict[str, float]:
-    """Each finger joint's effort limit (N m) from the hand URDF, in finger_joint_names() order."""
-    import xml.etree.ElementTree as ET
-
-    found = {j.get("name", ""): j.find("limit") for j in ET.parse(urdf_path("dex3")).getroot().iter("joint")}
-    out = {}
-    for name in finger_joint_names():
-        limit = found.get(name)
-        effort = float(limit.get("effort", "nan")) if limit is not None else math.nan
-        if not math.isfinite(effort) or effort <= 0:
-            raise RobotDescriptionError(f"the hand URDF gives {name} no positive effort limit")
-        out[name] = effort
-    return out
 
 
 def mesh_dir() -> Path:
@@ -207,7 +191,8 @@ def mujoco_spec(floor: bool = True, timestep_s: float = 0.005, variant: g1.Varia
             finger.armature = FINGER_ARMATURE_KGM2
             finger.damping = [FINGER_DAMPING_NMS_PER_RAD, 0.0, 0.0]
             finger.limited = mujoco.mjtLimited.mjLIMITED_TRUE
-        for name, limit in finger_efforts_nm().items():
+        for name in finger_joint_names():
+            limit = float(spec.joint(name).actfrcrange[1])  # the URDF's effort, as MuJoCo's importer read it
             # the hand's motor law in the bias (ctrl unused), holding the open pose until commanded
             motor = spec.add_actuator(name=name.removesuffix("_joint"), target=name)
             motor.trntype = mujoco.mjtTrn.mjTRN_JOINT

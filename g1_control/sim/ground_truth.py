@@ -21,35 +21,30 @@ class GroundTruthRecorder:
         self.sim, self.data = sim, sim.data
         self.hands = [m.body(n).id for n in g1.HAND_BODIES]
         self.feet = [m.body(n).id for n in g1.FOOT_BODIES]
-        self.boxes = [b.name for b in sim.scene.boxes]
-        self.bottles = [b.name for b in sim.scene.bottles]
+        self.objects = [(f"box_{b.name}", b.name) for b in sim.scene.boxes]
+        self.objects += [(f"bottle_{b.name}", b.name) for b in sim.scene.bottles]
+        """(key in arrays(), body name) of every free object the scene has."""
         self.t: list[float] = []
         self.hand_w: list[np.ndarray] = []
         self.sole_w: list[np.ndarray] = []
-        self.box_w: dict[str, list[np.ndarray]] = {b: [] for b in self.boxes}
-        self.bottle_w: dict[str, list[np.ndarray]] = {b: [] for b in self.bottles}
+        self.object_w: dict[str, list[np.ndarray]] = {key: [] for key, _ in self.objects}
 
     def sample(self, t_s: float) -> None:
         d = self.data
         self.t.append(t_s)
         self.hand_w.append(np.array([d.xpos[b] + d.xmat[b].reshape(3, 3) @ HAND_OFFSET_M for b in self.hands]))
         self.sole_w.append(np.array([d.xpos[b] + d.xmat[b].reshape(3, 3) @ SOLE_OFFSET_M for b in self.feet]))
-        for name in self.boxes:
+        for key, name in self.objects:
             pos, quat = self.sim.object_pose(name)
-            self.box_w[name].append(np.concatenate([pos, quat]))
-        for name in self.bottles:
-            pos, quat = self.sim.object_pose(name)
-            self.bottle_w[name].append(np.concatenate([pos, quat]))
+            self.object_w[key].append(np.concatenate([pos, quat]))
 
     def arrays(self) -> dict[str, np.ndarray]:
         """t_s, hands_w_m (n, 2, 3), soles_w_m (n, 2, 3), box_<name> and bottle_<name> (n, 7: position,
         quaternion wxyz)."""
         out = {"t_s": np.array(self.t), "hands_w_m": np.array(self.hand_w).reshape(-1, 2, 3),
                "soles_w_m": np.array(self.sole_w).reshape(-1, 2, 3)}
-        for name, rows in self.box_w.items():
-            out[f"box_{name}"] = np.array(rows).reshape(-1, 7)
-        for name, rows in self.bottle_w.items():
-            out[f"bottle_{name}"] = np.array(rows).reshape(-1, 7)
+        for key, rows in self.object_w.items():
+            out[key] = np.array(rows).reshape(-1, 7)
         return out
 
 

@@ -39,11 +39,10 @@ class HandsStage(Hands):
         self.hands = hands
         self.sides: tuple[dex3.Side, ...] = tuple(hands.link.sides)
         self._slots = {side: _finger_slots(side) for side in self.sides}
+        self._index = {side: dex3.SIDES.index(side) for side in self.sides}
         self._open = {side: dex3.hand_limits(side).open_rad for side in self.sides}
         self.grasps: dict[str, ForceLimitedGrasp | None] = {side: None for side in self.sides}
         """The grasp each hand is making (None: not grasping)."""
-        self.commands: dict[str, FingerCommand] = {}
-        """What went out to each hand on the last tick (after the safety layer)."""
 
     @property
     def tripped(self) -> str | None:
@@ -52,7 +51,6 @@ class HandsStage(Hands):
     def reset(self) -> None:
         self.hands.reset_trip()
         self.grasps = {side: None for side in self.sides}
-        self.commands = {}
 
     def update(self, ref: KinematicReference | None, now_s: float, body_faulted: bool) -> None:
         if body_faulted:
@@ -60,8 +58,7 @@ class HandsStage(Hands):
                 self.hands.trip("the body's safety layer damped the robot; the fingers were damped with it")
             return
         for side in self.sides:
-            i = dex3.SIDES.index(side)
-            limit = float(ref.grasp_nm[i]) if ref is not None else 0.0
+            limit = float(ref.grasp_nm[self._index[side]]) if ref is not None else 0.0
             if limit > 0.0:
                 grasp = self.grasps[side]
                 if grasp is None or grasp.torque_limit_nm != limit:
@@ -83,7 +80,7 @@ class HandsStage(Hands):
                     q = self._open[side]
                 command = FingerCommand(q_rad=q.copy(), kp=np.full(dex3.NUM_MOTORS, FOLLOW_KP),
                                         kd=np.full(dex3.NUM_MOTORS, FOLLOW_KD))
-            self.commands[side] = self.hands.write(side, command)
+            self.hands.write(side, command)
 
 
 __all__ = ["FOLLOW_KD", "FOLLOW_KP", "HandsStage"]

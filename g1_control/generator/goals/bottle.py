@@ -78,15 +78,15 @@ BOTTLE_GOOD_M = 0.005
 """A pose this close needs no leaning."""
 
 
-def held_wrench(held: HeldBottle, heading: float) -> tuple[np.ndarray, np.ndarray]:
-    """((2, 3) forces, (2, 3) moments): the held bottle's weight on the hand point, and its moment
+def held_wrench(bottle: Bottle, hand: int, heading: float) -> tuple[np.ndarray, np.ndarray]:
+    """((2, 3) forces, (2, 3) moments): the bottle's weight on the hand point of `hand`, and its moment
     there from the grasp centre (palm upright, fingers along `heading`): JointReference.hand_forces_w_n
     and hand_moments_w_nm, so the whole-body controller carries it. Its weight at the hand point
     alone, the wrist rolled ~0.2 N m short and the palm tilted 25 deg (launch/sim_bottle.yaml)."""
     forces, moments = np.zeros((2, 3)), np.zeros((2, 3))
-    weight = np.array([0.0, 0.0, -held.bottle.mass_kg * GRAVITY])
-    forces[held.hand] = weight
-    moments[held.hand] = np.cross(rot_z(np.asarray(heading)) @ grasp_offset(held.hand), weight)
+    weight = np.array([0.0, 0.0, -bottle.mass_kg * GRAVITY])
+    forces[hand] = weight
+    moments[hand] = np.cross(rot_z(np.asarray(heading)) @ grasp_offset(hand), weight)
     return forces, moments
 
 
@@ -266,7 +266,7 @@ def pick_bottle(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     ctx.grasp_nm[hand] = cfg.bottle_grasp_nm
     yield from ctx.run(keyframe_trajectory("bottle_close", [(0.0, grasp_res.q), (cfg.bottle_close_s, grasp_res.q)]),
                        keep=True)
-    ctx.held_bottle = HeldBottle(bottle, hand, above, heading)
+    ctx.held_bottle = HeldBottle(bottle, hand, above, heading, *held_wrench(bottle, hand, heading))
     ctx.info["held_from_s"] = ctx.t + cfg.bottle_slide_s  # lifted by the end of this move (report/outcomes.py)
     yield from ctx.run(keyframe_trajectory("bottle_lift", [(0.0, grasp_res.q), (cfg.bottle_slide_s, lift_res.q),
                                                            (cfg.bottle_slide_s + 0.3, lift_res.q)]), keep=True)

@@ -174,6 +174,10 @@ class HeldBottle:
     """The grasp centre's height above the bottle's base when it was picked."""
     heading_rad: float
     """The palm's heading while it holds the bottle (the plans keep it)."""
+    forces_w_n: np.ndarray
+    moments_w_nm: np.ndarray
+    """(2, 3) each: its weight and that weight's moment about the hand point while held (bottle.held_wrench),
+    what the whole-body plan's references carry."""
 
 
 class GoalContext:

@@ -39,7 +39,7 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from g1_control.generator.goals.approach import enter_whole_body
-from g1_control.generator.goals.bottle import held_wrench, pick_bottle, place_bottle
+from g1_control.generator.goals.bottle import pick_bottle, place_bottle
 from g1_control.generator.goals.box import GRASP_DISTANCE_M
 from g1_control.generator.goals.context import ARMS, GoalConfig, GoalContext, GoalFailed, world_pose_needed
 from g1_control.generator.goals.handling import held_forces, pick, place
@@ -232,7 +232,7 @@ class GoalGenerator(Generator):
 
     def _reference(self, command: Command, state: RobotState) -> KinematicReference:
         ref = self._plan_reference(command, state)
-        ref.grasp_nm = self.ctx.grasp_nm.copy()  # the fingers' grasps (trackers/hands.py), whoever planned the body
+        ref.grasp_nm[:] = self.ctx.grasp_nm  # the fingers' grasps (trackers/hands.py), whoever planned the body
         return ref
 
     def _plan_reference(self, command: Command, state: RobotState) -> KinematicReference:
@@ -243,7 +243,8 @@ class GoalGenerator(Generator):
             assert ctx.plan is not None
             j = ctx.plan.sample(ctx.t - ctx.plan_t0, self._joint)
             if ctx.held_bottle is not None:  # its weight, off the hand point, on the holding hand
-                j.hand_forces_w_n[:], j.hand_moments_w_nm[:] = held_wrench(ctx.held_bottle, ctx.held_bottle.heading_rad)
+                j.hand_forces_w_n[:] = ctx.held_bottle.forces_w_n
+                j.hand_moments_w_nm[:] = ctx.held_bottle.moments_w_nm
             else:
                 j.hand_moments_w_nm[:] = 0.0
             if ctx.overlay is not None:
