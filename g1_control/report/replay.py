@@ -78,8 +78,8 @@ def from_run(path: str | Path) -> Playback:
 
 
 def run_scene(folder: Path) -> ReplayScene | None:
-    """The scene of the launch.yaml a run folder holds, its boxes where truth.npz recorded them
-    (None: the run had no scene; a box without recorded poses stays where the scene put it)."""
+    """The scene of the launch.yaml a run folder holds, its boxes and bottles where truth.npz recorded
+    them (None: the run had no scene; one without recorded poses stays where the scene put it)."""
     import yaml
 
     launch_path = folder / "launch.yaml"
@@ -97,15 +97,16 @@ def run_scene(folder: Path) -> ReplayScene | None:
 
 
 def scene_with_truth(scene, truth: dict[str, np.ndarray]) -> ReplayScene | None:
-    """A ReplayScene of `scene` (a SceneConfig or its dict) with the boxes' recorded poses from
-    `truth` (report/outcomes.py GoalWatcher.arrays: t_s and box_<name>); None for an empty scene."""
+    """A ReplayScene of `scene` (a SceneConfig or its dict) with the boxes' and bottles' recorded poses
+    from `truth` (report/outcomes.py GoalWatcher.arrays: t_s, box_<name>, bottle_<name>); None for an
+    empty scene."""
     import dataclasses
 
     as_dict = dataclasses.asdict(scene) if dataclasses.is_dataclass(scene) and not isinstance(scene, type) \
         else dict(scene)
-    if not any(as_dict.get(k) for k in ("tables", "platforms", "boxes")):
+    if not any(as_dict.get(k) for k in ("tables", "platforms", "boxes", "bottles")):
         return None
-    poses = {k.removeprefix("box_"): v for k, v in truth.items() if k.startswith("box_") and len(v)}
+    poses = {k.split("_", 1)[1]: v for k, v in truth.items() if k.startswith(("box_", "bottle_")) and len(v)}
     return ReplayScene(scene_json=json.dumps(as_dict), object_t_s=truth.get("t_s", np.zeros(0)),
                        object_poses=poses)
 
