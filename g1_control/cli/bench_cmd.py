@@ -38,7 +38,7 @@ BENCHMARKS = {
     "bottle": ("g1_control.tools.bench_bottle:main",
                "a bottle picked with one Dex3 hand (force-limited grasp) and put down upright, --trials drawn scenes "
                "(table height, bottle size/mass/friction, hand, place) judged from ground truth; peak finger squeeze "
-               "against its limit; exits 1 on a fall"),
+               "against its limit; --carry: put down on a second table, walked to holding it; exits 1 on a fall"),
     "robust": ("g1_control.tools.bench_robust:main",
                "wbc vs ppo walking 0.6 m/s and the step (sim_step) on --draws seeded randomised robots (link mass, "
                "CoM, motor strength, latency, foot friction): falls, achieved vs commanded from ground truth; exits 1 "
@@ -85,6 +85,8 @@ def register(subparsers) -> None:
                         "swing reference, DCM, CoP, CoM height, fastest joint)")
     parser.add_argument("--write", action="store_true", help="envelope: write the measured envelope next to the "
                         "policy spec (the loop builder's command limits)")
+    parser.add_argument("--carry", action="store_true", help="bottle: put the bottle down on a second table "
+                        "1.0-1.8 m from the start, off to the side of the first (walked to holding it)")
     add_fanout_arguments(parser, what="/".join(FANS_OUT) + " trials")
     parser.set_defaults(func=_run)
 

@@ -17,9 +17,12 @@ other hand. Judged from the simulator only (not the goals' status):
   squeeze   the grasping hand's closing motors' torque (what the motor applies, MuJoCo's actuator
             force) while the grasp was asked for: the peak, against the grasp's torque limit
   fell      the loop's fall monitor or a safety trip
+With --carry the bottle goes instead onto a second table (the same ranges, its centre CARRY_DISTANCE_M
+from the robot's start, CARRY_BEARING_DEG to the side of the first, facing the start +-20 deg; the
+point 0.05-0.12 m in from its side facing the start): the robot walks there holding it.
 A refused goal (the planner said no before moving) counts as a failure, with its reason.
 
-    g1 bench bottle --seed 0 --trials 20 [--jobs 2] [--json out.json]
+    g1 bench bottle --seed 0 --trials 20 [--carry] [--jobs 2] [--json out.json]
 """
 
 from __future__ import annotations
@@ -55,10 +58,53 @@ PLACE_TOLERANCE_M = 0.05
 REST_TOLERANCE_M = 0.01
 UPRIGHT_DEG = 10.0
 STAND_S, PICK_S, PLACE_S, SETTLE_S = 2.0, 30.0, 12.0, 1.0
+CARRY_PLACE_S = 70.0
+"""--carry: the place goal's time (the walk to the second table included)."""
+CARRY_DISTANCE_M = (1.0, 1.8)
+CARRY_BEARING_DEG = (50.0, 110.0)
+PATH_CLEAR_M = 0.2
+"""--carry: the straight walk between the two stances keeps this far from both tables (redrawn otherwise)."""
 
 
-def draw_scene(seed: int, index: int) -> dict:
-    """The trial's scene (a pure function of seed and index)."""
+def _table_xy(centre: np.ndarray, yaw: float, local: np.ndarray) -> np.ndarray:
+    rot = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
+    return centre + rot @ local
+
+
+def _near_table(p: np.ndarray, centre: np.ndarray, yaw: float, margin: float) -> bool:
+    rot = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
+    local = rot.T @ (p - centre)
+    return bool(abs(local[0]) < TABLE_SIZE_M[0] / 2 + margin and abs(local[1]) < TABLE_SIZE_M[1] / 2 + margin)
+
+
+def _second_table(rng: np.random.Generator, scene: dict, radius: float) -> dict | None:
+    """--carry: a second table and the point on it (None: it meets the first, or the walk between
+    the two stances passes too near a table; the caller draws again)."""
+    first = scene["table"]
+    a_centre, a_yaw = np.asarray(first["center_xy_m"]), first["yaw_rad"]
+    side = float(rng.choice([-1.0, 1.0]))
+    bearing = math.atan2(a_centre[1], a_centre[0]) + side * math.radians(float(rng.uniform(*CARRY_BEARING_DEG)))
+    yaw = bearing + math.radians(float(rng.uniform(-TABLE_TURN_DEG, TABLE_TURN_DEG)))
+    centre = float(rng.uniform(*CARRY_DISTANCE_M)) * np.array([math.cos(bearing), math.sin(bearing)])
+    height = float(rng.uniform(*TABLE_HEIGHT_M))
+    local = np.array([-TABLE_SIZE_M[0] / 2 + float(rng.uniform(*INSET_M)) + radius, float(rng.uniform(-ALONG_M, ALONG_M))])
+    target = _table_xy(centre, yaw, local)
+    if float(np.hypot(*(centre - a_centre))) < 1.2:
+        return None
+    # the stances: 0.4 m out from each point, off the table's side facing the start
+    out_a = _table_xy(np.zeros(2), a_yaw, np.array([-1.0, 0.0]))
+    out_b = _table_xy(np.zeros(2), yaw, np.array([-1.0, 0.0]))
+    p, q = np.asarray(scene["bottle"]["xy_m"]) + 0.7 * out_a, target + 0.7 * out_b
+    for s in np.linspace(0.0, 1.0, 25):
+        x = p + s * (q - p)
+        if _near_table(x, a_centre, a_yaw, PATH_CLEAR_M) or _near_table(x, centre, yaw, PATH_CLEAR_M):
+            return None
+    return {"table_b": {"center_xy_m": [float(centre[0]), float(centre[1])], "yaw_rad": yaw},
+            "target_table": "table_b", "target_height_m": height, "target_xy_m": (float(target[0]), float(target[1]))}
+
+
+def draw_scene(seed: int, index: int, carry: bool = False) -> dict:
+    """The trial's scene (a pure function of seed, index and carry)."""
     rng = np.random.default_rng([seed, index])
     hand = str(rng.choice(["left", "right"]))
     side = 1.0 if hand == "left" else -1.0
@@ -73,12 +119,19 @@ def draw_scene(seed: int, index: int) -> dict:
     xy = centre + rot @ local
     # put down across, towards the other hand (the robot faces the table's x: along its -y for the left hand)
     move = rot @ np.array([float(rng.uniform(-0.03, 0.03)), -side * float(rng.uniform(*MOVE_M))])
-    return {"seed": seed, "index": index, "hand": hand, "table_height_m": height,
-            "table": {"center_xy_m": [float(centre[0]), float(centre[1])], "yaw_rad": yaw},
-            "bottle": {"xy_m": (float(xy[0]), float(xy[1])), "radius_m": radius,
-                       "height_m": float(rng.uniform(*HEIGHT_M)), "mass_kg": float(rng.uniform(*MASS_KG)),
-                       "friction": float(rng.uniform(*FRICTION))},
-            "target_xy_m": (float(xy[0] + move[0]), float(xy[1] + move[1]))}
+    scene = {"seed": seed, "index": index, "hand": hand, "table_height_m": height,
+             "table": {"center_xy_m": [float(centre[0]), float(centre[1])], "yaw_rad": yaw},
+             "bottle": {"xy_m": (float(xy[0]), float(xy[1])), "radius_m": radius,
+                        "height_m": float(rng.uniform(*HEIGHT_M)), "mass_kg": float(rng.uniform(*MASS_KG)),
+                        "friction": float(rng.uniform(*FRICTION))},
+             "target_xy_m": (float(xy[0] + move[0]), float(xy[1] + move[1]))}
+    if carry:
+        for _ in range(200):
+            second = _second_table(rng, scene, radius)
+            if second is not None:
+                return {**scene, **second, "carry": True}
+        raise RuntimeError(f"no second table for seed {seed}, trial {index}")
+    return scene
 
 
 def scene_launch(scene: dict):
@@ -86,20 +139,24 @@ def scene_launch(scene: dict):
     from g1_control.launch.schema import parse_launch
 
     top = scene["table_height_m"]
+    target, target_top = scene.get("target_table", "table"), scene.get("target_height_m", top)
+    tables = [{"name": "table", **scene["table"], "size_xy_m": list(TABLE_SIZE_M), "height_m": top}]
+    if "table_b" in scene:
+        tables.append({"name": "table_b", **scene["table_b"], "size_xy_m": list(TABLE_SIZE_M), "height_m": target_top})
+    place_s = CARRY_PLACE_S if "table_b" in scene else PLACE_S
     bottle = {"name": "bottle", "stands_on": "table", **scene["bottle"]}
     data = {
         "name": f"bench_bottle_{scene['seed']}_{scene['index']}",
         "backend": {"type": "mujoco", "mode": "lockstep", "physics_dt_s": 0.002, "hands": "dex3"},
         "rates": {"lowlevel_hz": 500, "tracker_hz": 250, "input_hz": 100, "estimator_hz": 100},
         "tracker": {"type": "wbc"}, "generator": {"type": "velocity"},
-        "scene": {"tables": [{"name": "table", **scene["table"], "size_xy_m": list(TABLE_SIZE_M), "height_m": top}],
-                  "bottles": [bottle]},
+        "scene": {"tables": tables, "bottles": [bottle]},
         "input": {"type": "scripted", "timeline": [
             {"duration_s": STAND_S, "label": "stand"},
             {"duration_s": PICK_S, "label": "pick", "goals": [{"kind": "pick", "object": "bottle", "hand": scene["hand"]}]},
-            {"duration_s": PLACE_S + SETTLE_S, "label": "place",
-             "goals": [{"kind": "place", "object": "bottle", "target": "table",
-                        "pos_w_m": [*scene["target_xy_m"], top]}]}]},
+            {"duration_s": place_s + SETTLE_S, "label": "place",
+             "goals": [{"kind": "place", "object": "bottle", "target": target,
+                        "pos_w_m": [*scene["target_xy_m"], target_top]}]}]},
         "output": {"video": False, "plot": False}, "viewer": False,
     }
     return parse_launch(data, str(data["name"]))
@@ -110,10 +167,9 @@ def _tilt_deg(quat_wxyz: np.ndarray) -> float:
     return math.degrees(math.acos(min(1.0, max(-1.0, 1.0 - 2.0 * (x * x + y * y)))))
 
 
-def run_trial(task: tuple[int, int]) -> dict:
-    """One drawn scene, run and judged (a plain function of its task, for fan_out)."""
-    seed, index = task
-    return run_scene(draw_scene(seed, index))
+def run_trial(task: tuple[int, int] | tuple[int, int, bool]) -> dict:
+    """One drawn scene, run and judged (a plain function of its task (seed, index[, carry]), for fan_out)."""
+    return run_scene(draw_scene(*task))
 
 
 def run_scene(scene: dict) -> dict:
@@ -132,10 +188,10 @@ def run_scene(scene: dict) -> dict:
     palm = m.body(f"{hand}_hand_palm_link").id
     closing = dex3.hand_limits(hand).closing_sign != 0
     start, _ = sim.object_pose("bottle")
-    top, height = scene["table_height_m"], scene["bottle"]["height_m"]
+    top, height = scene.get("target_height_m", scene["table_height_m"]), scene["bottle"]["height_m"]
     peak_tau, max_z, rel0, rel_dev = 0.0, -math.inf, None, 0.0
     t0 = time.perf_counter()
-    end = STAND_S + PICK_S + PLACE_S + SETTLE_S
+    end = STAND_S + PICK_S + (CARRY_PLACE_S if "table_b" in scene else PLACE_S) + SETTLE_S
     while loop.time_s < end - 1e-9 and not loop.fell:
         loop.run(0.02)
         pos, _ = sim.object_pose("bottle")
@@ -174,11 +230,13 @@ def main(args) -> int:
     from g1_control.fanout import fan_out
 
     n, seed = int(args.trials if args.trials is not None else 10), int(args.seed)
-    print(f"g1 bench bottle: seed {seed}, {n} drawn scenes (one Dex3 hand, whole-body controller; ground truth)")
+    carry = bool(getattr(args, "carry", False))
+    print(f"g1 bench bottle: seed {seed}, {n} drawn scenes (one Dex3 hand, whole-body controller; ground truth)"
+          + ("; carried to a second table" if carry else ""))
     print(f"{'trial':>5} {'hand':>5} {'table':>6} {'r':>6} {'h':>5} {'kg':>5}  {'lifted':>6} {'held':>5} {'placed':>6} "
           f"{'err cm':>6} {'tilt':>5} {'squeeze/limit':>13}  detail")
     rows = []
-    for r in fan_out(run_trial, [(seed, i) for i in range(n)], jobs=getattr(args, "jobs", 1) or 1,
+    for r in fan_out(run_trial, [(seed, i, carry) for i in range(n)], jobs=getattr(args, "jobs", 1) or 1,
                      ray=getattr(args, "ray", None)):
         rows.append(r)
         b = r["bottle"]
@@ -196,7 +254,7 @@ def main(args) -> int:
           f"falls {falls}; peak squeeze over the limit in {over}/{n}"
           + (f" (peak {max(squeezes):.2f} N m)" if squeezes else ""))
     if args.json:
-        Path(args.json).write_text(json.dumps({"seed": seed, "trials": rows, "placed": placed, "falls": falls}, indent=1))
+        Path(args.json).write_text(json.dumps({"seed": seed, "carry": carry, "trials": rows, "placed": placed, "falls": falls}, indent=1))
     return 1 if falls else 0
 
 

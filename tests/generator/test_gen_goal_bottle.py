@@ -76,3 +76,47 @@ def test_the_stance_for_a_bottle_faces_its_tables_near_side_with_the_bottle_by_t
         assert np.allclose(d, (STANCE_AHEAD_M, side * STANCE_SIDE_M)), d
         assert np.allclose(a.mid_xy - pelvis, PELVIS_TO_STANCE_MID_M * np.array([c, s]))
     assert bottle_stance(ctx, Bottle("f", (2.0, 2.0)), 1) is None, "on the floor: no table side to face"
+
+
+def test_a_held_bottles_moment_turns_with_the_robot_as_computed_afresh_at_the_new_heading():
+    """The executor turns the held bottle's moment with the plan's yaw (a carry turns the robot): at each
+    heading it must be what held_wrench computes for a pick made facing that way; its weight stays."""
+    import numpy as np
+
+    from g1_control.generator.goals.bottle import held_wrench, turned_moments
+    from g1_control.generator.goals.context import HeldBottle
+
+    bottle = Bottle("b", (1.0, 0.0), mass_kg=0.6)
+    for hand in (0, 1):
+        h0 = 0.4
+        held = HeldBottle(bottle, hand, 0.1, h0, *held_wrench(bottle, hand, h0))
+        assert np.abs(held.moments_w_nm[hand]).max() > 0.01  # the weight hangs inside the palm: a real moment
+        out = np.full((2, 3), np.nan)
+        for yaw in (h0, h0 + 0.5, h0 - 2.0, h0 + np.pi):
+            turned_moments(held, yaw, out)
+            _, fresh = held_wrench(bottle, hand, yaw)
+            assert np.allclose(out, fresh, atol=1e-12), (hand, yaw)
+        turned_moments(held, h0 + np.pi / 2, out)
+        assert not np.allclose(out, held.moments_w_nm)
+
+
+def test_a_place_on_another_table_stands_facing_its_near_side_with_the_point_by_the_holding_hand():
+    import math
+
+    import numpy as np
+
+    from g1_control.generator.goals.bottle import STANCE_AHEAD_M, STANCE_SIDE_M, place_stance
+    from g1_control.generator.goals.context import GoalConfig, GoalContext
+    from g1_control.scene import SceneConfig, Table
+
+    yaw = math.radians(-70.0)
+    table = Table("t2", (0.6, -1.2), (0.5, 0.9), 0.8, yaw_rad=yaw)
+    rot = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
+    point = np.array(table.center) + rot @ (-0.17, -0.1)  # near its -x side
+    ctx = GoalContext(SceneConfig(tables=[table]), GoalConfig())
+    for hand, side in ((0, 1.0), (1, -1.0)):
+        a = place_stance(ctx, point, "t2", hand)
+        assert abs(a.heading - yaw) < 1e-9, "square on to the table's side nearest the point"
+        c, s = math.cos(a.heading), math.sin(a.heading)
+        d = np.array([[c, s], [-s, c]]) @ (point - a.pelvis_xy())
+        assert np.allclose(d, (STANCE_AHEAD_M, side * STANCE_SIDE_M)), d

@@ -26,3 +26,21 @@ def test_sim_bottle_picks_the_bottle_and_puts_it_down_upright_by_ground_truth():
     start = launch.scene.bottle_center(launch.scene.bottles[0])
     assert np.allclose(bottle[0, :3], start, atol=0.003), "recorded where it stood"
     assert not loop.hands.tripped
+
+
+def test_sim_bottle_carry_walks_the_bottle_to_the_second_table_and_puts_it_down_upright():
+    launch = load_launch(LAUNCH_DIR / "sim_bottle_carry.yaml")
+    loop = build_loop(launch)
+    loop.reset()
+    watcher = GoalWatcher(loop)
+    loop.scheduler.run(round(launch.total_duration_s * loop.rates.lowlevel_hz), progress=watcher.tick)
+    assert not loop.fell
+    pick, place = watcher.outcomes()
+    assert pick["status"] == place["status"] == "reached", (pick, place)
+    assert any("carrying it to the stance beside the point" in text for _, text in loop.generator.log)
+    assert place["place_error_xy_m"] < 0.04 and place["box_tilt_deg"] < 3.0 and abs(place["place_error_z_m"]) < 0.01
+    bottle = watcher.arrays()["bottle_bottle"]
+    table_b = launch.scene.block("side_table")
+    assert table_b.contains_xy(bottle[-1, :2]), "it ended on the second table"
+    assert float(np.hypot(*(bottle[-1, :2] - bottle[0, :2]))) > 1.2, "carried, not nudged"
+    assert not loop.hands.tripped

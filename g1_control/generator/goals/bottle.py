@@ -16,12 +16,17 @@ pick (TaskGoal kind "pick", object a bottle, hand left or right):
 place (kind "place" while holding a bottle; pos_w_m: where its base goes, on the floor or the top of
   table/platform `target`): the hand carries it over the point, lowers it until its base is
   BOTTLE_PLACE_ABOVE_M over the top, opens (grasp_nm 0), and backs out the way it came in; the arms
-  go back to the standing pose.
+  go back to the standing pose. A point whose sidestep (below) would be longer than CARRY_BEYOND_M
+  is walked to with the bottle held (carry_bottle), to the stance a pick there would use (facing its
+  table's nearest side, place_stance): the hand first raises it
+  until its base is CARRY_CLEAR_M over the place's top, then the robot backs off, turns and walks
+  (whole-body steps, the arm held), and puts it down from there; its weight and moment on the hand go
+  into the controller's dynamics all the way, turned with the robot.
 Both are refused before anything moves when the hand cannot get there upright within
 BOTTLE_REFUSE_M (the closest pose's error is in the reason), or when the bottle is too short to
 grasp above its support. The place is made from where the pick left the robot; a point out of the
 hand's reach from there is stepped to sideways (the arm held as it holds the bottle), then planned
-again and refused if still out of reach (carrying a bottle while walking is not built).
+again and refused if still out of reach.
 """
 
 from __future__ import annotations
@@ -36,6 +41,7 @@ from g1_control.generator.goals.box import PELVIS_TO_STANCE_MID_M, Approach, edg
 from g1_control.generator.goals.context import GoalContext, GoalFailed, HeldBottle
 from g1_control.generator.goals.handling import GRAVITY
 from g1_control.generator.goals.poses import PosePlanner, PoseResult, ReachRefused, Sole, flat_soles, stance_heading
+from g1_control.generator.goals.stepping import Stance
 from g1_control.generator.whole_body import keyframe_trajectory
 from g1_control.robot import g1
 from g1_control.robot.dynamics import HAND_FRAMES
@@ -72,6 +78,19 @@ edge) before the arm goes back to its standing pose."""
 BOTTLE_REFUSE_M = 0.015
 """A hand pose further than this from its point (or tilted more than BOTTLE_REFUSE_RAD) is refused."""
 BOTTLE_REFUSE_RAD = 0.25
+CARRY_BEYOND_M = 0.5
+"""A place point out of reach whose sidestep (the stance beside it, facing as the robot faces) lies further
+than this from where the robot stands is walked to holding the bottle (carry_bottle), to the stance
+facing its table's nearest side (place_stance); nearer, the place sidesteps."""
+CARRY_AHEAD_M = 0.30
+CARRY_SIDE_M = 0.20
+"""Carried, the grasp centre this far ahead of the pelvis and to the holding hand's side. The pick holds it
+at arm's length (STANCE_AHEAD_M), where the arm cannot raise it further. 0.12 m to the side was tried:
+seed 14 trial 5 of bench bottle --carry then put its bottle down, but seeds 17 and 18 fell 3 and 2 times
+in the carry's turns on the spot (0 at 0.20 m)."""
+CARRY_CLEAR_M = 0.05
+"""Carried, the bottle's base passes at least this far above the top it is to be put on (raised before
+the walk where the pick left it lower, the walk's lower pelvis counted)."""
 BOTTLE_CROUCH_M = 0.12
 """The last of upright_hand_pose's modes lowers the pelvis towards this much below where it stands."""
 BOTTLE_GOOD_M = 0.005
@@ -88,6 +107,18 @@ def held_wrench(bottle: Bottle, hand: int, heading: float) -> tuple[np.ndarray, 
     forces[hand] = weight
     moments[hand] = np.cross(rot_z(np.asarray(heading)) @ grasp_offset(hand), weight)
     return forces, moments
+
+
+def turned_moments(held: HeldBottle, yaw: float, out: np.ndarray) -> None:
+    """held.moments_w_nm turned about the vertical from the pick's heading to `yaw`, into out (2, 3),
+    without allocating: the bottle hangs inside the palm, and the palm turns with the robot (a carry
+    turns it); the weight itself stays vertical."""
+    turn = yaw - held.heading_rad
+    c, s = math.cos(turn), math.sin(turn)
+    m = held.moments_w_nm
+    out[:, 0] = c * m[:, 0] - s * m[:, 1]
+    out[:, 1] = s * m[:, 0] + c * m[:, 1]
+    out[:, 2] = m[:, 2]
 
 
 def grasp_offset(hand: int) -> np.ndarray:
@@ -287,6 +318,67 @@ def _place_poses(ctx: GoalContext, held: HeldBottle, point: np.ndarray, top: flo
     return (q0, *poses)
 
 
+def place_stance(ctx: GoalContext, xy_w: np.ndarray, target: str | None, hand: int) -> Approach:
+    """Where to stand to put a bottle down at xy_w (world) with `hand`: facing the nearest side of
+    table/platform `target`, as a pick there would (bottle_stance); on the floor, facing the point from
+    where the robot is."""
+    support = ctx.scene.block(target) if target is not None and target != FLOOR else None
+    if support is not None:
+        normal, _ = edge_normal(support, np.asarray(xy_w, dtype=float))
+        heading = math.atan2(-normal[1], -normal[0])
+    else:
+        _, pos_w = ctx.world_pose()
+        heading = math.atan2(xy_w[1] - pos_w[1], xy_w[0] - pos_w[0])
+    return stance_beside(xy_w, heading, hand)
+
+
+def carry_bottle(ctx: GoalContext, held: HeldBottle, stance: Approach, top: float) -> Iterator[None]:
+    """Walk to `stance` (world) holding the bottle: raised first until its base is CARRY_CLEAR_M over
+    `top` (where it goes), then back off, turn, walk and correct the stance (module docstring)."""
+    cfg = ctx.config
+    q0 = ctx.hold_q()
+    soles = flat_soles(ctx.ik, q0)
+    heading = stance_heading(soles)
+    hand = held.hand
+    # Carried close to the body (CARRY_AHEAD_M, CARRY_SIDE_M from the pelvis) and high enough. The carry
+    # walks with the pelvis at its stepping height, lower than a stand, and the arm held as it is comes
+    # down as much: the hand's height over the pelvis is what counts (a 0.84 m top's edge caught a bottle
+    # lifted 6 cm over it, one raised standing taller met a 0.83 m one, and one raised at arm's length,
+    # 0.43 m ahead, rose 0.4 cm of the 4 it needed: bench bottle --carry seed 10 trial 1, seed 11 trial
+    # 10, seed 14 trial 4).
+    walk_pelvis = min(p[2] for p, _ in soles) + cfg.steps.pelvis_above_ground_m
+    need = top + CARRY_CLEAR_M + held.grasp_above_base_m  # the grasp centre's height, carried, at least
+    rot = rot_z(np.asarray(heading))
+    offset = rot @ grasp_offset(hand)
+
+    def carried(q: np.ndarray) -> float:  # the grasp centre's height with the pelvis at walk_pelvis
+        return float(ctx.poses.hand_point(q, hand)[2] + offset[2] - q[2]) + walk_pelvis
+
+    centre = ctx.poses.hand_point(q0, hand) + offset
+    near = np.append(q0[:2] + rot[:2, :2] @ np.array([CARRY_AHEAD_M, _side(hand) * CARRY_SIDE_M]), centre[2])
+    q = q0
+    for _ in range(3):
+        short = need - carried(q)
+        near[2] += max(short, 0.0)
+        (res,) = yield from ctx.compute("bottle carry", _poses, q, soles, hand, [near - offset], heading)
+        q = res.q
+        if need - carried(q) <= 0.005:
+            break
+    if need - carried(q) > 0.01:
+        base = carried(q) - held.grasp_above_base_m
+        raise GoalFailed(f"carrying '{held.bottle.name}': walking, the hand holds its base at most {base:.2f} m up, and "
+                         f"it must pass {CARRY_CLEAR_M * 100:.0f} cm over the {top:.2f} m top it goes on")
+    rise = carried(q) - carried(q0)
+    posture = q[7:].copy()
+    t1 = _move_s(ctx, q0, q)
+    yield from ctx.run(keyframe_trajectory("bottle_raise", [(0.0, q0), (t1, q), (t1 + 0.3, q)]), keep=True)
+    ctx.note(f"place {held.bottle.name}: carrying it to the stance beside the point (held close to the body, "
+             f"{rise * 100:+.0f} cm higher)")
+    yield from step_to(ctx, stance.mid_xy + ctx.offset(), stance.heading, cfg.steps, posture=posture,
+                       first_back_m=cfg.backup_m, name="carry")
+    yield from correct_stance(ctx, stance.mid_xy, stance.heading, cfg.steps, posture=posture)
+
+
 def place_bottle(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     cfg = ctx.config
     held = ctx.held_bottle
@@ -304,6 +396,11 @@ def place_bottle(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     else:
         top = ctx.scene.ground_height(point[:2])
     hand = held.hand
+    if not _within_reach(ctx, point[:2], hand):
+        here = Stance.of(ctx.ik, ctx.hold_q())
+        beside = stance_beside(point[:2], here.heading, hand)  # the sidestep's stance (below)
+        if float(np.hypot(*(beside.mid_xy + ctx.offset() - here.mid_xy))) > CARRY_BEYOND_M:
+            yield from carry_bottle(ctx, held, place_stance(ctx, point[:2], goal.target, hand), top)
     try:
         q0, over_res, down_res, out_res, back_res = yield from _place_poses(ctx, held, point, top)
     except ReachRefused as exc:
@@ -334,5 +431,5 @@ def place_bottle(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
                                                            (t4 + _move_s(ctx, back_res.q, home), home)]), keep=True)
 
 
-__all__ = ["GRASP_CENTRE_M", "grasp_height", "hand_points", "pick_bottle", "place_bottle",
-           "upright_hand_pose"]
+__all__ = ["GRASP_CENTRE_M", "carry_bottle", "grasp_height", "hand_points", "pick_bottle", "place_bottle",
+           "place_stance", "turned_moments", "upright_hand_pose"]

@@ -39,7 +39,7 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from g1_control.generator.goals.approach import enter_whole_body
-from g1_control.generator.goals.bottle import pick_bottle, place_bottle
+from g1_control.generator.goals.bottle import pick_bottle, place_bottle, turned_moments
 from g1_control.generator.goals.box import GRASP_DISTANCE_M
 from g1_control.generator.goals.context import ARMS, GoalConfig, GoalContext, GoalFailed, world_pose_needed
 from g1_control.generator.goals.handling import held_forces, pick, place
@@ -244,7 +244,7 @@ class GoalGenerator(Generator):
             j = ctx.plan.sample(ctx.t - ctx.plan_t0, self._joint)
             if ctx.held_bottle is not None:  # its weight, off the hand point, on the holding hand
                 j.hand_forces_w_n[:] = ctx.held_bottle.forces_w_n
-                j.hand_moments_w_nm[:] = ctx.held_bottle.moments_w_nm
+                turned_moments(ctx.held_bottle, yaw_of(j.root_quat_wxyz), j.hand_moments_w_nm)
             else:
                 j.hand_moments_w_nm[:] = 0.0
             if ctx.overlay is not None:
