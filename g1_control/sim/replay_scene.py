@@ -1,5 +1,5 @@
-"""What a replay draws besides the robot: a run's scene (tables, platforms, boxes) with its boxes
-moved from the recorded ground truth, or a clip's scene shapes and handled object.
+"""What a replay draws besides the robot: a run's scene (tables, platforms, boxes, bottles) with its
+boxes and bottles moved from the recorded ground truth, or a clip's scene shapes and handled object.
 
     scene = ReplayScene(scene_json=..., object_t_s=truth["t_s"], object_poses={"box": truth["box_box"]})
     spec = description.mujoco_spec(); scene.build(spec); model = spec.compile()

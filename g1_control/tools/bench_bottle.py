@@ -241,7 +241,8 @@ def main(args) -> int:
         rows.append(r)
         b = r["bottle"]
         detail = "FELL " + r["trip"] if r["fell"] else (r["refused"] or r["trip"])
-        print(f"{r['index']:>5} {r['hand']:>5} {r['table_height_m']:6.2f} {b['radius_m']:6.3f} {b['height_m']:5.2f} "
+        table = f"{r['table_height_m']:.2f}" + (f">{r['target_height_m']:.2f}" if "target_height_m" in r else "")
+        print(f"{r['index']:>5} {r['hand']:>5} {table:>6} {b['radius_m']:6.3f} {b['height_m']:5.2f} "
               f"{b['mass_kg']:5.2f}  {'yes' if r['lifted'] else 'no':>6} {'yes' if r['held'] else 'no':>5} "
               f"{'yes' if r['placed'] else 'no':>6} {r['place_error_m'] * 100:6.1f} {r['tilt_deg']:5.1f} "
               f"{r['peak_squeeze_nm']:6.2f}/{r['torque_limit_nm']:.2f}  {detail[:90]}", flush=True)
