@@ -9,14 +9,20 @@ from g1_control.report.outcomes import GoalWatcher, outcome_line
 from tests.paths import LAUNCH_DIR
 
 
-def test_sim_bottle_picks_the_bottle_and_puts_it_down_upright_by_ground_truth():
-    launch = load_launch(LAUNCH_DIR / "sim_bottle.yaml")
+def _run(name: str):
+    """The launch file run as `g1 launch` runs it, its goals watched from ground truth."""
+    launch = load_launch(LAUNCH_DIR / name)
     loop = build_loop(launch)
     assert loop.hands is not None and loop.chain["hands"].startswith("Dex3-1")
     loop.reset()
     watcher = GoalWatcher(loop)
     loop.scheduler.run(round(launch.total_duration_s * loop.rates.lowlevel_hz), progress=watcher.tick)
     assert not loop.fell
+    return launch, loop, watcher
+
+
+def test_sim_bottle_picks_the_bottle_and_puts_it_down_upright_by_ground_truth():
+    launch, loop, watcher = _run("sim_bottle.yaml")
     pick, place = watcher.outcomes()
     assert pick["status"] == place["status"] == "reached", (pick, place)
     assert pick["object_kind"] == "bottle" and 0.08 < pick["box_rise_m"] < 0.11 and pick["slip_m"] < 0.01
@@ -29,12 +35,7 @@ def test_sim_bottle_picks_the_bottle_and_puts_it_down_upright_by_ground_truth():
 
 
 def test_sim_bottle_carry_walks_the_bottle_to_the_second_table_and_puts_it_down_upright():
-    launch = load_launch(LAUNCH_DIR / "sim_bottle_carry.yaml")
-    loop = build_loop(launch)
-    loop.reset()
-    watcher = GoalWatcher(loop)
-    loop.scheduler.run(round(launch.total_duration_s * loop.rates.lowlevel_hz), progress=watcher.tick)
-    assert not loop.fell
+    launch, loop, watcher = _run("sim_bottle_carry.yaml")
     pick, place = watcher.outcomes()
     assert pick["status"] == place["status"] == "reached", (pick, place)
     assert any("carrying it to the stance beside the point" in text for _, text in loop.generator.log)
