@@ -71,15 +71,11 @@ def _table_xy(centre: np.ndarray, yaw: float, local: np.ndarray) -> np.ndarray:
     return centre + rot @ local
 
 
-def _near_table(p: np.ndarray, centre: np.ndarray, yaw: float, margin: float) -> bool:
-    rot = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
-    local = rot.T @ (p - centre)
-    return bool(abs(local[0]) < TABLE_SIZE_M[0] / 2 + margin and abs(local[1]) < TABLE_SIZE_M[1] / 2 + margin)
-
-
 def _second_table(rng: np.random.Generator, scene: dict, radius: float) -> dict | None:
     """--carry: a second table and the point on it (None: it meets the first, or the walk between
     the two stances passes too near a table; the caller draws again)."""
+    from g1_control.scene import Table
+
     first = scene["table"]
     a_centre, a_yaw = np.asarray(first["center_xy_m"]), first["yaw_rad"]
     side = float(rng.choice([-1.0, 1.0]))
@@ -95,9 +91,10 @@ def _second_table(rng: np.random.Generator, scene: dict, radius: float) -> dict 
     out_a = _table_xy(np.zeros(2), a_yaw, np.array([-1.0, 0.0]))
     out_b = _table_xy(np.zeros(2), yaw, np.array([-1.0, 0.0]))
     p, q = np.asarray(scene["bottle"]["xy_m"]) + 0.7 * out_a, target + 0.7 * out_b
+    tables = [Table("a", tuple(a_centre), TABLE_SIZE_M, yaw_rad=a_yaw), Table("b", tuple(centre), TABLE_SIZE_M, yaw_rad=yaw)]
     for s in np.linspace(0.0, 1.0, 25):
         x = p + s * (q - p)
-        if _near_table(x, a_centre, a_yaw, PATH_CLEAR_M) or _near_table(x, centre, yaw, PATH_CLEAR_M):
+        if any(t.contains_xy(x, margin_m=-PATH_CLEAR_M) for t in tables):  # within PATH_CLEAR_M of its outline
             return None
     return {"table_b": {"center_xy_m": [float(centre[0]), float(centre[1])], "yaw_rad": yaw},
             "target_table": "table_b", "target_height_m": height, "target_xy_m": (float(target[0]), float(target[1]))}
@@ -191,7 +188,7 @@ def run_scene(scene: dict) -> dict:
     top, height = scene.get("target_height_m", scene["table_height_m"]), scene["bottle"]["height_m"]
     peak_tau, max_z, rel0, rel_dev = 0.0, -math.inf, None, 0.0
     t0 = time.perf_counter()
-    end = STAND_S + PICK_S + (CARRY_PLACE_S if "table_b" in scene else PLACE_S) + SETTLE_S
+    end = launch.total_duration_s  # stand, pick, place and settle
     while loop.time_s < end - 1e-9 and not loop.fell:
         loop.run(0.02)
         pos, _ = sim.object_pose("bottle")

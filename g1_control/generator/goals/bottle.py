@@ -203,12 +203,9 @@ def _poses(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], hand: int, poi
 def bottle_stance(ctx: GoalContext, bottle: Bottle, hand: int) -> Approach | None:
     """Where to stand to pick `bottle` with `hand`: facing the side of its table nearest to it, the bottle
     STANCE_AHEAD_M ahead of the pelvis and STANCE_SIDE_M to the hand's side (None: on the floor)."""
-    support = ctx.scene.block(bottle.stands_on) if bottle.stands_on != FLOOR else None
-    if support is None:
+    if bottle.stands_on == FLOOR or ctx.scene.block(bottle.stands_on) is None:
         return None
-    xy = np.asarray(bottle.xy_m, dtype=float)
-    normal, _ = edge_normal(support, xy)
-    return stance_beside(xy, math.atan2(-normal[1], -normal[0]), hand)
+    return place_stance(ctx, np.asarray(bottle.xy_m, dtype=float), bottle.stands_on, hand)
 
 
 def stance_beside(xy_w: np.ndarray, heading: float, hand: int) -> Approach:
