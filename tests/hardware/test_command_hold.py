@@ -120,6 +120,18 @@ def test_a_command_without_torque_or_velocity_targets_is_its_own_hold_form(robot
     assert robot.backend.stats().holds == 0, "nothing to hold: no hold is counted"
 
 
+def test_a_velocity_target_without_torque_is_held_too(robot):
+    """A command whose only one-tick part is its velocity target (no feedforward torque) is not its own
+    hold form: once its life is up it is resent with the velocity target zeroed."""
+    sent = _wbc_like()
+    sent.tau_nm[:] = 0.0
+    robot.backend.write_command(sent)
+    frames = robot.listen(0.3)
+    assert _is_full(frames[0][1], sent), "the command goes out as it is first"
+    assert _is_hold_of(frames[-1][1], sent), "past its life the velocity target is no longer sent"
+    assert robot.backend.stats().holds == 1
+
+
 def test_damping_is_never_replaced_by_a_hold_form(robot):
     robot.backend.write_command(_wbc_like())
     robot.listen(0.15)  # the command is held by now
