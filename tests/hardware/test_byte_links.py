@@ -95,6 +95,72 @@ def test_serial_noise_is_counted_and_the_stream_recovers():
     robot_link.close()
 
 
+def test_commands_and_damping_keep_the_mode_machine_accepted_at_reset():
+    """A LowState_ reporting another mode_machine after reset (a spoofing publisher, a variant change)
+    is never echoed: with no expected variant given, the command and the damping after it still carry
+    the mode_machine accepted at reset (a robot ignores a LowCmd_ whose mode_machine is not its own)."""
+    tty_end, master_end = open_pty_pair()
+    robot = SerialLink("robot", master_end)
+    backend = LinkBackend(SerialLink("host", tty_end), command_rate_hz=RATE_HZ, connect_timeout_s=3.0,
+                          close_damping_s=0.0)
+
+    def frames(seconds: float) -> list:
+        got, end = [], time.monotonic() + seconds
+        while time.monotonic() < end:
+            got += [robot.decode_command(p) for p in robot.receive(0.01)]
+        return got
+
+    try:
+        robot.send(robot.encode(LowState(mode_machine=5, tick=1)))
+        assert backend.reset().mode_machine == 5
+        robot.send(robot.encode(LowState(mode_machine=4, tick=2)))
+        deadline = time.monotonic() + 2.0
+        while backend.read_state().mode_machine != 4 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert backend.read_state().mode_machine == 4
+        backend.write_command(_target())
+        commanded = frames(0.1)
+        backend.damp()
+        damped = [f for f in frames(0.15) if f.motor_kp_nm_per_rad[:g1.NUM_JOINTS].max() == 0.0]
+        assert commanded and damped
+        assert {f.mode_machine for f in commanded + damped} == {5}
+    finally:
+        backend.close()
+        robot.close()
+
+
+class _WritersByTick(SerialLink):
+    """A link that tells writers apart (as DDS does, by publication handle) but has no discovery: a
+    LowState_ with an odd tick comes from writer 1, one with an even tick from writer 2."""
+
+    def receive_tagged(self, timeout_s: float) -> list:
+        return [(p, 1 + LowState.from_c_bytes(p).tick % 2) for p in self.receive(timeout_s)]
+
+
+@pytest.mark.parametrize("ticks, publishers", [((1, 3, 5), 1), ((1, 2, 3), 2)])
+def test_a_second_writer_of_the_state_is_a_peer_fault_without_discovery(ticks, publishers):
+    """Where discovery cannot tell (or has not yet), two writers whose LowState_ both arrived within
+    the last second are a peer fault on their own; one writer is not."""
+    tty_end, master_end = open_pty_pair()
+    robot = SerialLink("robot", master_end)
+    backend = LinkBackend(_WritersByTick("host", tty_end), command_rate_hz=RATE_HZ, close_damping_s=0.0)
+    try:
+        for tick in ticks:
+            robot.send(robot.encode(LowState(mode_machine=5, tick=tick)))
+        deadline = time.monotonic() + 2.0
+        while backend.stats().states_received < len(ticks) and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert backend.stats().states_received == len(ticks)
+        assert backend.peers()[0] == publishers
+        if publishers == 1:
+            assert backend.peer_fault is None
+        else:
+            assert backend.peer_fault.startswith("2 publishers on rt/lowstate (2 sent within the last second)")
+    finally:
+        backend.close()
+        robot.close()
+
+
 @pytest.mark.parametrize("fd", [True, False])
 def test_can_virtual_bus_closes_the_loop(fd):
     channel = f"g1test-{uuid.uuid4().hex[:8]}"
