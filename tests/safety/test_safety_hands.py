@@ -97,6 +97,16 @@ def test_gains_and_torque_are_capped(rig):
     np.testing.assert_allclose(out.dq_radps, dex3.hand_limits("right").velocity_radps)
 
 
+def test_negative_gains_are_raised_to_zero(rig):
+    """A negative kp or kd would push a finger away from its target or feed its speed back: both are
+    clamped to 0, never passed on."""
+    hands, link, _ = rig
+    cmd = FingerCommand(q_rad=link.q["left"], kp=np.full(7, -2.0), kd=np.full(7, -0.3))
+    out = hands.write("left", cmd)
+    assert np.all(out.kp == 0.0) and np.all(out.kd == 0.0)
+    assert np.all(link.sent[-1][1].kd >= 0.0)
+
+
 def test_nan_is_refused_and_both_hands_damp_until_reset(rig):
     hands, link, clock = rig
     hands.write("right", _stiff(link.q["right"]))
