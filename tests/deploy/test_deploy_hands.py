@@ -91,6 +91,18 @@ def test_a_finger_outside_its_limits_is_refused(tmp_path, partition, emulated_ha
     assert reason.startswith(f"right_hand_middle_1_joint {lim.q_max_rad[4] + 0.3:.3f} rad (limits [0.000, 1.745])")
 
 
+def test_a_finger_that_reads_no_number_is_refused(tmp_path, partition, emulated_hands, monkeypatch):
+    """A NaN finger reading (a broken encoder or decoding) lies inside no limits: finger_limits fails."""
+    monkeypatch.setattr("g1_control.sim.dex3_hands.MISCALIBRATION_RAD", float("nan"))
+    emulator = emulated_hands()
+    emulator.inject("finger_miscalibrated", "right")
+    time.sleep(0.05)
+    rows, pf = _rows(tmp_path, partition)
+    status, reason = rows["finger_limits"]
+    assert status == FAIL and not pf.passed
+    assert reason.startswith("right_hand_middle_1_joint nan rad")
+
+
 def test_without_hands_the_rows_are_left_out(tmp_path):
     launch = load_launch(write_launch(tmp_path, FAST))
     pf = Preflight()
