@@ -10,7 +10,8 @@ What it does to each FingerCommand, per hand:
   command starts from the measured position), so a jump becomes a ramp;
 - kp, kd clamped to `max_kp`, `max_kd`; feed-forward torque to the URDF's effort limit;
 - the hand's state older than `stale_state_s`, never received, unchanged for `frozen_state_s`
-  (samples arriving with identical contents), or reporting an error: trip, damp.
+  (samples arriving with identical contents), reading a finger position that is not finite, or
+  reporting an error: trip, damp.
 """
 
 from __future__ import annotations
@@ -135,6 +136,9 @@ class GuardedHands:
         state = self.link.read(side)
         if state is None:
             return f"no state from the {side} hand yet; the fingers were damped"
+        if not np.all(np.isfinite(state.q_rad)):  # the first command's ramp starts from this reading
+            bad = [f"q_rad[{dex3.FINGERS[i]}]" for i in np.nonzero(~np.isfinite(state.q_rad))[0]]
+            return f"the {side} hand reads no number ({', '.join(bad[:4])}); the fingers were damped"
         if now - state.t_s > self.config.stale_state_s:
             return (f"the {side} hand's state is {now - state.t_s:.2f} s old (limit "
                     f"{self.config.stale_state_s:.2f} s); the fingers were damped")

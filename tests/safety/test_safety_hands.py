@@ -126,6 +126,21 @@ def test_nan_is_refused_and_both_hands_damp_until_reset(rig):
     assert not hands.write("left", _stiff(link.q["left"])).is_damping
 
 
+def test_a_hand_reading_nan_damps_and_no_nan_reaches_the_link(rig):
+    """The first command ramps from the measured position: a NaN finger reading would make that
+    target NaN (and every later one, each ramp step starting from the last). A hand that reads no
+    number trips and damps; nothing that is not finite reaches the link."""
+    hands, link, clock = rig
+    link.q["left"][2] = np.nan
+    out = hands.write("left", _stiff(dex3.hand_limits("left").open_rad))
+    assert out.is_damping
+    assert hands.tripped.startswith("the left hand reads no number (q_rad[thumb_2])")
+    link.q["left"][2] = 0.0
+    clock.t += 0.01
+    assert hands.write("left", _stiff(dex3.hand_limits("left").open_rad)).is_damping  # latched
+    assert link.sent and all(c.is_finite() for _, c in link.sent)
+
+
 @pytest.mark.parametrize("fault, words", [
     ("stale", "the left hand's state is 0.30 s old (limit 0.25 s)"),
     ("frozen", "the left hand's state has not changed for 0.60 s (limit 0.50 s): frozen"),
