@@ -254,6 +254,15 @@ def test_yes_is_refused_off_loopback(tmp_path, partition):
         in _reason(report, "launch_file")
 
 
+def test_yes_is_refused_on_a_can_bus_that_is_not_virtual(tmp_path, partition):
+    """A socketcan bus reaches a robot: --yes (nobody presses start and run) is refused there as off lo;
+    only the virtual bus counts as simulated."""
+    can = {**FAST, "backend": {**FAST["backend"], "type": "can", "can_interface": "socketcan", "channel": "can0"}}
+    report, refused, _ = preflight_only(write_launch(tmp_path, can), partition, yes=True)
+    assert refused is not None and _status(report)["interface"] == "not run"
+    assert "--yes answers start and run with nobody watching" in _reason(report, "launch_file")
+
+
 def test_the_motion_service_is_asked_in_the_preflight_and_a_release_that_would_fail_is_refused(
         tmp_path, partition, mock_robot):
     """The release of the built-in controller is a preflight row, asked with CheckMode only: a robot whose
