@@ -1,12 +1,15 @@
 """Policy metadata checks against the real holosoma ONNX files (fetched once into a cache)."""
 
+import json
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import yaml
 
 from g1_control.errors import PolicyMismatchError
 from g1_control.robot import g1
-from g1_control.trackers.policy_spec import builtin_specs, load_spec
+from g1_control.trackers.policy_spec import builtin_specs, check_against_onnx, check_against_robot, load_spec
 
 
 def test_builtin_specs_load_and_match_the_robot():
@@ -75,3 +78,62 @@ def test_spec_files_are_read_by_the_typed_loader(tmp_path, change, message):
     """The same loader as launch files: every key's type and range checked, the key path named."""
     with pytest.raises(PolicyMismatchError, match=message.replace(".", "\\.").replace("(", "\\(").replace("[", "\\[")):
         load_spec(variant(tmp_path, **change))
+
+
+def test_two_swapped_arm_joints_are_refused_naming_both(tmp_path):
+    """The joint order is compared over all 29 joints, not the legs only: a policy with the right
+    shoulder's pitch and roll swapped is refused, naming the index and both joints."""
+    names = list(g1.JOINT_NAMES)
+    i, j = g1.JOINT_INDEX["right_shoulder_pitch_joint"], g1.JOINT_INDEX["right_shoulder_roll_joint"]
+    names[i], names[j] = names[j], names[i]
+    with pytest.raises(PolicyMismatchError, match=f"joint order differs from the G1's at index {i}: policy has "
+                                                  "right_shoulder_roll_joint, robot has right_shoulder_pitch_joint"):
+        load_spec(variant(tmp_path, joint_names=names))
+
+
+def test_gains_read_as_nan_are_refused_naming_the_joint():
+    """Gains read from ONNX metadata are JSON, which allows NaN: a policy whose kd holds a NaN is
+    refused by the robot check, naming the joint and the value (a spec file's NaN is refused by the loader)."""
+    spec = load_spec("holosoma_loco_ppo")
+    kd = spec.kd.copy()
+    kd[g1.JOINT_INDEX["left_elbow_joint"]] = float("nan")
+    with pytest.raises(PolicyMismatchError, match="kd must be 29 finite numbers; left_elbow_joint is nan"):
+        check_against_robot(replace(spec, kd=kd))
+    check_against_robot(spec)
+
+
+@pytest.mark.parametrize("side", ["lower", "upper"])
+def test_a_default_pose_past_either_joint_limit_is_refused_naming_the_joint(tmp_path, side):
+    knee = g1.JOINT_INDEX["left_knee_joint"]
+    q = g1.DEFAULT_Q_RAD.copy()
+    q[knee] = g1.Q_MIN_RAD[knee] - 0.1 if side == "lower" else g1.Q_MAX_RAD[knee] + 0.1
+    with pytest.raises(PolicyMismatchError, match="default pose puts left_knee_joint outside its limits"):
+        load_spec(variant(tmp_path, default_q=q.tolist()))
+
+
+def test_a_network_with_another_action_count_than_the_specs_joints_is_refused():
+    """A spec naming 23 joints over a network that outputs 29 actions: refused, both counts named."""
+    spec = load_spec("holosoma_loco_ppo")
+    names = tuple(g1.JOINT_NAMES[i] for i in g1.G1_23DOF.active_joints)
+    with pytest.raises(PolicyMismatchError, match="ONNX outputs 29 actions for 23 joints"):
+        check_against_onnx(replace(spec, joint_names=names))
+
+
+@pytest.mark.parametrize("key", ["kp", "kd"])
+def test_a_policy_trained_with_other_gains_than_the_robots_is_refused_naming_the_joint(key):
+    """The spec's gains agree with the ONNX metadata, but the policy was trained with a knee gain
+    10 % off the G1's (beyond the 2 % rounding allowed): refused, naming the joint."""
+    spec = load_spec("holosoma_loco_ppo")
+    gains = getattr(spec, key).copy()
+    gains[g1.JOINT_INDEX["left_knee_joint"]] *= 1.1
+    trained = replace(spec, metadata={**spec.metadata, key: json.dumps(gains.tolist())}, **{key: gains})
+    with pytest.raises(PolicyMismatchError, match="gains for left_knee_joint .* do not match the G1's"):
+        check_against_onnx(trained)
+    check_against_onnx(spec)  # the shipped policy's own gains pass
+
+
+def test_spec_gains_a_tenth_off_the_training_gains_are_refused(tmp_path):
+    kp = g1.KP_DEFAULT.copy()
+    kp[g1.JOINT_INDEX["right_hip_pitch_joint"]] *= 1.1
+    with pytest.raises(PolicyMismatchError, match="kp in the spec differs from the kp the policy was trained with"):
+        load_spec(variant(tmp_path, gains={"kp": kp.tolist(), "kd": g1.KD_DEFAULT.tolist()}))
