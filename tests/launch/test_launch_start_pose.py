@@ -119,6 +119,8 @@ def test_the_emulators_mocap_speaks_the_rooms_frame():
     ([1.0, 2.0], "scene.robot_start: expected {xy_m: [x, y], yaw_rad: a}"),
     ({"xy_m": [1.0]}, "scene.robot_start.xy_m: expected 2 finite numbers, got [1.0]"),
     ({"xy_m": [1.0, math.nan]}, "scene.robot_start.xy_m: expected 2 finite numbers"),
+    ({"xy_m": [1.0, 2.0, 0.5]}, "scene.robot_start.xy_m: expected 2 finite numbers, got [1.0, 2.0, 0.5]"),
+    ({"yaw_rad": math.nan}, "scene.robot_start.yaw_rad: expected a finite number, got nan"),
     ({"yaw_rad": "north"}, "scene.robot_start.yaw_rad: expected a finite number, got 'north'"),
     ({"xy": [1.0, 2.0]}, "scene.robot_start: unknown key(s) xy; allowed: xy_m, yaw_rad"),
 ])

@@ -54,6 +54,15 @@ def test_wbt_is_refused_on_the_23dof_robot():
         check_tracker_fits(launch)
 
 
+def test_the_tracking_layer_walks_by_the_policy_and_is_refused_on_the_23dof_robot():
+    """tracker.type layer runs the 29-DoF walking policy between its whole-body phases: it is
+    checked against the variant like tracker.type policy, and refused by joint name."""
+    launch = load_launch(WALK_23, overrides=["tracker.type=layer", "generator.type=velocity",
+                                             "rates.tracker_hz=100"])
+    with pytest.raises(PolicyMismatchError, match=f"policy 'holosoma-loco-ppo' commands 29 joints, .* has no {DROPPED}"):
+        check_tracker_fits(launch)
+
+
 def test_a_23dof_policy_on_the_29dof_robot_leaves_joints_uncommanded():
     policy = SimpleNamespace(name="base23", joint_names=tuple(g1.JOINT_NAMES[i] for i in g1.G1_23DOF.active_joints))
     with pytest.raises(PolicyMismatchError, match=f"policy 'base23' commands 23 joints and leaves {DROPPED} of the "
