@@ -18,7 +18,7 @@ from g1_control.interfaces import Backend, InputDevice, Tracker
 from g1_control.loop.control_loop import ControlLoop
 from g1_control.robot import g1
 from g1_control.safety import SafetyConfig, SafetyEventKind, SafetyFilter
-from g1_control.types import Command, MotorCommand, RobotState
+from g1_control.types import Button, Command, MotorCommand, RobotState, TaskGoal
 
 
 class StandInRobot(Backend):
@@ -32,6 +32,8 @@ class StandInRobot(Backend):
         self.pelvis_z_m = pelvis_z_m
         self.q_rad = g1.DEFAULT_Q_RAD.copy()
         self.crc, self.peer, self.contacts = 0, None, ()
+        self.corrupt = None
+        """Set by a test: a function that spoils each state read from then on."""
         self.states: list[RobotState] = []
 
     def reset(self) -> RobotState:
@@ -42,6 +44,8 @@ class StandInRobot(Backend):
             self.t_s, self.tick = time.monotonic(), self.tick + 1
         state = RobotState(t_s=self.t_s, q_rad=self.q_rad.copy(), tick=self.tick,
                            base_pos_w_m=None if self.pelvis_z_m is None else np.array([0.0, 0.0, self.pelvis_z_m]))
+        if self.corrupt is not None:
+            self.corrupt(state)
         self.states.append(state)
         return state
 
@@ -195,6 +199,37 @@ def test_an_invalid_state_trips_naming_it():
     assert np.all(sent.kp == 0) and np.all(sent.kd > 0), "damping goes out at once, not at the next tracker tick"
 
 
+def _nan_acc(state: RobotState) -> None:
+    state.imu_acc_mps2[2] = np.nan
+
+
+def _long_quat(state: RobotState) -> None:
+    state.imu_quat_wxyz = np.array([1.05, 0.0, 0.0, 0.0])  # inside the filter's own 0.1 norm slack
+
+
+def _short_joints(state: RobotState) -> None:
+    state.q_rad = state.q_rad[:23]
+
+
+@pytest.mark.parametrize(("corrupt", "message"), [
+    (_nan_acc, "RobotState.imu_acc_mps2 contains NaN or inf"),
+    (_long_quat, "RobotState.imu_quat_wxyz has norm 1.0500; expected 1"),
+    (_short_joints, "RobotState.q_rad has shape (23,); expected (29,)"),
+])
+def test_a_corrupt_state_trips_naming_the_field_and_damps_at_once(corrupt, message):
+    """Every state the loop reads is validated before the estimator sees it: a NaN accelerometer,
+    a quaternion 5 % long, a joint array of the wrong length each trip naming the field, and
+    damping goes out on that tick."""
+    loop, robot, _ = _loop()
+    loop.run(0.11)  # the next state read (100 Hz) falls between two tracker ticks (50 Hz)
+    robot.corrupt = corrupt
+    loop.run(0.01)
+    trip = loop.safety.trip_event
+    assert trip is not None and (trip.kind, trip.detail) == (SafetyEventKind.ESTOP, f"invalid robot state: {message}")
+    sent = robot.last_command
+    assert np.all(sent.kp == 0) and np.all(sent.kd > 0)
+
+
 def test_the_tracker_acts_on_the_state_the_estimator_read_once_per_tick():
     loop, robot, _ = _loop()
     loop.run(0.2)  # 10 tracker ticks; the estimator runs at 100 Hz
@@ -208,6 +243,74 @@ def test_invalid_commands_leave_loop_records():
     loop.run(0.02)
     assert records == [{"type": "loop", "t_s": 0.0, "kind": "invalid_command", "detail": loop.events[0].detail}]
     assert "vx_mps is nan" in records[0]["detail"]
+
+
+@pytest.mark.parametrize(("bad", "message"), [
+    (Command(pelvis_height_m=float("nan")), "Command.pelvis_height_m is nan; it must be a finite number"),
+    (Command(buttons=frozenset({"estp"})), "Command has unknown buttons ['estp']"),
+    (Command(tasks=[TaskGoal("reach", goal_id="g", pos_w_m=np.array([0.4, np.nan, 1.0]))]),
+     "TaskGoal 'g' (reach) has position"),
+])
+def test_a_malformed_command_is_dropped_naming_the_field(bad, message):
+    """A NaN pelvis height, a misspelt button or a goal at NaN never reaches the generator: the
+    command is counted and recorded as invalid (naming the field) and the previous one stays in force."""
+    loop, _, records = _loop(device=Still([Command(vx_mps=0.2), bad]))
+    loop.run(0.02)
+    assert loop.invalid_commands == 1 and [e.kind for e in loop.events] == ["invalid_command"]
+    assert message in loop.events[0].detail and records[0]["detail"] == loop.events[0].detail
+    assert loop.command.vx_mps == 0.2 and loop.command.pelvis_height_m is None and not loop.command.tasks
+    assert not loop.faulted
+
+
+def test_the_damp_button_damps_at_once():
+    loop, robot, _ = _loop(device=Still([Command(vx_mps=0.2)] * 5 + [Command(buttons=frozenset({Button.DAMP}))]))
+    loop.run(0.1)
+    trip = loop.safety.trip_event
+    assert trip is not None and (trip.kind, trip.detail) == (SafetyEventKind.ESTOP, "damp pressed on the operator input")
+    assert abs(trip.t_s - 0.05) < 1e-9
+    assert np.all(robot.last_command.kp == 0) and np.all(robot.last_command.kd > 0)
+
+
+class LostAfter(InputDevice):
+    """Walks at 0.3 m/s; lost after `n` polls, and still returns the last command, as a device
+    that keeps its stale reading does."""
+
+    def __init__(self, n: int):
+        self.n, self.polls = n, 0
+
+    @property
+    def lost(self) -> bool:
+        return self.polls > self.n
+
+    def poll(self, now_s: float) -> Command:
+        self.polls += 1
+        return Command(vx_mps=0.3)
+
+
+def test_a_lost_device_is_no_input_whatever_it_still_returns():
+    """Once a device says it is lost, its commands are not acted on: the robot stops after
+    safety.input_zero_velocity_s and is damped after safety.input_lost_s."""
+    loop, robot, _ = _loop(device=LostAfter(10))  # input at 100 Hz: lost from 0.1 s
+    loop.run(0.1)
+    assert loop.command.vx_mps == 0.3
+    loop.run(0.25)
+    assert loop.command.vx_mps == 0.0 and not loop.faulted
+    loop.run(0.8)
+    assert loop.faulted and loop.safety.trip_event.kind == SafetyEventKind.INPUT_LOST
+    assert np.all(robot.last_command.kp == 0)
+
+
+def test_a_robot_that_collapses_after_another_trip_has_fallen():
+    """The fall monitor keeps watching once the robot is damped for another reason: the fall is
+    recorded, and the trip stays the first cause."""
+    loop, robot, _ = _loop()
+    loop.run(0.1)
+    loop.safety.estop("operator stop", loop.time_s, planned=True)
+    robot.pelvis_z_m = 0.3
+    loop.run(0.04)
+    assert loop.fell and loop.fall.detail == "pelvis at 0.30 m (limit 0.40)"
+    assert [e.kind for e in loop.events] == ["estop", "fall"]
+    assert loop.safety.trip_event.detail == "operator stop"
 
 
 def test_a_planned_ending_is_recorded_as_planned():
