@@ -72,6 +72,25 @@ def test_a_stall_is_one_miss_and_the_ticks_after_it_are_on_time():
     assert (late > 0).sum() == 1
 
 
+def test_a_tick_late_by_less_than_a_period_is_a_miss_and_its_lateness_reaches_the_safety_layer():
+    """A tick that finishes 0.5 ms past its deadline (less than the 2 ms period) counts as a miss, and
+    take_lateness (what the loop hands the safety layer's overrun check) reports it once."""
+    clock = FakeClock()
+    work = {"dt": 0.001}
+
+    def stage():
+        clock.t += work["dt"]
+
+    sched = Scheduler(500, [Stage("work", 500, stage)], wallclock=True, clock=clock, sleep=clock.sleep)
+    sched.run(3)
+    assert sched.take_lateness() == 0.0 and sched.deadline_misses == 0
+    work["dt"] = 0.0025
+    sched.run(1)
+    assert sched.deadline_misses == 1 and sched.misses_over_period == 0 and sched.skipped_ticks == 0
+    assert sched.take_lateness() == pytest.approx(0.0005)
+    assert sched.take_lateness() == 0.0  # taken: the next call reports only what came after
+
+
 def test_lockstep_never_sleeps_but_counts_overruns():
     clock = FakeClock()
 
