@@ -175,6 +175,14 @@ def test_speed_trigger_and_pelvis_height():
     assert pulled.vx_mps == pytest.approx(1.0) and pulled.pelvis_height_m == pytest.approx(0.6)
 
 
+def test_a_trigger_past_its_range_crouches_no_lower_than_the_limit():
+    """The pelvis height is not clipped after shaping, so the clamp on the raw axis is what keeps a
+    trigger reading 1.5 (a miscalibrated pad) from crouching below limits.pelvis_height_m."""
+    mapper = CommandMapper(no_slew(GAMEPAD), CommandLimits(pelvis_height_m=(0.6, 0.8)))
+    cmd = mapper.update(InputSnapshot(axes={"left_trigger": 1.5}), 0.0)
+    assert cmd.pelvis_height_m == pytest.approx(0.6) and mapper.stats.clamped_axis_values == 1
+
+
 def test_keyboard_keys_step_virtual_axes_and_space_stops():
     mapper = CommandMapper(no_slew(KEYBOARD), CommandLimits())
     cmd = mapper.update(InputSnapshot(pressed=("w", "w", "w", "a", "e")), 0.0)
