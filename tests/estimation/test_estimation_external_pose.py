@@ -66,6 +66,17 @@ def test_stale_future_jumping_and_invalid_poses_are_refused_by_name():
     assert "1 accepted, refused: 1 stale, 1 future, 2 jump, 1 invalid" in fusion.describe()
 
 
+def test_a_pose_stamped_before_the_odometry_history_is_refused_as_stale():
+    """Just after the start the odometry history is shorter than max_age_s: a pose stamped before its
+    first sample cannot be carried to now and is refused (stale), not compensated from the first sample."""
+    fusion = PoseFusion(_config(max_age_s=0.3))
+    fusion.update(Planar(1.0, 0.0, 0.0, 0.0))
+    fusion.update(Planar(1.01, 0.005, 0.0, 0.0))
+    assert not fusion.measure(PoseSample(0.9, 0.0, 0.0, 0.0))
+    assert fusion.counters.last_rejection == "stale: stamped 0.110 s ago, before the odometry history"
+    assert fusion.counters.accepted == 0 and fusion.fused == Planar(1.01, 0.005, 0.0, 0.0)
+
+
 def test_after_an_outage_agreeing_poses_are_reacquired_and_a_lone_wild_pose_is_not():
     """Odometry reading 70 % of a 0.5 m/s walk; motion capture lost from 1 s to 5 s: 0.6 m of drift, past
     max_jump_m. The poses after the outage agree with each other, so after `reacquire_poses` of them the
