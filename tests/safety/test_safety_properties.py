@@ -96,10 +96,15 @@ def test_no_unsafe_command_ever_leaves_the_filter(steps):
         state.t_s += now
         state.tick = i
         tripped_before = f.tripped
+        accepted = f.expected_mode_machine  # the first state's, once one got that far
         out = f.filter(cmd, state, now)
         assert_safe(out, state.mode_machine)
         if tripped_before:
             event("tripped before")
+            assert _damping(out)
+        elif state_kind == "healthy" and accepted is not None and accepted != state.mode_machine:
+            event("a healthy state after one of another mode_machine")  # the variant changed: that trips first
+            assert f.trip_event is not None and f.trip_event.kind == SafetyEventKind.MODE_MACHINE_CHANGED
             assert _damping(out)
         elif state_kind == "healthy" and cmd.is_finite():
             event("clamp path (untripped filter, finite command)")
