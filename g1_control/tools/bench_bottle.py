@@ -169,8 +169,9 @@ def run_trial(task: tuple[int, int] | tuple[int, int, bool]) -> dict:
     return run_scene(draw_scene(*task))
 
 
-def run_scene(scene: dict) -> dict:
-    """A scene (draw_scene's form), run and judged."""
+def run_scene(scene: dict, *, gait: bool = True) -> dict:
+    """A scene (draw_scene's form), run and judged. gait False: a carry walks in whole-body steps, as with a
+    tracker that has no gait of its own (GoalConfig.walk_while_holding off)."""
     from g1_control.launch.builder import build_loop
     from g1_control.robot import dex3
 
@@ -179,6 +180,7 @@ def run_scene(scene: dict) -> dict:
     loop.reset()
     sim = cast("MujocoBackend", loop.backend)
     gen = cast("GoalGenerator", loop.generator)
+    gen.config.walk_while_holding = gen.config.walk_while_holding and gait
     m, d = sim.model, sim.data
     hand = scene["hand"]
     h = dex3.SIDES.index(hand)

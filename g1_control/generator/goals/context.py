@@ -77,6 +77,9 @@ class GoalConfig:
     """Standing still this long (speed below settle_speed_mps) before a hand-over."""
     settle_speed_mps: float = 0.05
     walk_timeout_s: float = 45.0
+    carry_walk_speed_mps: float = 0.25
+    carry_turn_rate_radps: float = 0.4
+    """Walking holding something in a goal (approach.walk_holding, the tracker's own gait): at most this fast."""
     stand_s: float = 1.0
     """After a hand-over: from the measured pose to a clean standing pose."""
     move_s: float = 2.0
@@ -221,6 +224,10 @@ class GoalContext:
         self.held: Held | None = None
         self.held_bottle: HeldBottle | None = None
         """The bottle in one hand (goals/bottle.py)."""
+        self.carry_q: np.ndarray | None = None
+        """Walking with something held (GoalConfig.walk_while_holding): the upper body's held posture (g1 joint
+        order; the legs' entries unused) while the tracker walks by its own gait, from the operator's velocity
+        between goals or from `walk` in a goal (approach.walk_holding); None otherwise."""
         self.grasp_nm = np.zeros(2)
         """Per hand (left, right): the finger grasp the plan asks for (KinematicReference.grasp_nm)."""
         self.on_platform: str | None = None

@@ -38,13 +38,13 @@ from collections.abc import Callable, Iterator
 
 import numpy as np
 
-from g1_control.generator.goals.approach import enter_whole_body
+from g1_control.generator.goals.approach import enter_whole_body, stand_holding
 from g1_control.generator.goals.bottle import pick_bottle, place_bottle, turned_moments
 from g1_control.generator.goals.box import GRASP_DISTANCE_M
 from g1_control.generator.goals.context import ARMS, GoalConfig, GoalContext, GoalFailed, world_pose_needed
 from g1_control.generator.goals.handling import held_forces, pick, place
 from g1_control.generator.goals.platform import step_down, step_up
-from g1_control.generator.goals.poses import PosePlanner, ReachRefused, flat_soles, stance_heading
+from g1_control.generator.goals.poses import PosePlanner, ReachRefused, flat_soles
 from g1_control.generator.goals.reach import reach
 from g1_control.generator.styles import ROLLOUT_STYLES
 from g1_control.generator.whole_body import keyframe_trajectory
@@ -131,8 +131,8 @@ class GoalGenerator(Generator):
         self._style = "default"
         self._command = Command()
         self.walking_to_goal = False
-        self._carry_q: np.ndarray | None = None
-        """The held upper-body posture while walking with a box (GoalConfig.walk_while_holding); None otherwise."""
+        self._walking_held = False
+        """This tick's reference walks holding something (GoalContext.carry_q)."""
 
     def reset(self, state: RobotState) -> None:
         self.reset_state()
@@ -237,16 +237,19 @@ class GoalGenerator(Generator):
 
     def _plan_reference(self, command: Command, state: RobotState) -> KinematicReference:
         ctx = self.ctx
-        if self._carry_q is not None:
+        if ctx.carry_q is not None and ctx.phase != PHASE_WHOLE_BODY:
+            if not self._walking_held:  # the walk starts from where the robot is
+                self.walker.reset(state)
+                self._walking_held = True
+            if self._coro is not None and ctx.goal is not None:  # a goal's walk (approach.walk_holding)
+                command = Command(vx_mps=float(ctx.walk[0]), vy_mps=float(ctx.walk[1]),
+                                  wz_radps=float(ctx.walk[2]), style=command.style)
             return self._holding_reference(command, state)
+        self._walking_held = False
         if ctx.phase == PHASE_WHOLE_BODY:
             assert ctx.plan is not None
             j = ctx.plan.sample(ctx.t - ctx.plan_t0, self._joint)
-            if ctx.held_bottle is not None:  # its weight, off the hand point, on the holding hand
-                j.hand_forces_w_n[:] = ctx.held_bottle.forces_w_n
-                turned_moments(ctx.held_bottle, yaw_of(j.root_quat_wxyz), j.hand_moments_w_nm)
-            else:
-                j.hand_moments_w_nm[:] = 0.0
+            self._bottle_wrench(j, yaw_of(j.root_quat_wxyz))
             if ctx.overlay is not None:
                 style, t0 = ctx.overlay
                 q_now, q_next = style.pose(ctx.t - t0), style.pose(ctx.t - t0 + 0.01)
@@ -272,15 +275,27 @@ class GoalGenerator(Generator):
         ref.phase = PHASE_LOCOMOTION
         return ref
 
+    def _bottle_wrench(self, j: JointReference, yaw: float) -> None:
+        """A held bottle's weight, off the hand point, on the holding hand (its moment turned to `yaw`);
+        without one, no moments."""
+        held = self.ctx.held_bottle
+        if held is not None:
+            j.hand_forces_w_n[:] = held.forces_w_n
+            turned_moments(held, yaw, j.hand_moments_w_nm)
+        else:
+            j.hand_moments_w_nm[:] = 0.0
+
     def _holding_reference(self, command: Command, state: RobotState) -> KinematicReference:
-        """Walking with a box: the operator's velocity (the walker's limits) for the tracker's own gait,
-        the held upper-body posture, the box's forces on the hands turned with the robot's heading."""
-        assert self._carry_q is not None
+        """Walking with a box or a bottle held: the velocity (the walker's limits) for the tracker's own
+        gait, the held upper-body posture (GoalContext.carry_q), what is held on the hands turned with the
+        robot's heading."""
+        carry_q = self.ctx.carry_q
+        assert carry_q is not None
         walk = self.walker.update(Command(vx_mps=command.vx_mps, vy_mps=command.vy_mps,
                                           wz_radps=command.wz_radps), state)
         j = self._joint
         j.t_s = state.t_s
-        j.q_rad[:] = self._carry_q
+        j.q_rad[:] = carry_q
         j.dq_radps[:] = 0.0
         j.root_pos_w_m[:] = walk.root_pos_w_m
         j.root_quat_wxyz[:] = walk.root_quat_wxyz
@@ -290,7 +305,9 @@ class GoalGenerator(Generator):
         j.phase = PHASE_LOCOMOTION
         j.upper_body_override = True
         j.pelvis_height_m = command.pelvis_height_m
-        j.hand_forces_w_n[:] = held_forces(self.ctx, yaw_of(state.imu_quat_wxyz))
+        yaw = yaw_of(state.imu_quat_wxyz)
+        j.hand_forces_w_n[:] = held_forces(self.ctx, yaw)
+        self._bottle_wrench(j, yaw)
         ref = self._ref.set_from(j)
         ref.upper_body_override = True
         ref.pelvis_height_m = command.pelvis_height_m
@@ -359,12 +376,10 @@ class GoalGenerator(Generator):
         from the measured pose, where a place (or the next walk) starts."""
         ctx, cfg = self.ctx, self.config
         assert ctx.held is not None
-        self._carry_q = ctx.hold_q()[7:].copy()
+        ctx.carry_q = ctx.hold_q()[7:].copy()
         ctx.note(f"walk holding '{ctx.held.box.name}'")
         ctx.phase = PHASE_LOCOMOTION
         ctx.plan = None
-        assert ctx.state is not None
-        self.walker.reset(ctx.state)
         still_since: float | None = None
         while True:
             yield
@@ -377,25 +392,9 @@ class GoalGenerator(Generator):
                 still_since = ctx.t
             elif ctx.t - still_since >= cfg.settle_s:
                 break
-        # from the measured pose (the held arms) to a clean standing one at the nominal height, the
-        # box's weight ahead balanced: a place's footsteps start from it (its steps from the walking
-        # height rose 5 cm at once, and the robot fell with the box, measured)
-        q = ctx.measured_q()
-        q[7:] = np.concatenate([q[7:7 + len(g1.LEG_JOINTS)], self._carry_q[len(g1.LEG_JOINTS):]])
-        soles = flat_soles(self.ik, q)
-        ground = [ctx.scene.ground_height(p[:2]) if ctx.localised else 0.0 for p, _ in soles]
-        q[2] -= min(p[2] - g for (p, _), g in zip(soles, ground))  # the lower sole on its ground
-        soles = [(np.array([p[0], p[1], g]), r) for (p, r), g in zip(soles, ground)]
-        forces = held_forces(ctx, stance_heading(soles))
         box = ctx.held.box
         shift = np.array([-box.mass_kg / self.poses.mass_kg * GRASP_DISTANCE_M, 0.0])
-        posture = q[7:].copy()
-        q_stand = yield from ctx.compute("stand holding", PosePlanner.stand, q, soles,
-                                         min(ground) + self.poses.nominal_pelvis_m, posture, shift)
-        self._carry_q = None
-        ctx.note(f"stand holding '{box.name}'")
-        yield from ctx.run(keyframe_trajectory("hold", [(0.0, q), (cfg.move_s, q_stand)],
-                                               hand_forces=lambda tk: forces), keep=True)
+        yield from stand_holding(ctx, shift, lambda heading: held_forces(ctx, heading))
 
     def _stand_at(self, height: float, style_name: str) -> Iterator[None]:
         ctx = self.ctx
