@@ -33,14 +33,19 @@ def test_rate_that_does_not_divide_base_is_refused():
         Scheduler(500, [Stage("tracker", 30, lambda: None)])
 
 
-def test_wallclock_counts_deadline_misses_and_sleeps_otherwise():
+def _working(dt: float) -> tuple[FakeClock, dict, Scheduler]:
+    """A 500 Hz wall-clock scheduler on a fake clock whose one stage takes work["dt"] of it per tick."""
     clock = FakeClock()
-    work = {"dt": 0.0005}
+    work = {"dt": dt}
 
     def stage():
         clock.t += work["dt"]
 
-    sched = Scheduler(500, [Stage("work", 500, stage)], wallclock=True, clock=clock, sleep=clock.sleep)
+    return clock, work, Scheduler(500, [Stage("work", 500, stage)], wallclock=True, clock=clock, sleep=clock.sleep)
+
+
+def test_wallclock_counts_deadline_misses_and_sleeps_otherwise():
+    clock, work, sched = _working(0.0005)
     sched.run(10)
     assert sched.deadline_misses == 0
     assert clock.t == pytest.approx(10 * 0.002)  # slept to each deadline
@@ -75,13 +80,7 @@ def test_a_stall_is_one_miss_and_the_ticks_after_it_are_on_time():
 def test_a_tick_late_by_less_than_a_period_is_a_miss_and_its_lateness_reaches_the_safety_layer():
     """A tick that finishes 0.5 ms past its deadline (less than the 2 ms period) counts as a miss, and
     take_lateness (what the loop hands the safety layer's overrun check) reports it once."""
-    clock = FakeClock()
-    work = {"dt": 0.001}
-
-    def stage():
-        clock.t += work["dt"]
-
-    sched = Scheduler(500, [Stage("work", 500, stage)], wallclock=True, clock=clock, sleep=clock.sleep)
+    _, work, sched = _working(0.001)
     sched.run(3)
     assert sched.take_lateness() == 0.0 and sched.deadline_misses == 0
     work["dt"] = 0.0025
