@@ -5,6 +5,11 @@ measured world pose) and stands still until it has settled (`walk_to`); the whol
 takes over from the measured configuration (`enter_whole_body`: the soles where they are, so the
 hand-over does not jump) and steps the rest (`step_to`), correcting the stance against the world
 pose until it is where it should be (`correct_stance`).
+
+Holding something, where the tracker has a gait of its own (GoalConfig.walk_while_holding: the
+whole-body controller), a goal walks in that gait with the upper body held (`walk_holding`: back off,
+then turn, walk straight, turn, `turn_walk_turn`) and comes back under a whole-body plan standing
+(`stand_holding`), from where the steps into the stance start.
 """
 
 from __future__ import annotations
