@@ -262,6 +262,20 @@ class WbcConfig:
                                  f"{self.walking_heading_lag_full_speed_mps}")
 
 
+def pendulum_load_kg(hand_forces_w_n: np.ndarray) -> float:
+    """The held load (kg) the gait's pendulum walks with, at the hands: the hand forces' downward parts
+    when both hands carry (a box in both hands, launch/sim_wbc_carry.yaml: without it the DCM ran ahead
+    with 3 kg). A load in one hand alone (a bottle) is left out of the pendulum; it stays in the QP's
+    dynamics (the hand forces, WbcConfig.held_load_inertia). Counted, a 0.64 kg bottle in the right hand
+    threw the gait's back-off forward and sideways and the robot fell (`g1 bench bottle --carry --seed 22`,
+    trial 6; left out: 20/20 on each of seeds 14, 19-23 of bench bottle --carry, 120/120, against 99/100 over
+    seeds 14, 19-22 counted)."""
+    down = -hand_forces_w_n[:, 2]
+    if not bool(np.all(down > 0.0)):
+        return 0.0
+    return float(down.sum()) / cp.GRAVITY_MPS2
+
+
 def terrain_com_height_accel(err_m: float, vz_mps: float, gains: TaskGains, accel_mps2: float,
                              brake_mps2: float) -> float:
     """On steps, the CoM's vertical acceleration asked for, err_m below its target height and rising
@@ -616,8 +630,8 @@ class WholeBodyTracker(Tracker):
         com_vel = dyn.com_vel_mps
         self._com_from_pelvis_xy[:] = com[:2] - self._q[:2]
         # a held load (the hand forces' downward part, as a mass at the hands) walks with the body:
-        # the pendulum is the robot and the load together
-        load_kg = max(0.0, -float(dyn.hand_forces_w_n[:, 2].sum()) / cp.GRAVITY_MPS2)
+        # the pendulum is the robot and the load together (pendulum_load_kg: a load in both hands)
+        load_kg = pendulum_load_kg(dyn.hand_forces_w_n)
         com_xy, com_vel_xy = com[:2].copy(), com_vel[:2].copy()
         if load_kg > 0.0:
             share = load_kg / (dyn.mass_kg + load_kg)
