@@ -270,10 +270,10 @@ def pendulum_load_kg(hand_forces_w_n: np.ndarray) -> float:
     threw the gait's back-off forward and sideways and the robot fell (`g1 bench bottle --carry --seed 22`,
     trial 6; left out: 20/20 on each of seeds 14, 19-23 of bench bottle --carry, 120/120, against 99/100 over
     seeds 14, 19-22 counted)."""
-    down = -hand_forces_w_n[:, 2]
-    if not bool(np.all(down > 0.0)):
+    left, right = float(hand_forces_w_n[0, 2]), float(hand_forces_w_n[1, 2])  # per tick: no arrays made
+    if left >= 0.0 or right >= 0.0:
         return 0.0
-    return float(down.sum()) / cp.GRAVITY_MPS2
+    return -(left + right) / cp.GRAVITY_MPS2
 
 
 def terrain_com_height_accel(err_m: float, vz_mps: float, gains: TaskGains, accel_mps2: float,
