@@ -34,7 +34,8 @@ BENCHMARKS = {
                    "(achieved vs commanded, off-axis, falls, act() CPU p50/p99 vs RNEA+CRBA); exits 1 on a fall"),
     "objects": ("g1_control.tools.bench_objects:main",
                 "pick a box (floor/low/table/high support, 0.15-0.45 m, 0.2-6 kg, any yaw) and put it on another "
-                "support, --trials drawn scenes judged from ground truth; a table per bucket, every refusal's reason"),
+                "support, --trials drawn scenes judged from ground truth; a table per bucket, every refusal's reason; "
+                "--carry: 3-5 m between two tables on the whole-body controller's gait"),
     "bottle": ("g1_control.tools.bench_bottle:main",
                "a bottle picked with one Dex3 hand (force-limited grasp) and put down upright, --trials drawn scenes "
                "(table height, bottle size/mass/friction, hand, place) judged from ground truth; peak finger squeeze "
@@ -86,7 +87,9 @@ def register(subparsers) -> None:
     parser.add_argument("--write", action="store_true", help="envelope: write the measured envelope next to the "
                         "policy spec (the loop builder's command limits)")
     parser.add_argument("--carry", action="store_true", help="bottle: put the bottle down on a second table "
-                        "1.0-1.8 m from the start, off to the side of the first (walked to holding it)")
+                        "1.0-1.8 m from the start, off to the side of the first (walked to holding it); objects: "
+                        "carry the box 3-5 m between two 0.60-0.85 m tables (0.20-0.35 m, 1-4 kg) on the "
+                        "whole-body controller, its own gait walking it")
     add_fanout_arguments(parser, what="/".join(FANS_OUT) + " trials")
     parser.set_defaults(func=_run)
 

@@ -35,10 +35,14 @@ import re
 import time
 from collections import defaultdict
 from pathlib import Path
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from g1_control.scene import FLOOR, Box, SceneConfig, Table
+
+if TYPE_CHECKING:
+    from g1_control.generator.goals.executor import GoalGenerator
 from g1_control.teleop.scripted import GoalEntry, Segment
 
 HEIGHT_BUCKETS_M = {"floor": (0.0, 0.0), "low": (0.10, 0.45), "table": (0.45, 0.80), "high": (0.80, 0.95)}
@@ -53,6 +57,12 @@ REST_TOLERANCE_M = 0.03
 UPRIGHT_DEG = 10.0
 DROP_M = 0.05
 FALL_PELVIS_M = 0.30
+CARRY_HEIGHT_M = (0.60, 0.85)
+CARRY_BOX_SIDE_M = (0.20, 0.35)
+CARRY_MASS_KG = (1.0, 4.0)
+CARRY_DISTANCE_M = (3.0, 5.0)
+"""--carry: both supports tables of these heights, boxes of these sides and masses, the target this far from
+the box; the whole-body controller is the tracker, its own gait carries (GoalConfig.walk_while_holding)."""
 TRIAL_LIMIT_S = 110.0
 """Simulated time a trial may take (walk, pick, carry, place): a cap, trials stop when both goals end."""
 SETTLE_S = 2.0
@@ -79,7 +89,8 @@ def _extent_along(size_xy: np.ndarray, yaw: float, direction: np.ndarray) -> flo
 
 
 def _support(rng: np.random.Generator, name: str, bucket: str, edge_xy: np.ndarray, outward: np.ndarray,
-             item_size_xy: np.ndarray, item_yaw: float) -> tuple[Table | None, np.ndarray]:
+             item_size_xy: np.ndarray, item_yaw: float, heights: dict[str, tuple[float, float]] = HEIGHT_BUCKETS_M
+             ) -> tuple[Table | None, np.ndarray]:
     """A table (None for the floor) with an item of the given footprint near the edge at edge_xy whose
     outward normal is `outward`; returns the table and where the item's centre stands."""
     depth = _extent_along(item_size_xy, item_yaw, outward)
@@ -87,7 +98,7 @@ def _support(rng: np.random.Generator, name: str, bucket: str, edge_xy: np.ndarr
     center = edge_xy - inset * outward
     if bucket == "floor":
         return None, center
-    lo, hi = HEIGHT_BUCKETS_M[bucket]
+    lo, hi = heights[bucket]
     height = float(rng.uniform(lo, hi))
     across = _extent_along(item_size_xy, item_yaw, _rot(outward, math.pi / 2))
     size = (max(0.5, depth + 0.15 + rng.uniform(0.0, 0.3)), max(0.6, across + 0.2 + rng.uniform(0.0, 0.5)))
@@ -104,27 +115,32 @@ def _support(rng: np.random.Generator, name: str, bucket: str, edge_xy: np.ndarr
     return table, center
 
 
-def draw_scene(seed: int, index: int) -> dict:
-    """The trial's scene and goals, drawn from (seed, index) alone (module docstring). Returns
-    {scene, goals, target_xyz_m, source, target, mass_kg, size_m}."""
-    rng = np.random.default_rng([seed, index, 25])
-    buckets = list(HEIGHT_BUCKETS_M)
+def draw_scene(seed: int, index: int, carry: bool = False) -> dict:
+    """The trial's scene and goals, drawn from (seed, index) alone (module docstring); carry: from the
+    --carry ranges (CARRY_*). Returns {scene, goals, target_xyz_m, source, target, mass_kg, size_m,
+    carry_m}."""
+    rng = np.random.default_rng([seed, index, 25] if not carry else [seed, index, 25, 23])
+    heights = {"table": CARRY_HEIGHT_M} if carry else HEIGHT_BUCKETS_M
+    buckets = list(heights)
+    sides, masses = (CARRY_BOX_SIDE_M, CARRY_MASS_KG) if carry else (BOX_SIDE_M, BOX_MASS_KG)
+    distances = CARRY_DISTANCE_M if carry else TARGET_DISTANCE_M
     for _ in range(200):
-        src_bucket, dst_bucket = buckets[int(rng.integers(0, 4))], buckets[int(rng.integers(0, 4))]
-        size = rng.uniform(*BOX_SIDE_M, size=3)
-        mass = float(rng.uniform(*BOX_MASS_KG))
+        src_bucket = buckets[int(rng.integers(0, len(buckets)))]
+        dst_bucket = buckets[int(rng.integers(0, len(buckets)))]
+        size = rng.uniform(*sides, size=3)
+        mass = float(rng.uniform(*masses))
         box_yaw = float(rng.uniform(-math.pi, math.pi))
         bearing = math.radians(rng.uniform(-35.0, 35.0))
         dist = rng.uniform(*SOURCE_DISTANCE_M)
         toward_robot = -np.array([math.cos(bearing), math.sin(bearing)])
         edge_normal = _rot(toward_robot, math.radians(rng.uniform(-30.0, 30.0)))
         edge_xy = dist * np.array([math.cos(bearing), math.sin(bearing)])
-        table_a, box_xy = _support(rng, "table_a", src_bucket, edge_xy, edge_normal, size[:2], box_yaw)
+        table_a, box_xy = _support(rng, "table_a", src_bucket, edge_xy, edge_normal, size[:2], box_yaw, heights)
         # the target: on the robot's side of the first support, its near edge facing the box
         move = _rot(edge_normal, math.radians(rng.uniform(-70.0, 70.0)))
-        to_edge = rng.uniform(*TARGET_DISTANCE_M)
+        to_edge = rng.uniform(*distances)
         edge_b = box_xy + to_edge * move
-        table_b, target_xy = _support(rng, "table_b", dst_bucket, edge_b, -move, size[:2], box_yaw)
+        table_b, target_xy = _support(rng, "table_b", dst_bucket, edge_b, -move, size[:2], box_yaw, heights)
         box = Box("box", (float(box_xy[0]), float(box_xy[1])), stands_on=table_a.name if table_a else FLOOR,
                   size_m=(float(size[0]), float(size[1]), float(size[2])), mass_kg=mass, yaw_rad=box_yaw)
         tables = [t for t in (table_a, table_b) if t is not None]
@@ -145,7 +161,8 @@ def draw_scene(seed: int, index: int) -> dict:
                 "source": {"bucket": src_bucket, "height_m": table_a.height_m if table_a else 0.0,
                            "yaw_deg": math.degrees(table_a.yaw_rad) if table_a else None},
                 "target": {"bucket": dst_bucket, "height_m": top},
-                "mass_kg": mass, "size_m": [float(s) for s in size], "box_yaw_deg": math.degrees(box_yaw)}
+                "mass_kg": mass, "size_m": [float(s) for s in size], "box_yaw_deg": math.degrees(box_yaw),
+                "carry_m": float(np.hypot(*(target_xy - box_xy)))}
     raise RuntimeError(f"no valid scene for seed {seed}, trial {index}")
 
 
@@ -169,19 +186,27 @@ def _timeline(goals: list[GoalEntry]) -> list[Segment]:
     return [Segment(1.0, label="stand"), Segment(TRIAL_LIMIT_S, label="pick and place", goals=list(goals))]
 
 
-def run_trial(seed: int, index: int) -> dict:
-    """One trial, start to verdict (module docstring): a plain function of (seed, index)."""
+def run_trial(seed: int, index: int, carry: bool = False, gait: bool = True) -> dict:
+    """One trial, start to verdict (module docstring): a plain function of its arguments. carry: a --carry
+    scene on the whole-body controller (launch/sim_wbc_carry.yaml's chain); gait False: its carry walks in
+    whole-body steps, as with a tracker that has no gait (GoalConfig.walk_while_holding off)."""
     from g1_control.launch.builder import build_loop
     from g1_control.report.outcomes import GoalWatcher
     from g1_control.tools.physics_trials import Trial, trial_launch
 
-    drawn = draw_scene(seed, index)
-    trial = Trial(f"objects {seed}.{index}", _timeline(drawn["goals"]), tracker="layer", tracker_hz=100.0,
-                  scene=drawn["scene"])
+    drawn = draw_scene(seed, index, carry)
+    if carry:
+        trial = Trial(f"carry {seed}.{index}", _timeline(drawn["goals"]), tracker="wbc", tracker_hz=250.0,
+                      scene=drawn["scene"])
+    else:
+        trial = Trial(f"objects {seed}.{index}", _timeline(drawn["goals"]), tracker="layer", tracker_hz=100.0,
+                      scene=drawn["scene"])
     loop = build_loop(trial_launch(trial))
     loop.reset()
     watcher = GoalWatcher(loop)
     gen = loop.generator
+    if not gait:
+        cast("GoalGenerator", gen).config.walk_while_holding = False
     t0 = time.perf_counter()
     pelvis_min = math.inf
     ended_at: float | None = None
@@ -199,8 +224,12 @@ def run_trial(seed: int, index: int) -> dict:
     finally:
         wall = time.perf_counter() - t0
         loop.backend.close()
+    notes = [text for _, text in getattr(getattr(gen, "ctx", None), "log", [])]
+    walked = "gait" if any(text.startswith("stand holding") for text in notes) else \
+        "steps" if any(text.startswith("place stance") for text in notes) else None
     return judge(drawn, watcher.arrays(), dict(gen.goal_info), dict(gen.goal_messages), pelvis_min,
-                 loop.fall is not None, seed=seed, index=index, sim_s=float(loop.time_s), wall_s=wall)
+                 loop.fall is not None, seed=seed, index=index, carry=carry, gait=gait, walked=walked,
+                 sim_s=float(loop.time_s), wall_s=wall)
 
 
 def judge(drawn: dict, a: dict[str, np.ndarray], info: dict, messages: dict, pelvis_min_m: float, fall: bool,
@@ -241,7 +270,9 @@ def judge(drawn: dict, a: dict[str, np.ndarray], info: dict, messages: dict, pel
     fell_in = ""
     if fell:
         fell_in = f"{running[-1].get('kind')}: {running[-1].get('stage', 'start')}" if running else "no goal running"
+    place_s = place["end_s"] - place["start_s"] if place.get("end_s") is not None else None
     return {**extra, "source": drawn["source"], "target": drawn["target"], "mass_kg": drawn["mass_kg"],
+            "carry_m": drawn.get("carry_m"), "place_s": place_s,
             "weight": "heavy" if drawn["mass_kg"] >= HEAVY_KG else "light", "size_m": drawn["size_m"],
             "box_yaw_deg": drawn["box_yaw_deg"], "lifted": lifted, "held": held, "placed": placed,
             "upright": upright, "dropped": dropped, "fell": fell, "fell_in": fell_in, "success": success,
@@ -306,12 +337,14 @@ def main(args) -> int:
     env = environment()
     print(describe(env), flush=True)
     t0 = time.perf_counter()
+    carry = bool(getattr(args, "carry", False))
     results: list[dict] = []
-    for r in fan_out(_trial, [(seed, i) for i in range(n)], jobs=args.jobs, ray=args.ray):
+    for r in fan_out(_trial, [(seed, i, carry) for i in range(n)], jobs=args.jobs, ray=args.ray):
         results.append(r)
         _print_trial(r)
     table = summary(results)
-    print(f"\ng1 bench objects --seed {seed} --trials {n}: {time.perf_counter() - t0:.0f} s wall")
+    print(f"\ng1 bench objects{' --carry' if carry else ''} --seed {seed} --trials {n}: "
+          f"{time.perf_counter() - t0:.0f} s wall")
     print(f"{'bucket':14s} {'success':>8s}")
     for k, v in table.items():
         print(f"{k:14s} {v['success']:>3d}/{v['trials']:<3d}")
@@ -327,21 +360,22 @@ def main(args) -> int:
             for reason, count in counts.items():
                 print(f"  {bucket:11s} {count:3d}  {reason}")
     if args.json:
-        Path(args.json).write_text(json.dumps({"seed": seed, "trials": n, "environment": env, "table": table, "reasons": reasons,
-                                               "results": results},
+        Path(args.json).write_text(json.dumps({"seed": seed, "trials": n, "carry": carry, "environment": env, "table": table,
+                                               "reasons": reasons, "results": results},
                                               indent=1, default=float))
     return 0
 
 
-def _trial(task: tuple[int, int]) -> dict:
-    """One trial for fan_out (--jobs processes or a Ray cluster): run_trial(seed, index)."""
+def _trial(task: tuple[int, int, bool]) -> dict:
+    """One trial for fan_out (--jobs processes or a Ray cluster): run_trial(seed, index, carry)."""
     return run_trial(*task)
 
 
 def _print_trial(r: dict) -> None:
     s, d = r["source"], r["target"]
+    carried = f" carried {r['carry_m']:.1f} m ({r.get('walked') or 'not walked'})" if r.get("carry") else ""
     print(f"trial {r['index']:3d}: {s['bucket']:5s} {s['height_m']:.2f} m -> {d['bucket']:5s} {d['height_m']:.2f} m, "
-          f"box {'x'.join(f'{v:.2f}' for v in r['size_m'])} m {r['mass_kg']:.1f} kg: {_why(r)}  "
+          f"box {'x'.join(f'{v:.2f}' for v in r['size_m'])} m {r['mass_kg']:.1f} kg{carried}: {_why(r)}  "
           f"[{r['sim_s']:.0f} s sim, {r['wall_s']:.0f} s wall]", flush=True)
 
 

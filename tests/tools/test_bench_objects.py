@@ -6,6 +6,10 @@ import math
 import numpy as np
 
 from g1_control.tools.bench_objects import (
+    CARRY_BOX_SIDE_M,
+    CARRY_DISTANCE_M,
+    CARRY_HEIGHT_M,
+    CARRY_MASS_KG,
     HEIGHT_BUCKETS_M,
     _why,
     draw_scene,
@@ -32,6 +36,39 @@ def test_scenes_are_a_function_of_seed_and_index_within_the_ranges():
         d["scene"].validate("scene")
         buckets.add(d["source"]["bucket"])
     assert buckets == set(HEIGHT_BUCKETS_M)
+
+
+def test_the_objects_scenes_are_those_earlier_stops_measured():
+    """Seeds keep their scenes across changes to the drawing (--carry draws from its own stream): two
+    draws of seed 90 as they were when its figures were taken (stop 50)."""
+    a, b = draw_scene(90, 0), draw_scene(90, 1)
+    assert a["source"]["height_m"] == 0.0 and math.isclose(a["mass_kg"], 2.21878693986439)
+    np.testing.assert_allclose(a["target_xyz_m"], [1.5938461491343041, 0.7681383877961814, 0.9839207852635277])
+    assert math.isclose(b["source"]["height_m"], 0.8889167249457033) and math.isclose(b["mass_kg"], 4.643787007410345)
+    np.testing.assert_allclose(b["target_xyz_m"], [0.7393644711212342, 1.7758994675607502, 0.40120755870346264])
+
+
+def test_carry_scenes_are_two_tables_3_to_5_m_apart_within_the_carry_ranges():
+    assert draw_scene(3, 4, carry=True)["scene"] == draw_scene(3, 4, carry=True)["scene"]
+    assert draw_scene(3, 4, carry=True)["scene"] != draw_scene(3, 4)["scene"]
+    far = []
+    for i in range(30):
+        d = draw_scene(12, i, carry=True)
+        scene = d["scene"]
+        scene.validate("scene")
+        box = scene.boxes[0]
+        assert len(scene.tables) == 2 and box.stands_on == "table_a"
+        assert all(CARRY_BOX_SIDE_M[0] <= s <= CARRY_BOX_SIDE_M[1] for s in box.size_m)
+        assert CARRY_MASS_KG[0] <= box.mass_kg <= CARRY_MASS_KG[1]
+        for t in scene.tables:
+            assert CARRY_HEIGHT_M[0] <= t.height_m <= CARRY_HEIGHT_M[1]
+        target = np.asarray(d["target_xyz_m"])
+        assert scene.tables[1].contains_xy(target[:2]) and math.isclose(target[2], scene.tables[1].height_m + box.size_m[2] / 2)
+        moved = float(np.hypot(*(target[:2] - np.asarray(box.xy_m))))
+        assert math.isclose(moved, d["carry_m"])
+        assert CARRY_DISTANCE_M[0] <= moved <= CARRY_DISTANCE_M[1] + 0.3  # the edges this far apart, then inset
+        far.append(moved)
+    assert max(far) - min(far) > 1.0  # drawn over the range, not one distance
 
 
 def _arrays(box_z, hands_z, final_xy, tilt_rad=0.0):

@@ -144,6 +144,12 @@ def walk_holding(ctx: GoalContext, approach: Approach, carry_q: np.ndarray, *, o
     yield from turn_walk_turn(ctx, approach, out_m=out_m)
 
 
+GAIT_PELVIS_DROP_M = 0.06
+"""Walking by the whole-body controller's own gait (GoalConfig.walk_while_holding), the pelvis goes this
+much below its standing height at most: the gait holds the CoM 0.03 m lower, and 0.05 m more per m/s up
+to 0.6 m/s (trackers/wbc/tracker.py, WbcConfig.walking_com_lower_m and its speed terms)."""
+
+
 WALK_CLEAR_M = 0.25
 """walk_holding stops no nearer than this to a table's or platform's outline (the pelvis point): short of a
 table's stance, 0.2 m back from it lay 6 cm from another table, whose edge the pelvis met while the robot

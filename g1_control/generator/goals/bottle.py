@@ -39,6 +39,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from g1_control.generator.goals.approach import (
+    GAIT_PELVIS_DROP_M,
     correct_stance,
     enter_whole_body,
     stand_holding,
@@ -97,10 +98,6 @@ CARRY_SIDE_M = 0.20
 at arm's length (STANCE_AHEAD_M), where the arm cannot raise it further. 0.12 m to the side was tried:
 seed 14 trial 5 of bench bottle --carry then put its bottle down, but seeds 17 and 18 fell 3 and 2 times
 in the carry's turns on the spot (0 at 0.20 m)."""
-GAIT_PELVIS_DROP_M = 0.06
-"""Walking by the whole-body controller's own gait (GoalConfig.walk_while_holding), the pelvis goes this
-much below its standing height at most: the gait holds the CoM 0.03 m lower, and 0.05 m more per m/s up
-to 0.6 m/s (trackers/wbc/tracker.py, WbcConfig.walking_com_lower_m and its speed terms)."""
 CARRY_CLEAR_M = 0.05
 """Carried, the bottle's base passes at least this far above the top it is to be put on (raised before
 the walk where the pick left it lower, the walk's lower pelvis counted)."""

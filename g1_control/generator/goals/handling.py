@@ -15,9 +15,18 @@ from dataclasses import replace
 
 import numpy as np
 
-from g1_control.generator.goals.approach import correct_stance, enter_whole_body, step_to, walk_to
+from g1_control.generator.goals.approach import (
+    GAIT_PELVIS_DROP_M,
+    correct_stance,
+    enter_whole_body,
+    stand_holding,
+    step_to,
+    walk_holding,
+    walk_to,
+)
 from g1_control.generator.goals.box import (
     GRASP_DISTANCE_M,
+    Approach,
     grasp_width,
     hand_forces,
     hand_points,
@@ -70,11 +79,11 @@ PELVIS_SPEED_MPS = 0.15
 
 # -- planner jobs (GoalContext.compute: inline, or in the planner process) ---------------------------
 def carry_plan(poses: PosePlanner, q0: np.ndarray, steps: list[Footstep], cfg: SteppingConfig, posture: np.ndarray,
-               com_offset_h_m: np.ndarray, squeeze_n: float, weight_n: float) -> SteppingPlan:
+               com_offset_h_m: np.ndarray, squeeze_n: float, weight_n: float, name: str = "carry") -> SteppingPlan:
     """The carry's footsteps with the box's hand forces per sample, turned with the pelvis's heading."""
     forces = hand_forces(stance_heading(flat_soles(poses.ik, q0)), squeeze_n, weight_n)
     plan = stepping_trajectory(poses.ik, q0, steps, cfg, posture=posture, hand_forces=forces,
-                               com_offset_h_m=com_offset_h_m, name="carry")
+                               com_offset_h_m=com_offset_h_m, name=name)
     traj = plan.trajectory
     traj.hand_forces_w_n = np.array([hand_forces(y, squeeze_n, weight_n) for y in traj.root_rpy_rad[:, 2]])
     return plan
@@ -327,6 +336,16 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     carry_shift = box_com_shift(box.mass_kg, ctx.poses.mass_kg, GRASP_DISTANCE_M)
     far = float(np.hypot(*(approach.mid_xy - stance.mid_xy))) > 0.05 or \
         abs(wrap_angle(approach.heading - stance.heading)) > 0.05
+    if far and cfg.walk_while_holding:  # the tracker's own gait walks it there (walk_in_gait), where it can
+        walked = yield from walk_in_gait(ctx, approach, posture, weight, carry_shift, support)
+        if walked is not None:
+            posture, step_cfg = walked
+            yield from correct_stance(ctx, approach.mid_xy, approach.heading, step_cfg, posture=posture,
+                                      forces=hand_forces(approach.heading, squeeze, weight),
+                                      com_shift=ctx.poses.com_offset_m + carry_shift)
+            far = False
+        else:
+            posture = ctx.hold_q()[7:].copy()
     if far and support is not None:  # the box carried clear above the support's top, not into its side
         yield from raise_over(ctx, support, posture, carry_shift)
         posture = ctx.hold_q()[7:].copy()
@@ -487,8 +506,54 @@ before walking (the box stays held). A box 0.5-1 cm over a 0.92 m table dragged 
 fell (bench objects seed 19, trial 8); BOX_OVER_TOP_M is what is asked, this is what is accepted."""
 
 
+def walk_in_gait(ctx: GoalContext, approach: Approach, posture: np.ndarray, weight: float, com_shift: np.ndarray,
+                 over: Block | None) -> Generator[None, None, tuple[np.ndarray, SteppingConfig] | None]:
+    """Carry the held box to `approach` in the tracker's own gait (GoalConfig.walk_while_holding: the
+    whole-body controller): raised first, standing, until its bottom passes BOX_OVER_TOP_M over `over`'s
+    top with the gait's lower pelvis (GAIT_PELVIS_DROP_M below the nominal stand, the arms held as they
+    are, less the measured sag); then back off, turn, walk straight, turn (approach.walk_holding, the
+    box's forces on the hands turned with the heading by the executor's holding reference), stand holding
+    it, and the last steps into the stance in whole-body steps (carry, with its own check over the top).
+    Returns the posture and the stepping settings, as carry does; None, before walking, where the raise
+    leaves the bottom less than CARRY_CLEAR_M over the top in the gait: whole-body steps may walk taller
+    (carry keeps the raise's pelvis), the caller carries in them."""
+    cfg = ctx.config
+    if over is not None and ctx.held is not None and cfg.carry_over_check:
+        need = hands_over_m(ctx, over)
+
+        def walking_hands_m() -> float:
+            """The lower hand point with the pelvis level (the gait holds it so; a stand may pitch it) at
+            the gait's height over the soles, the arms and waist held as they are, less the sag."""
+            q0 = ctx.hold_q()
+            floor = min(float(p[2]) for p, _ in flat_soles(ctx.ik, q0))
+            level = q0.copy()
+            yaw = yaw_of(np.array([q0[6], q0[3], q0[4], q0[5]]))
+            level[3:7] = [0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)]
+            hands = min(float(ctx.poses.hand_point(level, i)[2]) for i in range(2))
+            walk_pelvis = floor + ctx.poses.nominal_pelvis_m - GAIT_PELVIS_DROP_M
+            return hands - float(q0[2]) + walk_pelvis - max(0.0, hands_sag_m(ctx))
+
+        low = walking_hands_m()
+        if low < need - 0.005:
+            yield from _raise_by(ctx, over, need - low, com_shift, need, strict=False)
+            posture = ctx.hold_q()[7:].copy()
+            was, low = low, walking_hands_m()
+            ctx.note(f"carry over '{over.name}' in the gait: the hands {was:.3f} m -> {low:.3f} m "
+                     f"({need:.3f} m asked)")
+        clear = low - (need - BOX_OVER_TOP_M)
+        if clear < CARRY_CLEAR_M:
+            ctx.note(f"carry over '{over.name}': in the gait the box's bottom would pass {clear * 100:.1f} cm over "
+                     f"the top (at least {CARRY_CLEAR_M * 100:.0f} cm): whole-body steps")
+            return None
+    yield from walk_holding(ctx, approach, posture, out_m=cfg.approach_offset_m, back_m=cfg.backup_m)
+    yield from stand_holding(ctx, com_shift, lambda heading: held_forces(ctx, heading))
+    posture = ctx.hold_q()[7:].copy()
+    return (yield from carry(ctx, approach.mid_xy + ctx.offset(), approach.heading, posture, weight, com_shift,
+                             over=over, back_m=0.0, name="carry in"))
+
+
 def carry(ctx: GoalContext, mid_xy: np.ndarray, heading: float, posture: np.ndarray, weight: float,
-          com_shift: np.ndarray, over: Block | None = None
+          com_shift: np.ndarray, over: Block | None = None, back_m: float | None = None, name: str = "carry"
           ) -> Generator[None, None, tuple[np.ndarray, SteppingConfig]]:
     """Footsteps to a stance with the box held: back up from the table, turn, walk, turn; the
     hand forces follow the robot's heading along the way.
@@ -501,10 +566,14 @@ def carry(ctx: GoalContext, mid_xy: np.ndarray, heading: float, posture: np.ndar
     left it (no higher than the nominal stand + STRAIGHT_KNEE_GUARD_M); still short, the box is raised
     as far as the arms go, standing, and planned once more; still less than CARRY_CLEAR_M over the
     top, the place refuses. Returns the upper-body posture and the stepping settings carried with
-    (the corrections after the carry use the same)."""
+    (the corrections after the carry use the same). back_m: how far it backs up first (None:
+    GoalConfig.backup_m); name: the plan's stage name."""
     cfg = ctx.config
     step_cfg = cfg.carry
-    plan = yield from _carry_plan(ctx, mid_xy, heading, posture, com_shift, step_cfg)
+    back = cfg.backup_m if back_m is None else back_m
+    plan = yield from _carry_plan(ctx, mid_xy, heading, posture, com_shift, step_cfg, back, name)
+    if plan is None:  # there already
+        return posture, step_cfg
     if over is not None and ctx.held is not None and cfg.carry_over_check:
         need = hands_over_m(ctx, over)
         sag = max(0.0, hands_sag_m(ctx))
@@ -519,7 +588,8 @@ def carry(ctx: GoalContext, mid_xy: np.ndarray, heading: float, posture: np.ndar
             floor = min(float(p[2]) for p, _ in flat_soles(ctx.ik, q0))
             kept = min(float(q0[2]) - floor, ctx.poses.nominal_pelvis_m + STRAIGHT_KNEE_GUARD_M)
             step_cfg = replace(cfg.carry, pelvis_above_ground_m=max(cfg.carry.pelvis_above_ground_m, kept))
-            plan = yield from _carry_plan(ctx, mid_xy, heading, posture, com_shift, step_cfg)
+            plan = yield from _carry_plan(ctx, mid_xy, heading, posture, com_shift, step_cfg, back, name)
+            assert plan is not None
             was, low = low, (yield from ctx.compute("carry check", lowest_hands_m, plan.trajectory)) - sag
             ctx.note(f"carry over '{over.name}': the hands {was:.3f} m -> {low:.3f} m ({attempt}; "
                      f"{need:.3f} m asked, sag {sag * 100:.1f} cm)")
@@ -534,22 +604,26 @@ def carry(ctx: GoalContext, mid_xy: np.ndarray, heading: float, posture: np.ndar
 
 
 def _carry_plan(ctx: GoalContext, mid_xy: np.ndarray, heading: float, posture: np.ndarray,
-                com_shift: np.ndarray, step_cfg: SteppingConfig) -> Generator[None, None, SteppingPlan]:
-    cfg = ctx.config
+                com_shift: np.ndarray, step_cfg: SteppingConfig, back_m: float, name: str
+                ) -> Generator[None, None, SteppingPlan | None]:
     q0 = ctx.hold_q()
     stance = Stance.of(ctx.ik, q0)
-    back = stance.mid_xy - cfg.backup_m * np.array([math.cos(stance.heading), math.sin(stance.heading)])
     ground = ctx.scene.ground_height
-    steps = walk_steps(stance, back, stance.heading, step_cfg, lambda xy: ground(xy), backward_max_m=1.0)
-    for st in steps:
-        stance = stance.apply(st)
+    steps: list[Footstep] = []
+    if back_m > 0:
+        back = stance.mid_xy - back_m * np.array([math.cos(stance.heading), math.sin(stance.heading)])
+        steps = walk_steps(stance, back, stance.heading, step_cfg, lambda xy: ground(xy), backward_max_m=1.0)
+        for st in steps:
+            stance = stance.apply(st)
     steps += walk_steps(stance, mid_xy, heading, step_cfg, lambda xy: ground(xy), then=steps)
+    if not steps:
+        return None
     held = ctx.held  # the box's squeeze (squeeze_for) and weight on the hands; none held: no forces
     squeeze, load = (held.squeeze_n, held.box.mass_kg * GRAVITY) if held is not None else (0.0, 0.0)
-    plan = yield from ctx.compute("carry", carry_plan, q0, steps, step_cfg, posture, ctx.poses.com_offset_m + com_shift,
-                                  squeeze, load)
+    plan = yield from ctx.compute(name, carry_plan, q0, steps, step_cfg, posture, ctx.poses.com_offset_m + com_shift,
+                                  squeeze, load, name)
     ctx.last_steps = plan
     if plan.sole_error_m > 0.03:
-        raise GoalFailed(f"carry: the footsteps are out of the legs' reach (plan off by "
+        raise GoalFailed(f"{name}: the footsteps are out of the legs' reach (plan off by "
                          f"{plan.sole_error_m * 100:.0f} cm)")
     return plan
