@@ -14,10 +14,12 @@ import time
 from dataclasses import replace
 
 import numpy as np
+import pytest
 
 from g1_control.generator.goals.approach import GAIT_PELVIS_DROP_M
 from g1_control.generator.goals.executor import REACHED, GoalConfig, GoalGenerator
 from g1_control.generator.goals.handling import BOX_OVER_TOP_M
+from g1_control.generator.goals.poses import flat_soles
 from g1_control.rotations import yaw_of
 from g1_control.scene import Box, SceneConfig, Table
 from g1_control.types import PHASE_LOCOMOTION, PHASE_WHOLE_BODY, Command, TaskGoal
@@ -108,3 +110,30 @@ def test_a_table_too_high_for_the_gaits_lower_pelvis_is_carried_to_in_whole_body
     assert any("in the gait the box's bottom would pass" in text and "whole-body steps" in text
                for _, text in gen.ctx.log)
     assert min(seen["carry"]) >= TABLE.height_m + BOX_OVER_TOP_M - 0.01
+
+
+def test_the_gaits_hand_height_is_taken_with_the_pelvis_level():
+    """gait_hands_m: the pose's arms and waist over a level pelvis at the gait's height (the gait holds the
+    pelvis level; a stand may pitch it). Pitched 0.15 rad either way, the same joints give the same walking
+    hands as level, where the pose's own hands move by centimetres."""
+    from types import SimpleNamespace
+
+    from g1_control.generator.goals.handling import gait_hands_m
+    from g1_control.generator.goals.poses import PosePlanner
+    from g1_control.robot import g1
+
+    poses = PosePlanner()
+    ctx = SimpleNamespace(ik=poses.ik, poses=poses)
+    q = poses.ik.nominal()
+    for side in ("left", "right"):
+        q[7 + g1.JOINT_INDEX[f"{side}_shoulder_pitch_joint"]] = -0.9  # holding something ahead
+    level = gait_hands_m(ctx, q)
+    hands = min(float(poses.hand_point(q, i)[2]) for i in range(2))
+    assert level == pytest.approx(hands - float(q[2]) + poses.nominal_pelvis_m - GAIT_PELVIS_DROP_M, abs=1e-6)
+    for pitch in (-0.15, 0.15):
+        pitched = q.copy()
+        pitched[3:7] = [0.0, math.sin(pitch / 2), 0.0, math.cos(pitch / 2)]
+        moved = min(float(poses.hand_point(pitched, i)[2]) for i in range(2)) - hands
+        assert abs(moved) > 0.02
+        floor = min(float(p[2]) for p, _ in flat_soles(poses.ik, pitched))  # the soles tilt with it
+        assert gait_hands_m(ctx, pitched) == pytest.approx(level + floor, abs=1e-6)

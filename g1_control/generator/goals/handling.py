@@ -506,6 +506,19 @@ before walking (the box stays held). A box 0.5-1 cm over a 0.92 m table dragged 
 fell (bench objects seed 19, trial 8); BOX_OVER_TOP_M is what is asked, this is what is accepted."""
 
 
+def gait_hands_m(ctx: GoalContext, q: np.ndarray) -> float:
+    """The lower hand point walking in the tracker's own gait with the waist and arms held as in q: the
+    pelvis level (the gait holds it so; a stand may pitch it, and the hands then sit ~5 cm higher than
+    they walk, measured on a floor pick's stand) at the gait's height over q's soles (GAIT_PELVIS_DROP_M
+    below the nominal stand)."""
+    floor = min(float(p[2]) for p, _ in flat_soles(ctx.ik, q))
+    level = q.copy()
+    yaw = yaw_of(np.array([q[6], q[3], q[4], q[5]]))
+    level[3:7] = [0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)]
+    hands = min(float(ctx.poses.hand_point(level, i)[2]) for i in range(2))
+    return hands - float(q[2]) + floor + ctx.poses.nominal_pelvis_m - GAIT_PELVIS_DROP_M
+
+
 def walk_in_gait(ctx: GoalContext, approach: Approach, posture: np.ndarray, weight: float, com_shift: np.ndarray,
                  over: Block | None) -> Generator[None, None, tuple[np.ndarray, SteppingConfig] | None]:
     """Carry the held box to `approach` in the tracker's own gait (GoalConfig.walk_while_holding: the
@@ -520,24 +533,11 @@ def walk_in_gait(ctx: GoalContext, approach: Approach, posture: np.ndarray, weig
     cfg = ctx.config
     if over is not None and ctx.held is not None and cfg.carry_over_check:
         need = hands_over_m(ctx, over)
-
-        def walking_hands_m() -> float:
-            """The lower hand point with the pelvis level (the gait holds it so; a stand may pitch it) at
-            the gait's height over the soles, the arms and waist held as they are, less the sag."""
-            q0 = ctx.hold_q()
-            floor = min(float(p[2]) for p, _ in flat_soles(ctx.ik, q0))
-            level = q0.copy()
-            yaw = yaw_of(np.array([q0[6], q0[3], q0[4], q0[5]]))
-            level[3:7] = [0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)]
-            hands = min(float(ctx.poses.hand_point(level, i)[2]) for i in range(2))
-            walk_pelvis = floor + ctx.poses.nominal_pelvis_m - GAIT_PELVIS_DROP_M
-            return hands - float(q0[2]) + walk_pelvis - max(0.0, hands_sag_m(ctx))
-
-        low = walking_hands_m()
+        low = gait_hands_m(ctx, ctx.hold_q()) - max(0.0, hands_sag_m(ctx))
         if low < need - 0.005:
             yield from _raise_by(ctx, over, need - low, com_shift, need, strict=False)
             posture = ctx.hold_q()[7:].copy()
-            was, low = low, walking_hands_m()
+            was, low = low, gait_hands_m(ctx, ctx.hold_q()) - max(0.0, hands_sag_m(ctx))
             ctx.note(f"carry over '{over.name}' in the gait: the hands {was:.3f} m -> {low:.3f} m "
                      f"({need:.3f} m asked)")
         clear = low - (need - BOX_OVER_TOP_M)
