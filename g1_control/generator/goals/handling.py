@@ -1,5 +1,7 @@
-"""Box handling: pick a box from where it stands (a table, the floor), carry it on the whole-body
-controller's own footsteps and set it down on a table, a platform or the floor.
+"""Box handling: pick a box from where it stands (a table, the floor), carry it and set it down on a
+table, a platform or the floor. The carry walks in the tracker's own gait where it has one
+(GoalConfig.walk_while_holding: the whole-body controller; `walk_in_gait`), else, or where the box
+would not clear the target's top with the gait's lower pelvis, on whole-body footsteps (`carry`).
 
 The squeeze and the box's weight are known hand forces in the controller's dynamics; while held,
 they turn with the robot's heading. A box is found by name or as the nearest one in front of the
@@ -10,7 +12,7 @@ down (`ctx.box_positions`).
 from __future__ import annotations
 
 import math
-from collections.abc import Generator, Iterator
+from collections.abc import Callable, Generator, Iterator
 from dataclasses import replace
 
 import numpy as np
@@ -479,15 +481,18 @@ def lowest_hands_m(poses: PosePlanner, traj, every_s: float = 0.1) -> float:
 
 
 def _raise_by(ctx: GoalContext, support: Block, dz_m: float, carry_shift: np.ndarray, need: float,
-              strict: bool = True) -> Iterator[None]:
+              strict: bool = True, accept: Callable[[np.ndarray], bool] | None = None) -> Generator[None, None, bool]:
     """Raise the held box's hands dz_m (standing still), else refuse (the box stays held); not
-    `strict`: as far as they go (refused only for the CoM)."""
+    `strict`: as far as they go (refused only for the CoM); accept: not at all (False, nothing moved)
+    where it says no to the raised pose. True: raised."""
     held = ctx.held
     assert held is not None
     q0 = ctx.hold_q()
     soles = flat_soles(ctx.ik, q0)
     heading = stance_heading(soles)
     up = yield from ctx.compute("raise", raised_pose, q0, soles, heading, dz_m, carry_shift, float(q0[2]))
+    if accept is not None and (up.com_error_m > 0.03 or not accept(up.q)):
+        return False
     if (strict and up.residual_m > 0.03) or up.com_error_m > 0.03:
         raise GoalFailed(f"box '{held.box.name}' cannot be held above '{support.name}' ({support.height_m:.2f} m): "
                          f"the hands get only within {up.residual_m * 100:.1f} cm of {need:.2f} m up "
@@ -497,6 +502,7 @@ def _raise_by(ctx: GoalContext, support: Block, dz_m: float, carry_shift: np.nda
     move = _move_s(q0, q_up, 1.5)
     yield from ctx.run(keyframe_trajectory("raise", [(0.0, q0), (move, q_up), (move + 0.5, q_up)],
                                            hand_forces=lambda _t: forces))
+    return True
 
 
 CARRY_CLEAR_M = 0.03
@@ -504,6 +510,14 @@ CARRY_CLEAR_M = 0.03
 the top along the whole carry's plan, less the measured sag of the hands, else the place refuses
 before walking (the box stays held). A box 0.5-1 cm over a 0.92 m table dragged on it and the robot
 fell (bench objects seed 19, trial 8); BOX_OVER_TOP_M is what is asked, this is what is accepted."""
+
+
+GAIT_RAISE_WITHIN_M = 0.01
+"""walk_in_gait raises the box only with a pose that puts the walking hands (gait_hands_m: the pelvis level)
+this near the height asked; else the carry is whole-body steps, unraised. A raise that got 2.4 of 5.1 cm
+walking (its pose pitched the pelvis: standing, the hands rose the 5 cm) left a pose from which, after the
+walk, the release could not reach the place (3.6 cm off; the same carry in whole-body steps, which needed no
+raise, put it down: launch/sim_wbc_carry.yaml with a 3.7 kg box, scratch variant 6, measured)."""
 
 
 def gait_hands_m(ctx: GoalContext, q: np.ndarray) -> float:
@@ -527,15 +541,22 @@ def walk_in_gait(ctx: GoalContext, approach: Approach, posture: np.ndarray, weig
     are, less the measured sag); then back off, turn, walk straight, turn (approach.walk_holding, the
     box's forces on the hands turned with the heading by the executor's holding reference), stand holding
     it, and the last steps into the stance in whole-body steps (carry, with its own check over the top).
-    Returns the posture and the stepping settings, as carry does; None, before walking, where the raise
-    leaves the bottom less than CARRY_CLEAR_M over the top in the gait: whole-body steps may walk taller
-    (carry keeps the raise's pelvis), the caller carries in them."""
+    Returns the posture and the stepping settings, as carry does; None, before walking, where no raise
+    pose gets the hands within GAIT_RAISE_WITHIN_M of the height asked (nothing moves) or the bottom would
+    pass less than CARRY_CLEAR_M over the top in the gait: whole-body steps may walk taller (carry keeps
+    the raise's pelvis), the caller carries in them."""
     cfg = ctx.config
     if over is not None and ctx.held is not None and cfg.carry_over_check:
         need = hands_over_m(ctx, over)
         low = gait_hands_m(ctx, ctx.hold_q()) - max(0.0, hands_sag_m(ctx))
         if low < need - 0.005:
-            yield from _raise_by(ctx, over, need - low, com_shift, need, strict=False)
+            sag = low - gait_hands_m(ctx, ctx.hold_q())
+            raised = yield from _raise_by(ctx, over, need - low, com_shift, need, strict=False,
+                                          accept=lambda q: gait_hands_m(ctx, q) + sag >= need - GAIT_RAISE_WITHIN_M)
+            if not raised:
+                ctx.note(f"carry over '{over.name}': in the gait the hands would be at {low:.3f} m and no pose raises "
+                         f"them to {need:.3f} m: whole-body steps")
+                return None
             posture = ctx.hold_q()[7:].copy()
             was, low = low, gait_hands_m(ctx, ctx.hold_q()) - max(0.0, hands_sag_m(ctx))
             ctx.note(f"carry over '{over.name}' in the gait: the hands {was:.3f} m -> {low:.3f} m "
