@@ -512,14 +512,6 @@ before walking (the box stays held). A box 0.5-1 cm over a 0.92 m table dragged 
 fell (bench objects seed 19, trial 8); BOX_OVER_TOP_M is what is asked, this is what is accepted."""
 
 
-GAIT_RAISE_WITHIN_M = 0.01
-"""walk_in_gait raises the box only with a pose that puts the walking hands (gait_hands_m: the pelvis level)
-this near the height asked; else the carry is whole-body steps, unraised. A raise that got 2.4 of 5.1 cm
-walking (its pose pitched the pelvis: standing, the hands rose the 5 cm) left a pose from which, after the
-walk, the release could not reach the place (3.6 cm off; the same carry in whole-body steps, which needed no
-raise, put it down: launch/sim_wbc_carry.yaml with a 3.7 kg box, scratch variant 6, measured)."""
-
-
 def gait_hands_m(ctx: GoalContext, q: np.ndarray) -> float:
     """The lower hand point walking in the tracker's own gait with the waist and arms held as in q: the
     pelvis level (the gait holds it so; a stand may pitch it, and the hands then sit ~5 cm higher than
@@ -541,26 +533,22 @@ def walk_in_gait(ctx: GoalContext, approach: Approach, posture: np.ndarray, weig
     are, less the measured sag); then back off, turn, walk straight, turn (approach.walk_holding, the
     box's forces on the hands turned with the heading by the executor's holding reference), stand holding
     it, and the last steps into the stance in whole-body steps (carry, with its own check over the top).
-    Returns the posture and the stepping settings, as carry does; None, before walking, where no raise
-    pose gets the hands within GAIT_RAISE_WITHIN_M of the height asked (nothing moves) or the bottom would
-    pass less than CARRY_CLEAR_M over the top in the gait: whole-body steps may walk taller (carry keeps
-    the raise's pelvis), the caller carries in them."""
+    Returns the posture and the stepping settings, as carry does; None, before walking, where the bottom
+    would pass less than CARRY_CLEAR_M over the top in the gait (the raise is planned first and made only
+    where its pose clears it): whole-body steps may walk taller (carry keeps the raise's pelvis), the
+    caller carries in them."""
     cfg = ctx.config
     if over is not None and ctx.held is not None and cfg.carry_over_check:
         need = hands_over_m(ctx, over)
-        low = gait_hands_m(ctx, ctx.hold_q()) - max(0.0, hands_sag_m(ctx))
-        if low < need - 0.005:
-            sag = low - gait_hands_m(ctx, ctx.hold_q())
-            raised = yield from _raise_by(ctx, over, need - low, com_shift, need, strict=False,
-                                          accept=lambda q: gait_hands_m(ctx, q) + sag >= need - GAIT_RAISE_WITHIN_M)
-            if not raised:
-                ctx.note(f"carry over '{over.name}': in the gait the hands would be at {low:.3f} m and no pose raises "
-                         f"them to {need:.3f} m: whole-body steps")
-                return None
-            posture = ctx.hold_q()[7:].copy()
-            was, low = low, gait_hands_m(ctx, ctx.hold_q()) - max(0.0, hands_sag_m(ctx))
-            ctx.note(f"carry over '{over.name}' in the gait: the hands {was:.3f} m -> {low:.3f} m "
-                     f"({need:.3f} m asked)")
+        sag = max(0.0, hands_sag_m(ctx))
+        low = gait_hands_m(ctx, ctx.hold_q()) - sag
+        if low < need - 0.005:  # raised, where the pose found clears the top in the gait (planned, then moved)
+            clears = lambda q: gait_hands_m(ctx, q) - sag - (need - BOX_OVER_TOP_M) >= CARRY_CLEAR_M
+            if (yield from _raise_by(ctx, over, need - low, com_shift, need, strict=False, accept=clears)):
+                posture = ctx.hold_q()[7:].copy()
+                was, low = low, gait_hands_m(ctx, ctx.hold_q()) - sag
+                ctx.note(f"carry over '{over.name}' in the gait: the hands {was:.3f} m -> {low:.3f} m "
+                         f"({need:.3f} m asked)")
         clear = low - (need - BOX_OVER_TOP_M)
         if clear < CARRY_CLEAR_M:
             ctx.note(f"carry over '{over.name}': in the gait the box's bottom would pass {clear * 100:.1f} cm over "
