@@ -338,7 +338,9 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     carry_shift = box_com_shift(box.mass_kg, ctx.poses.mass_kg, GRASP_DISTANCE_M)
     far = float(np.hypot(*(approach.mid_xy - stance.mid_xy))) > 0.05 or \
         abs(wrap_angle(approach.heading - stance.heading)) > 0.05
-    if far and cfg.walk_while_holding:  # the tracker's own gait walks it there (walk_in_gait), where it can
+    level = ctx.on_platform is None and abs(ctx.scene.ground_height(approach.mid_xy) - ctx.scene.ground_height(
+        stance.mid_xy - ctx.offset())) < 0.01  # no step up or down on the way (whole-body steps take those)
+    if far and cfg.walk_while_holding and level:  # the tracker's own gait walks it there (walk_in_gait), where it can
         walked = yield from walk_in_gait(ctx, approach, posture, weight, carry_shift, support)
         if walked is not None:
             posture, step_cfg = walked
