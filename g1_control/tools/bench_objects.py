@@ -21,7 +21,14 @@ a pick and a place goal. Judged from the simulator's ground truth only (not the 
             whole-body plan: approach, pick, raise, carry, place, ...)
 A refused goal (the planner said no before moving) counts as a failure; its reason is listed.
 
+--carry: the box carried between two tables 3-5 m apart (CARRY_*: both 0.60-0.85 m high, boxes 0.20-0.35 m,
+1-4 kg; drawn from their own stream, the objects draws unchanged) on the whole-body controller alone
+(launch/sim_wbc_carry.yaml's chain), which walks it in its own gait (handling.walk_in_gait); each trial says
+how the carry walked ("gait", "steps": whole-body steps, or "not walked": the pick or the place refused
+first), read from the goals' notes (the path taken, not the outcome: that is judged as above).
+
     g1 bench objects --seed 3 --trials 20 [--jobs 2] [--json out.json]
+    g1 bench objects --carry --seed 200 --trials 10 --jobs 2
 
 `run_trial(seed, index) -> dict` is the whole trial (a plain function of its arguments, for a
 process pool or a cluster); `main` fans it out over --jobs processes and prints the tables.
