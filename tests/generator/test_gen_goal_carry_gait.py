@@ -52,12 +52,11 @@ def _run(config: GoalConfig, scene: SceneConfig | None = None, target=LOW_TARGET
     ctx = gen.ctx
     while time.monotonic() < deadline and "place" not in gen.goal_status:
         state.t_s = k * DT
-        before = state.base_pos_w_m.copy()
+        before, yaw = state.base_pos_w_m.copy(), yaw_of(state.imu_quat_wxyz)
         carry_q = ctx.carry_q
         _tick(gen, inner, state, Command(tasks=goals[:1] if "pick" not in gen.goal_status else goals))
         if carry_q is not None and gen.phase == PHASE_LOCOMOTION:  # the goal walks in the gait, arms held
-            c = ctx.walk
-            yaw = yaw_of(state.imu_quat_wxyz) - c[2] * DT  # _tick moved the base as the inner walker asked: redo
+            c = ctx.walk  # the goal's walk moves the base from where it was before the tick (whatever _tick did)
             state.base_pos_w_m = before + DT * np.array([math.cos(yaw) * c[0] - math.sin(yaw) * c[1],
                                                          math.sin(yaw) * c[0] + math.cos(yaw) * c[1], 0.0])
             state.imu_quat_wxyz = np.array([math.cos((yaw + c[2] * DT) / 2), 0, 0, math.sin((yaw + c[2] * DT) / 2)])
