@@ -189,8 +189,10 @@ def test_a_light_box_behind_a_table_edge_is_reached_standing_off_it_and_leaning(
 def test_a_heavy_box_behind_a_table_edge_is_still_refused_with_the_pelvis_clearance(stances):
     box = _seed7_box(4.0)  # no leaning with 3 kg or more (stances.LEAN_MAX_KG)
     headings = pick_headings(box, SEED7_CENTER[:2], SEED7_TABLE, np.zeros(2))
-    with pytest.raises(StanceRefused, match=r"no stance can pick it up \(\d+ tried, pelvis down to 0.76 m\): the "
-                                            r"pelvis is 0\.\d+ m from 'table_a'"):
+    # every square-on stance close enough puts the pelvis within the edge's rule; the stances off the
+    # box's line (stances.SIDE_STEPS_M) keep it clear and get the hands no closer than 3 cm
+    with pytest.raises(StanceRefused, match=r"no stance can pick it up \(\d+ tried, pelvis down to 0.76 m\): ("
+                                            r"the pelvis is 0\.\d+ m from 'table_a'|the hands get only within \d)"):
         stances.plan(box, SEED7_CENTER, SEED7_TABLE, headings, lift_m=0.1, what="pick it up")
 
 

@@ -46,6 +46,7 @@ from g1_control.generator.goals.stances import (
     plan_stance,
     raised_pose,
     release_hold_poses,
+    straight_poses,
 )
 from g1_control.generator.goals.stepping import (
     STRAIGHT_KNEE_GUARD_M,
@@ -222,15 +223,18 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     squeeze = squeeze_for(ctx, box)
     mid = (soles[0][0][:2] + soles[1][0][:2]) / 2
     ahead = float((c[:2] - mid) @ np.array([math.cos(heading), math.sin(heading)]))
-    shift = box_com_shift(box.mass_kg, ctx.poses.mass_kg, ahead)
+    left = float((c[:2] - mid) @ np.array([-math.sin(heading), math.cos(heading)]))  # a stance off the box's line
+    shift = box_com_shift(box.mass_kg, ctx.poses.mass_kg, ahead, left)
     low = plan.pelvis_z_m < ctx.poses.nominal_pelvis_m + plan.ground_z_m - 0.02 or plan.lean
     pelvis_z = floor_z + plan.pelvis_z_m - plan.ground_z_m
     nominal_z = floor_z + ctx.poses.nominal_pelvis_m
     if low:  # nothing at hand height to catch: the hands come down over the box's sides
         via = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.12)
     else:  # the hands rise close to the body first (a table's edge is ~0.22 m ahead of the pelvis:
-        # moving them straight to the box dragged them over the table top, measured)
-        via = hand_points(c, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.08, ahead_m=-(ahead - RAISE_AHEAD_M))
+        # moving them straight to the box dragged them over the table top, measured), in front of it
+        # (from a stance off the box's line, the far hand's point beside the box went into the chest)
+        front = c - np.array([-math.sin(heading), math.cos(heading), 0.0]) * (left if plan.chosen.side_m else 0.0)
+        via = hand_points(front, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.08, ahead_m=-(ahead - RAISE_AHEAD_M))
     pre = hand_points(c, heading, width, cfg.pre_gap_m)
     con = hand_points(c, heading, width, -cfg.press_m)
     lift = hand_points(c, heading, width, -cfg.press_m, dz_m=cfg.lift_m)
@@ -249,13 +253,20 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
         around = yield from ctx.compute("around", detour_poses, q0, q_via, soles, heading, none, pelvis_z,
                                         plan.lean, _shifted(support, ctx.offset()),
                                         support.height_m + 2 * CLEAR_MARGIN_M, (), True, True)
+    straight: list[np.ndarray] = []
+    if plan.chosen.side_m:  # off the box's line one arm swings across it: the hands go straight to the pre-grasp
+        # points, not along the blend (its hand dipped under the table's top: stances.straight_poses)
+        straight = yield from ctx.compute("straight", straight_poses, q_via, q_pre, soles, heading, none, pelvis_z,
+                                          plan.lean)
     path = _timed(q0, [*around, q_via], 1.2)
     t = {"via": path[-1][0]}
-    t["pre"] = t["via"] + 1.0
+    t["pre"] = t["via"] + 1.0 + 0.5 * bool(straight)
     t["con"] = t["pre"] + 0.8
     t["squeeze"] = t["con"] + 0.5
     t["lift"] = t["squeeze"] + 1.2
-    keys = [(0.0, q0), *path, (t["pre"], q_pre), (t["con"], q_con), (t["squeeze"], q_con), (t["lift"], q_lift)]
+    across = [(t["via"] + (k + 1) / (len(straight) + 1) * (t["pre"] - t["via"]), q) for k, q in enumerate(straight)]
+    keys = [(0.0, q0), *path, *across, (t["pre"], q_pre), (t["con"], q_con), (t["squeeze"], q_con),
+            (t["lift"], q_lift)]
     if low:
         t["rise"] = t["lift"] + _move_s(q_lift, poses[4], 1.2)
         keys.append((t["rise"], poses[4]))

@@ -8,6 +8,11 @@ on the floor. The candidates:
             edge nearest to the box (pick from a support), any face (pick from the floor), facing
             the support's nearest edge (place on a support), or the robot's own way (place on the floor)
   gap       from the middle of the soles to the box's near face
+  side      on the box's centre line; only where no stance on it is kept at any level (a pick from a
+            support whose edge the heading meets more than ~12 deg aslant: SIDE_MIN_SIN), again
+            SIDE_STEPS_M off it, toward where the edge is farther: held square to its faces, a box
+            turned to the edge brings a stance on its line in on the diagonal, the pelvis or a knee
+            within the edge's rules (40 of 80 `g1 bench objects --carry` picks were refused so)
   pelvis    standing (nominal height), then lower in steps down to a squat at 0.42 m
   torso     upright, or leaning forward (pelvis pitched 0.4 rad, waist pulled forward 0.45 rad)
   deep      hands below DEEP_BELOW_M: a deep squat (pelvis DEEP_PELVIS_M, knees forward, heels down), the
@@ -173,6 +178,22 @@ BODY_SEGMENTS = (
     ("left_elbow_link", "left_wrist_roll_link", 0.035, False),
     ("right_elbow_link", "right_wrist_roll_link", 0.035, False),
 )
+SIDE_STEPS_M = (0.06,)
+"""A pick's stances off the box's centre line (module docstring): the soles' middle this far across the
+heading, the box held off to one side (the waist and arms take it; the CoM shift counts it). 0.12 m
+was tried too (`g1 bench objects` seeds 130-134, 140-147, the layer): both picks planned from it fell
+(145.4, a 2.7 kg box: the far hand never reached its face, the box's weight fed forward threw the robot
+back; 131.13 in the carry), the three from 0.06 m were placed (140.8, 146.6, 134.16)."""
+SIDE_MAX_KG = 3.0
+"""Off the line only a box lighter than this, and upright (not leaning). Measured (`g1 bench objects`
+seeds 130-134 and 140-142, the layer): of 6 picks off the line, the 2.0 and 2.1 kg upright ones were
+placed; the 5.2-5.4 kg ones fell at the pick or in the carry (3) or did not come up (1), and a 2.0 kg
+leaning squat by a 0.33 m table fell stepping in. With these rules and SIDE_STEPS_M, seeds 130-134 and
+140-151 (340 trials): 7 picks off the line, all lifted, none fell; 3 placed, 4 refused at the place (the
+floor, a 0.18 m table); every other trial as without them."""
+SIDE_MIN_SIN = 0.2
+"""Stances off the line only where the heading's lateral has at least this share of the edge's normal
+(the box turned ~12 deg or more to the edge): square on, a step aside brings the pelvis no farther out."""
 TABLE_TOP_THICKNESS_M = 0.04
 STANDING_GIVE_M = 0.06
 """A standing candidate's pelvis may sink this much below nominal to reach (the grasps of issue 17
@@ -223,10 +244,11 @@ class HoldPose:
     """The pelvis's tilt from upright."""
 
 
-def box_com_shift(mass_kg: float, robot_kg: float, ahead_m: float) -> np.ndarray:
+def box_com_shift(mass_kg: float, robot_kg: float, ahead_m: float, left_m: float = 0.0) -> np.ndarray:
     """Where the robot's own CoM goes (heading frame) so that robot and box together stand over the
-    soles: back by the box's share of the mass times how far ahead of the soles it is held."""
-    return np.array([-mass_kg / robot_kg * ahead_m, 0.0])
+    soles: back by the box's share of the mass times how far ahead of the soles it is held (and to
+    the right by that share of how far left of them it is)."""
+    return np.array([-mass_kg / robot_kg * ahead_m, -mass_kg / robot_kg * left_m])
 
 
 class StanceRefused(ReachRefused):
@@ -242,6 +264,8 @@ class Candidate:
     lean: int
     """UPRIGHT, LEAN, STAND_LEAN or DEEP + k (DEEP_BENDS[k])."""
     preferred: bool = False
+    side_m: float = 0.0
+    """The soles' middle this far to the left (across the heading) of the box's centre line."""
     residual_m: float = math.inf
     com_error_m: float = math.inf
     collision: str | None = None
@@ -257,8 +281,9 @@ class Candidate:
         return self.residual_m + self.com_error_m + (0.05 if self.collision else 0.0)
 
     def describe(self) -> str:
-        return (f"heading {math.degrees(self.heading):.0f} deg, soles' middle {self.gap_m:.2f} m from the box, pelvis "
-                f"{self.pelvis_z_m:.2f} m, {BENDS[int(self.lean)]}: hands "
+        side = f" and {abs(self.side_m):.2f} m to its {'left' if self.side_m > 0 else 'right'}" if self.side_m else ""
+        return (f"heading {math.degrees(self.heading):.0f} deg, soles' middle {self.gap_m:.2f} m from the box{side}, "
+                f"pelvis {self.pelvis_z_m:.2f} m, {BENDS[int(self.lean)]}: hands "
                 f"{self.residual_m * 100:.1f} cm off, CoM {self.com_error_m * 100:.1f} cm off"
                 + (f", {self.collision}" if self.collision else ""))
 
@@ -378,32 +403,44 @@ class StancePlanner:
             bent.append((STAND_LEAN,))
         best: Candidate | None = None
         tried = 0
-        for pelvis_z, bends in zip(levels, bent, strict=True):
-            kept: list[Candidate] = []
-            for heading in headings:
-                fwd = np.array([math.cos(heading), math.sin(heading)])
-                width = grasp_width(box, heading)
-                depth = grasp_width(box, heading + math.pi / 2)
-                for lean in bends:
-                    if lean == LEAN and (grasp_z > LEAN_BELOW_M or pelvis_z >= nominal - 1e-6 or mass >= LEAN_MAX_KG):
-                        continue  # leaning only helps below the waist, squatting
-                    preferred = max(GAPS_M[1], PREFERRED_CENTER_M - depth / 2)
-                    gaps = (preferred, *(g for g in GAPS_M if abs(g - preferred) > 0.02))
-                    if lean == STAND_LEAN:
-                        gaps = STAND_LEAN_GAPS_M
-                    for gap in gaps if pelvis_z >= nominal - 1e-6 or lean >= DEEP else [g for g in gaps if g >= 0.2]:
-                        mid = center_w[:2] - (gap + depth / 2) * fwd
-                        cand = Candidate(heading, mid, gap, pelvis_z, lean, preferred=gap == preferred)
-                        self._evaluate(cand, box, center_w, support, width, dz, mass, ground_z, lift_m, press_m)
-                        tried += 1
-                        if best is None or cand.score < best.score:
-                            best = cand
-                        if cand.feasible:
-                            kept.append(cand)
-            if kept:
-                chosen = min(kept, key=lambda k: (k.preferred is False, k.residual_m + k.com_error_m))
-                return StancePlan(Approach(chosen.mid_xy, chosen.heading), chosen, grasp_width(box, chosen.heading),
-                                  dz, tried, ground_z)
+        # on the box's line first, at every level; off it (a pick aslant to an edge) only where no stance on
+        # it is kept at any level
+        off_line = [(h, self._sides(h, center_w, support, lift_m, mass)) for h in headings]
+        for sides_of in ({h: (0.0,) for h in headings}, {h: s for h, s in off_line if s}):
+            for pelvis_z, bends in zip(levels, bent, strict=True):
+                kept: list[Candidate] = []
+                for heading in sides_of:
+                    fwd = np.array([math.cos(heading), math.sin(heading)])
+                    left = np.array([-fwd[1], fwd[0]])
+                    width = grasp_width(box, heading)
+                    depth = grasp_width(box, heading + math.pi / 2)
+                    for lean in bends:
+                        if lean != UPRIGHT and sides_of[heading] != (0.0,):
+                            continue  # off the line upright only (SIDE_MAX_KG)
+                        if lean == LEAN and (grasp_z > LEAN_BELOW_M or pelvis_z >= nominal - 1e-6 or
+                                             mass >= LEAN_MAX_KG):
+                            continue  # leaning only helps below the waist, squatting
+                        preferred = max(GAPS_M[1], PREFERRED_CENTER_M - depth / 2)
+                        gaps = (preferred, *(g for g in GAPS_M if abs(g - preferred) > 0.02))
+                        if lean == STAND_LEAN:
+                            gaps = STAND_LEAN_GAPS_M
+                        for gap in gaps if pelvis_z >= nominal - 1e-6 or lean >= DEEP else [g for g in gaps if g >= 0.2]:
+                            for side in sides_of[heading]:
+                                mid = center_w[:2] - (gap + depth / 2) * fwd + side * left
+                                cand = Candidate(heading, mid, gap, pelvis_z, lean,
+                                                 preferred=gap == preferred and not side, side_m=side)
+                                self._evaluate(cand, box, center_w, support, width, dz, mass, ground_z, lift_m,
+                                               press_m)
+                                tried += 1
+                                if best is None or cand.score < best.score:
+                                    best = cand
+                                if cand.feasible:
+                                    kept.append(cand)
+                                    break  # the nearest side that works
+                if kept:
+                    chosen = min(kept, key=lambda k: (k.preferred is False, k.residual_m + k.com_error_m))
+                    return StancePlan(Approach(chosen.mid_xy, chosen.heading), chosen,
+                                      grasp_width(box, chosen.heading), dz, tried, ground_z)
         assert best is not None
         why = best.collision if best.collision and best.residual_m <= FEASIBLE_RESIDUAL_M else \
             f"the hands get only within {best.residual_m * 100:.1f} cm" if best.residual_m > FEASIBLE_RESIDUAL_M else \
@@ -411,12 +448,25 @@ class StancePlanner:
         raise StanceRefused(f"{size}: no stance can {what} ({tried} tried, pelvis down to {min(levels):.2f} m): {why}; "
                             f"closest: {best.describe()}")
 
+    def _sides(self, heading: float, center_w: np.ndarray, support: Block | None, lift_m: float | None,
+               mass_kg: float) -> tuple[float, ...]:
+        """Stances off the box's centre line to try (a pick of a box lighter than SIDE_MAX_KG from a
+        support whose edge the heading meets aslant): SIDE_STEPS_M, toward where the stance is farther
+        from the edge."""
+        if support is None or lift_m is None or mass_kg >= SIDE_MAX_KG:
+            return ()
+        lateral = np.array([-math.sin(heading), math.cos(heading)])
+        away = float(lateral @ edge_normal(support, center_w[:2]))
+        if abs(away) < SIDE_MIN_SIN:
+            return ()
+        return tuple(math.copysign(d, away) for d in SIDE_STEPS_M)
+
     def _evaluate(self, cand: Candidate, box: Box, center_w: np.ndarray, support: Block | None, width: float,
                   dz: float, mass: float, ground_z: float, lift_m: float | None, press_m: float) -> None:
         q, soles = self.stance(cand.mid_xy, cand.heading, ground_z)
         c = center_w + np.array([0.0, 0.0, dz])
         depth = grasp_width(box, cand.heading + math.pi / 2)
-        shift = box_com_shift(mass, self.poses.mass_kg, cand.gap_m + depth / 2)
+        shift = box_com_shift(mass, self.poses.mass_kg, cand.gap_m + depth / 2, -cand.side_m)
         targets = [hand_points(c, cand.heading, width, -press_m)]
         if lift_m is not None:
             targets.append(hand_points(c, cand.heading, width, -press_m, dz_m=lift_m))
@@ -772,6 +822,20 @@ def raised_pose(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: 
     return stance_planner(poses).hold(q0, soles, (targets[0], targets[1]), heading, shift, pelvis_z, UPRIGHT)
 
 
+def straight_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: list[Sole], heading: float,
+                   shift: np.ndarray, pelvis_z: float, lean: int) -> list[np.ndarray]:
+    """Poses to put between q_a and q_b so that the hands go straight from where they are in q_a to
+    where they are in q_b (every DETOUR_SPACING_M, each solved from the one before), not along the
+    joint-space blend. Measured: from a stance off the box's line (SIDE_STEPS_M) the arm reaching across
+    swung from its via pose to the pre-grasp pose through ~2.9 rad of its shoulder, its hand dipped
+    under a 0.88 m table's top on the way and the robot fell (bench objects 133.1). Not for a stance on
+    the line: there the blend's dips are within what the picks were measured with, and the straight
+    poses threw one over (143.10: a wrist's turn)."""
+    a = [poses.hand_point(q_a, i) for i in range(2)]
+    b = [poses.hand_point(q_b, i) for i in range(2)]
+    return _along(poses, q_a, [a, b], soles, heading, shift, pelvis_z, lean)[:-1]
+
+
 def _along(poses: PosePlanner, q: np.ndarray, corners: list[list[np.ndarray]], soles: list[Sole], heading: float,
            shift: np.ndarray, pelvis_z: float, lean: int, spacing: float = DETOUR_SPACING_M) -> list[np.ndarray]:
     """Poses with the hands every `spacing` along the polyline `corners` (pairs of hand points; at
@@ -826,4 +890,4 @@ def place_heading(support: Block | None, xy: np.ndarray, robot_xy: np.ndarray) -
 
 __all__ = ["DEEP", "LEAN", "STAND_LEAN", "UPRIGHT", "Candidate", "StancePlan", "StancePlanner", "StanceRefused", "box_com_shift", "detour_poses", "edge_normal",
            "face_normals", "grasp_hold_poses", "hand_height", "path_meets", "pick_headings", "place_heading", "plan_stance",
-           "raised_pose", "release_hold_poses", "stance_planner"]
+           "raised_pose", "release_hold_poses", "stance_planner", "straight_poses"]
