@@ -35,7 +35,8 @@ BENCHMARKS = {
     "objects": ("g1_control.tools.bench_objects:main",
                 "pick a box (floor/low/table/high support, 0.15-0.45 m, 0.2-6 kg, any yaw) and put it on another "
                 "support, --trials drawn scenes judged from ground truth; a table per bucket, every refusal's reason; "
-                "--carry: 3-5 m between two tables on the whole-body controller's gait"),
+                "--tracker wbc: on the whole-body controller alone; --carry: 3-5 m between two tables on the "
+                "whole-body controller's gait"),
     "bottle": ("g1_control.tools.bench_bottle:main",
                "a bottle picked with one Dex3 hand (force-limited grasp) and put down upright, --trials drawn scenes "
                "(table height, bottle size/mass/friction, hand, place) judged from ground truth; peak finger squeeze "
@@ -90,6 +91,10 @@ def register(subparsers) -> None:
                         "1.0-1.8 m from the start, off to the side of the first (walked to holding it); objects: "
                         "carry the box 3-5 m between two 0.60-0.85 m tables (0.20-0.35 m, 1-4 kg) on the "
                         "whole-body controller, its own gait walking it")
+    parser.add_argument("--tracker", choices=("layer", "wbc"), default=None,
+                        help="objects: the scenes' tracker: layer (the default: the walking policy walks, the "
+                        "whole-body controller picks and places, a carry is whole-body steps) or wbc (the whole-body "
+                        "controller alone at 250 Hz, its own gait walking a held box; --carry always)")
     add_fanout_arguments(parser, what="/".join(FANS_OUT) + " trials")
     parser.set_defaults(func=_run)
 

@@ -29,6 +29,11 @@ first), read from the goals' notes (the path taken, not the outcome: that is jud
 
     g1 bench objects --seed 3 --trials 20 [--jobs 2] [--json out.json]
     g1 bench objects --carry --seed 200 --trials 10 --jobs 2
+    g1 bench objects --tracker wbc --seed 3 --trials 20 --jobs 2
+
+--tracker wbc: the objects scenes on the whole-body controller alone (250 Hz, as --carry), which walks a
+held box in its own gait where the place is on the same ground (else whole-body steps); the default is
+the tracking layer (the walking policy walks, the WBC picks and places; a carry is whole-body steps).
 
 `run_trial(seed, index) -> dict` is the whole trial (a plain function of its arguments, for a
 process pool or a cluster); `main` fans it out over --jobs processes and prints the tables.
@@ -70,6 +75,8 @@ CARRY_MASS_KG = (1.0, 4.0)
 CARRY_DISTANCE_M = (3.0, 5.0)
 """--carry: both supports tables of these heights, boxes of these sides and masses, the target this far from
 the box; the whole-body controller is the tracker, its own gait carries (GoalConfig.walk_while_holding)."""
+TRACKERS = ("layer", "wbc")
+"""--tracker: the objects scenes' tracker (run_trial)."""
 TRIAL_LIMIT_S = 110.0
 """Simulated time a trial may take (walk, pick, carry, place): a cap, trials stop when both goals end."""
 SETTLE_S = 2.0
@@ -193,10 +200,14 @@ def _timeline(goals: list[GoalEntry]) -> list[Segment]:
     return [Segment(1.0, label="stand"), Segment(TRIAL_LIMIT_S, label="pick and place", goals=list(goals))]
 
 
-def run_trial(seed: int, index: int, carry: bool = False, gait: bool = True) -> dict:
+def run_trial(seed: int, index: int, carry: bool = False, gait: bool = True, tracker: str = "layer") -> dict:
     """One trial, start to verdict (module docstring): a plain function of its arguments. carry: a --carry
-    scene on the whole-body controller (launch/sim_wbc_carry.yaml's chain); gait False: its carry walks in
-    whole-body steps, as with a tracker that has no gait (GoalConfig.walk_while_holding off)."""
+    scene on the whole-body controller (launch/sim_wbc_carry.yaml's chain); tracker: an objects scene's
+    ("layer": launch/sim_box.yaml's tracking layer, 100 Hz; "wbc": the whole-body controller alone, 250 Hz,
+    as --carry); gait False: a carry walks in whole-body steps, as with a tracker that has no gait
+    (GoalConfig.walk_while_holding off)."""
+    if tracker not in TRACKERS:
+        raise ValueError(f"tracker {tracker!r}: one of {', '.join(TRACKERS)}")
     from g1_control.launch.builder import build_loop
     from g1_control.report.outcomes import GoalWatcher
     from g1_control.tools.physics_trials import Trial, trial_launch
@@ -204,6 +215,9 @@ def run_trial(seed: int, index: int, carry: bool = False, gait: bool = True) -> 
     drawn = draw_scene(seed, index, carry)
     if carry:
         trial = Trial(f"carry {seed}.{index}", _timeline(drawn["goals"]), tracker="wbc", tracker_hz=250.0,
+                      scene=drawn["scene"])
+    elif tracker == "wbc":
+        trial = Trial(f"objects {seed}.{index}", _timeline(drawn["goals"]), tracker="wbc", tracker_hz=250.0,
                       scene=drawn["scene"])
     else:
         trial = Trial(f"objects {seed}.{index}", _timeline(drawn["goals"]), tracker="layer", tracker_hz=100.0,
@@ -236,6 +250,7 @@ def run_trial(seed: int, index: int, carry: bool = False, gait: bool = True) -> 
         "steps" if any(text.startswith("place stance") for text in notes) else None
     return judge(drawn, watcher.arrays(), dict(gen.goal_info), dict(gen.goal_messages), pelvis_min,
                  loop.fall is not None, seed=seed, index=index, carry=carry, gait=gait, walked=walked,
+                 tracker="wbc" if carry else tracker,
                  sim_s=float(loop.time_s), wall_s=wall)
 
 
@@ -284,7 +299,8 @@ def judge(drawn: dict, a: dict[str, np.ndarray], info: dict, messages: dict, pel
             "box_yaw_deg": drawn["box_yaw_deg"], "lifted": lifted, "held": held, "placed": placed,
             "upright": upright, "dropped": dropped, "fell": fell, "fell_in": fell_in, "success": success,
             "place_error_xy_m": err_xy, "place_error_z_m": err_z, "tilt_deg": tilt, "pelvis_min_m": pelvis_min_m,
-            "refused": refusals, "pick_status": pick.get("status"), "place_status": place.get("status")}
+            "refused": refusals, "pick_status": pick.get("status"), "place_status": place.get("status"),
+            "pick_stance": pick.get("stance")}
 
 
 def _why(r: dict) -> str:
@@ -345,13 +361,16 @@ def main(args) -> int:
     print(describe(env), flush=True)
     t0 = time.perf_counter()
     carry = bool(getattr(args, "carry", False))
+    tracker = getattr(args, "tracker", None) or "layer"
+    if carry and tracker != "wbc" and getattr(args, "tracker", None):
+        raise ValueError("--carry runs on the whole-body controller (--tracker wbc)")
     results: list[dict] = []
-    for r in fan_out(_trial, [(seed, i, carry) for i in range(n)], jobs=args.jobs, ray=args.ray):
+    for r in fan_out(_trial, [(seed, i, carry, True, tracker) for i in range(n)], jobs=args.jobs, ray=args.ray):
         results.append(r)
         _print_trial(r)
     table = summary(results)
-    print(f"\ng1 bench objects{' --carry' if carry else ''} --seed {seed} --trials {n}: "
-          f"{time.perf_counter() - t0:.0f} s wall")
+    flags = " --carry" if carry else f" --tracker {tracker}" if tracker != "layer" else ""
+    print(f"\ng1 bench objects{flags} --seed {seed} --trials {n}: {time.perf_counter() - t0:.0f} s wall")
     print(f"{'bucket':14s} {'success':>8s}")
     for k, v in table.items():
         print(f"{k:14s} {v['success']:>3d}/{v['trials']:<3d}")
@@ -367,14 +386,15 @@ def main(args) -> int:
             for reason, count in counts.items():
                 print(f"  {bucket:11s} {count:3d}  {reason}")
     if args.json:
-        Path(args.json).write_text(json.dumps({"seed": seed, "trials": n, "carry": carry, "environment": env, "table": table,
+        Path(args.json).write_text(json.dumps({"seed": seed, "trials": n, "carry": carry,
+                                               "tracker": "wbc" if carry else tracker, "environment": env, "table": table,
                                                "reasons": reasons, "results": results},
                                               indent=1, default=float))
     return 0
 
 
-def _trial(task: tuple[int, int, bool]) -> dict:
-    """One trial for fan_out (--jobs processes or a Ray cluster): run_trial(seed, index, carry)."""
+def _trial(task: tuple[int, int, bool, bool, str]) -> dict:
+    """One trial for fan_out (--jobs processes or a Ray cluster): run_trial(seed, index, carry, gait, tracker)."""
     return run_trial(*task)
 
 
