@@ -18,8 +18,11 @@ from g1_control.generator.goals.context import GoalConfig
 from g1_control.generator.goals.handling import ARMS_BACK, RAISE_AHEAD_M
 from g1_control.generator.goals.poses import PosePlanner
 from g1_control.generator.goals.stances import (
+    LEAN,
     SIDE_MAX_KG,
+    STAND_LEAN,
     TRUNK_EDGE_CLEARANCE_M,
+    UPRIGHT,
     StancePlanner,
     StanceRefused,
     box_com_shift,
@@ -140,3 +143,31 @@ def test_the_hand_reaching_across_goes_straight_to_the_pre_grasp_point(stances):
     chain = [q_via, *straight, q_pre]
     assert not any(path_meets(poses, u, v, heading, table) for u, v in pairwise(chain))
     assert lowest_over_top(chain) > table.height_m + 0.05
+
+
+def test_a_stance_on_the_line_kept_at_any_level_wins_over_one_beside_it(stances):
+    # bench objects 141.13 (0.5 kg on a 0.82 m table, turned 16 deg): standing upright beside the line
+    # reaches it, yet the pick is planned on the line, standing off the edge and leaning (the last level):
+    # tried at the same level, the stance beside won and the robot fell at the pick; on the line it is placed
+    box, table, center = _scene(141, 13)
+    plan = _pick(stances, box, table, center)
+    assert plan.chosen.side_m == 0.0 and plan.chosen.lean == STAND_LEAN
+
+
+def test_beside_the_line_only_upright_stances_are_tried(stances, monkeypatch):
+    # 131.13 (2.0 kg on a 0.33 m table): on the line, squats leaning are tried; beside it only upright ones
+    # (a leaning squat beside the line, planned by an earlier version, fell stepping in: SIDE_MAX_KG)
+    box, table, center = _scene(131, 13)
+    tried = []
+    evaluate = StancePlanner._evaluate
+
+    def spy(self, cand, *args):
+        tried.append(cand)
+        return evaluate(self, cand, *args)
+
+    monkeypatch.setattr(StancePlanner, "_evaluate", spy)
+    with pytest.raises(StanceRefused):
+        _pick(stances, box, table, center)
+    beside = [c for c in tried if c.side_m]
+    assert beside and all(c.lean == UPRIGHT for c in beside)
+    assert any(c.lean == LEAN for c in tried if not c.side_m)

@@ -16,3 +16,15 @@ def test_an_aslant_box_is_picked_from_beside_its_line_and_placed():
     assert "m to its left" in (r["pick_stance"] or ""), r["pick_stance"]
     assert r["success"] and not r["fell"] and not r["dropped"], r
     assert r["place_error_xy_m"] < 0.03 and r["tilt_deg"] < 3.0
+
+
+def test_the_far_hand_reaches_across_without_meeting_the_table():
+    """133.1: a 2.3 kg box on a 0.88 m table, picked from 6 cm to its right. With the hand points of the
+    via pose beside the box and the plain blend from there to the pre-grasp pose, the far hand met the
+    table's top and the robot fell at the pick (both OpenBLAS kernels); with the via pose in front of the
+    body and the hands straight from it (either alone suffices here), the box is lifted and held, no fall.
+    Its place (a 0.18 m table) is refused: no squat holds it that low (the waist's 35 N m)."""
+    r = run_trial(133, 1)
+    assert "m to its right" in (r["pick_stance"] or ""), r["pick_stance"]
+    assert r["lifted"] and r["held"] and not r["fell"] and not r["dropped"], r
+    assert r["place_status"] == "failed" and "waist_pitch_joint" in r["refused"][0]
