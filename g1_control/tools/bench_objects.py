@@ -213,15 +213,9 @@ def run_trial(seed: int, index: int, carry: bool = False, gait: bool = True, tra
     from g1_control.tools.physics_trials import Trial, trial_launch
 
     drawn = draw_scene(seed, index, carry)
-    if carry:
-        trial = Trial(f"carry {seed}.{index}", _timeline(drawn["goals"]), tracker="wbc", tracker_hz=250.0,
-                      scene=drawn["scene"])
-    elif tracker == "wbc":
-        trial = Trial(f"objects {seed}.{index}", _timeline(drawn["goals"]), tracker="wbc", tracker_hz=250.0,
-                      scene=drawn["scene"])
-    else:
-        trial = Trial(f"objects {seed}.{index}", _timeline(drawn["goals"]), tracker="layer", tracker_hz=100.0,
-                      scene=drawn["scene"])
+    tracker = "wbc" if carry else tracker
+    trial = Trial(f"{'carry' if carry else 'objects'} {seed}.{index}", _timeline(drawn["goals"]), tracker=tracker,
+                  tracker_hz=250.0 if tracker == "wbc" else 100.0, scene=drawn["scene"])
     loop = build_loop(trial_launch(trial))
     loop.reset()
     watcher = GoalWatcher(loop)
@@ -249,8 +243,7 @@ def run_trial(seed: int, index: int, carry: bool = False, gait: bool = True, tra
     walked = "gait" if any(text.startswith("stand holding") for text in notes) else \
         "steps" if any(text.startswith("place stance") for text in notes) else None
     return judge(drawn, watcher.arrays(), dict(gen.goal_info), dict(gen.goal_messages), pelvis_min,
-                 loop.fall is not None, seed=seed, index=index, carry=carry, gait=gait, walked=walked,
-                 tracker="wbc" if carry else tracker,
+                 loop.fall is not None, seed=seed, index=index, carry=carry, gait=gait, walked=walked, tracker=tracker,
                  sim_s=float(loop.time_s), wall_s=wall)
 
 
@@ -361,15 +354,15 @@ def main(args) -> int:
     print(describe(env), flush=True)
     t0 = time.perf_counter()
     carry = bool(getattr(args, "carry", False))
-    tracker = getattr(args, "tracker", None) or "layer"
-    if carry and tracker != "wbc" and getattr(args, "tracker", None):
+    if carry and getattr(args, "tracker", None) not in (None, "wbc"):
         raise ValueError("--carry runs on the whole-body controller (--tracker wbc)")
+    tracker = "wbc" if carry else getattr(args, "tracker", None) or "layer"
     results: list[dict] = []
     for r in fan_out(_trial, [(seed, i, carry, True, tracker) for i in range(n)], jobs=args.jobs, ray=args.ray):
         results.append(r)
         _print_trial(r)
     table = summary(results)
-    flags = " --carry" if carry else f" --tracker {tracker}" if tracker != "layer" else ""
+    flags = " --carry" if carry else " --tracker wbc" if tracker == "wbc" else ""
     print(f"\ng1 bench objects{flags} --seed {seed} --trials {n}: {time.perf_counter() - t0:.0f} s wall")
     print(f"{'bucket':14s} {'success':>8s}")
     for k, v in table.items():
@@ -386,8 +379,8 @@ def main(args) -> int:
             for reason, count in counts.items():
                 print(f"  {bucket:11s} {count:3d}  {reason}")
     if args.json:
-        Path(args.json).write_text(json.dumps({"seed": seed, "trials": n, "carry": carry,
-                                               "tracker": "wbc" if carry else tracker, "environment": env, "table": table,
+        Path(args.json).write_text(json.dumps({"seed": seed, "trials": n, "carry": carry, "tracker": tracker,
+                                               "environment": env, "table": table,
                                                "reasons": reasons, "results": results},
                                               indent=1, default=float))
     return 0

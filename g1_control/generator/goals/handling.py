@@ -223,7 +223,8 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     squeeze = squeeze_for(ctx, box)
     mid = (soles[0][0][:2] + soles[1][0][:2]) / 2
     ahead = float((c[:2] - mid) @ np.array([math.cos(heading), math.sin(heading)]))
-    left = float((c[:2] - mid) @ np.array([-math.sin(heading), math.cos(heading)]))  # a stance off the box's line
+    lateral = np.array([-math.sin(heading), math.cos(heading)])
+    left = float((c[:2] - mid) @ lateral)  # a stance off the box's line
     shift = box_com_shift(box.mass_kg, ctx.poses.mass_kg, ahead, left)
     low = plan.pelvis_z_m < ctx.poses.nominal_pelvis_m + plan.ground_z_m - 0.02 or plan.lean
     pelvis_z = floor_z + plan.pelvis_z_m - plan.ground_z_m
@@ -233,7 +234,7 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     else:  # the hands rise close to the body first (a table's edge is ~0.22 m ahead of the pelvis:
         # moving them straight to the box dragged them over the table top, measured), in front of it
         # (from a stance off the box's line, the far hand's point beside the box went into the chest)
-        front = c - np.array([-math.sin(heading), math.cos(heading), 0.0]) * (left if plan.chosen.side_m else 0.0)
+        front = c - np.append(lateral, 0.0) * (left if plan.chosen.side_m else 0.0)
         via = hand_points(front, heading, width, cfg.pre_gap_m + 0.03, dz_m=0.08, ahead_m=-(ahead - RAISE_AHEAD_M))
     pre = hand_points(c, heading, width, cfg.pre_gap_m)
     con = hand_points(c, heading, width, -cfg.press_m)

@@ -406,7 +406,9 @@ class StancePlanner:
         # on the box's line first, at every level; off it (a pick aslant to an edge) only where no stance on
         # it is kept at any level
         off_line = [(h, self._sides(h, center_w, support, lift_m, mass)) for h in headings]
-        for sides_of in ({h: (0.0,) for h in headings}, {h: s for h, s in off_line if s}):
+        passes: tuple[dict[float, tuple[float, ...]], ...] = ({h: (0.0,) for h in headings},
+                                                              {h: s for h, s in off_line if s})
+        for beside, sides_of in enumerate(passes):
             for pelvis_z, bends in zip(levels, bent, strict=True):
                 kept: list[Candidate] = []
                 for heading in sides_of:
@@ -415,7 +417,7 @@ class StancePlanner:
                     width = grasp_width(box, heading)
                     depth = grasp_width(box, heading + math.pi / 2)
                     for lean in bends:
-                        if lean != UPRIGHT and sides_of[heading] != (0.0,):
+                        if beside and lean != UPRIGHT:
                             continue  # off the line upright only (SIDE_MAX_KG)
                         if lean == LEAN and (grasp_z > LEAN_BELOW_M or pelvis_z >= nominal - 1e-6 or
                                              mass >= LEAN_MAX_KG):
