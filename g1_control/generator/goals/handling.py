@@ -259,13 +259,24 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
         # points, not along the blend (its hand dipped under the table's top: stances.straight_poses)
         straight = yield from ctx.compute("straight", straight_poses, q_via, q_pre, soles, heading, none, pelvis_z,
                                           plan.lean)
+    elif support is not None:  # on the line: straight only where the blend takes a hand into the support's top
+        straight = yield from ctx.compute("straight", straight_poses, q_via, q_pre, soles, heading, none, pelvis_z,
+                                          plan.lean, _shifted(support, ctx.offset()))
+        if straight:
+            ctx.note(f"the hands go straight to the pre-grasp points: the blend takes one into the top of "
+                     f"'{support.name}'")
     path = _timed(q0, [*around, q_via], 1.2)
     t = {"via": path[-1][0]}
-    t["pre"] = t["via"] + 1.0 + 0.5 * bool(straight)
+    if straight and not plan.chosen.side_m:  # timed by joint speed (a wrist's turn: straight_poses)
+        across = [(t["via"] + dt, q) for dt, q in _timed(q_via, [*straight, q_pre], 1.0)]
+        t["pre"] = across.pop()[0]
+    else:
+        t["pre"] = t["via"] + 1.0 + 0.5 * bool(straight)
+        across = [(t["via"] + (k + 1) / (len(straight) + 1) * (t["pre"] - t["via"]), q)
+                  for k, q in enumerate(straight)]
     t["con"] = t["pre"] + 0.8
     t["squeeze"] = t["con"] + 0.5
     t["lift"] = t["squeeze"] + 1.2
-    across = [(t["via"] + (k + 1) / (len(straight) + 1) * (t["pre"] - t["via"]), q) for k, q in enumerate(straight)]
     keys = [(0.0, q0), *path, *across, (t["pre"], q_pre), (t["con"], q_con), (t["squeeze"], q_con),
             (t["lift"], q_lift)]
     if low:

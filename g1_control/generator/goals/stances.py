@@ -825,14 +825,18 @@ def raised_pose(poses: PosePlanner, q0: np.ndarray, soles: list[Sole], heading: 
 
 
 def straight_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: list[Sole], heading: float,
-                   shift: np.ndarray, pelvis_z: float, lean: int) -> list[np.ndarray]:
+                   shift: np.ndarray, pelvis_z: float, lean: int, block: Block | None = None) -> list[np.ndarray]:
     """Poses to put between q_a and q_b so that the hands go straight from where they are in q_a to
     where they are in q_b (every DETOUR_SPACING_M, each solved from the one before), not along the
     joint-space blend. Measured: from a stance off the box's line (SIDE_STEPS_M) the arm reaching across
     swung from its via pose to the pre-grasp pose through ~2.9 rad of its shoulder, its hand dipped
-    under a 0.88 m table's top on the way and the robot fell (bench objects 133.1). Not for a stance on
-    the line: there the blend's dips are within what the picks were measured with, and the straight
-    poses threw one over (143.10: a wrist's turn)."""
+    under a 0.88 m table's top on the way and the robot fell (bench objects 133.1). block: only where the
+    blend takes a hand into its top (`path_meets`; else []): from a stance on the box's line the blend's
+    hand rose into a 0.85 m top's underside and the robot fell (bench objects 144.0, traced). The caller
+    times these poses by joint speed: spread evenly over a second, a wrist turned at 24.8 rad/s (its
+    limit 22) on 143.10."""
+    if block is not None and not path_meets(poses, q_a, q_b, heading, block):
+        return []
     a = [poses.hand_point(q_a, i) for i in range(2)]
     b = [poses.hand_point(q_b, i) for i in range(2)]
     return _along(poses, q_a, [a, b], soles, heading, shift, pelvis_z, lean)[:-1]
