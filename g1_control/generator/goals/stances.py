@@ -720,18 +720,26 @@ PATH_SAMPLES = 24
 BOX_SINK_M = 0.01
 """A held box's bottom counts as in a support's top this far below it."""
 ELBOWS = ("left_elbow_link", "right_elbow_link")
+WRISTS = ("left_wrist_pitch_link", "right_wrist_pitch_link")
+WRIST_CLEAR_M = 0.05
+"""The wrists keep this far from a support's outline (and under its underside less this) where a hand
+point keeps CLEAR_MARGIN_M: the wrist's links reach ~3 cm around its joint, and a blend that kept the
+hands and elbows clear took a wrist joint 2.6 cm outside a 0.89 m top's edge, 1.2 cm under it: the
+wrist met the underside rising and the robot fell at the pick (`g1 bench objects` 145.1, traced)."""
 
 
 def _probes(poses: PosePlanner, q: np.ndarray, heading: float, box_probes: tuple[tuple[float, float], ...],
-            tips: bool = True) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """The points that must stay clear of a support in pose q: (each hand point, its tip and the
-    elbows; with a box held, the box's points (forward, down) from the middle between the hands)."""
+            tips: bool = True) -> tuple[list[tuple[np.ndarray, float]], list[np.ndarray]]:
+    """The points that must stay clear of a support in pose q, each with its margin: (each hand point,
+    its tip and the elbows (CLEAR_MARGIN_M), the wrists (WRIST_CLEAR_M); with a box held, the box's
+    points (forward, down) from the middle between the hands)."""
     fwd = np.array([math.cos(heading), math.sin(heading), 0.0])
     frames = [poses.ik.frame_pose(q, HAND_FRAMES[i]) for i in range(2)]
     hands = [p for p, _ in frames]
-    body = [*hands, *(poses.ik.frame_pose(q, f)[0] for f in ELBOWS)]
+    body = [(p, CLEAR_MARGIN_M) for p in (*hands, *(poses.ik.frame_pose(q, f)[0] for f in ELBOWS))]
+    body += [(poses.ik.frame_pose(q, f)[0], WRIST_CLEAR_M) for f in WRISTS]
     if tips:
-        body += [p + HAND_TIP_M * r[:, 0] for p, r in frames]
+        body += [(p + HAND_TIP_M * r[:, 0], CLEAR_MARGIN_M) for p, r in frames]
     mid = (hands[0] + hands[1]) / 2
     return body, [mid + f * fwd - np.array([0.0, 0.0, d]) for f, d in box_probes]
 
@@ -742,16 +750,16 @@ def path_meets(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, heading: fl
     a hand, its tip or an elbow into `block`'s top (within CLEAR_MARGIN_M of its outline, between its
     underside less CLEAR_MARGIN_M and CLEAR_ABOVE_M above it), or the held box's points (`box_probes`, see _probes)
     below its top (a box set down on it ends resting there). tips: the hands' tips too."""
-    top, under = block.height_m + CLEAR_ABOVE_M, block.height_m - TABLE_TOP_THICKNESS_M - CLEAR_MARGIN_M
+    top, underside = block.height_m + CLEAR_ABOVE_M, block.height_m - TABLE_TOP_THICKNESS_M
     for s in np.linspace(0.0, 1.0, PATH_SAMPLES):
         q = q_a + s * (q_b - q_a)
         q[3:7] /= np.linalg.norm(q[3:7])
         body, box = _probes(poses, q, heading, box_probes, tips)
-        for p in body:
-            if under < p[2] < top and block.distance_xy(p[:2]) < CLEAR_MARGIN_M:
+        for p, margin in body:
+            if underside - margin < p[2] < top and block.distance_xy(p[:2]) < margin:
                 return True
         for p in box:
-            if under < p[2] < block.height_m - BOX_SINK_M and block.distance_xy(p[:2]) < CLEAR_MARGIN_M:
+            if underside - CLEAR_MARGIN_M < p[2] < block.height_m - BOX_SINK_M and block.distance_xy(p[:2]) < CLEAR_MARGIN_M:
                 return True
     return False
 
@@ -802,7 +810,8 @@ def detour_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: li
     if strict:  # a 5.6 kg box on a 0.84 m table: the way kept with a blend through the top caught a hand
         # under it and the robot fell at the lift (bench objects seed 12, trial 1)
         raise StanceRefused(f"the hands find no way around the top of '{block.name}' ({block.height_m:.2f} m): "
-                            f"every way tried passes within {CLEAR_MARGIN_M * 100:.0f} cm of it")
+                            f"every way tried passes within {CLEAR_MARGIN_M * 100:.0f} cm of it (a wrist within "
+                            f"{WRIST_CLEAR_M * 100:.0f} cm)")
     return best[1]
 
 
