@@ -37,6 +37,7 @@ from g1_control.generator.goals.box import (
 from g1_control.generator.goals.context import GoalContext, GoalFailed, Held
 from g1_control.generator.goals.poses import PosePlanner, ReachRefused, flat_soles, stance_heading
 from g1_control.generator.goals.stances import (
+    ARMS_BACK,
     CLEAR_MARGIN_M,
     box_com_shift,
     detour_poses,
@@ -58,18 +59,10 @@ from g1_control.generator.goals.stepping import (
     walk_steps,
 )
 from g1_control.generator.whole_body import keyframe_trajectory, smoothstep
-from g1_control.robot import g1
 from g1_control.rotations import wrap_angle, yaw_of
 from g1_control.scene import FLOOR, Block, Box
 from g1_control.types import PHASE_WHOLE_BODY, TaskGoal
 
-ARMS_BACK = g1.DEFAULT_Q_RAD.copy()
-"""Stepping up to a table: the arms swung back (hand points ~5 cm ahead of the pelvis instead of
-17 cm at table height), so the hands cannot catch the table's edge (it threw the robot over,
-measured)."""
-for _side in ("left", "right"):
-    ARMS_BACK[g1.JOINT_INDEX[f"{_side}_shoulder_pitch_joint"]] = 0.6
-    ARMS_BACK[g1.JOINT_INDEX[f"{_side}_elbow_joint"]] = 0.4
 RAISE_AHEAD_M = 0.10
 """Hands rise (and come back) this far ahead of the pelvis, above the box, on their way to it."""
 GRAVITY = 9.81

@@ -29,7 +29,8 @@ on the floor. The candidates:
 Each candidate is solved from the standing pose at its stance: both hands on the grasp points
 (and, for a pick, again lifted), the CoM over the soles shifted for the box's weight; it is kept
 when the hands are within FEASIBLE_RESIDUAL_M, the CoM within FEASIBLE_COM_M of its target and no
-leg, trunk or arm point comes into the support's top or the box. The highest pelvis with a kept
+leg, trunk or arm point comes into the support's top or the box (for a pick, also standing at the
+stance upright, the arms swung back as the robot steps in: ARMS_BACK, no arm under the top). The highest pelvis with a kept
 candidate wins (standing is easier on the controller than squatting), and among those the distance
 of issue 17's pick when kept, else the smallest reach residual and CoM error. When none is kept the place is refused before
 anything moves, with the reason and the closest pose.
@@ -195,6 +196,13 @@ SIDE_MIN_SIN = 0.2
 """Stances off the line only where the heading's lateral has at least this share of the edge's normal
 (the box turned ~12 deg or more to the edge): square on, a step aside brings the pelvis no farther out."""
 TABLE_TOP_THICKNESS_M = 0.04
+ARMS_BACK = g1.DEFAULT_Q_RAD.copy()
+"""Stepping up to a table: the arms swung back (hand points ~5 cm ahead of the pelvis instead of
+17 cm at table height), so the hands cannot catch the table's edge (it threw the robot over,
+measured)."""
+for _side in ("left", "right"):
+    ARMS_BACK[g1.JOINT_INDEX[f"{_side}_shoulder_pitch_joint"]] = 0.6
+    ARMS_BACK[g1.JOINT_INDEX[f"{_side}_elbow_joint"]] = 0.4
 STANDING_GIVE_M = 0.06
 """A standing candidate's pelvis may sink this much below nominal to reach (the grasps of issue 17
 gave ~1-3 cm); more is a squat, tried as one with its own checks (a 'standing' pose that sank to
@@ -502,6 +510,13 @@ class StancePlanner:
                 break  # not kept anyway: the rest is not worth its time
             if cand.collision is None:
                 cand.collision = self.collision(q, box, center_w, support)
+        if cand.collision is None and support is not None and lift_m is not None and worst_res <= FEASIBLE_RESIDUAL_M:
+            # a pick's stepping in: the robot stands at the stance upright, the arms swung back, before it bends
+            # to the hold pose (whose pelvis a reach moves back from the edge): the same rules there
+            stand, _ = self.stance(cand.mid_xy, cand.heading, ground_z)
+            stand[7:] = ARMS_BACK
+            if path_meets(self.poses, stand, stand, cand.heading, support, tips=False):
+                cand.collision = f"stepping in, an arm passes under the top of '{support.name}'"
         cand.residual_m, cand.com_error_m = worst_res, worst_com
 
     def deep_fault(self, q: np.ndarray, soles: list[Sole]) -> str | None:
