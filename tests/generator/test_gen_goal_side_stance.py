@@ -15,7 +15,6 @@ import pytest
 from g1_control.generator.goals import stances as stances_module
 from g1_control.generator.goals.box import hand_points
 from g1_control.generator.goals.context import GoalConfig
-from g1_control.generator.goals.handling import ARMS_BACK, RAISE_AHEAD_M
 from g1_control.generator.goals.poses import PosePlanner
 from g1_control.generator.goals.stances import (
     LEAN,
@@ -27,7 +26,6 @@ from g1_control.generator.goals.stances import (
     StanceRefused,
     box_com_shift,
     edge_normal,
-    grasp_hold_poses,
     hand_height,
     path_meets,
     pick_headings,
@@ -35,6 +33,7 @@ from g1_control.generator.goals.stances import (
 )
 from g1_control.robot.dynamics import HAND_FRAMES
 from g1_control.tools.bench_objects import draw_scene
+from tests.generator.bench_picks import via_and_pre
 
 
 @pytest.fixture(scope="module")
@@ -108,20 +107,9 @@ def test_the_hand_reaching_across_goes_straight_to_the_pre_grasp_point(stances):
     them: the plain blend between them takes a hand through the table's top (below it within 2 cm of
     its outline: path_meets); the straight poses between keep every blend clear and the hands over
     the top."""
-    box, table, center = _scene(133, 1)
-    plan = _pick(stances, box, table, center)
+    plan, table, soles, q_via, q_pre = via_and_pre(stances, 133, 1)
     assert plan.chosen.side_m != 0.0
-    q0, soles = stances.stance(plan.approach.mid_xy, plan.approach.heading, 0.0)
-    q0[7:] = ARMS_BACK  # as handling.pick steps in
-    heading, width = plan.approach.heading, plan.width_m
-    c = center + np.array([0.0, 0.0, plan.hand_dz_m])
-    ahead = float((c[:2] - plan.approach.mid_xy) @ np.array([math.cos(heading), math.sin(heading)]))
-    gap = GoalConfig().pre_gap_m
-    via = hand_points(c, heading, width, gap + 0.03, dz_m=0.08, ahead_m=-(ahead - RAISE_AHEAD_M))
-    pre = hand_points(c, heading, width, gap)
-    none = np.zeros(2)
-    steps = [("via", via, none, plan.pelvis_z_m, plan.lean), ("pre-grasp", pre, none, plan.pelvis_z_m, plan.lean)]
-    q_via, q_pre = grasp_hold_poses(stances.poses, q0, soles, heading, steps, box.name, "test")
+    heading, none = plan.approach.heading, np.zeros(2)
     poses = stances.poses
 
     def lowest_over_top(chain):

@@ -6,14 +6,12 @@ refuses it. 158.13 (first run after the change) keeps another stance and is plac
 
 import math
 
-import numpy as np
 import pytest
 
 from g1_control.generator.goals import stances as stances_module
-from g1_control.generator.goals.context import GoalConfig
 from g1_control.generator.goals.poses import PosePlanner
-from g1_control.generator.goals.stances import ARMS_BACK, StancePlanner, path_meets, pick_headings
-from g1_control.tools.bench_objects import draw_scene
+from g1_control.generator.goals.stances import StancePlanner, path_meets
+from tests.generator.bench_picks import planned_pick
 
 
 @pytest.fixture(scope="module")
@@ -21,26 +19,14 @@ def stances():
     return StancePlanner(PosePlanner())
 
 
-def _plan(stances, seed, index):
-    drawn = draw_scene(seed, index)
-    box = drawn["scene"].boxes[0]
-    table = drawn["scene"].block(box.stands_on)
-    center = np.array([*box.xy_m, table.height_m + box.size_m[2] / 2])
-    plan = stances.plan(box, center, table, pick_headings(box, center[:2], table, np.zeros(2)),
-                        lift_m=GoalConfig().lift_m, what="pick it up")
-    stand, _ = stances.stance(plan.approach.mid_xy, plan.approach.heading, 0.0)
-    stand[7:] = ARMS_BACK
-    return plan, table, stand
-
-
 def test_the_stance_kept_steps_in_with_the_arms_clear_of_the_top(stances, monkeypatch):
     # bench objects 158.13 (2.6 kg on a 0.85 m table): the stance the search keeps steps in clear ...
-    plan, table, stand = _plan(stances, 158, 13)
+    plan, table, _, stand = planned_pick(stances, 158, 13)
     assert not path_meets(stances.poses, stand, stand, plan.approach.heading, table, tips=False)
     # ... where, without the check, it kept one whose arms step in under the top's edge
     real = stances_module.path_meets
     monkeypatch.setattr(stances_module, "path_meets",
                         lambda poses, q_a, q_b, *a, **k: False if q_a is q_b else real(poses, q_a, q_b, *a, **k))
-    before, _, stand_before = _plan(stances, 158, 13)
+    before, _, _, stand_before = planned_pick(stances, 158, 13)
     assert abs(math.remainder(before.approach.heading - plan.approach.heading, 2 * math.pi)) > 0.1
     assert real(stances.poses, stand_before, stand_before, before.approach.heading, table, tips=False)

@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from g1_control.generator.goals import stances as stances_module
-from g1_control.generator.goals.handling import ARMS_BACK
 from g1_control.generator.goals.poses import PosePlanner
 from g1_control.generator.goals.stances import (
     CLEAR_MARGIN_M,
@@ -20,7 +19,7 @@ from g1_control.generator.goals.stances import (
     detour_poses,
     path_meets,
 )
-from tests.generator.test_gen_goal_straight_on_line import _via_and_pre
+from tests.generator.bench_picks import planned_pick, via_and_pre
 
 
 @pytest.fixture(scope="module")
@@ -45,9 +44,8 @@ def _wrist_under(poses, chain, table):
 
 
 def test_the_wrists_go_around_a_high_tops_edge_where_the_hands_alone_would_pass(stances, monkeypatch):
-    plan, table, _, q_via, _ = _via_and_pre(stances, 145, 1)
-    q0, soles = stances.stance(plan.approach.mid_xy, plan.approach.heading, 0.0)
-    q0[7:] = ARMS_BACK
+    plan, table, _, q0 = planned_pick(stances, 145, 1)
+    _, _, soles, q_via, _ = via_and_pre(stances, 145, 1)
     heading, poses = plan.approach.heading, stances.poses
     # the straight blend from the stance to the via pose: the wrist passes under the edge
     assert _wrist_under(poses, [q0, q_via], table) < WRIST_CLEAR_M
