@@ -731,6 +731,13 @@ the tips rose through its top on both other ways, and a hand hanging under an as
 it: "the hands find no way around" refused 9 of the 9 picks the trunk's rule let through on bench
 objects seeds 9-16 (physics); with this way 7 got past it (6 picked, 1 set back by the lift check)."""
 DETOUR_BACK_MAX_M = 0.2
+DETOUR_SINK_M = 0.2
+"""A detour's poses keep the pelvis within this of the hold's height: a way around a 0.90 m top whose
+first poses the IK solved with the pelvis at 0.26 m (the hands drawn back below the edge) put the
+reference pelvis on its way to the floor and the robot fell at the pick (`g1 bench objects` 153.19,
+traced). Ways that sank 6-17 cm are common and were picked (10 of the 99 picks from a support planned on
+seeds 140-157, plan only; 141.13 and 149.12 among them were placed in physics), so this only
+catches an IK that lost its branch."""
 PATH_SAMPLES = 24
 BOX_SINK_M = 0.01
 """A held box's bottom counts as in a support's top this far below it."""
@@ -817,6 +824,8 @@ def detour_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: li
             chain = _along(poses, q_a, corners, soles, heading, shift, pelvis_z, lean, spacing)[:-1]
         path = [q_a, *chain, q_b]
         bad = sum(path_meets(poses, u, v, heading, block, box_probes, tips) for u, v in pairwise(path))
+        if max((pelvis_z - float(q[2]) for q in chain), default=0.0) > DETOUR_SINK_M:
+            bad += len(path)  # a way the IK found only by dropping the pelvis: never kept
         if best is None or bad < best[0]:
             best = (bad, chain)
         if bad == 0:
@@ -826,7 +835,7 @@ def detour_poses(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, soles: li
         # under it and the robot fell at the lift (bench objects seed 12, trial 1)
         raise StanceRefused(f"the hands find no way around the top of '{block.name}' ({block.height_m:.2f} m): "
                             f"every way tried passes within {CLEAR_MARGIN_M * 100:.0f} cm of it (a wrist within "
-                            f"{WRIST_CLEAR_M * 100:.0f} cm)")
+                            f"{WRIST_CLEAR_M * 100:.0f} cm) or drops the pelvis more than {DETOUR_SINK_M * 100:.0f} cm")
     return best[1]
 
 
