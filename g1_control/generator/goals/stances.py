@@ -744,7 +744,7 @@ BOX_SINK_M = 0.01
 ELBOWS = ("left_elbow_link", "right_elbow_link")
 WRISTS = ("left_wrist_pitch_link", "right_wrist_pitch_link")
 WRIST_CLEAR_M = 0.05
-"""The wrists keep this far from a support's outline (and under its underside less this) where a hand
+"""The wrists keep this far outside a support's outline, or this far below its underside, where a hand
 point keeps CLEAR_MARGIN_M: the wrist's links reach ~3 cm around its joint, and a blend that kept the
 hands and elbows clear took a wrist joint 2.6 cm outside a 0.89 m top's edge, 1.2 cm under it: the
 wrist met the underside rising and the robot fell at the pick (`g1 bench objects` 145.1, traced)."""
@@ -770,8 +770,9 @@ def path_meets(poses: PosePlanner, q_a: np.ndarray, q_b: np.ndarray, heading: fl
                box_probes: tuple[tuple[float, float], ...] = (), tips: bool = True) -> bool:
     """Whether the straight configuration-space move from q_a to q_b (the way keyframes blend) takes
     a hand, its tip or an elbow into `block`'s top (within CLEAR_MARGIN_M of its outline, between its
-    underside less CLEAR_MARGIN_M and CLEAR_ABOVE_M above it), or the held box's points (`box_probes`, see _probes)
-    below its top (a box set down on it ends resting there). tips: the hands' tips too."""
+    underside less CLEAR_MARGIN_M and CLEAR_ABOVE_M above it), a wrist so within WRIST_CLEAR_M, or the
+    held box's points (`box_probes`, see _probes) below its top (a box set down on it ends resting
+    there). tips: the hands' tips too."""
     top, underside = block.height_m + CLEAR_ABOVE_M, block.height_m - TABLE_TOP_THICKNESS_M
     for s in np.linspace(0.0, 1.0, PATH_SAMPLES):
         q = q_a + s * (q_b - q_a)
