@@ -248,14 +248,13 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
                                         plan.lean, _shifted(support, ctx.offset()),
                                         support.height_m + 2 * CLEAR_MARGIN_M, (), True, True)
     straight: list[np.ndarray] = []
-    if plan.chosen.side_m:  # off the box's line one arm swings across it: the hands go straight to the pre-grasp
-        # points, not along the blend (its hand dipped under the table's top: stances.straight_poses)
+    if support is not None:  # off the box's line one arm swings across it: the hands go straight to the
+        # pre-grasp points, not along the blend (its hand dipped under the table's top); on the line only where
+        # the blend takes a hand into the support's top (stances.straight_poses)
+        block = None if plan.chosen.side_m else _shifted(support, ctx.offset())
         straight = yield from ctx.compute("straight", straight_poses, q_via, q_pre, soles, heading, none, pelvis_z,
-                                          plan.lean)
-    elif support is not None:  # on the line: straight only where the blend takes a hand into the support's top
-        straight = yield from ctx.compute("straight", straight_poses, q_via, q_pre, soles, heading, none, pelvis_z,
-                                          plan.lean, _shifted(support, ctx.offset()))
-        if straight:
+                                          plan.lean, block)
+        if straight and block is not None:
             ctx.note(f"the hands go straight to the pre-grasp points: the blend takes one into the top of "
                      f"'{support.name}'")
     path = _timed(q0, [*around, q_via], 1.2)

@@ -474,6 +474,7 @@ class StancePlanner:
     def _evaluate(self, cand: Candidate, box: Box, center_w: np.ndarray, support: Block | None, width: float,
                   dz: float, mass: float, ground_z: float, lift_m: float | None, press_m: float) -> None:
         q, soles = self.stance(cand.mid_xy, cand.heading, ground_z)
+        standing = q.copy()
         c = center_w + np.array([0.0, 0.0, dz])
         depth = grasp_width(box, cand.heading + math.pi / 2)
         shift = box_com_shift(mass, self.poses.mass_kg, cand.gap_m + depth / 2, -cand.side_m)
@@ -513,7 +514,7 @@ class StancePlanner:
         if cand.collision is None and support is not None and lift_m is not None and worst_res <= FEASIBLE_RESIDUAL_M:
             # a pick's stepping in: the robot stands at the stance upright, the arms swung back, before it bends
             # to the hold pose (whose pelvis a reach moves back from the edge): the same rules there
-            stand, _ = self.stance(cand.mid_xy, cand.heading, ground_z)
+            stand = standing.copy()
             stand[7:] = ARMS_BACK
             if path_meets(self.poses, stand, stand, cand.heading, support, tips=False):
                 cand.collision = f"stepping in, an arm passes under the top of '{support.name}'"
