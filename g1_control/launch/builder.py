@@ -111,8 +111,11 @@ def make_tracker(launch: LaunchFile) -> Tracker:
 
         policy = LocomotionPolicyTracker(load_spec(cfg.policy), VelocityCorrectionConfig(enabled=cfg.velocity_correction),
                                          envelope_limits=cfg.envelope_limits)
-        wbc = WholeBodyTracker(wbc_config(launch), variant=robot_variant(launch),
-                               hands=launch.backend.hands)
+        from g1_control.trackers.wbc.terrain import Terrain
+
+        # whole-body plans follow their own contacts; its gait walks only with a held load (layer.py)
+        wbc = WholeBodyTracker(wbc_config(launch, footsteps="velocity"), variant=robot_variant(launch),
+                               hands=launch.backend.hands, terrain=Terrain.of_scene(launch.scene))
         return TrackingLayer(policy, wbc, launch.rates.tracker_hz)
     raise LaunchFileError(f"tracker.type: unknown tracker '{cfg.type}'")
 
@@ -173,6 +176,7 @@ def make_generator(launch: LaunchFile, limits: CommandLimits | None = None,
     config.plan_in_background = launch.backend.mode == "wallclock" or launch.backend.type != "mujoco"
     if isinstance(tracker, TrackingLayer):  # the walking policy's own height range (its envelope)
         config.policy_height_m = tracker.policy.command_limits.pelvis_height_m
+        config.walk_while_holding = tracker.walks_holding()  # the WBC's gait carries (layer.py)
     if launch.tracker.type == "wbc":  # its gait walks at the heights asked, and with a held box
         config.policy_height_m = (WBC_MIN_PELVIS_HEIGHT_M, config.policy_height_m[1])
         config.walk_while_holding = True

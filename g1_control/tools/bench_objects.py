@@ -31,9 +31,10 @@ first), read from the goals' notes (the path taken, not the outcome: that is jud
     g1 bench objects --carry --seed 200 --trials 10 --jobs 2
     g1 bench objects --tracker wbc --seed 3 --trials 20 --jobs 2
 
---tracker wbc: the objects scenes on the whole-body controller alone (250 Hz, as --carry), which walks a
-held box in its own gait where the place is on the same ground (else whole-body steps); the default is
-the tracking layer (the walking policy walks, the WBC picks and places; a carry is whole-body steps).
+--tracker wbc: the objects scenes on the whole-body controller alone (250 Hz, as --carry); the default is
+the tracking layer (the walking policy walks, the WBC picks and places). Both walk a held box in the WBC's
+own gait where the place is on the same ground and the box is no heavier than GoalConfig.gait_carry_max_kg
+(the layer hands a walk holding something to its WBC, trackers/layer.py), else in whole-body steps.
 
 `run_trial(seed, index) -> dict` is the whole trial (a plain function of its arguments, for a
 process pool or a cluster); `main` fans it out over --jobs processes and prints the tables.

@@ -16,6 +16,12 @@ cleared), both run for `blend_s`, and the motor command is a torque-exact blend:
 so the drivers' torque tau + kp (q - q_meas) + kd (dq - dq_meas) is exactly a tauA_out + b tauB_out.
 Measured in the issue 17 investigation (standing, policy <-> WBC): largest per-tick torque jump
 11.8 N m for a hard switch, 0.3-0.6 N m with a 0.3 s blend.
+
+Walking with something held: a locomotion reference that carries a held object's forces on the hands
+(JointReference.hand_forces_w_n, the goals' walk holding) goes to the WBC as well when the WBC has a gait
+of its own (WbcConfig.footsteps "velocity"): it walks the reference's root twist with the load in its
+dynamics and the held upper body, where the walking policy knows nothing of the load (the goals'
+GoalConfig.walk_while_holding; launch/builder.py builds the layer's WBC so).
 """
 
 from __future__ import annotations
@@ -72,6 +78,7 @@ class TrackingLayer(Tracker):
         self.rate_hz = rate_hz
         self.every = max(1, round(rate_hz / policy.spec.rate_hz))
         self.blend_s = blend_s
+        self._walks_holding = self.walks_holding()
         self._policy_cmd, self._wbc_cmd, self._out = MotorCommand(), MotorCommand(), MotorCommand()
         self._stand = JointReference()
         """What the policy is given while the plan is whole-body (during a blend out of it): stand."""
@@ -123,8 +130,13 @@ class TrackingLayer(Tracker):
         n = min(self.profiled, PROFILE_TICKS)
         return self.cpu_s[:n].copy(), self.cpu_kind[:n].copy()
 
+    def walks_holding(self) -> bool:
+        """Whether a locomotion reference with a held load is walked by the WBC's own gait (module docstring)."""
+        return getattr(self.wbc, "gait", None) is not None
+
     def _act(self, reference: JointReference, state: RobotState) -> MotorCommand:
-        want = WBC if reference.phase == PHASE_WHOLE_BODY else POLICY
+        holding = self._walks_holding and bool(reference.hand_forces_w_n.any())
+        want = WBC if reference.phase == PHASE_WHOLE_BODY or holding else POLICY
         if want != self.active:
             self._switch(want, state)
         if want == WBC:

@@ -103,8 +103,8 @@ def test_a_bottle_is_carried_to_a_second_table_and_put_down_upright():
 
 
 def test_without_a_gait_the_bottle_is_carried_in_whole_body_steps():
-    """The same scene with a tracker that has no gait of its own (GoalConfig.walk_while_holding off, as under
-    the tracking layer): back off, turn and walk in whole-body steps with the arm held, then the place."""
+    """The same scene with a tracker that has no gait of its own (GoalConfig.walk_while_holding off): back off,
+    turn and walk in whole-body steps with the arm held, then the place."""
     r = bb.run_scene(bb.draw_scene(10, 1, True), gait=False)
     assert not r["fell"] and not r["refused"], r
     assert not any("stand holding" in line for line in r["log"]), "no gait walk"

@@ -1,6 +1,6 @@
 """`g1 bench objects --tracker wbc`: the objects scenes on the whole-body controller alone (250 Hz), which
-walks a held box in its own gait. Scene 141.16, a 4.4 kg box from a 0.86 m table to a 0.88 m one: on the
-tracking layer the carry is whole-body steps and the robot falls in it (`g1 bench objects --seed 141`);
+walks a held box in its own gait. Scene 141.16, a 4.4 kg box from a 0.86 m table to a 0.88 m one: carried
+in whole-body steps the robot fell (the tracking layer before it handed such walks to its WBC's gait);
 on the WBC the box is lifted, carried in the gait and set down within 3 cm, upright, never dropped, no
 fall (MuJoCo's ground truth; 1.0 cm with both the suite's OpenBLAS kernel and an AVX-512 host's own)."""
 

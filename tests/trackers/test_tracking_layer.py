@@ -66,3 +66,26 @@ def test_hand_over_by_phase_with_a_blend_and_the_policy_at_its_own_rate():
     # the WBC runs only while it is wanted (its 100 ticks and the 30-tick blend out); the policy at 50 Hz
     assert wbc.calls == 100 + 30
     assert policy.calls < 0.5 * (50 + 30 + 50) + 5
+
+
+@pytest.mark.parametrize("gait", [True, False])
+def test_walking_with_a_held_load_goes_to_the_wbc_where_it_has_a_gait(gait):
+    """A locomotion reference carrying a held object's forces on the hands is walked by the WBC's own
+    gait (the load in its dynamics); without forces, or with a WBC that has no gait, by the policy."""
+    policy, wbc = _Fake(1.0), _Fake(3.0)
+    wbc.gait = object() if gait else None
+    layer = TrackingLayer(policy, wbc, rate_hz=100.0, blend_s=0.0)
+    assert layer.walks_holding() is gait
+    ref, state = JointReference(), RobotState()
+    ref.phase = PHASE_LOCOMOTION
+    taus = []
+    for k in range(60):
+        state.t_s = k * 0.01
+        ref.hand_forces_w_n[:] = 0.0
+        if 20 <= k < 40:
+            ref.hand_forces_w_n[:, 2] = -9.81  # a 2 kg box, half in each hand
+        taus.append(layer.act(ref, state).tau_nm[0])
+    held = 3.0 if gait else 1.0
+    assert taus[:20] == pytest.approx([1.0] * 20) and taus[20:40] == pytest.approx([held] * 20)
+    assert taus[40:] == pytest.approx([1.0] * 20)
+    assert [s for _, s in layer.switches] == ([WBC, POLICY] if gait else [])
