@@ -80,6 +80,12 @@ class GoalConfig:
     carry_walk_speed_mps: float = 0.25
     carry_turn_rate_radps: float = 0.4
     """Walking holding something in a goal (approach.walk_holding, the tracker's own gait): at most this fast."""
+    gait_carry_max_kg: float = 5.0
+    """A goal carries a box this heavy at most in the tracker's own gait (walk_while_holding); a heavier one
+    in whole-body steps. With 5.3 and 5.7 kg boxes the gait staggered (the pelvis bobbing 0.60-0.72 m, the
+    robot moving 1.2 m/s at 0.25 commanded) and fell, on the tracking layer at 100 and 250 Hz and on the
+    WBC alone (`g1 bench objects` scenes 147.7, 143.0); 4.4 and 4.5 kg boxes were carried and placed
+    (141.16, 144.17, which fell in whole-body steps). Measured, one machine, stop 56."""
     stand_s: float = 1.0
     """After a hand-over: from the measured pose to a clean standing pose."""
     move_s: float = 2.0
@@ -137,7 +143,8 @@ class GoalConfig:
     walk_while_holding: bool = False
     """A velocity command while a box is held walks with it: the tracker walks by its own gait with
     the held upper-body posture and the box's forces on the hands (the whole-body controller with
-    footsteps 'velocity'). Off (a walking policy would drop the box), the robot stands holding it."""
+    footsteps 'velocity', alone or inside the tracking layer, which hands it such a walk). Off (a walking
+    policy would drop the box), the robot stands holding it."""
     bottle_grasp_nm: float = 0.5
     """A bottle's one-hand grasp (goals/bottle.py): each finger motor stops squeezing at this torque
     (trackers/grasp.py; the Dex3's motors give 1.4-2.45 N m). 0.5 N m at a finger's ~5 cm lever

@@ -1,7 +1,8 @@
 """Box handling: pick a box from where it stands (a table, the floor), carry it and set it down on a
 table, a platform or the floor. The carry walks in the tracker's own gait where it has one
-(GoalConfig.walk_while_holding: the whole-body controller; `walk_in_gait`), else, or where the box
-would not clear the target's top with the gait's lower pelvis, on whole-body footsteps (`carry`).
+(GoalConfig.walk_while_holding: the whole-body controller, alone or in the tracking layer; `walk_in_gait`),
+else, or where the box is heavier than GoalConfig.gait_carry_max_kg or would not clear the target's top
+with the gait's lower pelvis, on whole-body footsteps (`carry`).
 
 The squeeze and the box's weight are known hand forces in the controller's dynamics; while held,
 they turn with the robot's heading. A box is found by name or as the nearest one in front of the
@@ -355,7 +356,12 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
         abs(wrap_angle(approach.heading - stance.heading)) > 0.05
     level = ctx.on_platform is None and abs(ctx.scene.ground_height(approach.mid_xy) - ctx.scene.ground_height(
         stance.mid_xy - ctx.offset())) < 0.01  # no step up or down on the way (whole-body steps take those)
-    if far and cfg.walk_while_holding and level:  # the tracker's own gait walks it there (walk_in_gait), where it can
+    gait = far and cfg.walk_while_holding and level
+    if gait and box.mass_kg > cfg.gait_carry_max_kg:
+        gait = False
+        ctx.note(f"carry in whole-body steps: the box's {box.mass_kg:.1f} kg is more than the gait carries "
+                 f"({cfg.gait_carry_max_kg:.1f} kg)")
+    if gait:  # the tracker's own gait walks it there (walk_in_gait), where it can
         walked = yield from walk_in_gait(ctx, approach, posture, weight, carry_shift, support)
         if walked is not None:
             posture, step_cfg = walked
