@@ -182,3 +182,35 @@ def test_walk_holding_stops_short_of_the_stance_only_where_that_point_is_clear_o
     tolerance = GoalConfig().approach_tolerance_m
     assert 0.2 - tolerance <= ends["clear"] <= 0.2 + tolerance
     assert -tolerance <= ends["table beside"] <= tolerance
+
+
+class Drifter(Omni):
+    """Omni whose walk also slides sideways, `slip` m/s per m/s forward (a held load pulling it aside)."""
+
+    slip = -0.6
+
+    def step(self) -> None:
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        side = self.slip * self.walk[0]
+        self.xy = self.xy + DT_S * side * np.array([-s, c])
+        super().step()
+
+
+def test_turn_walk_turn_faces_its_point_again_when_the_walk_cannot_steer_onto_it():
+    """Walking, the robot steers at most carry_turn_rate_radps / 2: a point it slides past inside that
+    turning circle it would circle until the walk's timeout (scene 145.0 on the tracking layer). Off its
+    bearing by more than REFACE_RAD it turns on the spot to face the point again, and gets there."""
+    from g1_control.generator.goals.approach import REFACE_RAD
+
+    robot = Drifter(yaw=0.0)
+    robot.config = GoalConfig(walk_timeout_s=60.0)
+    approach = Approach(np.array([3.0, -2.0]), heading=0.0)
+    for _ in turn_walk_turn(robot, approach, out_m=0.2):  # type: ignore[arg-type]
+        robot.step()
+    goal = approach.pelvis_xy() - np.array([0.2, 0.0])
+    assert float(np.hypot(*(robot.xy - goal))) <= robot.config.approach_tolerance_m
+    assert robot.t < 30.0
+    cmds = np.array(robot.commands)
+    walking = cmds[:, 0] > 0
+    assert np.count_nonzero(np.diff(walking.astype(int)) == 1) >= 2, "it stopped walking to face the point again"
+    assert 0.3 < REFACE_RAD < math.pi / 2

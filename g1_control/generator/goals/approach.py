@@ -186,6 +186,8 @@ def turn_walk_turn(ctx: GoalContext, approach: Approach, *, out_m: float) -> Ite
                 stage = "walk"
         if stage == "walk" and (dist <= cfg.approach_tolerance_m or abs(bearing_err) > math.pi / 2):
             stage = "turn"  # there, or past it
+        elif stage == "walk" and abs(bearing_err) > REFACE_RAD:
+            stage = "face"  # the point inside the walk's turning circle: face it again on the spot
         if stage == "turn" and abs(wrap_angle(approach.heading - yaw)) <= cfg.approach_heading_tolerance_rad / 2:
             stage = "settle"
         if stage == "face":
@@ -209,6 +211,11 @@ def turn_walk_turn(ctx: GoalContext, approach: Approach, *, out_m: float) -> Ite
 
 FACE_TOLERANCE_RAD = 0.15
 """turn_walk_turn walks once it faces its point within this."""
+REFACE_RAD = 0.5
+"""... and faces it again, on the spot, once it is off its point's bearing by more than this: walking at
+carry_walk_speed_mps, turning at most carry_turn_rate_radps / 2, the robot cannot turn tighter than a
+1.25 m radius; a point it passed close beside it circled (the pick-and-place scene 145.0 on the tracking
+layer: 0.14-0.31 m from the point, 2.5 s at the full turn, until a hip over-speed trip; measured)."""
 
 
 def stand_holding(ctx: GoalContext, shift: np.ndarray | None = None,
