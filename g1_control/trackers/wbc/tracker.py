@@ -239,6 +239,13 @@ class WbcConfig:
     (relative to `posture`): the arms keep the box's pose (at 1 they served the balance, sagged and
     tilted, and a 3 kg box rolled out of the hands after 8 s, measured)."""
 
+    walking_held_pelvis: bool = True
+    """Walking by its own gait with a held load (hand forces), the pelvis is held at the walking height
+    (the nominal pelvis height less the walking lowering) and the CoM goes where the held posture puts it,
+    instead of the CoM at the default pose's walking height. A box held up in the arms (raised over a
+    table's top) lifts the CoM above the pelvis: with the CoM held at the default pose's height the pelvis
+    sank 0.77 -> 0.59 m standing, the robot drifted 0.5 m/s turning on the spot and fell (`g1 bench
+    objects` scene 165.5 on the tracking layer at 250 Hz, a 1.3 kg box at 1.1 m; measured, stop 56)."""
     held_load_inertia: bool = True
     """A held load's inertia in the dynamics: each hand's share of its weight (the hand forces'
     downward part) as a point mass moving with the hand (WbcModel.hand_masses_kg), so the hands'
@@ -656,11 +663,12 @@ class WholeBodyTracker(Tracker):
         # stepping up, the pelvis keeps its walking height (WbcConfig.terrain_hold_pelvis_up)
         step_up = (terrain and cfg.terrain_hold_pelvis_up and gt.swing_foot >= 0
                    and float(gt.landing_m[2]) > ground_z + self.gait.config.step_change_m)
-        if reference.pelvis_height_m is not None or step_up:
+        held = cfg.walking_held_pelvis and bool(reference.hand_forces_w_n.any())
+        if reference.pelvis_height_m is not None or step_up or held:
             # the pelvis held at the height asked (at most the walking height: knees stay bent), or at
-            # the walking height stepping up, by the CoM's height above the pelvis now (the posture sets
-            # it: crouched, the trunk leans and the pelvis drops further than the CoM; a swing leg raised
-            # over a riser lifts the CoM above the pelvis)
+            # the walking height stepping up or holding a load, by the CoM's height above the pelvis now
+            # (the posture sets it: crouched, the trunk leans and the pelvis drops further than the CoM;
+            # a swing leg raised over a riser, or a box held up in the arms, lifts the CoM above the pelvis)
             pelvis_z = float(self._q[2])  # after this tick's odometry step, as com
             pelvis = self._pelvis_height_m - lower
             if reference.pelvis_height_m is not None:
