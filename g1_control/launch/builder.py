@@ -111,11 +111,15 @@ def make_tracker(launch: LaunchFile) -> Tracker:
 
         policy = LocomotionPolicyTracker(load_spec(cfg.policy), VelocityCorrectionConfig(enabled=cfg.velocity_correction),
                                          envelope_limits=cfg.envelope_limits)
+        from g1_control.launch.schema import WBC_TRACKER_HZ
         from g1_control.trackers.wbc.terrain import Terrain
 
-        # whole-body plans follow their own contacts; its gait walks only with a held load (layer.py)
-        wbc = WholeBodyTracker(wbc_config(launch, footsteps="velocity"), variant=robot_variant(launch),
-                               hands=launch.backend.hands, terrain=Terrain.of_scene(launch.scene))
+        # whole-body plans follow their own contacts; at 250 Hz and faster its gait walks with a held load
+        # (layer.py); slower, a carry is whole-body steps (the gait carried worse at 100 Hz, measured)
+        gait = launch.rates.tracker_hz >= WBC_TRACKER_HZ
+        wbc = WholeBodyTracker(wbc_config(launch, footsteps="velocity" if gait else "plan"),
+                               variant=robot_variant(launch), hands=launch.backend.hands,
+                               terrain=Terrain.of_scene(launch.scene) if gait else None)
         return TrackingLayer(policy, wbc, launch.rates.tracker_hz)
     raise LaunchFileError(f"tracker.type: unknown tracker '{cfg.type}'")
 

@@ -34,7 +34,8 @@ first), read from the goals' notes (the path taken, not the outcome: that is jud
 --tracker wbc: the objects scenes on the whole-body controller alone (250 Hz, as --carry); the default is
 the tracking layer (the walking policy walks, the WBC picks and places). Both walk a held box in the WBC's
 own gait where the place is on the same ground and the box is no heavier than GoalConfig.gait_carry_max_kg
-(the layer hands a walk holding something to its WBC, trackers/layer.py), else in whole-body steps.
+(the layer, run at 250 Hz here, hands a walk holding something to its WBC, trackers/layer.py; launch files
+at 100 Hz carry in whole-body steps), else in whole-body steps.
 
 `run_trial(seed, index) -> dict` is the whole trial (a plain function of its arguments, for a
 process pool or a cluster); `main` fans it out over --jobs processes and prints the tables.
@@ -204,8 +205,8 @@ def _timeline(goals: list[GoalEntry]) -> list[Segment]:
 def run_trial(seed: int, index: int, carry: bool = False, gait: bool = True, tracker: str = "layer") -> dict:
     """One trial, start to verdict (module docstring): a plain function of its arguments. carry: a --carry
     scene on the whole-body controller (launch/sim_wbc_carry.yaml's chain); tracker: an objects scene's
-    ("layer": launch/sim_box.yaml's tracking layer, 100 Hz; "wbc": the whole-body controller alone, 250 Hz,
-    as --carry); gait False: a carry walks in whole-body steps, as with a tracker that has no gait
+    ("layer": launch/sim_box.yaml's tracking layer, run at 250 Hz so that its WBC's gait carries; "wbc": the
+    whole-body controller alone, 250 Hz, as --carry); gait False: a carry walks in whole-body steps, as with a tracker that has no gait
     (GoalConfig.walk_while_holding off)."""
     if tracker not in TRACKERS:
         raise ValueError(f"tracker {tracker!r}: one of {', '.join(TRACKERS)}")
@@ -216,7 +217,7 @@ def run_trial(seed: int, index: int, carry: bool = False, gait: bool = True, tra
     drawn = draw_scene(seed, index, carry)
     tracker = "wbc" if carry else tracker
     trial = Trial(f"{'carry' if carry else 'objects'} {seed}.{index}", _timeline(drawn["goals"]), tracker=tracker,
-                  tracker_hz=250.0 if tracker == "wbc" else 100.0, scene=drawn["scene"])
+                  tracker_hz=250.0, scene=drawn["scene"])
     loop = build_loop(trial_launch(trial))
     loop.reset()
     watcher = GoalWatcher(loop)

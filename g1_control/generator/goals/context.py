@@ -85,7 +85,10 @@ class GoalConfig:
     in whole-body steps. With 5.3 and 5.7 kg boxes the gait staggered (the pelvis bobbing 0.60-0.72 m, the
     robot moving 1.2 m/s at 0.25 commanded) and fell, on the tracking layer at 100 and 250 Hz and on the
     WBC alone (`g1 bench objects` scenes 147.7, 143.0); 4.4 and 4.5 kg boxes were carried and placed
-    (141.16, 144.17, which fell in whole-body steps). Measured, one machine, stop 56."""
+    (141.16, 144.17, which fell in whole-body steps). With the pelvis held while holding
+    (WbcConfig.walking_held_pelvis), on the layer at 250 Hz: 147.7 placed in the gait, 143.0 did not reach
+    its stance within the walk's 45 s and fell after (in whole-body steps it falls too). Measured, one
+    machine, stop 56."""
     stand_s: float = 1.0
     """After a hand-over: from the measured pose to a clean standing pose."""
     move_s: float = 2.0
