@@ -89,3 +89,19 @@ def test_walking_with_a_held_load_goes_to_the_wbc_where_it_has_a_gait(gait):
     assert taus[:20] == pytest.approx([1.0] * 20) and taus[20:40] == pytest.approx([held] * 20)
     assert taus[40:] == pytest.approx([1.0] * 20)
     assert [s for _, s in layer.switches] == ([WBC, POLICY] if gait else [])
+
+
+@pytest.mark.parametrize("hz", [100, 250])
+def test_the_launch_builder_gives_the_layers_wbc_a_gait_for_carries_at_250_hz_only(hz):
+    """At rates.tracker_hz >= 250 the layer walks a held box in its WBC's gait (its goals carry so:
+    GoalConfig.walk_while_holding); slower, the WBC has no gait and carries are whole-body steps."""
+    from g1_control.launch.builder import make_generator, make_tracker
+    from g1_control.launch.schema import load_launch
+    from tests.paths import LAUNCH_DIR
+
+    launch = load_launch(LAUNCH_DIR / "sim_box.yaml", [f"rates.tracker_hz={hz}"])
+    tracker = make_tracker(launch)
+    assert isinstance(tracker, TrackingLayer)
+    assert tracker.walks_holding() is (hz >= 250)
+    assert (tracker.wbc.gait is not None) is (hz >= 250)
+    assert make_generator(launch, None, tracker).config.walk_while_holding is (hz >= 250)
