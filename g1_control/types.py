@@ -380,6 +380,12 @@ class JointReference:
     """Known moments a held object exerts about the (left, right) hand point, world axes (N m): its
     weight acting off the hand point (a bottle held in one hand, generator/goals/bottle.py)."""
 
+    @property
+    def holding(self) -> bool:
+        """Whether a held object's forces are on the hands (the tracking layer's walk holding goes to its WBC;
+        the WBC's gait then holds the pelvis, WbcConfig.walking_held_pelvis)."""
+        return bool(self.hand_forces_w_n.any())
+
     def copy_from(self, src: JointReference) -> JointReference:
         """Copy every field of `src` into this reference's own arrays (no allocation); returns self."""
         self.t_s = src.t_s

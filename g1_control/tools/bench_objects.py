@@ -206,8 +206,8 @@ def run_trial(seed: int, index: int, carry: bool = False, gait: bool = True, tra
     """One trial, start to verdict (module docstring): a plain function of its arguments. carry: a --carry
     scene on the whole-body controller (launch/sim_wbc_carry.yaml's chain); tracker: an objects scene's
     ("layer": launch/sim_box.yaml's tracking layer, run at 250 Hz so that its WBC's gait carries; "wbc": the
-    whole-body controller alone, 250 Hz, as --carry); gait False: a carry walks in whole-body steps, as with a tracker that has no gait
-    (GoalConfig.walk_while_holding off)."""
+    whole-body controller alone, 250 Hz, as --carry); gait False: a carry walks in whole-body steps, as with
+    a tracker that has no gait (GoalConfig.walk_while_holding off)."""
     if tracker not in TRACKERS:
         raise ValueError(f"tracker {tracker!r}: one of {', '.join(TRACKERS)}")
     from g1_control.launch.builder import build_loop

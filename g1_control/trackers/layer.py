@@ -136,7 +136,7 @@ class TrackingLayer(Tracker):
         return getattr(self.wbc, "gait", None) is not None
 
     def _act(self, reference: JointReference, state: RobotState) -> MotorCommand:
-        holding = self._walks_holding and bool(reference.hand_forces_w_n.any())
+        holding = self._walks_holding and reference.holding
         want = WBC if reference.phase == PHASE_WHOLE_BODY or holding else POLICY
         if want != self.active:
             self._switch(want, state)

@@ -663,7 +663,7 @@ class WholeBodyTracker(Tracker):
         # stepping up, the pelvis keeps its walking height (WbcConfig.terrain_hold_pelvis_up)
         step_up = (terrain and cfg.terrain_hold_pelvis_up and gt.swing_foot >= 0
                    and float(gt.landing_m[2]) > ground_z + self.gait.config.step_change_m)
-        held = cfg.walking_held_pelvis and bool(reference.hand_forces_w_n.any())
+        held = cfg.walking_held_pelvis and reference.holding
         if reference.pelvis_height_m is not None or step_up or held:
             # the pelvis held at the height asked (at most the walking height: knees stay bent), or at
             # the walking height stepping up or holding a load, by the CoM's height above the pelvis now
