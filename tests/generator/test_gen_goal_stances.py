@@ -77,6 +77,22 @@ def test_box_on_a_low_table_gets_a_squat_the_ik_reaches(stances):
     assert stances.collision(contact, box, center, table) is None
 
 
+def test_a_place_holds_the_box_where_the_pick_took_it_not_where_a_pick_there_would(stances):
+    # a box taken at its centre (from a table above LOW_BOX_Z_M) and set on a low table: the place's hands go to
+    # its centre; planned with hand_height's higher grip it was let go above the top (bench objects 165.12)
+    table = Table("t", (1.5, 0.0), (0.6, 0.9), 0.3, 0.0)
+    box = Box("box", (1.37, 0.0), stands_on="t", size_m=(0.3, 0.3, 0.3), mass_kg=2.0)
+    center = np.array([1.37, 0.0, 0.45])
+    headings = [place_heading(table, center[:2], np.zeros(2))]
+    assert hand_height(box, 0.45) > 0.05  # a pick there would grip it this much above its centre
+    plan = stances.plan(box, center, table, headings, what="set it down there", hand_dz_m=0.0)
+    assert plan.hand_dz_m == 0.0
+    (pose,) = plan.chosen.poses
+    assert _hands_error(stances, pose, hand_points(center, plan.chosen.heading, plan.width_m, -0.01)) <= 0.015
+    unheld = stances.plan(box, center, table, headings, what="set it down there")
+    assert unheld.hand_dz_m == pytest.approx(hand_height(box, 0.45))
+
+
 def test_box_on_the_floor_below_the_squats_is_picked_from_a_deep_squat_or_refused_by_its_torque(stances):
     """Hands at 0.34 m: no squat reaches (they stop ~0.45 m); the deep squat does for 1.0 kg, and for
     2.0 kg the waist pitch would need more than its 35 N m: refused, naming it (stop 35 refused both

@@ -341,8 +341,11 @@ def place(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     # the box turns with the robot: as held, its faces across the new heading are the ones in the hands
     as_held = replace(box, yaw_rad=box.yaw_rad + wrap_angle(heading - held.heading_rad))
     ground = 0.0 if support is not None else ctx.scene.ground_height(center_w[:2])
+    # the hands where the pick took the box (Held.hand_dz_m), not where a pick at the place would: a tall box
+    # taken at its centre from a table and planned as gripped high for the floor was let go 11 cm up and
+    # fell over (`g1 bench objects` 163.7, traced)
     plan = yield from ctx.compute("stance", plan_stance, as_held, center_w, support, [heading], ground, None,
-                                  cfg.press_m, "set it down there")
+                                  cfg.press_m, "set it down there", held.hand_dz_m)
     ctx.note(f"place stance: {plan.chosen.describe()} ({plan.tried} tried; heading now {heading_now:.2f})")
     approach = plan.approach
     ctx.info.update(box=box.name, target_w_m=center_w.tolist(), stance=plan.chosen.describe())

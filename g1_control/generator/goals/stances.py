@@ -372,11 +372,12 @@ class StancePlanner:
     # -- the search ---------------------------------------------------------------------------------
     def plan(self, box: Box, center_w: np.ndarray, support: Block | None, headings: list[float], *,
              ground_z: float = 0.0, lift_m: float | None = None, press_m: float = 0.01,
-             what: str = "hold it") -> StancePlan:
+             what: str = "hold it", hand_dz_m: float | None = None) -> StancePlan:
         """The stance to hold `box` with its centre at center_w on `support` (None: the floor),
-        trying `headings` in order; lift_m: also lift it this much (a pick)."""
+        trying `headings` in order; lift_m: also lift it this much (a pick); hand_dz_m: the hands this
+        far above the box's centre (a held box: where the pick took it), None: `hand_height`."""
         center_w = np.asarray(center_w, dtype=float)
-        dz = hand_height(box, float(center_w[2]))
+        dz = hand_height(box, float(center_w[2])) if hand_dz_m is None else hand_dz_m
         mass = box.mass_kg
         nominal = self.poses.nominal_pelvis_m + ground_z
         grasp_z = float(center_w[2]) + dz - ground_z
@@ -657,10 +658,11 @@ def stance_planner(poses: PosePlanner) -> StancePlanner:
 
 
 def plan_stance(poses: PosePlanner, box: Box, center_w: np.ndarray, support: Block | None, headings: list[float],
-                ground_z: float, lift_m: float | None, press_m: float, what: str) -> StancePlan:
+                ground_z: float, lift_m: float | None, press_m: float, what: str,
+                hand_dz_m: float | None = None) -> StancePlan:
     """StancePlanner.plan as a planner job: the stance, squat and lean to hold `box` at center_w."""
     return stance_planner(poses).plan(box, center_w, support, headings, ground_z=ground_z, lift_m=lift_m,
-                                      press_m=press_m, what=what)
+                                      press_m=press_m, what=what, hand_dz_m=hand_dz_m)
 
 
 HoldStep = tuple[str, tuple[np.ndarray, np.ndarray], np.ndarray, float, int]
