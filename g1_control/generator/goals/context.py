@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from collections.abc import Callable, Generator, Iterator
+from collections.abc import Callable, Generator, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
@@ -227,6 +227,9 @@ class GoalContext:
     def reset(self) -> None:
         self.phase = PHASE_LOCOMOTION
         self.goal: TaskGoal | None = None
+        self.queued: Sequence[TaskGoal] = ()
+        """The goals waiting after this one, in order (the executor's queue): a pick grips a box where the
+        place queued after it will want it (handling.pick)."""
         self.plan: WholeBodyTrajectory | None = None
         self.plan_t0 = 0.0
         self.walk = np.zeros(3)

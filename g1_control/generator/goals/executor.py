@@ -125,6 +125,7 @@ class GoalGenerator(Generator):
     def reset_state(self) -> None:
         self.ctx.reset()
         self._queue: deque[TaskGoal] = deque()
+        self.ctx.queued = self._queue
         self._seen: set[str] = set()
         self._coro: Iterator[None] | None = None
         self._height: float | None = None

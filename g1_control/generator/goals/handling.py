@@ -40,9 +40,11 @@ from g1_control.generator.goals.poses import PosePlanner, ReachRefused, flat_sol
 from g1_control.generator.goals.stances import (
     ARMS_BACK,
     CLEAR_MARGIN_M,
+    StanceRefused,
     box_com_shift,
     detour_poses,
     grasp_hold_poses,
+    hand_height,
     pick_headings,
     place_heading,
     plan_stance,
@@ -182,6 +184,22 @@ def _move_s(q_a: np.ndarray, q_b: np.ndarray, least_s: float) -> float:
                abs(float(q_b[2] - q_a[2])) / PELVIS_SPEED_MPS)
 
 
+def place_grip_m(ctx: GoalContext, box: Box) -> float | None:
+    """The hands above the box's centre (stances.hand_height) that the place queued right after this pick will
+    set it down from; None: no such place, or one whose height is not known before the carry."""
+    nxt = ctx.queued[0] if ctx.queued else None
+    if nxt is None or nxt.kind != "place" or nxt.object not in (None, box.name):
+        return None
+    block = ctx.scene.block(nxt.target) if nxt.target not in (None, FLOOR) else None
+    if block is not None:
+        top = block.height_m
+    elif nxt.pos_w_m is not None and nxt.target in (None, FLOOR):
+        top = ctx.scene.ground_height(np.asarray(nxt.pos_w_m, dtype=float)[:2])
+    else:
+        return None
+    return hand_height(box, top + float(box.size[2]) / 2)
+
+
 def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     cfg = ctx.config
     if ctx.held is not None:
@@ -194,9 +212,22 @@ def pick(ctx: GoalContext, goal: TaskGoal) -> Iterator[None]:
     support = support_of(ctx, box, center)
     ground = ctx.scene.ground_height(center[:2]) if support is None else 0.0
     headings = pick_headings(box, center[:2], support, pos_w[:2])
-    # the stance, squat and lean for this box, before anything moves (refused here otherwise)
-    plan = yield from ctx.compute("stance", plan_stance, box, center, support, headings, ground, cfg.lift_m,
-                                  cfg.press_m, "pick it up")
+    # the stance, squat and lean for this box, before anything moves (refused here otherwise); where the place
+    # queued next will want the hands higher on the box (a tall box going low), that grip first: the place
+    # sets the box down from where the pick took it (Held.hand_dz_m), and from a grip at its centre the floor
+    # is out of reach (refused)
+    grip = place_grip_m(ctx, box)
+    plan = None
+    if grip is not None and grip > hand_height(box, float(center[2])) + 1e-6:
+        try:
+            plan = yield from ctx.compute("stance", plan_stance, box, center, support, headings, ground, cfg.lift_m,
+                                          cfg.press_m, "pick it up", grip)
+            ctx.note(f"pick grip: {grip * 100:.0f} cm above the box's centre, for the place queued next")
+        except StanceRefused as exc:
+            ctx.note(f"pick grip for the place queued next ({grip * 100:.0f} cm above the centre) refused: {exc}")
+    if plan is None:
+        plan = yield from ctx.compute("stance", plan_stance, box, center, support, headings, ground, cfg.lift_m,
+                                      cfg.press_m, "pick it up")
     ctx.note(f"pick stance: {plan.chosen.describe()} ({plan.tried} tried)")
     approach = plan.approach
     if ctx.phase != PHASE_WHOLE_BODY:
