@@ -1,7 +1,8 @@
 """A pick grips a box where the place queued right after it will set it down from (handling.place_grip_m): a
 tall box going to the floor or a low table is taken higher than at its centre, so that the place (which sets
 the box down from where the pick took it, context.Held.hand_dz_m) reaches its rest; no place next, another
-box's place, or a place whose height is not known before the carry: no look-ahead."""
+box's place, a place whose height is not known before the carry, or a box of PLACE_GRIP_MAX_KG or more: no
+look-ahead."""
 
 from collections import deque
 
@@ -9,7 +10,7 @@ import numpy as np
 import pytest
 
 from g1_control.generator.goals.context import GoalConfig, GoalContext
-from g1_control.generator.goals.handling import place_grip_m
+from g1_control.generator.goals.handling import PLACE_GRIP_MAX_KG, place_grip_m
 from g1_control.generator.goals.stances import hand_height
 from g1_control.scene import Box, SceneConfig, Table
 from g1_control.types import TaskGoal
@@ -44,3 +45,11 @@ def test_no_look_ahead_without_a_known_place_of_this_box_next(ctx_box):
     assert _grip(ctx_box, TaskGoal("place", "p", object="other", target="low")) is None
     assert _grip(ctx_box, TaskGoal("reach", "r"), TaskGoal("place", "p", target="low")) is None
     assert _grip(ctx_box, TaskGoal("place", "p")) is None  # "put it down in front": where, the carry decides
+
+
+def test_no_look_ahead_for_a_heavy_box():
+    heavy = Box("box", (1.0, 0.0), stands_on="high", size_m=(0.2, 0.2, 0.44), mass_kg=PLACE_GRIP_MAX_KG)
+    scene = SceneConfig(tables=[Table("high", (1.2, 0.2), (0.5, 1.2), 0.8)], boxes=[heavy])
+    ctx = GoalContext(scene, GoalConfig())
+    ctx.queued = deque([TaskGoal("place", "p", pos_w_m=np.array([0.5, -1.0, 0.0]))])
+    assert place_grip_m(ctx, heavy) is None
