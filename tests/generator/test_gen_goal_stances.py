@@ -7,6 +7,7 @@ the sides to a box on a high table goes around the table's top, not through it."
 
 import math
 import re
+from dataclasses import replace
 from itertools import pairwise
 
 import numpy as np
@@ -81,7 +82,7 @@ def test_a_place_holds_the_box_where_the_pick_took_it_not_where_a_pick_there_wou
     # a box taken at its centre (from a table above LOW_BOX_Z_M) and set on a low table: the place's hands go to
     # its centre; planned with hand_height's higher grip it was let go above the top (bench objects 165.12)
     table = Table("t", (1.5, 0.0), (0.6, 0.9), 0.3, 0.0)
-    box = Box("box", (1.37, 0.0), stands_on="t", size_m=(0.3, 0.3, 0.3), mass_kg=2.0)
+    box = Box("box", (1.37, 0.0), stands_on="t", size_m=(0.3, 0.3, 0.3), mass_kg=0.5)
     center = np.array([1.37, 0.0, 0.45])
     headings = [place_heading(table, center[:2], np.zeros(2))]
     assert hand_height(box, 0.45) > 0.05  # a pick there would grip it this much above its centre
@@ -91,6 +92,19 @@ def test_a_place_holds_the_box_where_the_pick_took_it_not_where_a_pick_there_wou
     assert _hands_error(stances, pose, hand_points(center, plan.chosen.heading, plan.width_m, -0.01)) <= 0.015
     unheld = stances.plan(box, center, table, headings, what="set it down there")
     assert unheld.hand_dz_m == pytest.approx(hand_height(box, 0.45))
+
+
+def test_a_place_leaning_a_heavy_box_down_past_the_waists_torque_is_refused(stances):
+    # the place's pose holds the box where it goes: its static torques within the actuators' limits, as a
+    # pick's lifted pose (bench objects 182.2, 3.2 kg leaned to a 0.34 m table, fell at the place)
+    table = Table("t", (1.5, 0.0), (0.6, 0.9), 0.3, 0.0)
+    center = np.array([1.37, 0.0, 0.5])
+    headings = [place_heading(table, center[:2], np.zeros(2))]
+    light = Box("box", (1.37, 0.0), stands_on="t", size_m=(0.2, 0.2, 0.4), mass_kg=0.5)
+    assert stances.plan(light, center, table, headings, what="set it down there", hand_dz_m=0.0).chosen.lean
+    heavy = replace(light, mass_kg=2.5)
+    with pytest.raises(StanceRefused, match="waist_pitch_joint needs [0-9]+ N m to hold still"):
+        stances.plan(heavy, center, table, headings, what="set it down there", hand_dz_m=0.0)
 
 
 def test_box_on_the_floor_below_the_squats_is_picked_from_a_deep_squat_or_refused_by_its_torque(stances):

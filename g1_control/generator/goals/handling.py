@@ -184,12 +184,12 @@ def _move_s(q_a: np.ndarray, q_b: np.ndarray, least_s: float) -> float:
                abs(float(q_b[2] - q_a[2])) / PELVIS_SPEED_MPS)
 
 
-PLACE_GRIP_MAX_KG = 3.0
+PLACE_GRIP_MAX_KG = 1.5
 """A pick grips for the place queued after it (place_grip_m) only a box lighter than this. Measured (`g1 bench
-objects`, the layer at 250 Hz, the trials whose pick the look-ahead changes): the six placed that were not
-before weighed 0.3-1.0 kg (seeds 140-151, 163.7); the two that fell were 4.4 kg (176.10, at the pick from a
-0.88 m table, its hands higher on the box) and 5.7 kg (143.0, in the carry's whole-body steps); without the
-look-ahead both were refused at the place, the box held."""
+objects`, the layer at 250 Hz, the trials whose pick the look-ahead changed): the nine placed that were not
+before weighed 0.3-1.1 kg (seeds 140-151, 163.7, 180.11, 182.3, 182.7); the four that fell weighed 1.9 and
+2.2 kg (179.4, 180.4: at the pick from 0.85-0.90 m tables, the hands higher on the box; 180.4 was placed
+without the look-ahead), 4.4 kg (176.10, at the pick) and 5.7 kg (143.0, in the carry's whole-body steps)."""
 
 
 def place_grip_m(ctx: GoalContext, box: Box) -> float | None:
