@@ -21,6 +21,7 @@ from g1_control.generator.goals.stances import (
     KNEES,
     MIN_PELVIS_M,
     STAND_LEAN,
+    UPRIGHT,
     StancePlanner,
     StanceRefused,
     detour_poses,
@@ -94,17 +95,17 @@ def test_a_place_holds_the_box_where_the_pick_took_it_not_where_a_pick_there_wou
     assert unheld.hand_dz_m == pytest.approx(hand_height(box, 0.45))
 
 
-def test_a_place_leaning_a_heavy_box_down_past_the_waists_torque_is_refused(stances):
-    # the place's pose holds the box where it goes: its static torques within the actuators' limits, as a
-    # pick's lifted pose (bench objects 182.2, 3.2 kg leaned to a 0.34 m table, fell at the place)
+def test_a_place_does_not_lean_a_heavy_box_down_past_the_waists_torque(stances):
+    # a leaning place's pose holds the box where it goes: its static torques within the actuators' limits, as
+    # a pick's lifted pose (bench objects 167.15, 2.7 kg leaned to a 0.31 m table: the waist saturated)
     table = Table("t", (1.5, 0.0), (0.6, 0.9), 0.3, 0.0)
     center = np.array([1.37, 0.0, 0.5])
     headings = [place_heading(table, center[:2], np.zeros(2))]
     light = Box("box", (1.37, 0.0), stands_on="t", size_m=(0.2, 0.2, 0.4), mass_kg=0.5)
     assert stances.plan(light, center, table, headings, what="set it down there", hand_dz_m=0.0).chosen.lean
     heavy = replace(light, mass_kg=2.5)
-    with pytest.raises(StanceRefused, match="waist_pitch_joint needs [0-9]+ N m to hold still"):
-        stances.plan(heavy, center, table, headings, what="set it down there", hand_dz_m=0.0)
+    plan = stances.plan(heavy, center, table, headings, what="set it down there", hand_dz_m=0.0)
+    assert plan.chosen.lean == UPRIGHT  # (an upright place is not checked: 4.4-5.3 kg boxes were placed so)
 
 
 def test_box_on_the_floor_below_the_squats_is_picked_from_a_deep_squat_or_refused_by_its_torque(stances):

@@ -123,10 +123,11 @@ seeds 90-99 (18 trials) inf -> 1.0: placed 2 -> 1 (93.3 refused), falls 3 -> 2, 
 up 9 -> 0; seeds 100-119, not looked at before (35 trials): placed 4 -> 4 (the same four), falls 7 -> 3,
 did not come up 21 -> 1. At 0.95 seeds 90-99 gave placed 1, falls 0. A leaning squat's trunk alone
 takes ~0.85-0.9 of the waist's limit, so light boxes are lifted leaning and heavier ones are refused (2 kg
-on a 0.53 m table: tests/generator/test_gen_goal_stances.py). A place's pose (the box held where it goes) keeps the same
-share: a 3.2 kg box leaned down to a 0.34 m table fell at the place (`g1 bench objects` 182.2), and a
-2.7 kg one leaned to a 0.31 m table put the waist at its 35 N m while the hands went 20 cm below the
-plan (167.15, traced; its static share 1.3)."""
+on a 0.53 m table: tests/generator/test_gen_goal_stances.py). A leaning place's pose (the box held where it goes) keeps the
+same share: a 2.7 kg box leaned to a 0.31 m table put the waist at its 35 N m while the hands went 20 cm
+below the plan and the box fell over (167.15, traced; its static share 1.3), and 3.2 kg leaned to a 0.34 m
+table fell at the place (182.2). Checked on every place, it also refused upright places of 4.4-5.3 kg
+boxes onto tables that were placed (147.7, 180.13, 182.13)."""
 FLAT_SOLE_M = 0.005
 FLAT_SOLE_RAD = 0.03
 """A deep squat's soles within this of where they stand, flat (the heels down: the ankles' dorsiflexion
@@ -501,9 +502,9 @@ class StancePlanner:
             held_kg = mass if len(cand.poses) > 1 or lift_m is None else 0.0
             if deep:
                 cand.collision = cand.collision or self.deep_fault(r.q, soles)
-            # a deep squat's every pose; otherwise a pick's lifted pose and a place's (the box still held there)
-            most = DEEP_TORQUE_SHARE if deep else HOLD_TORQUE_SHARE if lift_m is None or len(cand.poses) > 1 \
-                else math.inf
+            # a deep squat's every pose; otherwise a pick's lifted pose and a leaning place's (the box held there)
+            held_pose = len(cand.poses) > 1 if lift_m is not None else cand.lean != UPRIGHT
+            most = DEEP_TORQUE_SHARE if deep else HOLD_TORQUE_SHARE if held_pose else math.inf
             if math.isfinite(most):
                 cand.collision = cand.collision or self.torque_fault(r.q, soles, held_kg, most)
             if not squat and cand.pelvis_z_m - r.q[2] > STANDING_GIVE_M:
